@@ -1,0 +1,84 @@
+#include "cli.h"
+
+#include <cstdio>
+#include <iostream>
+
+namespace rvlio::cli {
+
+std::string Args::Get(const std::string& name, const std::string& fallback) const {
+  auto it = values_.find(name);
+  return (it == values_.end() || it->second.empty()) ? fallback : it->second.back();
+}
+
+const std::vector<std::string>& Args::GetAll(const std::string& name) const {
+  static const std::vector<std::string> kEmpty;
+  auto it = values_.find(name);
+  return it == values_.end() ? kEmpty : it->second;
+}
+
+void PrintUsage(const CommandSpec& spec) {
+  std::cout << "usage: rvlio " << spec.name;
+  for (const auto& o : spec.options) {
+    std::string item = "--" + o.name + (o.value.empty() ? "" : " " + o.value);
+    if (o.repeatable) item += " ...";
+    std::cout << " " << (o.required ? item : "[" + item + "]");
+  }
+  std::cout << "\n\n" << spec.summary << "\n\noptions:\n";
+  for (const auto& o : spec.options) {
+    std::string left = "--" + o.name + (o.value.empty() ? "" : " " + o.value);
+    std::cout << "  " << left;
+    for (size_t i = left.size(); i < 24; ++i) std::cout << ' ';
+    std::cout << " " << o.help << (o.repeatable ? " (repeatable)" : "") << "\n";
+  }
+  std::cout << "  --help                   this text\n";
+}
+
+int Fail(const std::string& command, const std::string& message, int exit_code) {
+  std::fprintf(stderr, "rvlio %s: error: %s\n", command.c_str(), message.c_str());
+  return exit_code;
+}
+
+int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out) {
+  for (int i = first; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      PrintUsage(spec);
+      return -1;
+    }
+    if (arg.rfind("--", 0) != 0) return Fail(spec.name, "unexpected argument '" + arg + "' (see --help)");
+    std::string name = arg.substr(2), value;
+    bool inline_value = false;
+    if (auto eq = name.find('='); eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+      inline_value = true;
+    }
+    const OptionSpec* opt = nullptr;
+    for (const auto& o : spec.options)
+      if (o.name == name) opt = &o;
+    if (!opt) return Fail(spec.name, "unknown option --" + name + " (see --help)");
+    if (!opt->value.empty() && !inline_value) {
+      if (i + 1 >= argc) return Fail(spec.name, "option --" + name + " needs a value " + opt->value);
+      value = argv[++i];
+    } else if (opt->value.empty() && inline_value) {
+      return Fail(spec.name, "option --" + name + " takes no value");
+    }
+    auto& slot = out->values_[name];
+    if (!opt->repeatable && !slot.empty())
+      return Fail(spec.name, "option --" + name + " given more than once");
+    slot.push_back(value);
+  }
+  for (const auto& o : spec.options)
+    if (o.required && !out->Has(o.name)) return Fail(spec.name, "missing required option --" + o.name);
+  return 0;
+}
+
+}  // namespace rvlio::cli
+
+namespace rvlio::cli {
+int EngineComesLater(const CommandSpec& spec, int argc, char** argv, const std::string& what) {
+  Args args;
+  if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  return Fail(spec.name, "this build has no " + what + " yet; it lands with a later issue", 2);
+}
+}  // namespace rvlio::cli

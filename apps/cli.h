@@ -1,0 +1,48 @@
+#pragma once
+// Minimal argument parsing for the rvlio subcommands: `--name value`,
+// `--name=value`, repeatable options and boolean flags. Parsing errors are
+// bad input (exit 2) with a one-line message.
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rvlio::cli {
+
+struct OptionSpec {
+  std::string name;   // without the leading dashes
+  std::string value;  // value placeholder for the usage line, empty for a flag
+  std::string help;
+  bool required = false;
+  bool repeatable = false;
+};
+
+struct CommandSpec {
+  std::string name;
+  std::string summary;
+  std::vector<OptionSpec> options;
+};
+
+class Args {
+ public:
+  bool Has(const std::string& name) const { return values_.count(name) > 0; }
+  std::string Get(const std::string& name, const std::string& fallback = "") const;
+  const std::vector<std::string>& GetAll(const std::string& name) const;
+  std::map<std::string, std::vector<std::string>> values_;
+};
+
+// Parses argv[first..argc). Returns 0 and fills `out` on success; on --help
+// prints the usage to stdout and returns -1; on a parsing error prints one
+// line to stderr and returns 2.
+int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out);
+void PrintUsage(const CommandSpec& spec);
+
+// One-line error on stderr in the contract's form: "rvlio CMD: error: MSG".
+int Fail(const std::string& command, const std::string& message, int exit_code = 2);
+
+}  // namespace rvlio::cli
+
+namespace rvlio::cli {
+// For a subcommand whose engine lands with a later issue: parses the options
+// (so --help works and typos are caught) and then exits 2 saying so.
+int EngineComesLater(const CommandSpec& spec, int argc, char** argv, const std::string& what);
+}  // namespace rvlio::cli

@@ -1,0 +1,72 @@
+// rvlio info --bag FILE [--lidar-topic T]: what is in a bag and whether its
+// LiDAR messages carry per-point times the reader understands.
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include "commands.h"
+#include "common_options.h"
+#include "rvlio/io/sensor_bag.h"
+
+namespace rvlio::cli {
+namespace {
+
+std::string Fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+  return buf;
+}
+
+std::string Join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ",") + s;
+  return out;
+}
+
+void PrintCloud(const BagTopicInfo& t) {
+  if (t.lidar_layout.empty()) return;
+  if (!t.decode_error.empty()) {
+    std::cout << "    layout: unknown (" << t.decode_error << ")\n";
+  } else {
+    std::cout << "    layout: " << t.lidar_layout << " (header stamp marks the scan "
+              << t.header_stamp << ")\n";
+  }
+  std::cout << "    fields: " << Join(t.fields) << "\n";
+  if (t.decode_error.empty()) {
+    std::cout << "    points per scan: " << Fixed(t.points_per_scan, 1) << " (mean of first "
+              << t.scans_sampled << ")\n";
+  }
+}
+
+void Print(const BagInfo& info) {
+  std::cout << "bag:      " << info.path << "\n"
+            << "duration: " << Fixed(info.end_s - info.start_s, 3) << " s\n"
+            << "start:    " << Fixed(info.start_s, 9) << " s\n"
+            << "end:      " << Fixed(info.end_s, 9) << " s\n"
+            << "messages: " << info.messages << "\n"
+            << "topics:\n";
+  for (const auto& t : info.topics) {
+    std::cout << "  " << t.topic << "  " << t.type << "  " << t.count << " msgs  "
+              << Fixed(t.rate_hz, 2) << " Hz\n";
+    PrintCloud(t);
+  }
+}
+
+}  // namespace
+
+int CmdInfo(int argc, char** argv) {
+  CommandSpec spec{"info",
+                   "Lists the topics of a ROS1 bag (type, count, rate) and, for PointCloud2\n"
+                   "topics, the detected per-point time layout, the fields and the mean\n"
+                   "number of valid points per scan (from the first few messages).",
+                   {{"bag", "FILE", "ROS1 bag", true, false},
+                    {"lidar-topic", "TOPIC", "analyse only this PointCloud2 topic", false, false}}};
+  Args args;
+  if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  StatusOr<BagInfo> info = ReadBagInfo(args.Get("bag"), args.Get("lidar-topic"));
+  if (!info.ok()) return Fail(spec.name, info.status().message(), info.status().exit_code());
+  Print(*info);
+  return 0;
+}
+
+}  // namespace rvlio::cli

@@ -1,0 +1,196 @@
+#include "run_pipeline.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "rvlio/io/atomic_file.h"
+#include "rvlio/io/config.h"
+#include "rvlio/io/run_outputs.h"
+#include "rvlio/io/sensor_bag.h"
+#include "rvlio/io/trajectory_io.h"
+#include "rvlio/odometry/odometry.h"
+
+namespace rvlio::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// A progress line on stderr for long runs, only when stderr is a terminal.
+class Progress {
+ public:
+  Progress(bool enabled, double bag_start_s, double bag_end_s)
+      : enabled_(enabled && isatty(STDERR_FILENO)), start_s_(bag_start_s), end_s_(bag_end_s) {}
+  void Update(int scans, TimeNs bag_time_ns) {
+    if (!enabled_) return;
+    const double wall = SecondsSince(t0_);
+    if (wall < 3.0 || wall - last_print_ < 0.5) return;
+    last_print_ = wall;
+    const double done = (NsToSeconds(bag_time_ns) - start_s_) / std::max(1e-9, end_s_ - start_s_);
+    const double eta = done > 0.01 ? wall * (1.0 - done) / done : 0.0;
+    std::fprintf(stderr, "\r  scans %d  %.1f scans/s  %3.0f%%  ETA %.0f s   ", scans,
+                 scans / wall, 100.0 * std::min(1.0, done), eta);
+    printed_ = true;
+  }
+  ~Progress() {
+    if (printed_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  double start_s_, end_s_;
+  Clock::time_point t0_ = Clock::now();
+  double last_print_ = 0.0;
+  bool printed_ = false;
+};
+
+nlohmann::json StatsJson(const OdometryStats& o, const SensorReaderStats& r) {
+  return {{"scans_received", o.scans_received},
+          {"scans_processed", o.scans_processed},
+          {"scans_before_imu", o.scans_before_imu},
+          {"scans_too_few_points", o.scans_too_few_points},
+          {"predict_only", o.predict_only},
+          {"diverged_resets", o.diverged_resets},
+          {"imu_gaps_over_scan", o.imu_gaps_over_scan},
+          {"started_moving", o.started_moving},
+          {"reader",
+           {{"scans", r.scans},
+            {"imu_samples", r.imu_samples},
+            {"empty_scans", r.empty_scans},
+            {"invalid_points", r.invalid_points},
+            {"imu_duplicates", r.imu_duplicates},
+            {"imu_non_monotonic", r.imu_non_monotonic},
+            {"imu_gaps", r.imu_gaps},
+            {"imu_max_gap_s", r.imu_max_gap_s}}}};
+}
+
+int RvActiveScans(const std::vector<ScanResult>& results) {
+  int n = 0;
+  for (const auto& r : results) n += r.rv.active ? 1 : 0;
+  return n;
+}
+
+struct RunData {
+  std::vector<ScanResult> results;
+  TimeNs first_ns = -1, last_ns = -1;
+  double wall_s = 0.0;
+};
+
+Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const Odometry& odo,
+                    const SensorReaderStats& reader_stats, const RunData& data,
+                    const std::string& layout, RunOutcome* outcome) {
+  namespace fs = std::filesystem;
+  const fs::path dir(req.out_dir);
+  if (Status s = WriteTum((dir / "trajectory.tum").string(), ToTrajectory(data.results)); !s.ok())
+    return s;
+  if (Status s = WriteMapPcd((dir / "map.pcd").string(), odo.MapPoints()); !s.ok()) return s;
+  if (Status s = WriteScansCsv((dir / "scans.csv").string(), data.results); !s.ok()) return s;
+  const TimingStats t = ComputeTimingStats(data.results);
+  const double duration_s =
+      data.first_ns >= 0 ? NsToSeconds(data.last_ns - data.first_ns) : 0.0;
+  nlohmann::json j;
+  j["version"] = RVLIO_VERSION;
+  j["command"] = "run";
+  j["bag"] = req.bag;
+  j["lidar_layout"] = layout;
+  j["backend"] = options.backend;
+  j["config"] = ToJson(options);
+  j["scan_count"] = data.results.size();
+  j["sequence_duration_s"] = duration_s;
+  j["per_scan_ms"] = {{"median", t.median_ms}, {"p95", t.p95_ms}, {"max", t.max_ms}};
+  j["estimator_total_s"] = t.total_ms / 1000.0;
+  j["wall_s"] = data.wall_s;
+  j["real_time_factor"] = t.total_ms > 0 ? duration_s / (t.total_ms / 1000.0) : 0.0;
+  j["real_time_factor_wall"] = data.wall_s > 0 ? duration_s / data.wall_s : 0.0;
+  j["peak_memory_mb"] = PeakMemoryMb();
+  j["rv_active_scans"] = RvActiveScans(data.results);
+  j["stats"] = StatsJson(odo.stats(), reader_stats);
+  j["warnings"] = odo.warnings();
+  outcome->scans = static_cast<int>(data.results.size());
+  outcome->median_ms = t.median_ms;
+  outcome->real_time_factor = j["real_time_factor"];
+  return WriteFileAtomically((dir / "summary.json").string(), j.dump(2) + "\n");
+}
+
+}  // namespace
+
+double PeakMemoryMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KB on Linux
+}
+
+bool PrepareOutputDir(const std::string& command, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    Fail(command, "cannot create output folder " + dir + ": " + ec.message());
+    return false;
+  }
+  const std::string probe = (std::filesystem::path(dir) / ".rvlio_write_test").string();
+  if (Status s = WriteFileAtomically(probe, "ok\n"); !s.ok()) {
+    Fail(command, "output folder " + dir + " is not writable: " + s.message());
+    return false;
+  }
+  std::filesystem::remove(probe, ec);
+  return true;
+}
+
+int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
+  StatusOr<OdometryOptions> options = LoadConfig(req.config_files, req.overrides);
+  if (!options.ok()) return Fail("run", options.status().message());
+  StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(*options);
+  if (!odo.ok()) return Fail("run", odo.status().message());
+  StatusOr<std::unique_ptr<SensorBagReader>> reader =
+      SensorBagReader::Open(req.bag, options->lidar, options->imu);
+  if (!reader.ok()) return Fail("run", reader.status().message());
+  if (!PrepareOutputDir("run", req.out_dir)) return 2;
+  StatusOr<BagInfo> info = ReadBagInfo(req.bag);
+  Progress progress(!req.quiet, info.ok() ? info->start_s : 0.0, info.ok() ? info->end_s : 1.0);
+
+  RunData data;
+  const auto t0 = Clock::now();
+  ImuSample imu;
+  Scan scan;
+  Status read_error;
+  for (;;) {
+    StatusOr<SensorMessage> m = (*reader)->Next(&imu, &scan);
+    if (!m.ok()) {
+      read_error = m.status();  // keep what was read: outputs are still written
+      break;
+    }
+    if (*m == SensorMessage::kEnd) break;
+    const TimeNs t = *m == SensorMessage::kImu ? imu.t_ns : scan.t_end_ns;
+    if (data.first_ns < 0) data.first_ns = t;
+    data.last_ns = std::max(data.last_ns, t);
+    if (*m == SensorMessage::kImu) (*odo)->AddImu(imu);
+    else (*odo)->AddScan(std::move(scan));
+    (*odo)->Poll(&data.results);
+    progress.Update(static_cast<int>(data.results.size()), t);
+  }
+  (*odo)->Finish(&data.results);
+  data.wall_s = SecondsSince(t0);
+  const Status written = WriteOutputs(req, *options, **odo, (*reader)->stats(), data,
+                                      (*reader)->lidar_layout(), outcome);
+  for (const auto& w : (*odo)->warnings()) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
+  if (!written.ok()) return Fail("run", written.message(), written.exit_code());
+  if (!read_error.ok())
+    return Fail("run", read_error.message() + " (outputs hold the scans read before it)");
+  if (data.results.empty())
+    return Fail("run", "no scan could be processed from " + req.bag +
+                           " (see summary.json stats: IMU coverage, points per scan)");
+  return 0;
+}
+
+}  // namespace rvlio::cli

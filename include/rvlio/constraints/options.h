@@ -1,0 +1,31 @@
+#pragma once
+// Point-to-plane association (DESIGN.md section 3).
+#include "rvlio/common/options.h"
+
+namespace rvlio {
+
+struct ConstraintOptions {
+  int num_neighbors = 5;                // k nearest map points per scan point
+  double max_neighbor_distance = 2.0;   // m, farthest neighbour accepted
+  double max_plane_distance = 0.1;      // m, every neighbour must be this close to the plane
+  double planarity_min_ratio = 0.1;     // lambda_mid / lambda_max must exceed this (not a line)
+  double planarity_max_ratio = 0.1;     // lambda_min / lambda_mid must stay below this (flat)
+  double max_residual = 1.0;            // m, |r| above this is an outlier at association time
+  double lidar_noise = 0.03;            // m, std of one point-to-plane residual
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("num_neighbors", num_neighbors, Spec().Range(3, 20));
+    v.Field("max_neighbor_distance", max_neighbor_distance, Spec().Unit("m").Positive());
+    v.Field("max_plane_distance", max_plane_distance, Spec().Unit("m").Positive());
+    v.Field("planarity_min_ratio", planarity_min_ratio, Spec().Range(0.0, 1.0)
+                                                         .Help("reject line-like neighbourhoods"));
+    v.Field("planarity_max_ratio", planarity_max_ratio, Spec().Range(0.0, 1.0)
+                                                         .Help("reject non-flat neighbourhoods"));
+    v.Field("max_residual", max_residual, Spec().Unit("m").Positive());
+    v.Field("lidar_noise", lidar_noise, Spec().Unit("m").Positive().Help("residual std (R = sigma^2)"));
+  }
+  Status Validate() { return ValidateFields(*this, "constraints"); }
+};
+
+}  // namespace rvlio

@@ -1,0 +1,33 @@
+#pragma once
+// The whole evaluation of `rvlio eval`: associate, align, APE, RPE, end-point
+// and along-axis error (DESIGN.md section 7).
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/types.h"
+#include "rvlio/eval/align.h"
+#include "rvlio/eval/metrics.h"
+#include "rvlio/eval/options.h"
+#include "rvlio/eval/stats.h"
+
+namespace rvlio {
+
+struct EvalResult {
+  size_t matched = 0;
+  AlignMode align = AlignMode::kSe3;  // the alignment used (origin after a fallback)
+  Similarity3 T_ref_est;
+  ErrorStats ape_m;          // APE translation
+  ErrorStats ape_rot_deg;    // APE rotation angle
+  RpeResult rpe;             // on the aligned estimate (Sim3 scale applies)
+  double end_point_error_m = 0.0;
+  AlongAxisError along_axis;
+  std::vector<std::string> warnings;
+};
+
+// Errors (bad input): invalid options, empty or unordered trajectories, no
+// matching stamps, an RPE delta that leaves no pair.
+StatusOr<EvalResult> Evaluate(const Trajectory& ref, const Trajectory& est, EvalOptions options);
+
+}  // namespace rvlio

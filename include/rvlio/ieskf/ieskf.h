@@ -1,0 +1,76 @@
+#pragma once
+// Iterated error-state Kalman filter on the 24-dim manifold of paper
+// Section 2 (FAST-LIO2 structure): per-sample IMU propagation of state and
+// covariance, and the iterated point-to-plane update of paper Eq. (1) with
+// re-association and the RV modules inside every iteration (Alg. 3).
+#include <functional>
+#include <vector>
+
+#include "rvlio/common/types.h"
+#include "rvlio/constraints/constraint.h"
+#include "rvlio/constraints/options.h"
+#include "rvlio/ieskf/options.h"
+#include "rvlio/imu/options.h"
+#include "rvlio/lidar/deskew.h"
+#include "rvlio/math/state.h"
+#include "rvlio/rv/options.h"
+#include "rvlio/rv/rv.h"
+
+namespace rvlio {
+
+// Builds the constraint list of the scan for a given state: association
+// against the map (supplied by the pipeline, so the filter owns no map).
+using AssociateFn = std::function<void(const FilterState&, ConstraintList*)>;
+
+struct IeskfUpdateResult {
+  bool ok = false;            // false: no usable constraints or diverged (state untouched)
+  bool diverged = false;      // non-finite or exploding covariance: reset to the prior
+  int iterations = 0;
+  int num_constraints = 0;    // of the last iteration
+  double last_step_norm = 0.0;
+  RvReport rv;                // of the last iteration
+};
+
+class Ieskf {
+ public:
+  Ieskf(const IeskfOptions& options, const ImuOptions& imu, const ConstraintOptions& constraints,
+        const RvOptions& rv);
+
+  // Starts the filter at t_ns from a static alignment; P from the init stds.
+  void Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu);
+
+  // One IMU sample: propagates state and covariance from the current time to
+  // the sample's time (midpoint of the held and the new measurement).
+  void Propagate(const ImuSample& imu);
+  // Propagates to t_ns holding the last IMU measurement (scan end).
+  void PropagateTo(TimeNs t_ns);
+
+  // Pose samples recorded by propagation since the last ClearPoseHistory();
+  // the first entry is the state at the time of clearing.
+  const std::vector<ImuPoseSample>& pose_history() const { return pose_history_; }
+  void ClearPoseHistory();
+
+  // Iterated update, paper Eq. (1): re-associates, applies RV, solves.
+  IeskfUpdateResult Update(const AssociateFn& associate);
+
+  const FilterState& state() const { return x_; }
+  const Matrix24d& covariance() const { return P_; }
+  TimeNs time_ns() const { return t_ns_; }
+
+ private:
+  void Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s);
+  void RecordPose(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu);
+
+  IeskfOptions options_;
+  ImuOptions imu_;
+  ConstraintOptions constraints_;
+  RvOptions rv_;
+  FilterState x_;
+  Matrix24d P_ = Matrix24d::Identity();
+  TimeNs t_ns_ = 0;
+  ImuSample last_imu_;
+  std::vector<ImuPoseSample> pose_history_;
+  RvWorkspace rv_workspace_;
+};
+
+}  // namespace rvlio

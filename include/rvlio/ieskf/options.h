@@ -1,0 +1,35 @@
+#pragma once
+// Iterated error-state Kalman filter (paper Section 2, Eq. 1-3).
+#include "rvlio/common/options.h"
+
+namespace rvlio {
+
+struct IeskfOptions {
+  int max_iterations = 4;             // iterated update cap per scan
+  double convergence_eps = 1e-3;      // increment norm (rad and m) that ends the iteration
+  bool estimate_extrinsics = false;   // extrinsics fixed by default (paper 3.2)
+  double init_pos_std = 1e-3;         // m, initial position std
+  double init_rot_std = 1e-3;         // rad
+  double init_vel_std = 0.1;          // m/s
+  double init_bias_gyro_std = 1e-3;   // rad/s
+  double init_bias_acc_std = 0.05;    // m/s^2
+  double init_extrinsic_std = 1e-5;   // rad and m
+  double init_gravity_std = 1e-4;     // m/s^2
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("max_iterations", max_iterations, Spec().Range(1, 50));
+    v.Field("convergence_eps", convergence_eps, Spec().Positive());
+    v.Field("estimate_extrinsics", estimate_extrinsics, Spec());
+    v.Field("init_pos_std", init_pos_std, Spec().Unit("m").Positive());
+    v.Field("init_rot_std", init_rot_std, Spec().Unit("rad").Positive());
+    v.Field("init_vel_std", init_vel_std, Spec().Unit("m/s").Positive());
+    v.Field("init_bias_gyro_std", init_bias_gyro_std, Spec().Unit("rad/s").Positive());
+    v.Field("init_bias_acc_std", init_bias_acc_std, Spec().Unit("m/s^2").Positive());
+    v.Field("init_extrinsic_std", init_extrinsic_std, Spec().Unit("rad, m").Positive());
+    v.Field("init_gravity_std", init_gravity_std, Spec().Unit("m/s^2").Positive());
+  }
+  Status Validate() { return ValidateFields(*this, "ieskf"); }
+};
+
+}  // namespace rvlio

@@ -1,0 +1,31 @@
+#pragma once
+// The files `rvlio run` writes (DESIGN.md section 6), each atomically.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/types.h"
+#include "rvlio/odometry/odometry.h"
+
+namespace rvlio {
+
+// Binary PCD (x y z float32) through PCL, written to a temporary file and
+// renamed into place.
+Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
+
+// One row per scan: time, status, point and constraint counts, the RV report
+// and the processing time.
+Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results);
+
+// The estimated trajectory (IMU in world at each scan end).
+Trajectory ToTrajectory(const std::vector<ScanResult>& results);
+
+// Median, 95th percentile and maximum of the per-scan processing times, ms.
+struct TimingStats {
+  double median_ms = 0.0, p95_ms = 0.0, max_ms = 0.0, total_ms = 0.0;
+};
+TimingStats ComputeTimingStats(const std::vector<ScanResult>& results);
+
+}  // namespace rvlio

@@ -1,0 +1,96 @@
+#pragma once
+// ROS1 bag access for sensor data, through Debian's rosbag storage library.
+// The estimators never see ROS types: scans and IMU samples come out as the
+// library's own types (common/types.h).
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/types.h"
+#include "rvlio/imu/options.h"
+#include "rvlio/lidar/options.h"
+
+namespace rvlio {
+
+// Counts of what the reader skipped or repaired; reported in summary.json.
+struct SensorReaderStats {
+  int64_t scans = 0;
+  int64_t imu_samples = 0;
+  int64_t empty_scans = 0;            // scans with no finite point left (skipped)
+  int64_t invalid_points = 0;         // NaN/Inf/zero (no-return) points dropped
+  int64_t out_of_range_points = 0;    // outside [lidar.min_range, lidar.max_range], dropped
+  int64_t imu_invalid = 0;            // samples with NaN/Inf values (dropped)
+  int64_t imu_duplicates = 0;         // samples with the stamp of the previous one (dropped)
+  int64_t imu_non_monotonic = 0;      // samples older than the previous one (dropped)
+  int64_t imu_gaps = 0;               // gaps longer than imu.max_gap
+  double imu_max_gap_s = 0.0;
+};
+
+enum class SensorMessage { kImu, kScan, kEnd };
+
+// Streams IMU samples and decoded scans in bag time order without loading the
+// whole bag.
+class SensorBagReader {
+ public:
+  virtual ~SensorBagReader() = default;
+  // Fails (InvalidInput) for a missing/unreadable/truncated bag, or a topic
+  // that is not there (the message lists the topics that are).
+  static StatusOr<std::unique_ptr<SensorBagReader>> Open(const std::string& path,
+                                                         const LidarOptions& lidar,
+                                                         const ImuOptions& imu);
+  // Fills *imu or *scan and says which; kEnd at the end. A scan's points are
+  // range-cropped and finite, with absolute per-point times; t_start_ns and
+  // t_end_ns are the earliest and latest point times. Messages come in bag
+  // record time order; dropped IMU samples and empty scans are skipped (and
+  // counted in stats()). A corrupt message or chunk is InvalidInput, and every
+  // later call returns the same error.
+  virtual StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) = 0;
+  virtual const SensorReaderStats& stats() const = 0;
+  virtual std::string lidar_layout() const = 0;  // "ouster", "velodyne", "hesai" or "livox"
+};
+
+// Writes sensor data as ROS1 messages (used by the simulator and the tests).
+class SensorBagWriter {
+ public:
+  virtual ~SensorBagWriter() = default;
+  // Writes to path + ".tmp" and renames on Close(): a failed run leaves no half bag.
+  static StatusOr<std::unique_ptr<SensorBagWriter>> Create(const std::string& path);
+  // Ouster driver layout (x y z intensity float32, t uint32 ns from scan start,
+  // reflectivity uint16, ring uint16, ambient uint16, range uint32 mm). When
+  // scan.points.size() == rows * cols the cloud is organized (rows x cols,
+  // row-major by ring, zero points for no-return); otherwise it is 1 x N.
+  // The header stamp is scan.t_start_ns.
+  virtual Status WriteOusterScan(const std::string& topic, const std::string& frame_id,
+                                 const Scan& scan, int rows, int cols) = 0;
+  virtual Status WriteImu(const std::string& topic, const std::string& frame_id,
+                          const ImuSample& sample) = 0;
+  virtual Status Close() = 0;
+};
+
+// What `rvlio info` prints.
+struct BagTopicInfo {
+  std::string topic;
+  std::string type;
+  int64_t count = 0;
+  double rate_hz = 0.0;
+  std::string lidar_layout;     // PointCloud2 topics: detected layout
+  std::vector<std::string> fields;  // PointCloud2 topics: field names
+  double points_per_scan = 0.0;     // PointCloud2 topics: mean points per message
+  std::string header_stamp;         // PointCloud2 topics: "start" or "end" (auto-detected)
+  std::string decode_error;         // PointCloud2 topics: why the layout is unknown
+  int64_t scans_sampled = 0;        // PointCloud2 topics: messages decoded for the figures
+};
+struct BagInfo {
+  std::string path;
+  double start_s = 0.0, end_s = 0.0;
+  int64_t messages = 0;
+  std::vector<BagTopicInfo> topics;
+};
+// Lists every topic; decodes the first few messages of each PointCloud2 topic
+// (only of `lidar_topic` when it is given; it must then be a PointCloud2 topic).
+StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic = "");
+
+}  // namespace rvlio

@@ -1,0 +1,38 @@
+#pragma once
+// LiDAR input and preprocessing options.
+#include <string>
+
+#include "rvlio/common/options.h"
+
+namespace rvlio {
+
+struct LidarOptions {
+  std::string topic = "/os_cloud_node/points";
+  std::string type = "auto";          // auto | ouster | velodyne | hesai | livox
+  std::string header_stamp = "auto";  // auto | start | end: what the header stamp marks
+  double min_range = 0.5;             // m, points closer are dropped (sensor body)
+  double max_range = 100.0;           // m
+  double voxel_size = 0.5;            // m, scan downsampling before association
+  int point_stride = 1;               // keep every n-th raw point before the voxel filter
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("topic", topic, Spec().Help("PointCloud2 topic in the bag"));
+    v.Field("type", type, Spec().Choices({"auto", "ouster", "velodyne", "hesai", "livox"})
+                              .Help("per-point time layout; auto detects it from the field names"));
+    v.Field("header_stamp", header_stamp, Spec().Choices({"auto", "start", "end"})
+                              .Help("whether the header stamp marks scan start or end; auto detects it from the time field"));
+    v.Field("min_range", min_range, Spec().Unit("m").Range(0.0, 1000.0).Help("minimum point range"));
+    v.Field("max_range", max_range, Spec().Unit("m").Positive().Help("maximum point range"));
+    v.Field("voxel_size", voxel_size, Spec().Unit("m").Range(0.0, 10.0).Help("scan voxel downsampling (0: off)"));
+    v.Field("point_stride", point_stride, Spec().Range(1, 1000).Help("keep every n-th raw point"));
+  }
+  Status Validate() {
+    Status s = ValidateFields(*this, "lidar");
+    if (s.ok() && !(max_range > min_range))
+      return Status::InvalidInput("lidar.max_range must be greater than lidar.min_range");
+    return s;
+  }
+};
+
+}  // namespace rvlio

@@ -1,0 +1,122 @@
+#pragma once
+// The working map of the odometry (DESIGN.md section 1, map/): an
+// incremental voxel-hash map with exact k-nearest-neighbour search.
+//
+// Points (world frame, m) live in cubic voxels of edge MapOptions::voxel_size.
+// A voxel keeps at most max_points_per_voxel points; a new point closer than
+// min_point_distance to a point already in its voxel is skipped. Voxels are
+// found through an open-addressing hash table (linear probing, power-of-two
+// capacity, load <= 1/2); each voxel owns a fixed block of float storage laid
+// out as x[cap], y[cap], z[cap] so that the distance loop of a query
+// vectorizes. Memory is reused: removed voxels return their block to a free
+// list, and queries allocate nothing.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rvlio/map/options.h"
+#include "rvlio/map/voxel_key.h"
+
+namespace rvlio {
+
+// Largest k a query can ask for.
+constexpr int kMaxNeighbors = 32;
+
+// Result of one k-nearest query, owned by the caller and reused across
+// queries: the first `size` entries, sorted by increasing distance.
+struct NeighborBuffer {
+  int size = 0;
+  std::array<Eigen::Vector3d, kMaxNeighbors> points;  // world, m
+  std::array<double, kMaxNeighbors> dist2;            // squared distance to the query, m^2
+};
+
+class VoxelMap {
+ public:
+  explicit VoxelMap(const MapOptions& options = MapOptions());
+
+  // Inserts points (world, m). Non-finite points are ignored.
+  void Insert(const std::vector<Eigen::Vector3d>& p_world);
+  // Inserts one point; true when it was stored (not skipped by the voxel's
+  // capacity or by min_point_distance).
+  bool InsertPoint(const Eigen::Vector3d& p_world);
+
+  // Exact k nearest stored points of q_world among those within max_dist (m),
+  // sorted by distance into *out. Returns out->size (< k when fewer points are
+  // within max_dist). 1 <= k <= kMaxNeighbors. No heap allocation.
+  int KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
+               NeighborBuffer* out) const;
+
+  // Removes every voxel whose centre is farther than radius (m) from
+  // center_world (the sensor position: keeps a working window).
+  void RemoveFar(const Eigen::Vector3d& center_world, double radius);
+
+  void Clear();
+
+  size_t Size() const { return num_points_; }       // stored points
+  size_t NumVoxels() const { return num_voxels_; }  // occupied voxels
+  bool Empty() const { return num_points_ == 0; }
+  const MapOptions& options() const { return options_; }
+
+  // Calls f(const Eigen::Vector3d& p_world) for every stored point, in an
+  // unspecified but deterministic order.
+  template <class F>
+  void ForEachPoint(F&& f) const {
+    for (const Slot& s : slots_) {
+      if (s.block < 0) continue;
+      const float* x = BlockData(s.block);
+      const int n = counts_[s.block];
+      for (int i = 0; i < n; ++i) f(Eigen::Vector3d(x[i], x[i + cap_], x[i + 2 * cap_]));
+    }
+  }
+  std::vector<Eigen::Vector3d> Points() const;
+
+ private:
+  struct Slot {
+    VoxelKey key;
+    int32_t block = -1;  // -1: empty slot
+  };
+  struct Offset {
+    int8_t dx, dy, dz;
+  };
+  class Candidates;
+
+  int FindSlot(const VoxelKey& key) const;  // slot index, or -1
+  int FindOrCreateBlock(const VoxelKey& key);
+  int AllocateBlock();
+  void InsertSlot(const Slot& s);  // key must be absent; no growth check
+  void Rebuild(size_t capacity, const std::vector<Slot>& slots);
+  const float* BlockData(int block) const { return pool_.data() + block * stride_; }
+  float* BlockData(int block) { return pool_.data() + block * stride_; }
+
+  void ScanBlock(int block, const float q[3], Candidates* c) const;
+  void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
+                   const float q[3], Candidates* c) const;
+  void VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
+                  Candidates* c) const;
+  void ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3], Candidates* c) const;
+
+  MapOptions options_;
+  double inv_voxel_size_ = 1.0;
+  float min_d2_ = 0.0f;
+  int cap_ = 1;     // points per voxel block
+  int stride_ = 3;  // floats per block (3 * cap_)
+
+  std::vector<Slot> slots_;
+  size_t mask_ = 0;
+  std::vector<float> pool_;        // blocks of x[cap], y[cap], z[cap]
+  std::vector<int32_t> counts_;    // points in each block
+  std::vector<int32_t> free_blocks_;
+  std::vector<Slot> scratch_slots_;  // reused by RemoveFar / growth
+  size_t num_voxels_ = 0;
+  size_t num_points_ = 0;
+
+  // shells_[r]: voxel offsets with Chebyshev norm r, faces before edges before
+  // corners (better pruning), for r <= kPrecomputedShells.
+  static constexpr int kPrecomputedShells = 3;
+  std::array<std::vector<Offset>, kPrecomputedShells + 1> shells_;
+};
+
+}  // namespace rvlio

@@ -1,0 +1,55 @@
+#pragma once
+// The IESKF backend of the odometry pipeline (see odometry.h).
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "rvlio/ieskf/ieskf.h"
+#include "rvlio/lidar/preprocess.h"
+#include "rvlio/map/output_map.h"
+#include "rvlio/map/voxel_map.h"
+#include "rvlio/odometry/odometry.h"
+
+namespace rvlio {
+
+class IeskfOdometry : public Odometry {
+ public:
+  explicit IeskfOdometry(const OdometryOptions& options);
+
+  void AddImu(const ImuSample& imu) override;
+  void AddScan(Scan scan) override;
+  void Poll(std::vector<ScanResult>* out) override;
+  void Finish(std::vector<ScanResult>* out) override;
+
+  const OdometryStats& stats() const override { return stats_; }
+  std::vector<std::string> warnings() const override { return warnings_; }
+  std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
+
+  const FilterState& state() const { return filter_.state(); }
+
+ private:
+  void TryInitialize(const ImuSample& imu);
+  void ProcessFrontScan(std::vector<ScanResult>* out);
+  void Predict(TimeNs t_end_ns);
+  ScanStatus Correct(ScanResult* r);
+  void InsertIntoMap();
+
+  OdometryOptions options_;
+  Ieskf filter_;
+  VoxelMap map_;
+  OutputMap output_map_;
+  ScanPreprocessor preprocessor_;
+  Pose3 T_imu_lidar_;
+  OdometryStats stats_;
+  std::vector<std::string> warnings_;
+  std::vector<ImuSample> init_samples_;
+  std::deque<ImuSample> imu_buffer_;
+  std::deque<Scan> scans_;
+  int scans_since_trim_ = 0;
+  // Per-scan workspaces, reused to avoid allocation in the hot path.
+  std::vector<LidarPoint> kept_points_;
+  std::vector<Eigen::Vector3d> p_lidar_end_;
+  std::vector<Eigen::Vector3d> p_world_;
+};
+
+}  // namespace rvlio

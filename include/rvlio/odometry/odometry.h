@@ -1,0 +1,72 @@
+#pragma once
+// The odometry pipeline: AddImu / AddScan in, one ScanResult per scan out.
+// Per scan it reads like the recipe of DESIGN.md section 8:
+//   Predict -> Downsample -> Deskew -> Associate -> RV -> Update -> Insert.
+// It owns one estimator and the map; no I/O.
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/types.h"
+#include "rvlio/math/pose.h"
+#include "rvlio/odometry/options.h"
+#include "rvlio/rv/rv.h"
+
+namespace rvlio {
+
+enum class ScanStatus {
+  kUpdated = 0,      // the estimator used the scan
+  kMapInit = 1,      // first scan: it started the map
+  kPredictOnly = 2,  // too few constraints: IMU prediction kept, scan inserted
+  kDiverged = 3,     // update diverged: reset to the last good state
+};
+const char* ScanStatusName(ScanStatus s);
+
+struct ScanResult {
+  TimeNs t_ns = 0;  // scan end time: the output stamp
+  Pose3 T_world_imu;
+  Eigen::Vector3d v_world_imu = Eigen::Vector3d::Zero();
+  ScanStatus status = ScanStatus::kUpdated;
+  int raw_points = 0;
+  int downsampled_points = 0;
+  int constraints = 0;
+  int iterations = 0;
+  RvReport rv;
+  double ms = 0.0;  // processing time of this scan, wall clock
+};
+
+// Counts of what was skipped or repaired, reported in summary.json.
+struct OdometryStats {
+  int64_t scans_received = 0;
+  int64_t scans_processed = 0;
+  int64_t scans_before_imu = 0;       // LiDAR started before the IMU / during initialization
+  int64_t scans_too_few_points = 0;   // skipped: fewer than kMinScanPoints after preprocessing
+  int64_t predict_only = 0;
+  int64_t diverged_resets = 0;
+  int64_t imu_gaps_over_scan = 0;     // IMU gaps longer than the scan period
+  bool initialized = false;
+  bool started_moving = false;        // static initialization saw motion
+};
+
+class Odometry {
+ public:
+  // Validates the options; fails for a backend this build does not have.
+  static StatusOr<std::unique_ptr<Odometry>> Create(const OdometryOptions& options);
+  virtual ~Odometry() = default;
+
+  virtual void AddImu(const ImuSample& imu) = 0;
+  virtual void AddScan(Scan scan) = 0;
+  // Processes every buffered scan whose end is covered by IMU data.
+  virtual void Poll(std::vector<ScanResult>* out) = 0;
+  // End of input: processes the remaining scans with the IMU data there is.
+  virtual void Finish(std::vector<ScanResult>* out) = 0;
+
+  virtual const OdometryStats& stats() const = 0;
+  virtual std::vector<std::string> warnings() const = 0;
+  // The full map for output (coarse resolution), world frame.
+  virtual std::vector<Eigen::Vector3d> MapPoints() const = 0;
+};
+
+}  // namespace rvlio

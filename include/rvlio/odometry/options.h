@@ -1,0 +1,52 @@
+#pragma once
+// The whole configuration of a run: one section per module. This is what
+// `--config` files and `--set key=value` fill (io/config.h).
+#include <string>
+
+#include "rvlio/common/options.h"
+#include "rvlio/constraints/options.h"
+#include "rvlio/ieskf/options.h"
+#include "rvlio/imu/options.h"
+#include "rvlio/lidar/options.h"
+#include "rvlio/map/options.h"
+#include "rvlio/rv/options.h"
+#include "rvlio/smoother/options.h"
+
+namespace rvlio {
+
+struct OdometryOptions {
+  std::string backend = "ieskf";  // ieskf | smoother
+  LidarOptions lidar;
+  ImuOptions imu;
+  ExtrinsicsSection extrinsics;
+  MapOptions map;
+  ConstraintOptions constraints;
+  RvOptions rv;
+  IeskfOptions ieskf;
+  SmootherOptions smoother;
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("backend", backend, Spec().Choices({"ieskf", "smoother"}).Help("estimator"));
+    v.Section("lidar", lidar);
+    v.Section("imu", imu);
+    v.Section("extrinsics", extrinsics);
+    v.Section("map", map);
+    v.Section("constraints", constraints);
+    v.Section("rv", rv);
+    v.Section("ieskf", ieskf);
+    v.Section("smoother", smoother);
+  }
+
+  // Ranges and choices of every key, then the cross-field rules of each module.
+  Status Validate() {
+    Status s = ValidateFields(*this);
+    if (!s.ok()) return s;
+    for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
+                     constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate()})
+      if (!m.ok()) return m;
+    return Status::Ok();
+  }
+};
+
+}  // namespace rvlio

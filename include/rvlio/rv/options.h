@@ -1,0 +1,40 @@
+#pragma once
+// RV modules (paper Section 3, Alg. 1-3; DESIGN.md section 4).
+#include "rvlio/common/options.h"
+
+namespace rvlio {
+
+struct RvOptions {
+  bool enabled = true;            // master switch for the criterion and both modules
+  bool reinforce = true;          // Alg. 2
+  bool repair = true;             // Alg. 3 repair step
+  double eps0 = 0.5;              // SCV threshold on d_i = |u_i . n_alpha|
+  double eps1 = 0.1;              // repair threshold on d_i (eps1 <= eps0)
+  double k0 = 1.0;                // Eq. (19) coefficient
+  double activation_ratio = 0.9;  // active when this fraction of d_i <= eps0
+  int max_iterations = 10;        // cap of the Alg. 2 refit loop
+  bool clamp = true;              // never let K weaken an SCV: K = min(K, 1)
+  int min_constraints = 20;       // fewer constraints: criterion not evaluated
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("enabled", enabled, Spec().Help("vector-distribution criterion and RV modules"));
+    v.Field("reinforce", reinforce, Spec().Help("reinforced vectors, Alg. 2"));
+    v.Field("repair", repair, Spec().Help("repaired vectors, Alg. 3"));
+    v.Field("eps0", eps0, Spec().Range(0.0, 1.0).Help("SCV threshold on |u.n_alpha|"));
+    v.Field("eps1", eps1, Spec().Range(0.0, 1.0).Help("repair threshold on |u.n_alpha|"));
+    v.Field("k0", k0, Spec().Positive().Help("Eq. (19) coefficient"));
+    v.Field("activation_ratio", activation_ratio, Spec().Range(0.0, 1.0)
+                                                   .Help("fraction of coplanar vectors that activates RV"));
+    v.Field("max_iterations", max_iterations, Spec().Range(1, 100).Help("Alg. 2 iteration cap"));
+    v.Field("clamp", clamp, Spec().Help("K = min(K, 1): reinforcement never weakens an SCV"));
+    v.Field("min_constraints", min_constraints, Spec().Range(3, 100000));
+  }
+  Status Validate() {
+    Status s = ValidateFields(*this, "rv");
+    if (s.ok() && eps1 > eps0) return Status::InvalidInput("rv.eps1 must not exceed rv.eps0 (Alg. 3)");
+    return s;
+  }
+};
+
+}  // namespace rvlio

@@ -1,0 +1,106 @@
+#pragma once
+// Analytic ray intersection for the simulator's world: rough axis-aligned
+// surfaces (a plane displaced by a smooth height field), oriented boxes and
+// finite cylinders. Rays have unit directions, so the ray parameter t is the
+// range in metres. Every shape also gives its distance from a point (used by
+// the tests to check that simulated points lie on the surfaces).
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "rvlio/sim/random.h"
+
+namespace rvlio::sim {
+
+struct Ray {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dir = Eigen::Vector3d::UnitX();  // unit length
+};
+
+// Smooth deterministic displacement h(u, v) = sum_k A_k sin(a_k u + b_k v + phi_k)
+// (m). Its magnitude is bounded by amplitude_bound() = sum |A_k| and its
+// gradient norm by slope_bound() = sum |A_k| |(a_k, b_k)|.
+class HeightField {
+ public:
+  struct Wave {
+    double amplitude;  // m
+    double ku, kv;     // rad/m
+    double phase;      // rad
+  };
+  HeightField() = default;
+  explicit HeightField(std::vector<Wave> waves);
+  // `components` waves with random directions, wavelengths log-uniform in
+  // [lambda_min, lambda_max], amplitudes proportional to the wavelength
+  // (similar slope per wave) and summing to `amplitude`.
+  static HeightField Random(Rng& rng, int components, double amplitude, double lambda_min,
+                            double lambda_max);
+
+  double Height(double u, double v) const;
+  double Height(double u, double v, double* dh_du, double* dh_dv) const;
+  double amplitude_bound() const { return amplitude_bound_; }
+  double slope_bound() const { return slope_bound_; }
+  bool flat() const { return waves_.empty(); }
+  const std::vector<Wave>& waves() const { return waves_; }
+
+ private:
+  std::vector<Wave> waves_;
+  double amplitude_bound_ = 0.0;
+  double slope_bound_ = 0.0;
+};
+
+// Axis-aligned rectangle in the (u, v) coordinates of a face.
+struct Rect2 {
+  double u_min = 0.0, u_max = 0.0, v_min = 0.0, v_max = 0.0;
+  bool Contains(double u, double v) const {
+    return u >= u_min && u <= u_max && v >= v_min && v <= v_max;
+  }
+};
+
+// A bounded rough surface p[axis] = offset + h(p[u], p[v]) where
+// (u, v) = (axis + 1, axis + 2) mod 3, for (p[u], p[v]) inside `bounds` and
+// outside every hole. Two-sided.
+struct Face {
+  int axis = 2;
+  double offset = 0.0;
+  Rect2 bounds;
+  std::vector<Rect2> holes;
+  HeightField relief;
+
+  int UAxis() const { return (axis + 1) % 3; }
+  int VAxis() const { return (axis + 2) % 3; }
+  bool Covers(double u, double v) const;
+  // The first crossing of the ray with the (unbounded) height field in
+  // [t_min, t_max]; true (and *t) when it lies inside the face.
+  bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
+  // |p[axis] - offset - h(p[u], p[v])| where the face covers p, else +inf.
+  double Distance(const Eigen::Vector3d& p) const;
+};
+
+// Box with centre, orientation R_world_box and half extents (m).
+struct Box {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_world_box = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5);
+
+  // Entry point of the ray in (t_min, t_max]; false for no hit or an origin
+  // inside the box.
+  bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
+  double Distance(const Eigen::Vector3d& p) const;  // |signed distance|
+  Eigen::AlignedBox3d Bounds() const;
+};
+
+// Solid finite cylinder: axis through `center` along unit `axis`, closed by
+// two discs at +-half_length.
+struct Cylinder {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double radius = 0.5;
+  double half_length = 1.0;
+
+  bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
+  double Distance(const Eigen::Vector3d& p) const;  // |signed distance|
+  Eigen::AlignedBox3d Bounds() const;
+};
+
+}  // namespace rvlio::sim

@@ -1,0 +1,203 @@
+#pragma once
+// Options of the deterministic tunnel simulator (issue 3). Presets
+// (sim/presets.h) fill a SimOptions; `rvlio simulate --set key=value` edits
+// it through the same Visit() list as every other options struct.
+//
+// Frames: world = gravity-aligned (z up), origin and yaw of the IMU at the
+// start pose (DESIGN.md section 2). The tunnel axis is world x; the world
+// geometry is placed relative to the start pose by world.start_*.
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "rvlio/common/options.h"
+#include "rvlio/imu/options.h"
+
+namespace rvlio {
+
+// Geometry of the simulated world: a rectangular tunnel (or a closed hall)
+// with rough surfaces, a feature-rich entrance region and sparse features.
+struct SimWorldOptions {
+  std::string layout = "tunnel";  // tunnel | hall
+  double width = 10.45;           // m, extent along world y
+  double height = 7.8;            // m, floor to ceiling
+  double length = 100.5;          // m, extent along world x (entrance to end wall)
+  double start_depth = 5.0;       // m, start pose behind the entrance (tunnel) / front wall (hall)
+  double start_height = 0.3;      // m, IMU height above the floor at the start pose
+  double start_lateral = 0.0;     // m, start pose y offset from the centre line
+  bool open_entrance = true;      // tunnel entrance open (hall: false, a wall with openings)
+  bool end_wall = true;           // closed far end
+  double roughness_amplitude = 0.04;   // m, bound of the surface displacement (sum of waves)
+  double roughness_wavelength_min = 0.8;  // m
+  double roughness_wavelength_max = 4.0;  // m
+  int roughness_components = 4;       // seeded sinusoids per surface
+  double clutter_length = 15.0;  // m, feature-rich region from the entrance (hall: whole room)
+  int clutter_count = 40;        // boxes, pillars and irregular blocks in that region
+  double sparse_spacing = 20.0;  // m between sparse features after it (0: none)
+  double path_clearance = 1.2;   // m, features keep this distance from the flight path
+  double pillar_spacing = 0.0;   // m, grid of floor-to-ceiling pillars (0: none; hall)
+  int openings = 0;              // doorways in the hall walls (hall only)
+  bool stairs = false;           // a flight of stairs along a wall (hall only)
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("layout", layout, Spec().Choices({"tunnel", "hall"}).Help("world type"));
+    v.Field("width", width, Spec().Unit("m").Range(2.0, 200.0).Help("extent along y"));
+    v.Field("height", height, Spec().Unit("m").Range(2.0, 100.0).Help("floor to ceiling"));
+    v.Field("length", length, Spec().Unit("m").Range(5.0, 20000.0).Help("extent along x"));
+    v.Field("start_depth", start_depth, Spec().Unit("m").Min(0.5)
+                                            .Help("start pose behind the entrance along x"));
+    v.Field("start_height", start_height, Spec().Unit("m").Range(0.05, 100.0)
+                                              .Help("IMU height above the floor at start"));
+    v.Field("start_lateral", start_lateral, Spec().Unit("m").Range(-100.0, 100.0)
+                                                .Help("start y offset from the centre line"));
+    v.Field("open_entrance", open_entrance, Spec().Help("tunnel entrance open"));
+    v.Field("end_wall", end_wall, Spec().Help("closed far end"));
+    v.Field("roughness_amplitude", roughness_amplitude, Spec().Unit("m").Range(0.0, 0.5)
+                                        .Help("bound of the surface height field"));
+    v.Field("roughness_wavelength_min", roughness_wavelength_min, Spec().Unit("m").Range(0.1, 100.0));
+    v.Field("roughness_wavelength_max", roughness_wavelength_max, Spec().Unit("m").Range(0.1, 100.0));
+    v.Field("roughness_components", roughness_components, Spec().Range(1, 16)
+                                        .Help("sinusoids per surface"));
+    v.Field("clutter_length", clutter_length, Spec().Unit("m").Range(0.0, 20000.0)
+                                                  .Help("feature-rich region from the entrance"));
+    v.Field("clutter_count", clutter_count, Spec().Range(0, 5000).Help("objects in that region"));
+    v.Field("sparse_spacing", sparse_spacing, Spec().Unit("m").Range(0.0, 20000.0)
+                                                  .Help("spacing of sparse features (0: none)"));
+    v.Field("path_clearance", path_clearance, Spec().Unit("m").Range(0.0, 10.0)
+                                                  .Help("free space around the flight path"));
+    v.Field("pillar_spacing", pillar_spacing, Spec().Unit("m").Range(0.0, 1000.0)
+                                                  .Help("pillar grid spacing (0: none)"));
+    v.Field("openings", openings, Spec().Range(0, 32).Help("doorways in the hall walls"));
+    v.Field("stairs", stairs, Spec().Help("a flight of stairs (hall)"));
+  }
+};
+
+// Spinning LiDAR (defaults: Ouster OS1-32).
+struct SimLidarOptions {
+  std::string topic = "/os_cloud_node/points";
+  std::string frame_id = "os_lidar";
+  int beams = 32;                 // rows (rings), row 0 = top beam
+  double vfov_min = -22.5;        // deg, lowest beam elevation
+  double vfov_max = 22.5;         // deg, highest beam elevation
+  int columns = 1024;             // azimuth columns per revolution
+  double rate = 10.0;             // Hz, revolutions per second
+  double range_noise = 0.03;      // m, std of the Gaussian range noise
+  double min_range = 0.5;         // m, closer returns are dropped
+  double max_range = 100.0;       // m, farther returns are dropped
+  double dropout = 0.0;           // probability of a random missing return
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("topic", topic, Spec().Help("PointCloud2 topic written"));
+    v.Field("frame_id", frame_id, Spec().Help("header frame of the clouds"));
+    v.Field("beams", beams, Spec().Range(1, 512).Help("number of rings"));
+    v.Field("vfov_min", vfov_min, Spec().Unit("deg").Range(-89.0, 89.0).Help("lowest elevation"));
+    v.Field("vfov_max", vfov_max, Spec().Unit("deg").Range(-89.0, 89.0).Help("highest elevation"));
+    v.Field("columns", columns, Spec().Range(8, 8192).Help("azimuth columns per revolution"));
+    v.Field("rate", rate, Spec().Unit("Hz").Range(1.0, 100.0).Help("revolutions per second"));
+    v.Field("range_noise", range_noise, Spec().Unit("m").Range(0.0, 5.0).Help("range noise std"));
+    v.Field("min_range", min_range, Spec().Unit("m").Range(0.0, 1000.0));
+    v.Field("max_range", max_range, Spec().Unit("m").Positive());
+    v.Field("dropout", dropout, Spec().Range(0.0, 1.0).Help("probability of a missing return"));
+  }
+};
+
+// IMU (defaults near a consumer MEMS IMU); noise is simulated as
+// discrete white noise sigma_d = sigma_c * sqrt(rate) and a bias random walk
+// b_{k+1} = b_k + sigma_rw * sqrt(dt) * n_k.
+struct SimImuOptions {
+  std::string topic = "/imu/data";
+  std::string frame_id = "imu";
+  double rate = 200.0;                     // Hz
+  double gyro_noise_density = 2.0e-4;      // rad/s/sqrt(Hz)
+  double accel_noise_density = 2.0e-3;     // m/s^2/sqrt(Hz)
+  double gyro_bias_random_walk = 2.0e-5;   // rad/s^2/sqrt(Hz)
+  double accel_bias_random_walk = 2.0e-4;  // m/s^3/sqrt(Hz)
+  std::array<double, 3> gyro_bias = {0.002, -0.0015, 0.001};  // rad/s, initial bias
+  std::array<double, 3> accel_bias = {0.04, -0.03, 0.05};     // m/s^2, initial bias
+  double gravity = 9.81;                   // m/s^2
+  double vibration_accel = 0.0;            // m/s^2, motor vibration amplitude (0: off)
+  double vibration_gyro = 0.0;             // rad/s, motor vibration amplitude (0: off)
+  double vibration_frequency = 87.0;       // Hz
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("topic", topic, Spec().Help("sensor_msgs/Imu topic written"));
+    v.Field("frame_id", frame_id, Spec().Help("header frame of the IMU messages"));
+    v.Field("rate", rate, Spec().Unit("Hz").Range(10.0, 100000.0));
+    v.Field("gyro_noise_density", gyro_noise_density, Spec().Unit("rad/s/sqrt(Hz)").Range(0.0, 1.0));
+    v.Field("accel_noise_density", accel_noise_density, Spec().Unit("m/s^2/sqrt(Hz)").Range(0.0, 10.0));
+    v.Field("gyro_bias_random_walk", gyro_bias_random_walk, Spec().Unit("rad/s^2/sqrt(Hz)").Range(0.0, 1.0));
+    v.Field("accel_bias_random_walk", accel_bias_random_walk, Spec().Unit("m/s^3/sqrt(Hz)").Range(0.0, 10.0));
+    v.Field("gyro_bias", gyro_bias, Spec().Unit("rad/s").Range(-1.0, 1.0).Help("initial gyro bias"));
+    v.Field("accel_bias", accel_bias, Spec().Unit("m/s^2").Range(-5.0, 5.0).Help("initial accel bias"));
+    v.Field("gravity", gravity, Spec().Unit("m/s^2").Range(9.0, 10.5));
+    v.Field("vibration_accel", vibration_accel, Spec().Unit("m/s^2").Range(0.0, 50.0)
+                                                  .Help("motor vibration amplitude (0: off)"));
+    v.Field("vibration_gyro", vibration_gyro, Spec().Unit("rad/s").Range(0.0, 10.0)
+                                                .Help("motor vibration amplitude (0: off)"));
+    v.Field("vibration_frequency", vibration_frequency, Spec().Unit("Hz").Positive());
+  }
+};
+
+// Multirotor-like flight through waypoints: a static phase at the first
+// waypoint, then straight segments with jerk-limited speed ramps ("shocks")
+// and a hover at each waypoint; attitude follows the required thrust.
+struct SimTrajectoryOptions {
+  // "x,y,z; x,y,z; ..." in the world frame (m); the first one must be 0,0,0.
+  std::string waypoints = "0,0,0; 0,0,2.5; 30,0,2.5; 30,0,4.5; 50,0,4.5";
+  double static_duration = 3.0;  // s at rest before the first motion
+  double cruise_speed = 1.5;     // m/s on mostly horizontal segments
+  double climb_speed = 0.8;      // m/s on mostly vertical segments
+  double ramp_time = 0.8;        // s of each speed ramp (peak accel = 2.1875 speed / ramp_time)
+  double hover_time = 1.5;       // s at rest at each intermediate waypoint
+  double yaw_amplitude = 0.05;   // rad, small yaw motion after the static phase
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("waypoints", waypoints, Spec().Unit("m").Help("'x,y,z; x,y,z; ...' starting at 0,0,0"));
+    v.Field("static_duration", static_duration, Spec().Unit("s").Range(0.0, 3600.0));
+    v.Field("cruise_speed", cruise_speed, Spec().Unit("m/s").Range(0.05, 30.0));
+    v.Field("climb_speed", climb_speed, Spec().Unit("m/s").Range(0.05, 30.0));
+    v.Field("ramp_time", ramp_time, Spec().Unit("s").Range(0.05, 60.0)
+                                        .Help("duration of each speed ramp"));
+    v.Field("hover_time", hover_time, Spec().Unit("s").Range(0.0, 3600.0));
+    v.Field("yaw_amplitude", yaw_amplitude, Spec().Unit("rad").Range(0.0, 1.5));
+  }
+};
+
+struct SimOptions {
+  int64_t seed = 1;           // every random choice derives from it
+  double duration = 50.0;     // s of data
+  double start_time = 1.7e9;  // s, absolute time of the first sample (ROS stamps)
+  SimWorldOptions world;
+  SimLidarOptions lidar;
+  SimImuOptions imu;
+  SimTrajectoryOptions trajectory;
+  ExtrinsicsSection extrinsics = DefaultExtrinsics();  // LiDAR pose in the IMU frame
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("seed", seed, Spec().Min(0).Help("random seed"));
+    v.Field("duration", duration, Spec().Unit("s").Range(0.2, 36000.0));
+    v.Field("start_time", start_time, Spec().Unit("s").Range(1.0, 4.0e9)
+                                          .Help("absolute time of the first sample"));
+    v.Section("world", world);
+    v.Section("lidar", lidar);
+    v.Section("imu", imu);
+    v.Section("trajectory", trajectory);
+    v.Section("extrinsics", extrinsics);
+  }
+
+  // Ranges of every key, then the cross-field rules (src/sim/options.cpp).
+  Status Validate();
+
+  static ExtrinsicsSection DefaultExtrinsics() {
+    ExtrinsicsSection e;
+    e.imu_T_lidar.translation = {0.05, 0.0, 0.1};
+    return e;
+  }
+};
+
+}  // namespace rvlio

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages rvlio needs, only those that are missing.
+# Safe to run again: when everything is present it does nothing but check.
+# Uses sudo only when not root.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config git ccache
+  libeigen3-dev libceres-dev libsuitesparse-dev libyaml-cpp-dev
+  libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
+  libpcl-dev
+  librosbag-storage-dev libsensor-msgs-dev libroscpp-core-dev
+  pluginlib-dev libclass-loader-dev librcpputils-dev libament-index-cpp-dev
+  python3-rosbag python3-matplotlib python3-yaml
+)
+# Extra packages the test command needs (Snakemake workflow test).
+if [[ "${1:-}" == "--with-test-tools" ]]; then
+  packages+=(snakemake)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install_deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then
+  command -v sudo >/dev/null || { echo "install_deps: not root and no sudo; install: ${missing[*]}" >&2; exit 1; }
+  SUDO="sudo"
+fi
+echo "install_deps: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install_deps: done"

@@ -1,0 +1,102 @@
+#include "rvlio/constraints/associate.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rvlio/common/check.h"
+#include "rvlio/constraints/plane_fit.h"
+
+namespace rvlio {
+
+namespace {
+
+AssociationOutcome FromPlaneStatus(PlaneStatus status) {
+  switch (status) {
+    case PlaneStatus::kValid: return AssociationOutcome::kAccepted;
+    case PlaneStatus::kTooFewPoints: return AssociationOutcome::kTooFewNeighbors;
+    case PlaneStatus::kDegenerate: return AssociationOutcome::kDegenerate;
+    case PlaneStatus::kLineLike: return AssociationOutcome::kLineLike;
+    case PlaneStatus::kNotFlat: return AssociationOutcome::kNotFlat;
+    case PlaneStatus::kFarFromPlane: return AssociationOutcome::kFarFromPlane;
+  }
+  return AssociationOutcome::kDegenerate;
+}
+
+}  // namespace
+
+const char* ToString(AssociationOutcome outcome) {
+  switch (outcome) {
+    case AssociationOutcome::kAccepted: return "accepted";
+    case AssociationOutcome::kTooFewNeighbors: return "too_few_neighbors";
+    case AssociationOutcome::kDegenerate: return "degenerate";
+    case AssociationOutcome::kLineLike: return "line_like";
+    case AssociationOutcome::kNotFlat: return "not_flat";
+    case AssociationOutcome::kFarFromPlane: return "far_from_plane";
+    case AssociationOutcome::kLargeResidual: return "large_residual";
+  }
+  return "unknown";
+}
+
+void AssociationStats::Count(AssociationOutcome outcome) {
+  ++num_points;
+  switch (outcome) {
+    case AssociationOutcome::kAccepted: ++num_accepted; break;
+    case AssociationOutcome::kTooFewNeighbors: ++num_too_few_neighbors; break;
+    case AssociationOutcome::kDegenerate: ++num_degenerate; break;
+    case AssociationOutcome::kLineLike: ++num_line_like; break;
+    case AssociationOutcome::kNotFlat: ++num_not_flat; break;
+    case AssociationOutcome::kFarFromPlane: ++num_far_from_plane; break;
+    case AssociationOutcome::kLargeResidual: ++num_large_residual; break;
+  }
+}
+
+AssociationOutcome AssociatePoint(const Eigen::Vector3d& p_lidar, const Pose3& T_world_lidar,
+                                  const VoxelMap& map, const ConstraintOptions& options,
+                                  NeighborBuffer* neighbors, Constraint* out) {
+  const Eigen::Vector3d p_world = T_world_lidar * p_lidar;
+  const int k = std::min(options.num_neighbors, kMaxNeighbors);
+  if (map.KNearest(p_world, k, options.max_neighbor_distance, neighbors) < k)
+    return AssociationOutcome::kTooFewNeighbors;
+  const LocalPlane plane = FitLocalPlane(*neighbors, PlaneThresholds::From(options));
+  if (!plane.valid()) return FromPlaneStatus(plane.status);
+
+  // The normal's sign is arbitrary; orient it towards the sensor so that
+  // records are reproducible and readable (RV only uses |u . n_alpha|).
+  Eigen::Vector3d u = plane.normal;
+  if (u.dot(T_world_lidar.t - plane.centroid) < 0.0) u = -u;
+  const double r = u.dot(p_world - plane.centroid);  // Eq. (3)
+  if (!(std::abs(r) <= options.max_residual)) return AssociationOutcome::kLargeResidual;
+
+  out->p_lidar = p_lidar;
+  out->normal_world = u;
+  out->q_world = plane.centroid;
+  out->residual = r;
+  out->weight = 1.0;
+  out->role = RvRole::kPlain;
+  return AssociationOutcome::kAccepted;
+}
+
+void Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
+               const Pose3& T_imu_lidar, const VoxelMap& map, const ConstraintOptions& options,
+               ConstraintList* out, AssociationStats* stats) {
+  RVLIO_CHECK(out != nullptr);
+  out->clear();
+  out->reserve(p_lidar.size());
+  const Pose3 T_world_lidar = T_world_imu * T_imu_lidar;
+  AssociationStats local;
+  double sum_abs_residual = 0.0;
+  NeighborBuffer neighbors;
+  Constraint c;
+  for (const Eigen::Vector3d& p : p_lidar) {
+    const AssociationOutcome outcome =
+        AssociatePoint(p, T_world_lidar, map, options, &neighbors, &c);
+    local.Count(outcome);
+    if (outcome != AssociationOutcome::kAccepted) continue;
+    sum_abs_residual += std::abs(c.residual);
+    out->push_back(c);
+  }
+  if (local.num_accepted > 0) local.mean_abs_residual = sum_abs_residual / local.num_accepted;
+  if (stats != nullptr) *stats = local;
+}
+
+}  // namespace rvlio

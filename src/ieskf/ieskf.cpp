@@ -1,0 +1,203 @@
+#include "rvlio/ieskf/ieskf.h"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "rvlio/common/check.h"
+#include "rvlio/constraints/point_to_plane.h"
+#include "rvlio/math/so3.h"
+
+namespace rvlio {
+namespace {
+
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+
+// Prior covariance from the configured standard deviations.
+Matrix24d InitialCovariance(const IeskfOptions& o) {
+  Vector24d sd;
+  sd.segment<3>(FilterState::kRot).setConstant(o.init_rot_std);
+  sd.segment<3>(FilterState::kPos).setConstant(o.init_pos_std);
+  sd.segment<3>(FilterState::kVel).setConstant(o.init_vel_std);
+  sd.segment<3>(FilterState::kBg).setConstant(o.init_bias_gyro_std);
+  sd.segment<3>(FilterState::kBa).setConstant(o.init_bias_acc_std);
+  sd.segment<6>(FilterState::kExtRot).setConstant(o.init_extrinsic_std);
+  sd.segment<3>(FilterState::kGrav).setConstant(o.init_gravity_std);
+  return sd.cwiseAbs2().asDiagonal();
+}
+
+bool IsHealthy(const FilterState& x, const Matrix24d& P) {
+  if (!x.R_world_imu.allFinite() || !x.p_world_imu.allFinite() || !x.v_world_imu.allFinite() ||
+      !x.bg.allFinite() || !x.ba.allFinite() || !x.g_world.allFinite() || !P.allFinite())
+    return false;
+  // Exploding covariance: a position std of kilometres means the filter lost it.
+  return P.diagonal().maxCoeff() < 1e6 && P.diagonal().minCoeff() > -1e-9;
+}
+
+// Accumulates H^T R^-1 H and H^T R^-1 z over the constraints (paper Eq. 1).
+// Columns: [dtheta, dp] and, when extrinsics are estimated, [dphi, dt].
+int AccumulateNormalEquations(const ConstraintList& constraints, const FilterState& x,
+                              bool with_extrinsics, double inv_sigma2, Matrix12d* HtRinvH,
+                              Vector12d* HtRinvz) {
+  HtRinvH->setZero();
+  HtRinvz->setZero();
+  const Pose3 T_world_imu = x.T_world_imu(), T_imu_lidar = x.T_imu_lidar();
+  Eigen::Matrix<double, 1, 12> h;
+  for (const Constraint& c : constraints) {
+    const double r = PointToPlaneResidualWithExtrinsics(c, T_world_imu, T_imu_lidar, &h);
+    const double w = c.weight * inv_sigma2;
+    if (with_extrinsics) {
+      HtRinvH->noalias() += w * h.transpose() * h;
+      HtRinvz->noalias() += w * r * h.transpose();
+    } else {
+      const auto h6 = h.leftCols<6>();
+      HtRinvH->topLeftCorner<6, 6>().noalias() += w * h6.transpose() * h6;
+      HtRinvz->head<6>().noalias() += w * r * h6.transpose();
+    }
+  }
+  return static_cast<int>(constraints.size());
+}
+
+}  // namespace
+
+Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
+             const ConstraintOptions& constraints, const RvOptions& rv)
+    : options_(options), imu_(imu), constraints_(constraints), rv_(rv) {}
+
+void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu) {
+  x_ = x0;
+  P_ = InitialCovariance(options_);
+  t_ns_ = t_ns;
+  last_imu_ = last_imu;
+  ClearPoseHistory();
+}
+
+void Ieskf::ClearPoseHistory() {
+  pose_history_.clear();
+  RecordPose(last_imu_.gyro_imu, last_imu_.acc_imu);
+}
+
+void Ieskf::RecordPose(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu) {
+  ImuPoseSample s;
+  s.t_ns = t_ns_;
+  s.R_world_imu = x_.R_world_imu;
+  s.p_world_imu = x_.p_world_imu;
+  s.v_world_imu = x_.v_world_imu;
+  s.gyro_imu = gyro_imu - x_.bg;
+  s.acc_world = x_.R_world_imu * (acc_imu - x_.ba) + x_.g_world;
+  pose_history_.push_back(s);
+}
+
+void Ieskf::Propagate(const ImuSample& imu) {
+  if (imu.t_ns > t_ns_) {
+    const double dt_s = NsToSeconds(imu.t_ns - t_ns_);
+    Step(0.5 * (last_imu_.gyro_imu + imu.gyro_imu), 0.5 * (last_imu_.acc_imu + imu.acc_imu), dt_s);
+    t_ns_ = imu.t_ns;
+  }
+  last_imu_ = imu;
+  RecordPose(imu.gyro_imu, imu.acc_imu);
+}
+
+void Ieskf::PropagateTo(TimeNs t_ns) {
+  if (t_ns <= t_ns_) return;
+  Step(last_imu_.gyro_imu, last_imu_.acc_imu, NsToSeconds(t_ns - t_ns_));
+  t_ns_ = t_ns;
+  RecordPose(last_imu_.gyro_imu, last_imu_.acc_imu);
+}
+
+// Mean and error-state propagation over dt with constant (bias-corrected)
+// rate w and specific force a, right perturbation on R:
+//   R+ = R Exp(w dt),  v+ = v + (R a + g) dt,  p+ = p + v dt + 1/2 (R a + g) dt^2
+//   dtheta+ = Exp(-w dt) dtheta - Jr(w dt) dt dbg
+//   dv+     = dv + (-R [a]x dtheta - R dba + dg) dt,   dp+ = dp + dv dt
+// and P+ = F P F^T + Q with Q from the continuous noise densities.
+void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s) {
+  const Eigen::Vector3d w = gyro_imu - x_.bg;
+  const Eigen::Vector3d a = acc_imu - x_.ba;
+  const Eigen::Matrix3d R = x_.R_world_imu;
+  const Eigen::Vector3d a_world = R * a + x_.g_world;
+
+  Matrix24d F = Matrix24d::Identity();
+  const Eigen::Vector3d w_dt = w * dt_s;
+  F.block<3, 3>(FilterState::kRot, FilterState::kRot) = so3::Exp(-w_dt);
+  F.block<3, 3>(FilterState::kRot, FilterState::kBg) = -so3::Jr(w_dt) * dt_s;
+  F.block<3, 3>(FilterState::kPos, FilterState::kVel) = Eigen::Matrix3d::Identity() * dt_s;
+  F.block<3, 3>(FilterState::kVel, FilterState::kRot) = -R * so3::Hat(a) * dt_s;
+  F.block<3, 3>(FilterState::kVel, FilterState::kBa) = -R * dt_s;
+  F.block<3, 3>(FilterState::kVel, FilterState::kGrav) = Eigen::Matrix3d::Identity() * dt_s;
+
+  x_.p_world_imu += x_.v_world_imu * dt_s + 0.5 * a_world * dt_s * dt_s;
+  x_.v_world_imu += a_world * dt_s;
+  x_.R_world_imu = R * so3::Exp(w_dt);
+
+  P_ = F * P_ * F.transpose();
+  auto add_diag = [&](int index, double variance) {
+    for (int i = 0; i < 3; ++i) P_(index + i, index + i) += variance;
+  };
+  add_diag(FilterState::kRot, imu_.gyro_noise_density * imu_.gyro_noise_density * dt_s);
+  add_diag(FilterState::kVel, imu_.accel_noise_density * imu_.accel_noise_density * dt_s);
+  add_diag(FilterState::kBg, imu_.gyro_bias_random_walk * imu_.gyro_bias_random_walk * dt_s);
+  add_diag(FilterState::kBa, imu_.accel_bias_random_walk * imu_.accel_bias_random_walk * dt_s);
+}
+
+// Iterated update, paper Eq. (1), in information form. With
+//   e = J^-1 (x^v [-] x^0),  Pv = J^-1 P J^-T  (Eq. 2),
+// the increment minimizing |z + H d|^2_R + |e + d|^2_Pv is
+//   d = -(H^T R^-1 H + Pv^-1)^-1 (H^T R^-1 z + Pv^-1 e),
+// which equals -K z - (I - K H) e of Eq. (1); the posterior covariance
+// (I - K H) Pv equals (H^T R^-1 H + Pv^-1)^-1.
+IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
+  IeskfUpdateResult result;
+  const FilterState x0 = x_;
+  const Matrix24d P0 = P_;
+  const Matrix24d P0_inv = P0.ldlt().solve(Matrix24d::Identity());
+  const bool with_ext = options_.estimate_extrinsics;
+  const double inv_sigma2 = 1.0 / (constraints_.lidar_noise * constraints_.lidar_noise);
+  const int cols = with_ext ? 12 : 6;
+  const int kMinConstraints = 6;
+
+  FilterState x = x0;
+  Matrix24d S = P0;
+  ConstraintList constraints;
+  Matrix12d HtRinvH;
+  Vector12d HtRinvz;
+  for (int it = 0; it < options_.max_iterations; ++it) {
+    associate(x, &constraints);
+    // Alg. 3: criterion, reinforcement, repair; a no-op edit when RV is off
+    // (the report still carries the localizability figure).
+    result.rv = ApplyRv(rv_, x.T_world_lidar(), &constraints, &rv_workspace_);
+    result.num_constraints = static_cast<int>(constraints.size());
+    if (result.num_constraints < kMinConstraints) break;
+    AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz);
+
+    const Matrix24d J_inv = BoxminusJacobianInverse(x, x0);
+    const Matrix24d J = BoxminusJacobian(x, x0);
+    const Vector24d e = J_inv * Boxminus(x, x0);
+    const Matrix24d Pv_inv = J.transpose() * P0_inv * J;
+    Matrix24d A = Pv_inv;
+    A.topLeftCorner(cols, cols) += HtRinvH.topLeftCorner(cols, cols);
+    Vector24d b = Pv_inv * e;
+    b.head(cols) += HtRinvz.head(cols);
+    const Eigen::LDLT<Matrix24d> ldlt(A);
+    const Vector24d dx = -ldlt.solve(b);
+    S = ldlt.solve(Matrix24d::Identity());
+    x = Boxplus(x, dx);
+    result.iterations = it + 1;
+    result.last_step_norm = dx.norm();
+    if (!dx.allFinite()) break;
+    if (result.last_step_norm < options_.convergence_eps) break;
+  }
+  if (result.iterations == 0) return result;  // too few constraints: prediction only
+  S = 0.5 * (S + S.transpose());
+  if (!IsHealthy(x, S)) {
+    result.diverged = true;  // keep the prior (x0, P0): the last good state
+    return result;
+  }
+  x_ = x;
+  P_ = S;
+  result.ok = true;
+  return result;
+}
+
+}  // namespace rvlio

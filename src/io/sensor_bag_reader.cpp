@@ -1,0 +1,175 @@
+// SensorBagReader over rosbag::Bag + rosbag::View: IMU samples and decoded
+// scans of two topics, streamed in bag (record) time order.
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/PointCloud2.h>
+
+#include "rosbag_common.h"
+#include "rvlio/io/sensor_bag.h"
+
+namespace rvlio {
+namespace {
+
+using bag_detail::ToNs;
+using bag_detail::ToView;
+
+constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
+
+bool AllFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
+
+// Reads the first message of the LiDAR topic so that a cloud without a
+// usable time field fails at Open, not minutes into a run.
+StatusOr<std::string> PeekLayout(const rosbag::Bag& bag, const LidarOptions& lidar) {
+  rosbag::View view(bag, rosbag::TopicQuery(lidar.topic));
+  for (const rosbag::MessageInstance& m : view) {
+    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+    if (!msg) break;
+    return DetectPointCloud2Layout(ToView(*msg, lidar.topic), lidar.type);
+  }
+  return std::string();
+}
+
+class RosbagSensorReader final : public SensorBagReader {
+ public:
+  RosbagSensorReader(std::string path, LidarOptions lidar, ImuOptions imu)
+      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)) {}
+
+  Status Init() {
+    if (Status s = bag_detail::OpenForRead(path_, &bag_); !s.ok()) return s;
+    try {
+      const auto topics = bag_detail::TopicTypes(bag_);
+      if (Status s = bag_detail::RequireTopic(path_, topics, lidar_.topic,
+                                              bag_detail::kPointCloud2Type, "lidar.topic");
+          !s.ok())
+        return s;
+      if (Status s = bag_detail::RequireTopic(path_, topics, imu_.topic, bag_detail::kImuType,
+                                              "imu.topic");
+          !s.ok())
+        return s;
+      StatusOr<std::string> layout = PeekLayout(bag_, lidar_);
+      if (!layout.ok()) return layout.status();
+      layout_ = *layout;
+      view_ = std::make_unique<rosbag::View>(
+          bag_, rosbag::TopicQuery(std::vector<std::string>{lidar_.topic, imu_.topic}));
+      it_ = view_->begin();
+    } catch (const std::exception& e) {
+      return ReadError(e);
+    }
+    return Status::Ok();
+  }
+
+  StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override {
+    RVLIO_CHECK(imu != nullptr && scan != nullptr);
+    if (!error_.ok()) return error_;
+    try {
+      while (it_ != view_->end()) {
+        const rosbag::MessageInstance& m = *it_;
+        const bool is_imu = m.getTopic() == imu_.topic;
+        StatusOr<bool> got = is_imu ? ReadImu(m, imu) : ReadScan(m, scan);
+        ++it_;
+        if (!got.ok()) return error_ = got.status();
+        if (*got) return is_imu ? SensorMessage::kImu : SensorMessage::kScan;
+      }
+    } catch (const std::exception& e) {
+      return error_ = ReadError(e);
+    }
+    return SensorMessage::kEnd;
+  }
+
+  const SensorReaderStats& stats() const override { return stats_; }
+  std::string lidar_layout() const override { return layout_; }
+
+ private:
+  Status ReadError(const std::exception& e) const {
+    return Status::InvalidInput("reading bag '" + path_ + "' failed (" + e.what() +
+                                "); truncated or corrupt?");
+  }
+
+  // True when *out holds a new sample; false when it was dropped.
+  StatusOr<bool> ReadImu(const rosbag::MessageInstance& m, ImuSample* out) {
+    auto msg = m.instantiate<sensor_msgs::Imu>();
+    if (!msg) return Status::InvalidInput("imu.topic '" + imu_.topic + "' in '" + path_ +
+                                          "' does not hold sensor_msgs/Imu");
+    ImuSample s;
+    s.t_ns = ToNs(msg->header.stamp);
+    const double scale = imu_.accel_unit == "g" ? kStandardGravity : 1.0;
+    const auto& a = msg->linear_acceleration;
+    const auto& w = msg->angular_velocity;
+    s.acc_imu = scale * Eigen::Vector3d(a.x, a.y, a.z);
+    s.gyro_imu = Eigen::Vector3d(w.x, w.y, w.z);
+    if (!AllFinite(s.acc_imu) || !AllFinite(s.gyro_imu)) {
+      ++stats_.imu_invalid;
+      return false;
+    }
+    if (have_imu_ && !AcceptImuStamp(s.t_ns)) return false;
+    have_imu_ = true;
+    last_imu_ns_ = s.t_ns;
+    ++stats_.imu_samples;
+    *out = s;
+    return true;
+  }
+
+  bool AcceptImuStamp(TimeNs t_ns) {
+    if (t_ns == last_imu_ns_) {
+      ++stats_.imu_duplicates;
+      return false;
+    }
+    if (t_ns < last_imu_ns_) {
+      ++stats_.imu_non_monotonic;
+      return false;
+    }
+    const double gap_s = NsToSeconds(t_ns - last_imu_ns_);
+    stats_.imu_max_gap_s = std::max(stats_.imu_max_gap_s, gap_s);
+    if (gap_s > imu_.max_gap) ++stats_.imu_gaps;
+    return true;
+  }
+
+  // True when *out holds a scan with points; false for an empty scan.
+  StatusOr<bool> ReadScan(const rosbag::MessageInstance& m, Scan* out) {
+    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+    if (!msg) return Status::InvalidInput("lidar.topic '" + lidar_.topic + "' in '" + path_ +
+                                          "' does not hold sensor_msgs/PointCloud2");
+    DecodeStats decode;
+    StatusOr<Scan> scan = DecodePointCloud2(ToView(*msg, lidar_.topic), lidar_, &decode);
+    if (!scan.ok()) return scan.status();
+    layout_ = decode.layout;
+    stats_.invalid_points += decode.invalid_points;
+    stats_.out_of_range_points += decode.out_of_range_points;
+    if (scan->points.empty()) {
+      ++stats_.empty_scans;
+      return false;
+    }
+    ++stats_.scans;
+    *out = std::move(scan).value();
+    return true;
+  }
+
+  std::string path_;
+  LidarOptions lidar_;
+  ImuOptions imu_;
+  rosbag::Bag bag_;
+  std::unique_ptr<rosbag::View> view_;
+  rosbag::View::iterator it_;
+  std::string layout_;
+  SensorReaderStats stats_;
+  Status error_;
+  bool have_imu_ = false;
+  TimeNs last_imu_ns_ = 0;
+};
+
+}  // namespace
+
+StatusOr<std::unique_ptr<SensorBagReader>> SensorBagReader::Open(const std::string& path,
+                                                                 const LidarOptions& lidar,
+                                                                 const ImuOptions& imu) {
+  auto reader = std::make_unique<RosbagSensorReader>(path, lidar, imu);
+  if (Status s = reader->Init(); !s.ok()) return s;
+  return std::unique_ptr<SensorBagReader>(std::move(reader));
+}
+
+}  // namespace rvlio

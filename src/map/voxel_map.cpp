@@ -1,0 +1,320 @@
+#include "rvlio/map/voxel_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "rvlio/common/check.h"
+
+namespace rvlio {
+
+namespace {
+
+constexpr size_t kInitialCapacity = 1024;  // slots (power of two)
+constexpr int kDistanceChunk = 64;         // points per vectorized distance pass
+
+// Offsets of Chebyshev norm r, faces first, then edges, then corners (by the
+// number of non-zero components) so that queries tighten their bound early.
+template <class Offset>
+std::vector<Offset> MakeShell(int r) {
+  std::vector<Offset> shell;
+  for (int dx = -r; dx <= r; ++dx)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dz = -r; dz <= r; ++dz)
+        if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) == r)
+          shell.push_back(Offset{static_cast<int8_t>(dx), static_cast<int8_t>(dy),
+                                 static_cast<int8_t>(dz)});
+  auto rank = [](const Offset& o) {
+    return std::abs(o.dx) + std::abs(o.dy) + std::abs(o.dz);
+  };
+  std::stable_sort(shell.begin(), shell.end(),
+                   [&](const Offset& a, const Offset& b) { return rank(a) < rank(b); });
+  return shell;
+}
+
+// Distance along one axis from q (local coordinate in the home voxel, in
+// [0, s)) to the voxel at integer offset d: 0 inside the same slab.
+inline double AxisGap(int d, double q_local, double s) {
+  if (d > 0) return d * s - q_local;
+  if (d < 0) return q_local - (d + 1) * s;
+  return 0.0;
+}
+
+}  // namespace
+
+// The k best candidates of one query, sorted ascending by squared distance.
+// `limit` is the exclusive bound a new candidate must beat: just above
+// max_dist^2 until k candidates are held, then the k-th distance.
+class VoxelMap::Candidates {
+ public:
+  Candidates(int k, float max_d2)
+      : k_(k), limit_(std::nextafter(max_d2, std::numeric_limits<float>::infinity())) {}
+
+  float limit() const { return limit_; }
+  int size() const { return n_; }
+  int index(int i) const { return idx_[i]; }
+
+  void Offer(float d2, int32_t index) {
+    // d2 < limit_ is checked by the caller.
+    int i = n_ < k_ ? n_++ : k_ - 1;
+    while (i > 0 && d2_[i - 1] > d2) {
+      d2_[i] = d2_[i - 1];
+      idx_[i] = idx_[i - 1];
+      --i;
+    }
+    d2_[i] = d2;
+    idx_[i] = index;
+    if (n_ == k_) limit_ = d2_[k_ - 1];
+  }
+
+ private:
+  int k_;
+  int n_ = 0;
+  float limit_;
+  std::array<float, kMaxNeighbors> d2_;
+  std::array<int32_t, kMaxNeighbors> idx_;  // float index of x in pool_
+};
+
+VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
+  RVLIO_CHECK(options.voxel_size > 0.0);
+  RVLIO_CHECK(options.max_points_per_voxel >= 1);
+  inv_voxel_size_ = 1.0 / options.voxel_size;
+  min_d2_ = static_cast<float>(options.min_point_distance * options.min_point_distance);
+  cap_ = options.max_points_per_voxel;
+  stride_ = 3 * cap_;
+  for (int r = 0; r <= kPrecomputedShells; ++r) shells_[r] = MakeShell<Offset>(r);
+  Rebuild(kInitialCapacity, {});
+}
+
+void VoxelMap::Clear() {
+  pool_.clear();
+  counts_.clear();
+  free_blocks_.clear();
+  num_points_ = 0;
+  Rebuild(kInitialCapacity, {});
+}
+
+// ---------------------------------------------------------------- hash table
+
+int VoxelMap::FindSlot(const VoxelKey& key) const {
+  size_t i = HashVoxelKey(key) & mask_;
+  while (slots_[i].block >= 0) {
+    if (slots_[i].key == key) return static_cast<int>(i);
+    i = (i + 1) & mask_;
+  }
+  return -1;
+}
+
+void VoxelMap::InsertSlot(const Slot& s) {
+  size_t i = HashVoxelKey(s.key) & mask_;
+  while (slots_[i].block >= 0) i = (i + 1) & mask_;
+  slots_[i] = s;
+}
+
+void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
+  slots_.assign(capacity, Slot());
+  mask_ = capacity - 1;
+  num_voxels_ = slots.size();
+  for (const Slot& s : slots) InsertSlot(s);
+}
+
+int VoxelMap::AllocateBlock() {
+  if (!free_blocks_.empty()) {
+    const int b = free_blocks_.back();
+    free_blocks_.pop_back();
+    counts_[b] = 0;
+    return b;
+  }
+  const int b = static_cast<int>(counts_.size());
+  counts_.push_back(0);
+  pool_.resize(pool_.size() + stride_);
+  return b;
+}
+
+int VoxelMap::FindOrCreateBlock(const VoxelKey& key) {
+  const int found = FindSlot(key);
+  if (found >= 0) return slots_[found].block;
+  if (2 * (num_voxels_ + 1) > slots_.size()) {  // keep the load <= 1/2
+    scratch_slots_.clear();
+    for (const Slot& s : slots_)
+      if (s.block >= 0) scratch_slots_.push_back(s);
+    Rebuild(2 * slots_.size(), scratch_slots_);
+  }
+  Slot s;
+  s.key = key;
+  s.block = AllocateBlock();
+  InsertSlot(s);
+  ++num_voxels_;
+  return s.block;
+}
+
+// ------------------------------------------------------------------ updates
+
+bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
+  if (!IsKeyable(p_world.x(), p_world.y(), p_world.z(), inv_voxel_size_)) return false;
+  const VoxelKey key = KeyOf(p_world, inv_voxel_size_);
+  const int found = FindSlot(key);
+  const float px = static_cast<float>(p_world.x());
+  const float py = static_cast<float>(p_world.y());
+  const float pz = static_cast<float>(p_world.z());
+  if (found >= 0) {
+    const int b = slots_[found].block;
+    const int n = counts_[b];
+    if (n >= cap_) return false;
+    const float* x = BlockData(b);
+    for (int i = 0; i < n; ++i) {
+      const float dx = x[i] - px, dy = x[i + cap_] - py, dz = x[i + 2 * cap_] - pz;
+      if (dx * dx + dy * dy + dz * dz < min_d2_) return false;
+    }
+  }
+  const int b = found >= 0 ? slots_[found].block : FindOrCreateBlock(key);
+  float* x = BlockData(b);
+  const int n = counts_[b]++;
+  x[n] = px;
+  x[n + cap_] = py;
+  x[n + 2 * cap_] = pz;
+  ++num_points_;
+  return true;
+}
+
+void VoxelMap::Insert(const std::vector<Eigen::Vector3d>& p_world) {
+  for (const Eigen::Vector3d& p : p_world) InsertPoint(p);
+}
+
+void VoxelMap::RemoveFar(const Eigen::Vector3d& center_world, double radius) {
+  const double r2 = radius * radius;
+  const double s = options_.voxel_size;
+  scratch_slots_.clear();
+  bool removed = false;
+  for (const Slot& slot : slots_) {
+    if (slot.block < 0) continue;
+    const Eigen::Vector3d c((slot.key.x + 0.5) * s, (slot.key.y + 0.5) * s,
+                            (slot.key.z + 0.5) * s);
+    if ((c - center_world).squaredNorm() > r2) {
+      num_points_ -= counts_[slot.block];
+      counts_[slot.block] = 0;
+      free_blocks_.push_back(slot.block);
+      removed = true;
+    } else {
+      scratch_slots_.push_back(slot);
+    }
+  }
+  if (removed) Rebuild(slots_.size(), scratch_slots_);
+}
+
+std::vector<Eigen::Vector3d> VoxelMap::Points() const {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(num_points_);
+  ForEachPoint([&](const Eigen::Vector3d& p) { out.push_back(p); });
+  return out;
+}
+
+// ------------------------------------------------------------------ queries
+
+// Squared distances of a whole block in a branch-free pass (vectorized by the
+// compiler), then a scalar pass over the few that beat the current limit.
+void VoxelMap::ScanBlock(int block, const float q[3], Candidates* c) const {
+  const float* x = BlockData(block);
+  const float* y = x + cap_;
+  const float* z = y + cap_;
+  const int n = counts_[block];
+  const int32_t base = block * stride_;
+  float d2[kDistanceChunk];
+  for (int start = 0; start < n; start += kDistanceChunk) {
+    const int m = std::min(kDistanceChunk, n - start);
+    for (int i = 0; i < m; ++i) {
+      const float dx = x[start + i] - q[0];
+      const float dy = y[start + i] - q[1];
+      const float dz = z[start + i] - q[2];
+      d2[i] = dx * dx + dy * dy + dz * dz;
+    }
+    for (int i = 0; i < m; ++i)
+      if (d2[i] < c->limit()) c->Offer(d2[i], base + start + i);
+  }
+}
+
+// Visits the voxel home + (dx, dy, dz) unless its box is already farther than
+// the current limit (exact box distance from the query).
+void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
+                           const float q[3], Candidates* c) const {
+  const double s = options_.voxel_size;
+  const double gx = AxisGap(dx, q_local[0], s);
+  const double gy = AxisGap(dy, q_local[1], s);
+  const double gz = AxisGap(dz, q_local[2], s);
+  if (gx * gx + gy * gy + gz * gz > c->limit()) return;
+  const int slot = FindSlot(VoxelKey{home.x + dx, home.y + dy, home.z + dz});
+  if (slot >= 0) ScanBlock(slots_[slot].block, q, c);
+}
+
+void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
+                          Candidates* c) const {
+  if (r <= kPrecomputedShells) {
+    for (const Offset& o : shells_[r]) VisitOffset(home, o.dx, o.dy, o.dz, q_local, q, c);
+    return;
+  }
+  for (int dx = -r; dx <= r; ++dx) {
+    for (int dy = -r; dy <= r; ++dy) {
+      const bool side = std::abs(dx) == r || std::abs(dy) == r;
+      const int dz_step = side ? 1 : 2 * r;  // interior columns: only the two caps
+      for (int dz = -r; dz <= r; dz += dz_step) VisitOffset(home, dx, dy, dz, q_local, q, c);
+    }
+  }
+}
+
+// Fallback when the search window holds more voxels than the table has
+// slots: test every occupied voxel's box instead of hashing every offset.
+void VoxelMap::ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3],
+                             Candidates* c) const {
+  const double s = options_.voxel_size;
+  for (const Slot& slot : slots_) {
+    if (slot.block < 0) continue;
+    const Eigen::Vector3d lo(slot.key.x * s, slot.key.y * s, slot.key.z * s);
+    const Eigen::Vector3d gap =
+        (lo - q_world).cwiseMax(q_world - lo - Eigen::Vector3d::Constant(s)).cwiseMax(0.0);
+    if (gap.squaredNorm() > c->limit()) continue;
+    ScanBlock(slot.block, q, c);
+  }
+}
+
+int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
+                       NeighborBuffer* out) const {
+  RVLIO_CHECK(k >= 1 && k <= kMaxNeighbors);
+  RVLIO_CHECK(out != nullptr);
+  out->size = 0;
+  if (num_points_ == 0 || !(max_dist > 0.0)) return 0;
+  if (!IsKeyable(q_world.x(), q_world.y(), q_world.z(), inv_voxel_size_)) return 0;
+
+  const double s = options_.voxel_size;
+  const double max_d = std::min(max_dist, 1.0e6 * s);
+  Candidates c(k, static_cast<float>(max_d * max_d));
+  const float q[3] = {static_cast<float>(q_world.x()), static_cast<float>(q_world.y()),
+                      static_cast<float>(q_world.z())};
+  const VoxelKey home = KeyOf(q_world, inv_voxel_size_);
+  const double q_local[3] = {q_world.x() - home.x * s, q_world.y() - home.y * s,
+                             q_world.z() - home.z * s};
+
+  // Shell r lies at least (r - 1) s from any point of the home voxel, so
+  // shells up to floor(max_d / s) + 1 can hold points within max_d.
+  const int max_shell = static_cast<int>(std::floor(max_d / s)) + 1;
+  const double window = std::pow(2.0 * max_shell + 1.0, 3);
+  if (window > static_cast<double>(slots_.size())) {
+    ScanAllVoxels(q_world, q, &c);
+  } else {
+    for (int r = 0; r <= max_shell; ++r) {
+      const double shell_gap = std::max(0, r - 1) * s;
+      if (shell_gap * shell_gap > c.limit()) break;  // nothing closer remains
+      VisitShell(r, home, q_local, q, &c);
+    }
+  }
+
+  out->size = c.size();
+  for (int i = 0; i < c.size(); ++i) {
+    const float* p = pool_.data() + c.index(i);
+    out->points[i] = Eigen::Vector3d(p[0], p[cap_], p[2 * cap_]);
+    out->dist2[i] = (out->points[i] - q_world).squaredNorm();
+  }
+  return out->size;
+}
+
+}  // namespace rvlio

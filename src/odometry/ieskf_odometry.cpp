@@ -1,0 +1,161 @@
+// The IESKF backend of the odometry pipeline (paper-exact mode).
+#include "rvlio/odometry/ieskf_odometry.h"
+
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "rvlio/constraints/associate.h"
+#include "rvlio/imu/static_init.h"
+#include "rvlio/lidar/deskew.h"
+
+namespace rvlio {
+namespace {
+
+constexpr int kMinScanPoints = 50;          // fewer after preprocessing: scan skipped
+constexpr int kRemoveFarEveryScans = 10;    // working-map trimming period
+constexpr TimeNs kNominalScanPeriodNs = 100000000;  // 10 Hz, for the IMU-gap warning
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
+    : options_(options),
+      filter_(options.ieskf, options.imu, options.constraints, options.rv),
+      map_(options.map),
+      output_map_(options.map.output_resolution),
+      preprocessor_(options.lidar) {
+  const auto& e = options.extrinsics.imu_T_lidar;
+  T_imu_lidar_ = Pose3(Eigen::Quaterniond(e.rotation_xyzw[3], e.rotation_xyzw[0],
+                                          e.rotation_xyzw[1], e.rotation_xyzw[2]),
+                       Eigen::Vector3d(e.translation[0], e.translation[1], e.translation[2]));
+}
+
+void IeskfOdometry::AddImu(const ImuSample& imu) {
+  if (!imu_buffer_.empty() && imu.t_ns - imu_buffer_.back().t_ns > kNominalScanPeriodNs)
+    ++stats_.imu_gaps_over_scan;
+  if (!stats_.initialized) {
+    TryInitialize(imu);
+    return;
+  }
+  imu_buffer_.push_back(imu);
+}
+
+// Static alignment once imu.init_duration of samples has been collected.
+void IeskfOdometry::TryInitialize(const ImuSample& imu) {
+  init_samples_.push_back(imu);
+  const TimeNs span = imu.t_ns - init_samples_.front().t_ns;
+  if (span < SecondsToNs(options_.imu.init_duration)) return;
+  const StaticAlignment a = AlignStatic(init_samples_);
+  FilterState x0;
+  x0.R_world_imu = a.R_world_imu;
+  x0.g_world = a.g_world;
+  x0.bg = a.gyro_bias;
+  x0.R_imu_lidar = T_imu_lidar_.R;
+  x0.t_imu_lidar = T_imu_lidar_.t;
+  filter_.Initialize(x0, imu.t_ns, imu);
+  stats_.initialized = true;
+  stats_.started_moving = a.moving;
+  if (a.moving)
+    warnings_.push_back("the sequence starts moving (acc std " + std::to_string(a.acc_std) +
+                        " m/s^2, gyro std " + std::to_string(a.gyro_std) +
+                        " rad/s); initialized from the mean IMU values");
+  init_samples_.clear();
+}
+
+void IeskfOdometry::AddScan(Scan scan) {
+  ++stats_.scans_received;
+  if (!stats_.initialized || scan.t_start_ns < filter_.time_ns()) {
+    ++stats_.scans_before_imu;  // no IMU state covers this scan
+    return;
+  }
+  scans_.push_back(std::move(scan));
+}
+
+void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
+  while (!scans_.empty() && !imu_buffer_.empty() &&
+         imu_buffer_.back().t_ns >= scans_.front().t_end_ns) {
+    ProcessFrontScan(out);
+  }
+}
+
+void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
+  while (!scans_.empty()) ProcessFrontScan(out);
+}
+
+void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
+  Scan scan = std::move(scans_.front());
+  scans_.pop_front();
+  const auto start = std::chrono::steady_clock::now();
+  Predict(scan.t_end_ns);
+  preprocessor_.Run(scan, &kept_points_);
+  if (static_cast<int>(kept_points_.size()) < kMinScanPoints) {
+    ++stats_.scans_too_few_points;
+    filter_.ClearPoseHistory();
+    return;
+  }
+  DeskewToScanEnd(filter_.pose_history(), filter_.state().T_imu_lidar(), kept_points_,
+                  scan.t_end_ns, &p_lidar_end_);
+  ScanResult r;
+  r.raw_points = static_cast<int>(scan.points.size());
+  r.downsampled_points = static_cast<int>(p_lidar_end_.size());
+  r.status = map_.Empty() ? ScanStatus::kMapInit : Correct(&r);
+  InsertIntoMap();
+  filter_.ClearPoseHistory();
+  r.t_ns = scan.t_end_ns;
+  r.T_world_imu = filter_.state().T_world_imu();
+  r.v_world_imu = filter_.state().v_world_imu;
+  r.ms = MillisecondsSince(start);
+  ++stats_.scans_processed;
+  out->push_back(std::move(r));
+}
+
+// Propagates with every buffered IMU sample up to the scan end, then to the
+// scan end itself.
+void IeskfOdometry::Predict(TimeNs t_end_ns) {
+  while (!imu_buffer_.empty() && imu_buffer_.front().t_ns <= t_end_ns) {
+    filter_.Propagate(imu_buffer_.front());
+    imu_buffer_.pop_front();
+  }
+  filter_.PropagateTo(t_end_ns);
+}
+
+// Associate -> RV -> Update, iterated inside the filter (paper Alg. 3).
+ScanStatus IeskfOdometry::Correct(ScanResult* r) {
+  const AssociateFn associate = [this](const FilterState& x, ConstraintList* constraints) {
+    AssociationStats stats;
+    Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_, options_.constraints,
+              constraints, &stats);
+  };
+  const IeskfUpdateResult u = filter_.Update(associate);
+  r->constraints = u.num_constraints;
+  r->iterations = u.iterations;
+  r->rv = u.rv;
+  if (u.diverged) {
+    ++stats_.diverged_resets;
+    return ScanStatus::kDiverged;
+  }
+  if (!u.ok) {
+    ++stats_.predict_only;
+    return ScanStatus::kPredictOnly;
+  }
+  return ScanStatus::kUpdated;
+}
+
+void IeskfOdometry::InsertIntoMap() {
+  const Pose3 T_world_lidar = filter_.state().T_world_lidar();
+  p_world_.resize(p_lidar_end_.size());
+  for (size_t i = 0; i < p_lidar_end_.size(); ++i) p_world_[i] = T_world_lidar * p_lidar_end_[i];
+  map_.Insert(p_world_);
+  output_map_.Insert(p_world_);
+  if (++scans_since_trim_ >= kRemoveFarEveryScans) {
+    map_.RemoveFar(T_world_lidar.t, options_.map.working_radius);
+    scans_since_trim_ = 0;
+  }
+}
+
+}  // namespace rvlio

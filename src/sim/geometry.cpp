@@ -1,0 +1,250 @@
+#include "rvlio/sim/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rvlio::sim {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kRootTol = 1e-9;      // m, |g| at which a surface root is accepted
+constexpr double kNewtonBelow = 2e-3;  // m, switch from safe marching to Newton
+constexpr int kMaxSteps = 200;
+
+// g(t) = (o_w + t r_w - offset) - h(o_u + t r_u, o_v + t r_v): signed height of
+// the ray point above the rough surface; its roots are the crossings.
+struct SurfaceFunction {
+  const Face& face;
+  double ow, rw, ou, ru, ov, rv;
+
+  double operator()(double t) const {
+    return ow + t * rw - face.offset - face.relief.Height(ou + t * ru, ov + t * rv);
+  }
+  double WithSlope(double t, double* dg_dt) const {
+    double hu = 0.0, hv = 0.0;
+    const double h = face.relief.Height(ou + t * ru, ov + t * rv, &hu, &hv);
+    *dg_dt = rw - hu * ru - hv * rv;
+    return ow + t * rw - face.offset - h;
+  }
+};
+
+// Safeguarded Newton/bisection on a bracket [a, b] with g(a), g(b) of
+// opposite signs (sa = sign of g(a)).
+double RefineBracket(const SurfaceFunction& g, double a, double b, double sa) {
+  double t = 0.5 * (a + b);
+  for (int i = 0; i < 60; ++i) {
+    double slope = 0.0;
+    const double value = g.WithSlope(t, &slope);
+    if (std::abs(value) < kRootTol || b - a < 1e-12) return t;
+    if ((value > 0) == (sa > 0)) a = t; else b = t;
+    const double newton = slope != 0.0 ? t - value / slope : kInf;
+    t = (newton > a && newton < b) ? newton : 0.5 * (a + b);
+  }
+  return t;
+}
+
+// First root of g in [t0, t1]. Sphere tracing with the Lipschitz bound L of g
+// never steps over a root: |g(t + s) - g(t)| <= L s, so g keeps its sign for
+// s < |g(t)| / L. Near the surface Newton takes over; a sign change brackets
+// the root for RefineBracket.
+bool FirstRoot(const SurfaceFunction& g, double lipschitz, double t0, double t1, double* root) {
+  double t = t0;
+  double value = g(t);
+  const double s0 = value >= 0 ? 1.0 : -1.0;
+  for (int i = 0; i < kMaxSteps; ++i) {
+    if (std::abs(value) < kRootTol) {
+      *root = t;
+      return true;
+    }
+    double next = t + std::abs(value) / lipschitz;
+    if (std::abs(value) < kNewtonBelow) {
+      double slope = 0.0;
+      g.WithSlope(t, &slope);
+      const double newton = slope != 0.0 ? t - value / slope : kInf;
+      if (newton > t && newton <= t1 + 1e-9) next = std::max(next, newton);
+    }
+    if (next > t1) {
+      // No root up to the slab's end unless Newton jumped across one.
+      if (t1 <= t) return false;
+      next = t1;
+    }
+    const double next_value = g(next);
+    if ((next_value >= 0 ? 1.0 : -1.0) != s0) {
+      *root = std::abs(next_value) < kRootTol ? next : RefineBracket(g, t, next, s0);
+      return true;
+    }
+    if (next >= t1) return false;
+    t = next;
+    value = next_value;
+  }
+  return false;
+}
+
+}  // namespace
+
+HeightField::HeightField(std::vector<Wave> waves) : waves_(std::move(waves)) {
+  for (const Wave& w : waves_) {
+    amplitude_bound_ += std::abs(w.amplitude);
+    slope_bound_ += std::abs(w.amplitude) * std::hypot(w.ku, w.kv);
+  }
+}
+
+HeightField HeightField::Random(Rng& rng, int components, double amplitude, double lambda_min,
+                                double lambda_max) {
+  if (components <= 0 || amplitude <= 0.0) return HeightField();
+  std::vector<double> lambdas(static_cast<size_t>(components));
+  double sum = 0.0;
+  for (double& l : lambdas) {
+    l = lambda_min * std::pow(lambda_max / lambda_min, rng.Uniform());
+    sum += l;
+  }
+  std::vector<Wave> waves;
+  for (double l : lambdas) {
+    const double dir = rng.Uniform(0.0, 2.0 * M_PI);
+    const double k = 2.0 * M_PI / l;
+    waves.push_back({amplitude * l / sum, k * std::cos(dir), k * std::sin(dir),
+                     rng.Uniform(0.0, 2.0 * M_PI)});
+  }
+  return HeightField(std::move(waves));
+}
+
+double HeightField::Height(double u, double v) const {
+  double h = 0.0;
+  for (const Wave& w : waves_) h += w.amplitude * std::sin(w.ku * u + w.kv * v + w.phase);
+  return h;
+}
+
+double HeightField::Height(double u, double v, double* dh_du, double* dh_dv) const {
+  double h = 0.0, hu = 0.0, hv = 0.0;
+  for (const Wave& w : waves_) {
+    const double arg = w.ku * u + w.kv * v + w.phase;
+    const double s = std::sin(arg), c = std::cos(arg);
+    h += w.amplitude * s;
+    hu += w.amplitude * w.ku * c;
+    hv += w.amplitude * w.kv * c;
+  }
+  *dh_du = hu;
+  *dh_dv = hv;
+  return h;
+}
+
+bool Face::Covers(double u, double v) const {
+  if (!bounds.Contains(u, v)) return false;
+  for (const Rect2& h : holes)
+    if (h.Contains(u, v)) return false;
+  return true;
+}
+
+bool Face::Intersect(const Ray& ray, double t_min, double t_max, double* t) const {
+  const int a = axis, ua = UAxis(), va = VAxis();
+  const SurfaceFunction g{*this, ray.origin[a], ray.dir[a], ray.origin[ua], ray.dir[ua],
+                          ray.origin[va], ray.dir[va]};
+  const double amp = relief.amplitude_bound();
+  // The surface lies in the slab |p[axis] - offset| <= amp.
+  double t0 = t_min, t1 = t_max;
+  if (std::abs(g.rw) < 1e-15) {
+    if (std::abs(g.ow - offset) > amp) return false;
+    if (amp == 0.0) return false;
+  } else {
+    const double ta = (offset - amp - g.ow) / g.rw, tb = (offset + amp - g.ow) / g.rw;
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+  }
+  if (t0 > t1) return false;
+  double root = 0.0;
+  if (amp == 0.0) {
+    root = (offset - g.ow) / g.rw;
+  } else {
+    const double lipschitz = std::abs(g.rw) + relief.slope_bound() * std::hypot(g.ru, g.rv);
+    if (!FirstRoot(g, lipschitz, t0, t1, &root)) return false;
+  }
+  if (root < t_min || root > t_max) return false;
+  if (!Covers(g.ou + root * g.ru, g.ov + root * g.rv)) return false;
+  *t = root;
+  return true;
+}
+
+double Face::Distance(const Eigen::Vector3d& p) const {
+  const double u = p[UAxis()], v = p[VAxis()];
+  if (!Covers(u, v)) return kInf;
+  return std::abs(p[axis] - offset - relief.Height(u, v));
+}
+
+bool Box::Intersect(const Ray& ray, double t_min, double t_max, double* t) const {
+  const Eigen::Vector3d o = R_world_box.transpose() * (ray.origin - center);
+  const Eigen::Vector3d d = R_world_box.transpose() * ray.dir;
+  double t_near = -kInf, t_far = kInf;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(d[i]) < 1e-15) {
+      if (std::abs(o[i]) > half[i]) return false;
+      continue;
+    }
+    double ta = (-half[i] - o[i]) / d[i], tb = (half[i] - o[i]) / d[i];
+    if (ta > tb) std::swap(ta, tb);
+    t_near = std::max(t_near, ta);
+    t_far = std::min(t_far, tb);
+    if (t_near > t_far) return false;
+  }
+  if (t_near <= 0.0 || t_near < t_min || t_near > t_max) return false;
+  *t = t_near;
+  return true;
+}
+
+double Box::Distance(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d q = (R_world_box.transpose() * (p - center)).cwiseAbs() - half;
+  const double outside = q.cwiseMax(0.0).norm();
+  const double inside = std::min(q.maxCoeff(), 0.0);
+  return std::abs(outside + inside);
+}
+
+Eigen::AlignedBox3d Box::Bounds() const {
+  const Eigen::Vector3d extent = R_world_box.cwiseAbs() * half;
+  return Eigen::AlignedBox3d(center - extent, center + extent);
+}
+
+bool Cylinder::Intersect(const Ray& ray, double t_min, double t_max, double* t) const {
+  const Eigen::Vector3d w = ray.origin - center;
+  const double wa = w.dot(axis), da = ray.dir.dot(axis);
+  const Eigen::Vector3d wp = w - wa * axis, dp = ray.dir - da * axis;
+  if (wp.squaredNorm() < radius * radius && std::abs(wa) < half_length) return false;  // inside
+  double best = kInf;
+  // Side: |wp + t dp|^2 = r^2, entering root.
+  const double A = dp.squaredNorm(), B = wp.dot(dp), C = wp.squaredNorm() - radius * radius;
+  if (A > 1e-18) {
+    const double disc = B * B - A * C;
+    if (disc >= 0.0) {
+      const double ts = (-B - std::sqrt(disc)) / A;
+      if (ts > 0.0 && std::abs(wa + ts * da) <= half_length) best = ts;
+    }
+  }
+  // Caps at axial coordinate +-half_length.
+  if (std::abs(da) > 1e-15) {
+    for (double s : {-half_length, half_length}) {
+      const double tc = (s - wa) / da;
+      if (tc > 0.0 && tc < best && (wp + tc * dp).squaredNorm() <= radius * radius) best = tc;
+    }
+  }
+  if (best < t_min || best > t_max) return false;
+  *t = best;
+  return true;
+}
+
+double Cylinder::Distance(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d w = p - center;
+  const double wa = w.dot(axis);
+  const double dr = (w - wa * axis).norm() - radius, dz = std::abs(wa) - half_length;
+  const double outside = std::hypot(std::max(dr, 0.0), std::max(dz, 0.0));
+  const double inside = std::min(std::max(dr, dz), 0.0);
+  return std::abs(outside + inside);
+}
+
+Eigen::AlignedBox3d Cylinder::Bounds() const {
+  Eigen::Vector3d extent;
+  for (int i = 0; i < 3; ++i)
+    extent[i] = std::abs(axis[i]) * half_length + radius * std::sqrt(std::max(0.0, 1.0 - axis[i] * axis[i]));
+  return Eigen::AlignedBox3d(center - extent, center + extent);
+}
+
+}  // namespace rvlio::sim
