@@ -20,17 +20,18 @@ namespace {
 constexpr const char* kName = "eval";
 
 CommandSpec EvalSpec() {
-  return {kName,
-          "ATE/RPE of an estimated trajectory against ground truth, with the definitions of the evo\n"
-          "tool. Trajectories are TUM (t x y z qx qy qz qw) or KITTI (3x4 rows, assumed 10 Hz)\n"
-          "files, detected by their column count. Exit status 2 on bad input.",
-          {{"gt", "FILE", "reference trajectory", true, false},
-           {"est", "FILE", "estimated trajectory", true, false},
-           {"align", "MODE", "se3 | sim3 | origin | none (default se3)", false, false},
-           {"rpe-delta", "N", "RPE step (default 1)", false, false},
-           {"rpe-unit", "UNIT", "frames | meters (default frames)", false, false},
-           {"max-dt", "S", "association tolerance in seconds (default 0.01)", false, false},
-           {"json", "", "print one JSON object instead of the table", false, false}}};
+  return {
+      kName,
+      "ATE/RPE of an estimated trajectory against ground truth, with the definitions of the evo\n"
+      "tool. Trajectories are TUM (t x y z qx qy qz qw) or KITTI (3x4 rows, assumed 10 Hz)\n"
+      "files, detected by their column count. Exit status 2 on bad input.",
+      {{"gt", "FILE", "reference trajectory", true, false},
+       {"est", "FILE", "estimated trajectory", true, false},
+       {"align", "MODE", "se3 | sim3 | origin | none (default se3)", false, false},
+       {"rpe-delta", "N", "RPE step (default 1)", false, false},
+       {"rpe-unit", "UNIT", "frames | meters (default frames)", false, false},
+       {"max-dt", "S", "association tolerance in seconds (default 0.01)", false, false},
+       {"json", "", "print one JSON object instead of the table", false, false}}};
 }
 
 bool ParseNumber(const std::string& text, double* value) {
@@ -65,8 +66,8 @@ nlohmann::json Num(double v) {
 }
 
 nlohmann::json StatsJson(const ErrorStats& s) {
-  return {{"rmse", Num(s.rmse)}, {"mean", Num(s.mean)},     {"median", Num(s.median)},
-          {"std", Num(s.std)},   {"min", Num(s.min)},       {"max", Num(s.max)}};
+  return {{"rmse", Num(s.rmse)}, {"mean", Num(s.mean)}, {"median", Num(s.median)},
+          {"std", Num(s.std)},   {"min", Num(s.min)},   {"max", Num(s.max)}};
 }
 
 void PrintJson(const EvalResult& r) {
@@ -92,8 +93,8 @@ void PrintRow(const char* label, const ErrorStats& s, const std::string& note = 
 }
 
 void PrintTable(const EvalResult& r, const EvalOptions& options) {
-  std::printf("matched poses  %zu   align %s   scale %.10g\n\n", r.matched,
-              AlignModeName(r.align), r.T_ref_est.scale);
+  std::printf("matched poses  %zu   align %s   scale %.10g\n\n", r.matched, AlignModeName(r.align),
+              r.T_ref_est.scale);
   std::printf("%-14s %12s %12s %12s %12s %12s %12s\n", "metric", "rmse", "mean", "median", "std",
               "min", "max");
   PrintRow("APE [m]", r.ape_m);

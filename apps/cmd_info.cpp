@@ -38,11 +38,20 @@ void PrintCloud(const BagTopicInfo& t) {
   }
 }
 
+// Seconds with all nine decimals, from the exact ns.
+std::string Stamp(TimeNs t_ns) {
+  char buf[64];
+  const TimeNs s = t_ns / kNsPerSecond, ns = t_ns % kNsPerSecond;
+  std::snprintf(buf, sizeof(buf), "%lld.%09lld", static_cast<long long>(s),
+                static_cast<long long>(ns < 0 ? -ns : ns));
+  return buf;
+}
+
 void Print(const BagInfo& info) {
   std::cout << "bag:      " << info.path << "\n"
-            << "duration: " << Fixed(info.end_s - info.start_s, 3) << " s\n"
-            << "start:    " << Fixed(info.start_s, 9) << " s\n"
-            << "end:      " << Fixed(info.end_s, 9) << " s\n"
+            << "duration: " << Fixed(NsToSeconds(info.end_ns - info.start_ns), 3) << " s\n"
+            << "start:    " << Stamp(info.start_ns) << " s\n"
+            << "end:      " << Stamp(info.end_ns) << " s\n"
             << "messages: " << info.messages << "\n"
             << "topics:\n";
   for (const auto& t : info.topics) {

@@ -18,6 +18,7 @@ AssociationOutcome FromPlaneStatus(PlaneStatus status) {
     case PlaneStatus::kLineLike: return AssociationOutcome::kLineLike;
     case PlaneStatus::kNotFlat: return AssociationOutcome::kNotFlat;
     case PlaneStatus::kFarFromPlane: return AssociationOutcome::kFarFromPlane;
+    case PlaneStatus::kUncertain: return AssociationOutcome::kUncertain;
   }
   return AssociationOutcome::kDegenerate;
 }
@@ -32,6 +33,7 @@ const char* ToString(AssociationOutcome outcome) {
     case AssociationOutcome::kLineLike: return "line_like";
     case AssociationOutcome::kNotFlat: return "not_flat";
     case AssociationOutcome::kFarFromPlane: return "far_from_plane";
+    case AssociationOutcome::kUncertain: return "uncertain";
     case AssociationOutcome::kLargeResidual: return "large_residual";
   }
   return "unknown";
@@ -46,6 +48,7 @@ void AssociationStats::Count(AssociationOutcome outcome) {
     case AssociationOutcome::kLineLike: ++num_line_like; break;
     case AssociationOutcome::kNotFlat: ++num_not_flat; break;
     case AssociationOutcome::kFarFromPlane: ++num_far_from_plane; break;
+    case AssociationOutcome::kUncertain: ++num_uncertain; break;
     case AssociationOutcome::kLargeResidual: ++num_large_residual; break;
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
 
@@ -38,6 +39,14 @@ double MaxPlaneDistance(const Eigen::Vector3d* points, int n, const Eigen::Vecto
   return max_distance;
 }
 
+// sqrt(sigma^2 / (n lambda_mid)), see the header.
+double NormalStd(const Eigen::Vector3d& eigenvalues, int n, double point_noise) {
+  double sigma2 = point_noise * point_noise;
+  if (n > 3) sigma2 = std::max(sigma2, n * eigenvalues(0) / (n - 3));
+  if (!(eigenvalues(1) > 0.0)) return std::numeric_limits<double>::infinity();
+  return std::sqrt(sigma2 / (n * eigenvalues(1)));
+}
+
 PlaneStatus Classify(const LocalPlane& plane, const PlaneThresholds& t) {
   const double l_min = plane.eigenvalues(0);
   const double l_mid = plane.eigenvalues(1);
@@ -46,6 +55,7 @@ PlaneStatus Classify(const LocalPlane& plane, const PlaneThresholds& t) {
   if (!(l_mid > 0.0) || l_mid < t.planarity_min_ratio * l_max) return PlaneStatus::kLineLike;
   if (l_min > t.planarity_max_ratio * l_mid) return PlaneStatus::kNotFlat;
   if (plane.max_distance > t.max_plane_distance) return PlaneStatus::kFarFromPlane;
+  if (t.max_normal_std > 0.0 && plane.normal_std > t.max_normal_std) return PlaneStatus::kUncertain;
   return PlaneStatus::kValid;
 }
 
@@ -59,6 +69,7 @@ const char* ToString(PlaneStatus status) {
     case PlaneStatus::kLineLike: return "line_like";
     case PlaneStatus::kNotFlat: return "not_flat";
     case PlaneStatus::kFarFromPlane: return "far_from_plane";
+    case PlaneStatus::kUncertain: return "uncertain";
   }
   return "unknown";
 }
@@ -82,6 +93,7 @@ LocalPlane FitLocalPlane(const Eigen::Vector3d* points, int n, const PlaneThresh
   plane.eigenvalues = solver.eigenvalues().cwiseMax(0.0);
   plane.normal = solver.eigenvectors().col(0).normalized();
   plane.max_distance = MaxPlaneDistance(points, n, plane.normal, plane.centroid);
+  plane.normal_std = NormalStd(plane.eigenvalues, n, thresholds.point_noise);
   plane.status = Classify(plane, thresholds);
   return plane;
 }

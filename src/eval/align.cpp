@@ -44,10 +44,14 @@ std::string UmeyamaConcern(const Trajectory& ref, const AlignOptions& options) {
 
 const char* AlignModeName(AlignMode mode) {
   switch (mode) {
-    case AlignMode::kNone: return "none";
-    case AlignMode::kOrigin: return "origin";
-    case AlignMode::kSe3: return "se3";
-    case AlignMode::kSim3: return "sim3";
+    case AlignMode::kNone:
+      return "none";
+    case AlignMode::kOrigin:
+      return "origin";
+    case AlignMode::kSe3:
+      return "se3";
+    case AlignMode::kSim3:
+      return "sim3";
   }
   return "?";
 }
@@ -99,7 +103,8 @@ StatusOr<Similarity3> Umeyama(const Eigen::Matrix3Xd& x_est, const Eigen::Matrix
   T.R_ref_est = svd.matrixU() * s_diag.asDiagonal() * svd.matrixV().transpose();
   if (with_scale) {
     if (!(sigma2_x > 0.0))
-      return Status::InvalidInput("Umeyama Sim3 alignment is degenerate: the estimate has no spread");
+      return Status::InvalidInput(
+          "Umeyama Sim3 alignment is degenerate: the estimate has no spread");
     T.scale = d.dot(s_diag) / sigma2_x;
   }
   T.t_ref_est = mu_y - T.scale * (T.R_ref_est * mu_x);
@@ -135,17 +140,16 @@ AlignmentResult Align(const Trajectory& ref_matched, const Trajectory& est_match
   if (mode == AlignMode::kSe3 || mode == AlignMode::kSim3) {
     std::string concern = UmeyamaConcern(ref_matched, options);
     if (concern.empty()) {
-      StatusOr<Similarity3> T = Umeyama(Positions(est_matched), Positions(ref_matched),
-                                        mode == AlignMode::kSim3);
+      StatusOr<Similarity3> T =
+          Umeyama(Positions(est_matched), Positions(ref_matched), mode == AlignMode::kSim3);
       if (T.ok()) {
         result.T_ref_est = *T;
         return result;
       }
       concern = T.status().message();
     }
-    result.warnings.push_back(std::string(AlignModeName(mode)) +
-                              " alignment is ill-conditioned (" + concern +
-                              "); fell back to origin alignment");
+    result.warnings.push_back(std::string(AlignModeName(mode)) + " alignment is ill-conditioned (" +
+                              concern + "); fell back to origin alignment");
     result.used = AlignMode::kOrigin;
   }
   result.T_ref_est = OriginAlignment(ref_matched.front(), est_matched.front());

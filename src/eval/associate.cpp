@@ -1,6 +1,10 @@
 #include "rvlio/eval/associate.h"
 
 #include <algorithm>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 
@@ -16,47 +20,55 @@ Status CheckOrdered(const Trajectory& trajectory, const char* name) {
   return Status::Ok();
 }
 
-TimeNs AbsDiff(TimeNs a, TimeNs b) { return a > b ? a - b : b - a; }
+std::vector<double> Seconds(const Trajectory& trajectory) {
+  std::vector<double> s(trajectory.size());
+  for (size_t i = 0; i < trajectory.size(); ++i) s[i] = StampSeconds(trajectory[i].t_ns);
+  return s;
+}
 
-// Index of the stamp of `sorted` nearest to t; the first one of equally near
-// stamps (numpy.argmin). Binary search: O(log n).
-size_t Nearest(const Trajectory& sorted, TimeNs t) {
-  const auto by_time = [](const StampedPose& p, TimeNs x) { return p.t_ns < x; };
-  const size_t upper = static_cast<size_t>(
-      std::lower_bound(sorted.begin(), sorted.end(), t, by_time) - sorted.begin());
+// numpy.argmin(|sorted - t|): the nearest stamp, the first of equally near
+// ones. The rounded differences are still unimodal along a sorted array, so
+// the minimum sits next to the insertion point: binary search, O(log n).
+size_t Nearest(const std::vector<double>& sorted, double t) {
+  const auto diff = [&](size_t j) { return std::fabs(sorted[j] - t); };
+  const size_t upper =
+      static_cast<size_t>(std::lower_bound(sorted.begin(), sorted.end(), t) - sorted.begin());
   size_t best = upper;
-  if (upper == sorted.size() ||
-      (upper > 0 && AbsDiff(sorted[upper - 1].t_ns, t) <= AbsDiff(sorted[upper].t_ns, t))) {
-    // The predecessor wins ties; step back to the first of its repeated stamps.
-    best = upper - 1;
-    const TimeNs stamp = sorted[best].t_ns;
-    best = static_cast<size_t>(
-        std::lower_bound(sorted.begin(), sorted.begin() + best, stamp, by_time) - sorted.begin());
-  }
+  if (upper == sorted.size() || (upper > 0 && diff(upper - 1) <= diff(upper))) best = upper - 1;
+  while (best > 0 && diff(best - 1) <= diff(best)) --best;  // first of equal differences
   return best;
 }
 
 }  // namespace
 
-StatusOr<Association> Associate(const Trajectory& ref, const Trajectory& est, TimeNs max_dt_ns) {
+double StampSeconds(TimeNs t_ns) {
+  const uint64_t magnitude =
+      t_ns < 0 ? 0 - static_cast<uint64_t>(t_ns) : static_cast<uint64_t>(t_ns);
+  char text[48];
+  std::snprintf(text, sizeof(text), "%s%" PRIu64 ".%09" PRIu64, t_ns < 0 ? "-" : "",
+                magnitude / uint64_t{1000000000}, magnitude % uint64_t{1000000000});
+  return std::strtod(text, nullptr);  // correctly rounded, as numpy's parser
+}
+
+StatusOr<Association> Associate(const Trajectory& ref, const Trajectory& est, double max_dt_s) {
   if (Status s = CheckOrdered(ref, "reference"); !s.ok()) return s;
   if (Status s = CheckOrdered(est, "estimated"); !s.ok()) return s;
-  // evo: the second trajectory (estimate) is the "longer" one only when it is
+  // evo: the second trajectory (estimate) is the longer one only when it is
   // strictly longer.
   const bool est_longer = est.size() > ref.size();
-  const Trajectory& shorter = est_longer ? ref : est;
-  const Trajectory& longer = est_longer ? est : ref;
+  const std::vector<double> shorter = Seconds(est_longer ? ref : est);
+  const std::vector<double> longer = Seconds(est_longer ? est : ref);
   Association a;
   for (size_t i = 0; i < shorter.size(); ++i) {
-    const size_t j = Nearest(longer, shorter[i].t_ns);
-    if (AbsDiff(longer[j].t_ns, shorter[i].t_ns) > max_dt_ns) continue;
+    const size_t j = Nearest(longer, shorter[i]);
+    if (!(std::fabs(longer[j] - shorter[i]) <= max_dt_s)) continue;
     a.ref_index.push_back(est_longer ? i : j);
     a.est_index.push_back(est_longer ? j : i);
   }
   if (a.size() == 0) {
     std::ostringstream os;
     os << "no matching timestamps between reference (" << ref.size() << " poses) and estimate ("
-       << est.size() << " poses) with |dt| <= " << NsToSeconds(max_dt_ns) << " s";
+       << est.size() << " poses) with |dt| <= " << max_dt_s << " s";
     return Status::InvalidInput(os.str());
   }
   return a;

@@ -9,7 +9,7 @@ StatusOr<EvalResult> Evaluate(const Trajectory& ref, const Trajectory& est, Eval
   if (Status s = options.Validate(); !s.ok()) return s;
   StatusOr<AlignMode> mode = ParseAlignMode(options.align);
   if (!mode.ok()) return mode.status();
-  StatusOr<Association> association = Associate(ref, est, SecondsToNs(options.max_dt));
+  StatusOr<Association> association = Associate(ref, est, options.max_dt);
   if (!association.ok()) return association.status();
   Trajectory ref_m, est_m;
   ApplyAssociation(*association, ref, est, &ref_m, &est_m);

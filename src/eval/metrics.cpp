@@ -127,7 +127,8 @@ AlongAxisError ComputeAlongAxisError(const Trajectory& ref, const Trajectory& es
   for (const StampedPose& p : ref) mean += p.p_world_imu;
   mean /= static_cast<double>(ref.size());
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const StampedPose& p : ref) cov += (p.p_world_imu - mean) * (p.p_world_imu - mean).transpose();
+  for (const StampedPose& p : ref)
+    cov += (p.p_world_imu - mean) * (p.p_world_imu - mean).transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
   if (eig.eigenvalues()(2) > 0.0) out.axis = eig.eigenvectors().col(2).normalized();
   double sum_sq = 0.0;

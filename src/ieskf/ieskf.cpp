@@ -108,14 +108,17 @@ void Ieskf::PropagateTo(TimeNs t_ns) {
 
 // Mean and error-state propagation over dt with constant (bias-corrected)
 // rate w and specific force a, right perturbation on R:
-//   R+ = R Exp(w dt),  v+ = v + (R a + g) dt,  p+ = p + v dt + 1/2 (R a + g) dt^2
+//   R+ = R Exp(w dt),  v+ = v + (Rm a + g) dt,  p+ = p + v dt + 1/2 (Rm a + g) dt^2
+//   with Rm = R Exp(w dt / 2),
 //   dtheta+ = Exp(-w dt) dtheta - Jr(w dt) dt dbg
 //   dv+     = dv + (-R [a]x dtheta - R dba + dg) dt,   dp+ = dp + dv dt
 // and P+ = F P F^T + Q with Q from the continuous noise densities.
 void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s) {
   const Eigen::Vector3d w = gyro_imu - x_.bg;
   const Eigen::Vector3d a = acc_imu - x_.ba;
-  const Eigen::Matrix3d R = x_.R_world_imu;
+  // The specific force is rotated with the mid-interval attitude: second
+  // order in dt, where the start attitude would bias a turning trajectory.
+  const Eigen::Matrix3d R = x_.R_world_imu * so3::Exp(0.5 * w * dt_s);
   const Eigen::Vector3d a_world = R * a + x_.g_world;
 
   Matrix24d F = Matrix24d::Identity();
@@ -129,7 +132,7 @@ void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu
 
   x_.p_world_imu += x_.v_world_imu * dt_s + 0.5 * a_world * dt_s * dt_s;
   x_.v_world_imu += a_world * dt_s;
-  x_.R_world_imu = R * so3::Exp(w_dt);
+  x_.R_world_imu = x_.R_world_imu * so3::Exp(w_dt);
 
   P_ = F * P_ * F.transpose();
   auto add_diag = [&](int index, double variance) {

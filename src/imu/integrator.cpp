@@ -36,9 +36,8 @@ ImuSample InterpolateImu(const std::vector<ImuSample>& samples, TimeNs t_ns) {
   } else if (t_ns >= samples.back().t_ns) {
     out = samples.back();
   } else {
-    const auto next = std::upper_bound(
-        samples.begin(), samples.end(), t_ns,
-        [](TimeNs t, const ImuSample& s) { return t < s.t_ns; });
+    const auto next = std::upper_bound(samples.begin(), samples.end(), t_ns,
+                                       [](TimeNs t, const ImuSample& s) { return t < s.t_ns; });
     const ImuSample& a = *(next - 1);
     const ImuSample& b = *next;
     const double s = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);

@@ -53,8 +53,7 @@ Matrix12d ImuNoise::ContinuousCov() const {
   Matrix12d Q = Matrix12d::Zero();
   Q.block<3, 3>(kGyro, kGyro) = Isotropic(gyro_noise_density * gyro_noise_density);
   Q.block<3, 3>(kAccel, kAccel) = Isotropic(accel_noise_density * accel_noise_density);
-  Q.block<3, 3>(kGyroBias, kGyroBias) =
-      Isotropic(gyro_bias_random_walk * gyro_bias_random_walk);
+  Q.block<3, 3>(kGyroBias, kGyroBias) = Isotropic(gyro_bias_random_walk * gyro_bias_random_walk);
   Q.block<3, 3>(kAccelBias, kAccelBias) =
       Isotropic(accel_bias_random_walk * accel_bias_random_walk);
   return Q;

@@ -110,7 +110,8 @@ Status AtomicFileWriter::Commit() {
   if (::fsync(fd_) != 0) return FailAndDiscard("cannot sync", errno);
   const int fd = std::exchange(fd_, -1);
   if (::close(fd) != 0) return FailAndDiscard("cannot close", errno);
-  if (::rename(temp_path_.c_str(), path_.c_str()) != 0) return FailAndDiscard("cannot rename", errno);
+  if (::rename(temp_path_.c_str(), path_.c_str()) != 0)
+    return FailAndDiscard("cannot rename", errno);
   temp_path_.clear();
   SyncDirectory(ParentDirectory(path_));
   return Status::Ok();

@@ -14,8 +14,6 @@ namespace {
 
 constexpr int kScansToSample = 5;
 
-double Seconds(const ros::Time& t) { return NsToSeconds(bag_detail::ToNs(t)); }
-
 // Layout, fields and mean point count from the first few messages.
 void DescribeCloudTopic(const rosbag::Bag& bag, BagTopicInfo* info) {
   LidarOptions lidar;  // auto layout and stamp; no range crop: count every valid point
@@ -54,7 +52,8 @@ BagTopicInfo DescribeTopic(const rosbag::Bag& bag, const std::string& topic,
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   info.count = view.size();
   if (info.count > 1) {
-    const double span = Seconds(view.getEndTime()) - Seconds(view.getBeginTime());
+    const double span = NsToSeconds(bag_detail::ToNs(view.getEndTime()) -
+                                    bag_detail::ToNs(view.getBeginTime()));
     if (span > 0.0) info.rate_hz = double(info.count - 1) / span;
   }
   if (decode_clouds && type == bag_detail::kPointCloud2Type) DescribeCloudTopic(bag, &info);
@@ -74,8 +73,10 @@ StatusOr<BagInfo> Describe(const std::string& path, const rosbag::Bag& bag,
   rosbag::View all(bag);
   info.messages = all.size();
   if (info.messages > 0) {
-    info.start_s = Seconds(all.getBeginTime());
-    info.end_s = Seconds(all.getEndTime());
+    info.start_ns = bag_detail::ToNs(all.getBeginTime());
+    info.end_ns = bag_detail::ToNs(all.getEndTime());
+    info.start_s = NsToSeconds(info.start_ns);
+    info.end_s = NsToSeconds(info.end_ns);
   }
   for (const auto& [topic, type] : topics) {
     const bool decode = lidar_topic.empty() || lidar_topic == topic;

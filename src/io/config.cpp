@@ -22,10 +22,14 @@ std::string Quote(const std::string& text) { return "'" + text + "'"; }
 // What a node holds, for "expected X, got Y" messages.
 std::string Describe(const Node& n) {
   switch (n.kind) {
-    case Node::Kind::kNull: return "an empty value";
-    case Node::Kind::kSequence: return "a list";
-    case Node::Kind::kMap: return "a mapping";
-    case Node::Kind::kScalar: break;
+    case Node::Kind::kNull:
+      return "an empty value";
+    case Node::Kind::kSequence:
+      return "a list";
+    case Node::Kind::kMap:
+      return "a mapping";
+    case Node::Kind::kScalar:
+      break;
   }
   return Quote(n.scalar);
 }
@@ -69,11 +73,20 @@ bool IsDecimalText(const std::string& s) {
 bool ParseDouble(const std::string& s, double* out) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   for (const char* t : {".inf", ".Inf", ".INF", "+.inf", "+.Inf", "+.INF"})
-    if (s == t) { *out = kInf; return true; }
+    if (s == t) {
+      *out = kInf;
+      return true;
+    }
   for (const char* t : {"-.inf", "-.Inf", "-.INF"})
-    if (s == t) { *out = -kInf; return true; }
+    if (s == t) {
+      *out = -kInf;
+      return true;
+    }
   for (const char* t : {".nan", ".NaN", ".NAN"})
-    if (s == t) { *out = std::numeric_limits<double>::quiet_NaN(); return true; }
+    if (s == t) {
+      *out = std::numeric_limits<double>::quiet_NaN();
+      return true;
+    }
   if (!IsDecimalText(s)) return false;
   *out = std::strtod(s.c_str(), nullptr);
   return true;
@@ -169,8 +182,14 @@ std::string LastSegment(const std::string& key) {
   return dot == std::string::npos ? key : key.substr(dot + 1);
 }
 
-// The known key closest to `key`: a small edit of the whole key, or the same
-// (or nearly the same) name in another section (one extra edit).
+std::string Parent(const std::string& key) {
+  const size_t dot = key.rfind('.');
+  return dot == std::string::npos ? "" : key.substr(0, dot);
+}
+
+// The known key closest to `key`: a small edit of the whole key, the same (or
+// nearly the same) name in another section, or else the only key of the same
+// section whose name starts with the given one ("smoother.window").
 std::string ClosestKey(const std::string& key, const std::vector<std::string>& known) {
   const std::string last = LastSegment(key);
   const size_t threshold = std::max<size_t>(1, std::min<size_t>(3, last.size() / 3));
@@ -183,7 +202,11 @@ std::string ClosestKey(const std::string& key, const std::vector<std::string>& k
       best = k;
     }
   }
-  return best;
+  if (!best.empty() || last.size() < 3) return best;
+  std::vector<std::string> prefixed;
+  for (const auto& k : known)
+    if (Parent(k) == Parent(key) && LastSegment(k).rfind(last, 0) == 0) prefixed.push_back(k);
+  return prefixed.size() == 1 ? prefixed[0] : "";
 }
 
 bool IsKeyChar(char c) {
@@ -210,8 +233,8 @@ bool IsPlainSafe(const std::string& s) {
   for (char c : s)
     if (!IsKeyChar(c) && c != '/' && c != '.' && c != '-') return false;
   for (const char* r : {"true", "false", "True", "False", "TRUE", "FALSE", "null", "Null", "NULL",
-                        "yes", "no", "Yes", "No", "YES", "NO", "on", "off", "On", "Off", "ON",
-                        "OFF", "y", "n", "Y", "N"})
+                        "yes",  "no",    "Yes",  "No",    "YES",  "NO",    "on",   "off",  "On",
+                        "Off",  "ON",    "OFF",  "y",     "n",    "Y",     "N"})
     if (s == r) return false;
   return true;
 }
@@ -251,7 +274,8 @@ StatusOr<Node> ParseOverride(const std::string& assignment) {
   const size_t eq = assignment.find('=');
   const std::string key = Trim(assignment.substr(0, eq));
   if (eq == std::string::npos || key.empty())
-    return Status::InvalidInput("--set " + Quote(assignment) + ": expected KEY=VALUE, e.g. rv.eps0=0.3");
+    return Status::InvalidInput("--set " + Quote(assignment) +
+                                ": expected KEY=VALUE, e.g. rv.eps0=0.3");
   const std::vector<std::string> parts = SplitKey(key);
   for (const auto& p : parts)
     if (p.empty() || p.find_first_of(" \t") != std::string::npos)
@@ -277,9 +301,15 @@ StatusOr<Node> ParseOverride(const std::string& assignment) {
 Status Read(const Node& n, const std::string& key, const std::string& where, bool* out) {
   if (n.kind == Node::Kind::kScalar) {
     for (const char* t : {"true", "True", "TRUE"})
-      if (n.scalar == t) { *out = true; return Status::Ok(); }
+      if (n.scalar == t) {
+        *out = true;
+        return Status::Ok();
+      }
     for (const char* f : {"false", "False", "FALSE"})
-      if (n.scalar == f) { *out = false; return Status::Ok(); }
+      if (n.scalar == f) {
+        *out = false;
+        return Status::Ok();
+      }
   }
   return Expected(n, key, where, "true or false");
 }
@@ -366,7 +396,8 @@ std::string DumpVisitor::FormatDouble(double x) {
   const double magnitude = std::fabs(x);
   if (std::strchr(buf, 'e') != nullptr && magnitude >= 1.0 && magnitude < 1e16) {
     // %g writes 100 as 1e+02; plain digits read better for moderate values.
-    const int decimals = std::max(0, precision - 1 - static_cast<int>(std::floor(std::log10(magnitude))));
+    const int decimals =
+        std::max(0, precision - 1 - static_cast<int>(std::floor(std::log10(magnitude))));
     std::snprintf(buf, sizeof(buf), "%.*f", decimals, x);
   }
   std::string s = buf;

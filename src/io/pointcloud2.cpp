@@ -215,11 +215,13 @@ TimeRange ScanTimes(const PointCursor& cursor, const Layout& layout) {
   return r;
 }
 
-// Maps a raw time value to absolute ns.
+// Maps a raw time value to absolute ns: relative layouts add the raw value
+// (ns) plus a shift to the integer stamp, so that no precision is lost.
 struct TimeMapping {
   bool relative = true;
-  double offset_ns = 0.0;  // relative: stamp + shift; absolute: 0
-  double scale = 1.0;      // absolute: raw value * scale = ns
+  TimeNs stamp_ns = 0;
+  double shift_ns = 0.0;
+  bool seconds = true;  // absolute: raw value in s (else ns)
 };
 
 TimeMapping RelativeMapping(const PointCloud2View& cloud, const TimeRange& range,
@@ -236,7 +238,8 @@ TimeMapping RelativeMapping(const PointCloud2View& cloud, const TimeRange& range
     stats->stamp_is_end = mostly_negative;
   }
   TimeMapping m;
-  m.offset_ns = static_cast<double>(cloud.header_stamp_ns) + shift;
+  m.stamp_ns = cloud.header_stamp_ns;
+  m.shift_ns = shift;
   return m;
 }
 
@@ -246,25 +249,36 @@ TimeMapping AbsoluteMapping(const PointCloud2View& cloud, const Layout& layout,
                             const TimeRange& range, DecodeStats* stats) {
   TimeMapping m;
   m.relative = false;
-  m.scale = 1e9;
   const double stamp = static_cast<double>(cloud.header_stamp_ns);
   if (layout.kind == TimeKind::kAbsoluteNsOrS && range.valid > 0 &&
       std::abs(range.max - stamp) < std::abs(range.max * 1e9 - stamp)) {
-    m.scale = 1.0;
+    m.seconds = false;
   }
   if (range.valid > 0) {
+    const double scale = m.seconds ? 1e9 : 1.0;
     stats->stamp_is_end =
-        std::abs(stamp - range.max * m.scale) < std::abs(stamp - range.min * m.scale);
+        std::abs(stamp - range.max * scale) < std::abs(stamp - range.min * scale);
   }
   return m;
 }
 
-// Absolute ns of a raw time, or false when it is unusable.
+// Absolute ns of a raw time, or false when it is unusable. Absolute seconds
+// are split into whole and fractional seconds to keep the double's precision.
 bool ToAbsoluteNs(double raw, const TimeMapping& m, TimeNs* t_ns) {
   if (std::isnan(raw)) return false;
-  const double t = m.relative ? m.offset_ns + raw : raw * m.scale;
-  if (!(std::abs(t) < kMaxAbsoluteNs)) return false;
-  *t_ns = static_cast<TimeNs>(std::llround(t));
+  if (m.relative) {
+    *t_ns = m.stamp_ns + static_cast<TimeNs>(std::llround(raw + m.shift_ns));
+    return true;
+  }
+  const double ns = m.seconds ? raw * 1e9 : raw;
+  if (!(std::abs(ns) < kMaxAbsoluteNs)) return false;
+  if (!m.seconds) {
+    *t_ns = static_cast<TimeNs>(std::llround(raw));
+    return true;
+  }
+  const double whole_s = std::floor(raw);
+  *t_ns = static_cast<TimeNs>(whole_s) * kNsPerSecond +
+          static_cast<TimeNs>(std::llround((raw - whole_s) * 1e9));
   return true;
 }
 

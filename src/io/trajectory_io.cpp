@@ -2,14 +2,14 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
-#include <cctype>
 #include <fstream>
 #include <limits>
 #include <vector>
@@ -56,14 +56,14 @@ std::vector<std::string> Split(const std::string& line) {
 StatusOr<std::vector<DataLine>> ReadDataLines(const std::string& path, const std::string& what) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0)
-    return Status::InvalidInput("cannot open " + what + " file '" + path + "': " +
-                                std::strerror(errno));
+    return Status::InvalidInput("cannot open " + what + " file '" + path +
+                                "': " + std::strerror(errno));
   if (S_ISDIR(st.st_mode))
     return Status::InvalidInput("cannot read " + what + " file '" + path + "': it is a directory");
   std::ifstream in(path);
   if (!in)
-    return Status::InvalidInput("cannot open " + what + " file '" + path + "': " +
-                                std::strerror(errno));
+    return Status::InvalidInput("cannot open " + what + " file '" + path +
+                                "': " + std::strerror(errno));
   std::vector<DataLine> lines;
   std::string text;
   for (int number = 1; std::getline(in, text); ++number) {
@@ -86,9 +86,9 @@ bool ParseFinite(const std::string& text, double* value) {
 Status ParseValues(const std::string& path, const DataLine& line, size_t first, double* out) {
   for (size_t i = first; i < line.tokens.size(); ++i)
     if (!ParseFinite(line.tokens[i], &out[i - first]))
-      return LineError(path, line.number,
-                       "value " + std::to_string(i + 1) + " '" + line.tokens[i] +
-                           "' is not a finite number");
+      return LineError(
+          path, line.number,
+          "value " + std::to_string(i + 1) + " '" + line.tokens[i] + "' is not a finite number");
   return Status::Ok();
 }
 
@@ -113,8 +113,7 @@ Status CheckOrder(const std::string& path, const std::vector<DataLine>& lines,
       return LineError(path, lines[i].number,
                        "time stamp " + lines[i].tokens[0] +
                            " is earlier than the previous one (line " +
-                           std::to_string(lines[i - 1].number) +
-                           "); stamps must not decrease");
+                           std::to_string(lines[i - 1].number) + "); stamps must not decrease");
   return Status::Ok();
 }
 
@@ -184,8 +183,8 @@ Status AssignKittiTimes(const std::string& path, const std::string& times_path, 
   if (!lines.ok()) return lines.status();
   if (lines->size() != trajectory->size())
     return Status::InvalidInput("times file '" + times_path + "' has " +
-                                std::to_string(lines->size()) + " stamps but '" + path +
-                                "' has " + std::to_string(trajectory->size()) + " poses");
+                                std::to_string(lines->size()) + " stamps but '" + path + "' has " +
+                                std::to_string(trajectory->size()) + " poses");
   for (size_t i = 0; i < lines->size(); ++i) {
     const DataLine& line = (*lines)[i];
     if (Status s = CheckValueCount(times_path, line, 1, "t"); !s.ok()) return s;
@@ -279,14 +278,15 @@ StatusOr<Trajectory> ReadTrajectory(const std::string& path, const std::string& 
 std::string FormatTumLine(const StampedPose& pose) {
   const bool negative = pose.t_ns < 0;
   // Magnitude as unsigned so that INT64_MIN cannot overflow.
-  const uint64_t magnitude = negative ? 0 - static_cast<uint64_t>(pose.t_ns)
-                                      : static_cast<uint64_t>(pose.t_ns);
+  const uint64_t magnitude =
+      negative ? 0 - static_cast<uint64_t>(pose.t_ns) : static_cast<uint64_t>(pose.t_ns);
   const Eigen::Quaterniond q = pose.q_world_imu.normalized();
   const Eigen::Vector3d& p = pose.p_world_imu;
   char buf[1536];  // room for %.9f of any finite double
-  std::snprintf(buf, sizeof(buf), "%s%" PRIu64 ".%09" PRIu64 " %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n",
-                negative ? "-" : "", magnitude / 1000000000ULL, magnitude % 1000000000ULL, p.x(),
-                p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+  std::snprintf(buf, sizeof(buf),
+                "%s%" PRIu64 ".%09" PRIu64 " %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n",
+                negative ? "-" : "", magnitude / uint64_t{1000000000},
+                magnitude % uint64_t{1000000000}, p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
   return buf;
 }
 

@@ -13,6 +13,7 @@ namespace {
 
 constexpr size_t kInitialCapacity = 1024;  // slots (power of two)
 constexpr int kDistanceChunk = 64;         // points per vectorized distance pass
+constexpr int kFirstBlockCapacity = 4;     // points in a new voxel's block
 
 // Offsets of Chebyshev norm r, faces first, then edges, then corners (by the
 // number of non-zero components) so that queries tighten their bound early.
@@ -53,18 +54,18 @@ class VoxelMap::Candidates {
 
   float limit() const { return limit_; }
   int size() const { return n_; }
-  int index(int i) const { return idx_[i]; }
+  const Eigen::Vector3f& point(int i) const { return p_[i]; }
 
-  void Offer(float d2, int32_t index) {
+  void Offer(float d2, float x, float y, float z) {
     // d2 < limit_ is checked by the caller.
     int i = n_ < k_ ? n_++ : k_ - 1;
     while (i > 0 && d2_[i - 1] > d2) {
       d2_[i] = d2_[i - 1];
-      idx_[i] = idx_[i - 1];
+      p_[i] = p_[i - 1];
       --i;
     }
     d2_[i] = d2;
-    idx_[i] = index;
+    p_[i] = Eigen::Vector3f(x, y, z);
     if (n_ == k_) limit_ = d2_[k_ - 1];
   }
 
@@ -73,7 +74,7 @@ class VoxelMap::Candidates {
   int n_ = 0;
   float limit_;
   std::array<float, kMaxNeighbors> d2_;
-  std::array<int32_t, kMaxNeighbors> idx_;  // float index of x in pool_
+  std::array<Eigen::Vector3f, kMaxNeighbors> p_;
 };
 
 VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
@@ -81,16 +82,15 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
   RVLIO_CHECK(options.max_points_per_voxel >= 1);
   inv_voxel_size_ = 1.0 / options.voxel_size;
   min_d2_ = static_cast<float>(options.min_point_distance * options.min_point_distance);
-  cap_ = options.max_points_per_voxel;
-  stride_ = 3 * cap_;
+  max_points_ = options.max_points_per_voxel;
+  free_blocks_.resize(CapacityClass(max_points_) + 1);
   for (int r = 0; r <= kPrecomputedShells; ++r) shells_[r] = MakeShell<Offset>(r);
   Rebuild(kInitialCapacity, {});
 }
 
 void VoxelMap::Clear() {
   pool_.clear();
-  counts_.clear();
-  free_blocks_.clear();
+  for (auto& list : free_blocks_) list.clear();
   num_points_ = 0;
   Rebuild(kInitialCapacity, {});
 }
@@ -99,7 +99,7 @@ void VoxelMap::Clear() {
 
 int VoxelMap::FindSlot(const VoxelKey& key) const {
   size_t i = HashVoxelKey(key) & mask_;
-  while (slots_[i].block >= 0) {
+  while (slots_[i].offset >= 0) {
     if (slots_[i].key == key) return static_cast<int>(i);
     i = (i + 1) & mask_;
   }
@@ -108,7 +108,7 @@ int VoxelMap::FindSlot(const VoxelKey& key) const {
 
 void VoxelMap::InsertSlot(const Slot& s) {
   size_t i = HashVoxelKey(s.key) & mask_;
-  while (slots_[i].block >= 0) i = (i + 1) & mask_;
+  while (slots_[i].offset >= 0) i = (i + 1) & mask_;
   slots_[i] = s;
 }
 
@@ -119,34 +119,58 @@ void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
   for (const Slot& s : slots) InsertSlot(s);
 }
 
-int VoxelMap::AllocateBlock() {
-  if (!free_blocks_.empty()) {
-    const int b = free_blocks_.back();
-    free_blocks_.pop_back();
-    counts_[b] = 0;
-    return b;
-  }
-  const int b = static_cast<int>(counts_.size());
-  counts_.push_back(0);
-  pool_.resize(pool_.size() + stride_);
-  return b;
-}
-
-int VoxelMap::FindOrCreateBlock(const VoxelKey& key) {
-  const int found = FindSlot(key);
-  if (found >= 0) return slots_[found].block;
+int VoxelMap::CreateSlot(const VoxelKey& key) {
   if (2 * (num_voxels_ + 1) > slots_.size()) {  // keep the load <= 1/2
     scratch_slots_.clear();
     for (const Slot& s : slots_)
-      if (s.block >= 0) scratch_slots_.push_back(s);
+      if (s.offset >= 0) scratch_slots_.push_back(s);
     Rebuild(2 * slots_.size(), scratch_slots_);
   }
   Slot s;
   s.key = key;
-  s.block = AllocateBlock();
+  s.capacity = std::min(kFirstBlockCapacity, max_points_);
+  s.offset = AllocateBlock(s.capacity);
   InsertSlot(s);
   ++num_voxels_;
-  return s.block;
+  return FindSlot(key);
+}
+
+// ------------------------------------------------------------ block storage
+
+// Capacities are min(4 * 2^c, max_points_) for class c = 0, 1, ...
+int VoxelMap::CapacityClass(int capacity) const {
+  int c = 0;
+  while ((kFirstBlockCapacity << c) < capacity) ++c;
+  return c;
+}
+
+int32_t VoxelMap::AllocateBlock(int capacity) {
+  std::vector<int32_t>& list = free_blocks_[CapacityClass(capacity)];
+  if (!list.empty()) {
+    const int32_t offset = list.back();
+    list.pop_back();
+    return offset;
+  }
+  const size_t offset = pool_.size();
+  RVLIO_CHECK(offset + 3 * capacity < static_cast<size_t>(std::numeric_limits<int32_t>::max()));
+  pool_.resize(offset + 3 * capacity);
+  return static_cast<int32_t>(offset);
+}
+
+void VoxelMap::FreeBlock(int32_t offset, int capacity) {
+  free_blocks_[CapacityClass(capacity)].push_back(offset);
+}
+
+// Moves a full voxel to a block of the next capacity class.
+void VoxelMap::GrowBlock(Slot* s) {
+  const int new_capacity = std::min(2 * s->capacity, max_points_);
+  const int32_t new_offset = AllocateBlock(new_capacity);  // may reallocate pool_
+  for (int axis = 0; axis < 3; ++axis)
+    std::copy_n(pool_.begin() + s->offset + axis * s->capacity, s->count,
+                pool_.begin() + new_offset + axis * new_capacity);
+  FreeBlock(s->offset, s->capacity);
+  s->offset = new_offset;
+  s->capacity = new_capacity;
 }
 
 // ------------------------------------------------------------------ updates
@@ -154,26 +178,28 @@ int VoxelMap::FindOrCreateBlock(const VoxelKey& key) {
 bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
   if (!IsKeyable(p_world.x(), p_world.y(), p_world.z(), inv_voxel_size_)) return false;
   const VoxelKey key = KeyOf(p_world, inv_voxel_size_);
-  const int found = FindSlot(key);
   const float px = static_cast<float>(p_world.x());
   const float py = static_cast<float>(p_world.y());
   const float pz = static_cast<float>(p_world.z());
-  if (found >= 0) {
-    const int b = slots_[found].block;
-    const int n = counts_[b];
-    if (n >= cap_) return false;
-    const float* x = BlockData(b);
-    for (int i = 0; i < n; ++i) {
-      const float dx = x[i] - px, dy = x[i + cap_] - py, dz = x[i + 2 * cap_] - pz;
+  int slot = FindSlot(key);
+  if (slot >= 0) {
+    const Slot& s = slots_[slot];
+    if (s.count >= max_points_) return false;
+    const float* x = pool_.data() + s.offset;
+    for (int i = 0; i < s.count; ++i) {
+      const float dx = x[i] - px, dy = x[i + s.capacity] - py, dz = x[i + 2 * s.capacity] - pz;
       if (dx * dx + dy * dy + dz * dz < min_d2_) return false;
     }
+  } else {
+    slot = CreateSlot(key);
   }
-  const int b = found >= 0 ? slots_[found].block : FindOrCreateBlock(key);
-  float* x = BlockData(b);
-  const int n = counts_[b]++;
-  x[n] = px;
-  x[n + cap_] = py;
-  x[n + 2 * cap_] = pz;
+  Slot& s = slots_[slot];
+  if (s.count == s.capacity) GrowBlock(&s);
+  float* x = pool_.data() + s.offset;
+  x[s.count] = px;
+  x[s.count + s.capacity] = py;
+  x[s.count + 2 * s.capacity] = pz;
+  ++s.count;
   ++num_points_;
   return true;
 }
@@ -184,20 +210,18 @@ void VoxelMap::Insert(const std::vector<Eigen::Vector3d>& p_world) {
 
 void VoxelMap::RemoveFar(const Eigen::Vector3d& center_world, double radius) {
   const double r2 = radius * radius;
-  const double s = options_.voxel_size;
+  const double vs = options_.voxel_size;
   scratch_slots_.clear();
   bool removed = false;
-  for (const Slot& slot : slots_) {
-    if (slot.block < 0) continue;
-    const Eigen::Vector3d c((slot.key.x + 0.5) * s, (slot.key.y + 0.5) * s,
-                            (slot.key.z + 0.5) * s);
+  for (const Slot& s : slots_) {
+    if (s.offset < 0) continue;
+    const Eigen::Vector3d c((s.key.x + 0.5) * vs, (s.key.y + 0.5) * vs, (s.key.z + 0.5) * vs);
     if ((c - center_world).squaredNorm() > r2) {
-      num_points_ -= counts_[slot.block];
-      counts_[slot.block] = 0;
-      free_blocks_.push_back(slot.block);
+      num_points_ -= s.count;
+      FreeBlock(s.offset, s.capacity);
       removed = true;
     } else {
-      scratch_slots_.push_back(slot);
+      scratch_slots_.push_back(s);
     }
   }
   if (removed) Rebuild(slots_.size(), scratch_slots_);
@@ -214,12 +238,11 @@ std::vector<Eigen::Vector3d> VoxelMap::Points() const {
 
 // Squared distances of a whole block in a branch-free pass (vectorized by the
 // compiler), then a scalar pass over the few that beat the current limit.
-void VoxelMap::ScanBlock(int block, const float q[3], Candidates* c) const {
-  const float* x = BlockData(block);
-  const float* y = x + cap_;
-  const float* z = y + cap_;
-  const int n = counts_[block];
-  const int32_t base = block * stride_;
+void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
+  const float* x = pool_.data() + s.offset;
+  const float* y = x + s.capacity;
+  const float* z = y + s.capacity;
+  const int n = s.count;
   float d2[kDistanceChunk];
   for (int start = 0; start < n; start += kDistanceChunk) {
     const int m = std::min(kDistanceChunk, n - start);
@@ -230,7 +253,10 @@ void VoxelMap::ScanBlock(int block, const float q[3], Candidates* c) const {
       d2[i] = dx * dx + dy * dy + dz * dz;
     }
     for (int i = 0; i < m; ++i)
-      if (d2[i] < c->limit()) c->Offer(d2[i], base + start + i);
+      if (d2[i] < c->limit()) {
+        const int j = start + i;
+        c->Offer(d2[i], x[j], y[j], z[j]);
+      }
   }
 }
 
@@ -244,7 +270,7 @@ void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const d
   const double gz = AxisGap(dz, q_local[2], s);
   if (gx * gx + gy * gy + gz * gz > c->limit()) return;
   const int slot = FindSlot(VoxelKey{home.x + dx, home.y + dy, home.z + dz});
-  if (slot >= 0) ScanBlock(slots_[slot].block, q, c);
+  if (slot >= 0) ScanBlock(slots_[slot], q, c);
 }
 
 void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
@@ -268,12 +294,12 @@ void VoxelMap::ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3],
                              Candidates* c) const {
   const double s = options_.voxel_size;
   for (const Slot& slot : slots_) {
-    if (slot.block < 0) continue;
+    if (slot.offset < 0) continue;
     const Eigen::Vector3d lo(slot.key.x * s, slot.key.y * s, slot.key.z * s);
     const Eigen::Vector3d gap =
         (lo - q_world).cwiseMax(q_world - lo - Eigen::Vector3d::Constant(s)).cwiseMax(0.0);
     if (gap.squaredNorm() > c->limit()) continue;
-    ScanBlock(slot.block, q, c);
+    ScanBlock(slot, q, c);
   }
 }
 
@@ -310,8 +336,7 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
 
   out->size = c.size();
   for (int i = 0; i < c.size(); ++i) {
-    const float* p = pool_.data() + c.index(i);
-    out->points[i] = Eigen::Vector3d(p[0], p[cap_], p[2 * cap_]);
+    out->points[i] = c.point(i).cast<double>();
     out->dist2[i] = (out->points[i] - q_world).squaredNorm();
   }
   return out->size;

@@ -56,8 +56,7 @@ SpeedBiasBlock SpeedBiasBlock::FromArray(const double* params) {
 }
 
 PoseBlock Plus(const PoseBlock& x, const PoseBlock::Tangent& delta) {
-  const Eigen::Quaterniond q =
-      x.q_world_imu * so3::ExpQuat(delta.segment<3>(PoseBlock::kRot));
+  const Eigen::Quaterniond q = x.q_world_imu * so3::ExpQuat(delta.segment<3>(PoseBlock::kRot));
   return PoseBlock(q.normalized(), x.p_world_imu + delta.segment<3>(PoseBlock::kTrans));
 }
 

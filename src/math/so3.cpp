@@ -57,8 +57,8 @@ Eigen::Quaterniond ExpQuat(const Eigen::Vector3d& w) {
   const double half = 0.5 * theta;
   // sin(theta/2)/theta, with its series below kTaylorAngle.
   const double t2 = theta * theta;
-  const double s = theta < kTaylorAngle ? 0.5 - t2 / 48.0 + t2 * t2 / 3840.0
-                                        : std::sin(half) / theta;
+  const double s =
+      theta < kTaylorAngle ? 0.5 - t2 / 48.0 + t2 * t2 / 3840.0 : std::sin(half) / theta;
   return Eigen::Quaterniond(std::cos(half), s * w.x(), s * w.y(), s * w.z());
 }
 

@@ -12,8 +12,7 @@ template <typename BlockFn>
 Matrix24d RotationBlockDiagonal(const FilterState& x, const FilterState& x0, BlockFn f) {
   Matrix24d J = Matrix24d::Identity();
   J.block<3, 3>(S::kRot, S::kRot) = f(so3::Log(x0.R_world_imu.transpose() * x.R_world_imu));
-  J.block<3, 3>(S::kExtRot, S::kExtRot) =
-      f(so3::Log(x0.R_imu_lidar.transpose() * x.R_imu_lidar));
+  J.block<3, 3>(S::kExtRot, S::kExtRot) = f(so3::Log(x0.R_imu_lidar.transpose() * x.R_imu_lidar));
   return J;
 }
 

@@ -92,13 +92,13 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   scans_.pop_front();
   const auto start = std::chrono::steady_clock::now();
   Predict(scan.t_end_ns);
-  preprocessor_.Run(scan, &kept_points_);
-  if (static_cast<int>(kept_points_.size()) < kMinScanPoints) {
+  preprocessor_.Downsample(scan, &downsampled_);
+  if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {
     ++stats_.scans_too_few_points;
     filter_.ClearPoseHistory();
     return;
   }
-  DeskewToScanEnd(filter_.pose_history(), filter_.state().T_imu_lidar(), kept_points_,
+  DeskewToScanEnd(filter_.pose_history(), filter_.state().T_imu_lidar(), downsampled_.points,
                   scan.t_end_ns, &p_lidar_end_);
   ScanResult r;
   r.raw_points = static_cast<int>(scan.points.size());

@@ -8,15 +8,37 @@
 
 namespace rvlio {
 
+namespace {
+
+// Upper triangle of a running sum of w u u^T (cheaper than 3x3 outer products).
+struct SymmetricSum {
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  void Add(const Eigen::Vector3d& u) {
+    xx += u.x() * u.x();
+    xy += u.x() * u.y();
+    xz += u.x() * u.z();
+    yy += u.y() * u.y();
+    yz += u.y() * u.z();
+    zz += u.z() * u.z();
+  }
+  Eigen::Matrix3d ToMatrix() const {
+    Eigen::Matrix3d S;
+    S << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return S;
+  }
+};
+
+}  // namespace
+
 bool IsUsableNormal(const Eigen::Vector3d& u) {
-  if (!u.allFinite()) return false;
-  return u.squaredNorm() > 1e-24;
+  const double n2 = u.squaredNorm();
+  return std::isfinite(n2) && n2 > 1e-24;  // NaN or inf in any component fails
 }
 
 void RvWorkspace::Load(const ConstraintList& constraints) {
   const size_t n = constraints.size();
   u.resize(n);
-  d.assign(n, 0.0);
+  d.resize(n);
   cls.resize(n);
   num_usable = 0;
   for (size_t i = 0; i < n; ++i) {
@@ -29,15 +51,16 @@ void RvWorkspace::Load(const ConstraintList& constraints) {
       u[i].setZero();
       cls[i] = VectorClass::kUnusable;
     }
+    d[i] = 0.0;
   }
 }
 
 Eigen::Matrix3d NormalScatter(const RvWorkspace& ws, VectorClass which) {
-  Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+  SymmetricSum S;
   for (int i = 0; i < ws.size(); ++i) {
-    if (ws.cls[i] == which) S.noalias() += ws.u[i] * ws.u[i].transpose();
+    if (ws.cls[i] == which) S.Add(ws.u[i]);
   }
-  return S;
+  return S.ToMatrix();
 }
 
 PlaneFit FitPlane(const Eigen::Matrix3d& S) {
@@ -69,10 +92,12 @@ CriterionResult EvaluateCriterion(const RvOptions& options, const ConstraintList
   result.S = NormalScatter(*ws, VectorClass::kCoplanar);       // all usable vectors
   result.fit = FitPlane(result.S);                             // steps 3-5
   result.num_usable = ws->num_usable;
-  ComputeDistances(result.fit.n_alpha, ws);                    // step 6, Eq. (15)
+  const Eigen::Vector3d n = result.fit.n_alpha;
   for (int i = 0; i < ws->size(); ++i) {
     if (ws->cls[i] != VectorClass::kCoplanar) continue;
-    if (ws->d[i] > options.eps0) {
+    const double d = CoplanarityDistance(ws->u[i], n);         // step 6, Eq. (15)
+    ws->d[i] = d;
+    if (d > options.eps0) {
       ws->cls[i] = VectorClass::kScv;                          // step 8
     } else {
       ++result.num_within_eps0;

@@ -12,11 +12,20 @@ namespace rvlio {
 
 Eigen::Matrix3d PositionInformation(const ConstraintList& constraints, double sigma) {
   RVLIO_CHECK(sigma > 0.0);
-  Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;  // upper triangle
   for (const Constraint& c : constraints) {
-    if (!c.normal_world.allFinite() || !std::isfinite(c.weight)) continue;
-    info.noalias() += c.weight * c.normal_world * c.normal_world.transpose();
+    const Eigen::Vector3d& u = c.normal_world;
+    const Eigen::Vector3d wu = c.weight * u;
+    if (!std::isfinite(wu.squaredNorm() + u.squaredNorm())) continue;
+    xx += wu.x() * u.x();
+    xy += wu.x() * u.y();
+    xz += wu.x() * u.z();
+    yy += wu.y() * u.y();
+    yz += wu.y() * u.z();
+    zz += wu.z() * u.z();
   }
+  Eigen::Matrix3d info;
+  info << xx, xy, xz, xy, yy, yz, xz, yz, zz;
   return info / (sigma * sigma);
 }
 

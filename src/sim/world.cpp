@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "rvlio/common/check.h"
 
@@ -13,6 +14,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 void World::AddFace(Face face, float reflectivity) {
+  RVLIO_CHECK_MSG(faces_.size() < kMaxFaces, "too many faces for the ray caster");
   faces_.push_back(std::move(face));
   face_reflectivity_.push_back(reflectivity);
   finalized_ = false;
@@ -79,12 +81,23 @@ bool World::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, d
   const Ray ray{origin, dir};
   double best = t_max;
   bool found = false;
+  // Faces in the order the ray reaches their slabs; a slab that starts beyond
+  // the best hit cannot hold a nearer one.
+  std::pair<double, int> order[kMaxFaces];
+  size_t n = 0;
   for (size_t i = 0; i < faces_.size(); ++i) {
+    double t0 = 0.0, t1 = 0.0;
+    if (!faces_[i].Slab(ray, 1e-9, t_max, &t0, &t1)) continue;
+    order[n++] = {t0, static_cast<int>(i)};
+  }
+  std::sort(order, order + n);
+  for (size_t k = 0; k < n && order[k].first <= best; ++k) {
+    const int i = order[k].second;
     double t = 0.0;
-    if (faces_[i].Intersect(ray, 1e-9, best, &t)) {
+    if (faces_[static_cast<size_t>(i)].Intersect(ray, 1e-9, best, &t)) {
       best = t;
       found = true;
-      *hit = {t, face_reflectivity_[i], ShapeKind::kFace, static_cast<int>(i)};
+      *hit = {t, face_reflectivity_[static_cast<size_t>(i)], ShapeKind::kFace, i};
     }
   }
   if (features_.empty()) return found;

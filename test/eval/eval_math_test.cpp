@@ -94,25 +94,31 @@ Trajectory Stamps(const std::vector<TimeNs>& t) {
   return out;
 }
 
-// numpy.argmin over |long - t|: the first of equally near stamps.
+// numpy.argmin(|long - t|) over double seconds: the first of equally near.
 size_t BruteNearest(const Trajectory& longer, TimeNs t) {
+  const auto diff = [&](size_t j) {
+    return std::fabs(StampSeconds(longer[j].t_ns) - StampSeconds(t));
+  };
   size_t best = 0;
   for (size_t j = 1; j < longer.size(); ++j)
-    if (std::llabs(longer[j].t_ns - t) < std::llabs(longer[best].t_ns - t)) best = j;
+    if (diff(j) < diff(best)) best = j;
   return best;
 }
 
-TEST(Associate, MatchesBruteForceArgminOverRandomTrials) {
+TEST(Associate, MatchesLinearArgminOverRandomTrials) {
   std::mt19937 rng(11);
-  for (int trial = 0; trial < 200; ++trial) {
-    // Coarse integer stamps (steps of 0..3) create ties and repeated stamps.
+  constexpr TimeNs kBase = 1311868226000000000LL;  // realistic stamps: ties break as in numpy
+  constexpr TimeNs kMs = 1000000;
+  int ties = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    // Steps of 0..3 ms create exact decimal ties and repeated stamps.
     std::vector<TimeNs> a(1 + rng() % 30), b(1 + rng() % 30);
-    TimeNs t = rng() % 5;
-    for (TimeNs& x : a) x = (t += rng() % 4);
-    t = rng() % 5;
-    for (TimeNs& x : b) x = (t += rng() % 4);
+    TimeNs t = kBase + (rng() % 5) * kMs;
+    for (TimeNs& x : a) x = (t += (rng() % 4) * kMs);
+    t = kBase + (rng() % 5) * kMs;
+    for (TimeNs& x : b) x = (t += (rng() % 4) * kMs + (rng() % 2) * kMs / 2);
     const Trajectory ref = Stamps(a), est = Stamps(b);
-    const TimeNs max_dt = rng() % 3;
+    const double max_dt = (rng() % 3) * 1e-3;
     StatusOr<Association> assoc = Associate(ref, est, max_dt);
     const bool est_longer = est.size() > ref.size();
     const Trajectory& shorter = est_longer ? ref : est;
@@ -120,7 +126,10 @@ TEST(Associate, MatchesBruteForceArgminOverRandomTrials) {
     std::vector<size_t> expect_short, expect_long;
     for (size_t i = 0; i < shorter.size(); ++i) {
       const size_t j = BruteNearest(longer, shorter[i].t_ns);
-      if (std::llabs(longer[j].t_ns - shorter[i].t_ns) <= max_dt) {
+      if (j > 0 && std::llabs(longer[j - 1].t_ns - shorter[i].t_ns) ==
+                       std::llabs(longer[j].t_ns - shorter[i].t_ns))
+        ++ties;
+      if (std::fabs(StampSeconds(longer[j].t_ns) - StampSeconds(shorter[i].t_ns)) <= max_dt) {
         expect_short.push_back(i);
         expect_long.push_back(j);
       }
@@ -133,40 +142,61 @@ TEST(Associate, MatchesBruteForceArgminOverRandomTrials) {
     EXPECT_EQ(est_longer ? assoc->ref_index : assoc->est_index, expect_short);
     EXPECT_EQ(est_longer ? assoc->est_index : assoc->ref_index, expect_long);
   }
+  EXPECT_GT(ties, 10);  // the trials did exercise tie breaking
+}
+
+TEST(Associate, DecimalTiesBreakInDoubleSecondsLikeEvo) {
+  // From the fr2_desk fixture: the estimate stamp 1311868226.310950 is exactly
+  // 1.65 ms from both 226.3093 and 226.3126; in double seconds the later one is
+  // nearer, and evo (numpy) takes it. Exact-nanosecond ties would take the first.
+  const Trajectory ref =
+      Stamps({1311868226309300000LL, 1311868226312600000LL, 1311868226400000000LL});
+  const Trajectory est = Stamps({1311868226310950000LL});
+  StatusOr<Association> a = Associate(ref, est, 0.01);
+  ASSERT_TRUE(a.ok());
+  EXPECT_EQ(a->ref_index, (std::vector<size_t>{1}));
+  EXPECT_EQ(StampSeconds(1311868226310950000LL), 1311868226.310950);
+  EXPECT_EQ(StampSeconds(-1500000000LL), -1.5);
 }
 
 TEST(Associate, ShorterTrajectoryDrivesAndPairsAreNotOneToOne) {
   // Reference is shorter: each reference stamp takes its nearest estimate.
-  const Trajectory ref = Stamps({100, 104});
-  const Trajectory est = Stamps({99, 101, 102, 103, 110});
-  StatusOr<Association> a = Associate(ref, est, 5);
+  // Units of 0.25 s keep the double differences exact (true ties).
+  const auto q = [](std::vector<TimeNs> v) {
+    for (TimeNs& x : v) x *= 250000000;
+    return Stamps(v);
+  };
+  const Trajectory ref = q({100, 104});
+  const Trajectory est = q({99, 101, 102, 103, 110});
+  StatusOr<Association> a = Associate(ref, est, 5 * 0.25);
   ASSERT_TRUE(a.ok());
   EXPECT_EQ(a->ref_index, (std::vector<size_t>{0, 1}));
   EXPECT_EQ(a->est_index, (std::vector<size_t>{0, 3}));  // tie 99/101 -> first, 103 nearest 104
   // Estimate shorter: two estimate stamps share one reference partner.
-  const Trajectory ref2 = Stamps({0, 100, 200});
-  const Trajectory est2 = Stamps({95, 105});
-  a = Associate(ref2, est2, 10);
+  const Trajectory ref2 = q({0, 100, 200});
+  const Trajectory est2 = q({95, 105});
+  a = Associate(ref2, est2, 10 * 0.25);
   ASSERT_TRUE(a.ok());
   EXPECT_EQ(a->ref_index, (std::vector<size_t>{1, 1}));
   EXPECT_EQ(a->est_index, (std::vector<size_t>{0, 1}));
 }
 
 TEST(Associate, ToleranceIsInclusiveAndEqualLengthsIterateTheEstimate) {
-  const Trajectory ref = Stamps({0, 1000});
-  const Trajectory est = Stamps({10, 1011});
-  StatusOr<Association> a = Associate(ref, est, 10);
+  const Trajectory ref = Stamps({0, 500000000});
+  const Trajectory est = Stamps({250000000, 760000000});
+  StatusOr<Association> a = Associate(ref, est, 0.25);
   ASSERT_TRUE(a.ok());
-  EXPECT_EQ(a->size(), 1u);
+  ASSERT_EQ(a->size(), 1u);  // 0.25 s kept (inclusive), 0.26 s dropped
   EXPECT_EQ(a->est_index[0], 0u);
+  EXPECT_EQ(a->ref_index[0], 0u);  // tie 0 / 0.5 s: the first
 }
 
 TEST(Associate, RejectsEmptyUnorderedAndDisjoint) {
-  EXPECT_FALSE(Associate(Stamps({}), Stamps({1}), 10).ok());
-  StatusOr<Association> a = Associate(Stamps({5, 3}), Stamps({1, 2}), 10);
+  EXPECT_FALSE(Associate(Stamps({}), Stamps({1}), 0.01).ok());
+  StatusOr<Association> a = Associate(Stamps({5, 3}), Stamps({1, 2}), 0.01);
   ASSERT_FALSE(a.ok());
   EXPECT_NE(a.status().message().find("earlier"), std::string::npos);
-  a = Associate(Stamps({0, 1}), Stamps({1000000000, 2000000000}), 10000000);
+  a = Associate(Stamps({0, 1}), Stamps({1000000000, 2000000000}), 0.01);
   ASSERT_FALSE(a.ok());
   EXPECT_NE(a.status().message().find("no matching timestamps"), std::string::npos);
 }
@@ -204,8 +234,9 @@ TEST(Umeyama, PlanarPointsAreEnoughAndReflectionsAreAvoided) {
   std::mt19937 rng(5);
   for (int trial = 0; trial < 50; ++trial) {
     Eigen::Matrix3Xd x(3, 20);
-    for (int i = 0; i < 20; ++i) x.col(i) = Eigen::Vector3d(RandomVector(rng, 3.0).head<2>().x(),
-                                                           RandomVector(rng, 3.0).y(), 0.0);
+    for (int i = 0; i < 20; ++i)
+      x.col(i) =
+          Eigen::Vector3d(RandomVector(rng, 3.0).head<2>().x(), RandomVector(rng, 3.0).y(), 0.0);
     const Similarity3 truth = RandomSimilarity(rng, false);
     StatusOr<Similarity3> T = Umeyama(x, Transform(truth, x), false);
     ASSERT_TRUE(T.ok());
@@ -376,15 +407,17 @@ TEST(Rpe, KnownRelativeError) {
   for (int i = 0; i < 3; ++i) {
     ref[i].p_world_imu = Eigen::Vector3d(i, 0, 0);
     est[i].p_world_imu = Eigen::Vector3d(1.1 * i, 0, 0);
-    est[i].q_world_imu = Eigen::Quaterniond(Eigen::AngleAxisd(i * 2.0 * M_PI / 180, Eigen::Vector3d::UnitZ()));
+    est[i].q_world_imu =
+        Eigen::Quaterniond(Eigen::AngleAxisd(i * 2.0 * M_PI / 180, Eigen::Vector3d::UnitZ()));
   }
   StatusOr<RpeResult> r = ComputeRpe(ref, est, RpeOptions());
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->pairs, 2u);
   // Pair (1,2): P_rel translation is R(2 deg)^T (1.1, 0, 0); Q_rel = (1, 0, 0).
   const Eigen::Vector3d p_rel =
-      Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitZ()).inverse() * Eigen::Vector3d(1.1, 0, 0);
-  EXPECT_NEAR(r->trans_m.min, 0.1, 1e-12);                                   // pair (0,1)
+      Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitZ()).inverse() *
+      Eigen::Vector3d(1.1, 0, 0);
+  EXPECT_NEAR(r->trans_m.min, 0.1, 1e-12);                                        // pair (0,1)
   EXPECT_NEAR(r->trans_m.max, (p_rel - Eigen::Vector3d(1, 0, 0)).norm(), 1e-12);  // pair (1,2)
   EXPECT_NEAR(r->rot_deg.mean, 2.0, 1e-9);
 }
@@ -415,7 +448,8 @@ TEST(Ape, RotationAngleOfKnownOffsets) {
   for (size_t i = 0; i < est.size(); ++i) {
     const double deg = 1.0 + i;
     const Eigen::Vector3d axis = RandomVector(rng, 1.0).normalized();
-    est[i].q_world_imu = ref[i].q_world_imu * Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, axis));
+    est[i].q_world_imu =
+        ref[i].q_world_imu * Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, axis));
   }
   const std::vector<double> e = ApeRotationErrorsDeg(ref, est);
   for (size_t i = 0; i < e.size(); ++i) EXPECT_NEAR(e[i], 1.0 + i, 1e-9);

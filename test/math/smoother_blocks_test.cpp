@@ -181,8 +181,7 @@ TEST(SpeedBiasBlock, ArrayLayoutAndAxioms) {
     for (int k = 0; k < 9; ++k) d(k) = std::normal_distribution<double>(0.0, 1.0)(rng);
     EXPECT_LT((Minus(Plus(x, d), x) - d).cwiseAbs().maxCoeff(), 1e-12);
     const SpeedBiasBlock z = Plus(x, Minus(y, x));
-    EXPECT_LT((z.v_world_imu - y.v_world_imu).norm() + (z.bg - y.bg).norm() +
-                  (z.ba - y.ba).norm(),
+    EXPECT_LT((z.v_world_imu - y.v_world_imu).norm() + (z.bg - y.bg).norm() + (z.ba - y.ba).norm(),
               1e-12);
   }
 }

@@ -128,8 +128,11 @@ TEST(So3, LogNearPi) {
 
 TEST(So3, LogExactlyPiAboutSeveralAxes) {
   std::mt19937 rng(8);
-  std::vector<Vector3d> axes = {Vector3d::UnitX(), Vector3d::UnitY(), Vector3d::UnitZ(),
-                                Vector3d(1, 1, 0).normalized(), Vector3d(1, -1, 1).normalized(),
+  std::vector<Vector3d> axes = {Vector3d::UnitX(),
+                                Vector3d::UnitY(),
+                                Vector3d::UnitZ(),
+                                Vector3d(1, 1, 0).normalized(),
+                                Vector3d(1, -1, 1).normalized(),
                                 Vector3d(0, -2, 1).normalized()};
   for (int i = 0; i < 20; ++i) axes.push_back(RandomUnit(rng));
   for (const Vector3d& axis : axes) {

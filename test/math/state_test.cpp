@@ -60,7 +60,8 @@ double StateDistance(const FilterState& a, const FilterState& b) {
 }
 
 TEST(FilterState, OffsetsTileTheTangentSpace) {
-  const int offsets[] = {S::kRot, S::kPos, S::kVel, S::kBg, S::kBa, S::kExtRot, S::kExtPos, S::kGrav};
+  const int offsets[] = {S::kRot, S::kPos,    S::kVel,    S::kBg,
+                         S::kBa,  S::kExtRot, S::kExtPos, S::kGrav};
   for (int i = 0; i < 8; ++i) EXPECT_EQ(offsets[i], 3 * i);
   EXPECT_EQ(S::kDim, 24);
 }
@@ -102,7 +103,8 @@ TEST(FilterState, PosesComposeTheComponents) {
   std::mt19937 rng(24);
   const FilterState x = RandomState(rng);
   const Vector3d p_lidar(1.0, -2.0, 0.5);
-  const Vector3d expected = x.R_world_imu * (x.R_imu_lidar * p_lidar + x.t_imu_lidar) + x.p_world_imu;
+  const Vector3d expected =
+      x.R_world_imu * (x.R_imu_lidar * p_lidar + x.t_imu_lidar) + x.p_world_imu;
   EXPECT_LT((x.T_world_lidar() * p_lidar - expected).norm(), 1e-12);
 }
 

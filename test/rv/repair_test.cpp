@@ -85,7 +85,9 @@ TEST(RepairTest, RepairsExactlyTheCoplanarVectorsWithinEps1AtThePose) {
     EXPECT_GT(expected_repaired, 0);
     // The repaired wall normals carry no axial information any more.
     for (const Constraint& c : list) {
-      if (c.role == RvRole::kRepaired) EXPECT_NEAR(c.normal_world.dot(set.axis), 0.0, 0.05);
+      if (c.role == RvRole::kRepaired) {
+        EXPECT_NEAR(c.normal_world.dot(set.axis), 0.0, 0.05);
+      }
     }
   }
 }

@@ -57,6 +57,10 @@ struct TunnelSpec {
   int num_scv = 40;
   double axial_noise = 0.02;    // std of the axial component of wall normals
   double scv_min_axial = 0.7;   // SCVs have |axial component| in [scv_min_axial, 1]
+  // > 0: SCVs come from one structure (their in-plane direction has this
+  // spread around one azimuth and their axial components one sign), so they
+  // tilt the Alg. 1 plane; <= 0: uniform azimuth and random sign.
+  double scv_azimuth_spread = 0.0;
 };
 
 inline TunnelSet MakeTunnelSet(std::mt19937& rng, const TunnelSpec& spec) {
@@ -69,6 +73,9 @@ inline TunnelSet MakeTunnelSet(std::mt19937& rng, const TunnelSpec& spec) {
   std::uniform_int_distribution<int> wall(0, 3);
   std::uniform_real_distribution<double> phi(-M_PI, M_PI), s(spec.scv_min_axial, 1.0);
   std::bernoulli_distribution coin(0.5);
+  const double azimuth0 = phi(rng);
+  std::normal_distribution<double> azimuth(azimuth0, std::max(spec.scv_azimuth_spread, 1e-9));
+  const bool one_structure = spec.scv_azimuth_spread > 0.0;
   const int n = spec.num_coplanar + spec.num_scv;
   // Random interleaving of wall and special vectors.
   std::vector<bool> scv(n, false);
@@ -77,7 +84,8 @@ inline TunnelSet MakeTunnelSet(std::mt19937& rng, const TunnelSpec& spec) {
   for (int i = 0; i < n; ++i) {
     Eigen::Vector3d u;
     if (scv[i]) {
-      const double a = s(rng) * (coin(rng) ? 1.0 : -1.0), f = phi(rng);
+      const double a = s(rng) * (one_structure || coin(rng) ? 1.0 : -1.0);
+      const double f = one_structure ? azimuth(rng) : phi(rng);
       u = a * set.axis + std::sqrt(1.0 - a * a) * (std::cos(f) * e1 + std::sin(f) * e2);
     } else {
       const double theta = wall(rng) * M_PI / 2.0 + spread(rng);

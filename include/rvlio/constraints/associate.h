@@ -23,6 +23,7 @@ enum class AssociationOutcome : uint8_t {
   kLineLike,         // neighbours on a line (ring line, edge): normal undetermined
   kNotFlat,          // neighbours not on one plane (corner, clutter)
   kFarFromPlane,     // a neighbour farther than max_plane_distance from the plane
+  kUncertain,        // normal too uncertain for the point noise (max_normal_std_deg)
   kLargeResidual,    // |r| > max_residual (outlier)
 };
 
@@ -36,6 +37,7 @@ struct AssociationStats {
   int num_line_like = 0;
   int num_not_flat = 0;
   int num_far_from_plane = 0;
+  int num_uncertain = 0;
   int num_large_residual = 0;
   double mean_abs_residual = 0.0;  // over accepted constraints, m
 

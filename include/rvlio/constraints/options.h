@@ -12,6 +12,7 @@ struct ConstraintOptions {
   double planarity_max_ratio = 0.1;     // lambda_min / lambda_mid must stay below this (flat)
   double max_residual = 1.0;            // m, |r| above this is an outlier at association time
   double lidar_noise = 0.03;            // m, std of one point-to-plane residual
+  double max_normal_std_deg = 0.0;      // deg, reject planes whose normal is this uncertain (0: off)
 
   template <class V>
   void Visit(V& v) {
@@ -24,6 +25,8 @@ struct ConstraintOptions {
                                                          .Help("reject non-flat neighbourhoods"));
     v.Field("max_residual", max_residual, Spec().Unit("m").Positive());
     v.Field("lidar_noise", lidar_noise, Spec().Unit("m").Positive().Help("residual std (R = sigma^2)"));
+    v.Field("max_normal_std_deg", max_normal_std_deg, Spec().Unit("deg").Range(0.0, 90.0)
+        .Help("reject planes whose normal's predicted tilt std (from lidar_noise) exceeds this; 0: off"));
   }
   Status Validate() { return ValidateFields(*this, "constraints"); }
 };

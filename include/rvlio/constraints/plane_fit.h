@@ -15,6 +15,18 @@
 //   line-like : lambda_mid < planarity_min_ratio * lambda_max   (ring line, edge)
 //   not flat  : lambda_min > planarity_max_ratio * lambda_mid   (corner, clutter)
 //   far point : some |u . (p_i - c)| > max_plane_distance
+//   uncertain : the normal's predicted tilt std exceeds max_normal_std
+//
+// The last test is what keeps noisy near-lines out: points with in-plane
+// covariance eigenvalues lambda_max, lambda_mid and noise sigma along the
+// normal determine the normal's tilt towards the mid axis with variance
+// sigma^2 / (n lambda_mid) (the slope variance of a line regression), so
+//   normal_std = sqrt(sigma^2 / (n lambda_mid)),
+//   sigma^2    = max(point_noise^2, n lambda_min / (n - 3))
+// (the configured sensor noise, or the fit's own residual variance when that
+// is larger). A ring line has lambda_mid ~ 0 and an arbitrary normal; a small
+// patch of noisy points has a poorly determined one. Both are rejected.
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -32,6 +44,7 @@ enum class PlaneStatus : uint8_t {
   kLineLike,       // lambda_mid / lambda_max below planarity_min_ratio
   kNotFlat,        // lambda_min / lambda_mid above planarity_max_ratio
   kFarFromPlane,   // a point farther than max_plane_distance from the plane
+  kUncertain,      // normal's predicted tilt std above max_normal_std
 };
 
 const char* ToString(PlaneStatus status);
@@ -41,6 +54,7 @@ struct LocalPlane {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();    // point q on the plane, m
   Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero(); // covariance, ascending, m^2
   double max_distance = 0.0;  // largest |u . (p_i - q)| over the points, m
+  double normal_std = 0.0;    // predicted 1-sigma tilt of the normal, rad
   PlaneStatus status = PlaneStatus::kTooFewPoints;
 
   bool valid() const { return status == PlaneStatus::kValid; }
@@ -54,9 +68,12 @@ struct PlaneThresholds {
   double planarity_min_ratio = 0.1;
   double planarity_max_ratio = 0.1;
   double max_plane_distance = 0.1;  // m
+  double max_normal_std = 0.0;      // rad, 0: test off
+  double point_noise = 0.03;        // m, std of a map point along the normal
 
   static PlaneThresholds From(const ConstraintOptions& o) {
-    return PlaneThresholds{o.planarity_min_ratio, o.planarity_max_ratio, o.max_plane_distance};
+    return PlaneThresholds{o.planarity_min_ratio, o.planarity_max_ratio, o.max_plane_distance,
+                           o.max_normal_std_deg * M_PI / 180.0, o.lidar_noise};
   }
 };
 

@@ -18,9 +18,9 @@ struct EvalResult {
   size_t matched = 0;
   AlignMode align = AlignMode::kSe3;  // the alignment used (origin after a fallback)
   Similarity3 T_ref_est;
-  ErrorStats ape_m;          // APE translation
-  ErrorStats ape_rot_deg;    // APE rotation angle
-  RpeResult rpe;             // on the aligned estimate (Sim3 scale applies)
+  ErrorStats ape_m;        // APE translation
+  ErrorStats ape_rot_deg;  // APE rotation angle
+  RpeResult rpe;           // on the aligned estimate (Sim3 scale applies)
   double end_point_error_m = 0.0;
   AlongAxisError along_axis;
   std::vector<std::string> warnings;

@@ -38,8 +38,8 @@ std::vector<std::pair<size_t, size_t>> RpePairs(const Trajectory& est, const Rpe
 
 struct RpeResult {
   size_t pairs = 0;
-  ErrorStats trans_m;    // ||translation(E_i)||
-  ErrorStats rot_deg;    // angle(E_i)
+  ErrorStats trans_m;  // ||translation(E_i)||
+  ErrorStats rot_deg;  // angle(E_i)
 };
 
 // E_i = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j), Q = reference, P = estimate. Error when
@@ -52,8 +52,8 @@ double EndPointError(const Trajectory& ref, const Trajectory& est);
 
 struct AlongAxisError {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  // principal axis of the reference positions
-  double rmse_m = 0.0;     // of a_k = axis . (t_est_k - t_ref_k)
-  double max_abs_m = 0.0;  // max |a_k|
+  double rmse_m = 0.0;                              // of a_k = axis . (t_est_k - t_ref_k)
+  double max_abs_m = 0.0;                           // max |a_k|
 };
 
 // Position error projected on the principal axis (eigenvector of the largest

@@ -9,9 +9,9 @@
 namespace rvlio {
 
 struct EvalOptions {
-  std::string align = "se3";      // se3 | sim3 | origin | none
-  double max_dt = 0.01;           // s, largest |t_ref - t_est| of an associated pair
-  double rpe_delta = 1.0;         // frames (integer) or metres of travelled path
+  std::string align = "se3";        // se3 | sim3 | origin | none
+  double max_dt = 0.01;             // s, largest |t_ref - t_est| of an associated pair
+  double rpe_delta = 1.0;           // frames (integer) or metres of travelled path
   std::string rpe_unit = "frames";  // frames | meters
   // Umeyama needs a reference that is not a straight line: when the second
   // principal standard deviation of the reference positions is below this
@@ -25,8 +25,7 @@ struct EvalOptions {
             Spec().Choices({"se3", "sim3", "origin", "none"}).Help("alignment of the estimate"));
     v.Field("max_dt", max_dt, Spec().Unit("s").Min(0.0).Help("association tolerance"));
     v.Field("rpe_delta", rpe_delta, Spec().Positive().Help("RPE step, in rpe_unit"));
-    v.Field("rpe_unit", rpe_unit,
-            Spec().Choices({"frames", "meters"}).Help("unit of rpe_delta"));
+    v.Field("rpe_unit", rpe_unit, Spec().Choices({"frames", "meters"}).Help("unit of rpe_delta"));
     v.Field("min_lateral_ratio", min_lateral_ratio,
             Spec().Range(0.0, 1.0).Help("collinearity threshold of the Umeyama fallback"));
     v.Field("min_align_poses", min_align_poses,

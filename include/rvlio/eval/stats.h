@@ -7,7 +7,7 @@ namespace rvlio {
 
 struct ErrorStats {
   size_t count = 0;
-  double rmse = 0.0;    // sqrt(mean(e^2))
+  double rmse = 0.0;  // sqrt(mean(e^2))
   double mean = 0.0;
   double median = 0.0;  // mean of the two middle values for an even count (numpy)
   double std = 0.0;     // population standard deviation (ddof = 0)

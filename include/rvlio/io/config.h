@@ -35,11 +35,11 @@ namespace config_detail {
 struct Node {
   enum class Kind { kNull, kScalar, kSequence, kMap };
   Kind kind = Kind::kNull;
-  std::string scalar;            // kScalar: the text as written (unquoted)
-  std::vector<Node> items;       // kSequence elements; kMap values
-  std::vector<std::string> keys; // kMap keys, parallel to items
-  std::vector<int> key_lines;    // kMap: line of each key
-  int line = 0;                  // 1-based line in the source, 0 if unknown (--set)
+  std::string scalar;             // kScalar: the text as written (unquoted)
+  std::vector<Node> items;        // kSequence elements; kMap values
+  std::vector<std::string> keys;  // kMap keys, parallel to items
+  std::vector<int> key_lines;     // kMap: line of each key
+  int line = 0;                   // 1-based line in the source, 0 if unknown (--set)
 };
 
 // Parses a whole file (top level must be a mapping or empty). Errors name the
@@ -57,10 +57,10 @@ std::string Where(const std::string& source, int line);
 Status Read(const Node& n, const std::string& key, const std::string& where, bool* out);
 Status Read(const Node& n, const std::string& key, const std::string& where, std::string* out);
 Status Read(const Node& n, const std::string& key, const std::string& where, double* out);
-Status ReadInteger(const Node& n, const std::string& key, const std::string& where,
-                   int64_t min, int64_t max, int64_t* out);
-Status ReadNumbers(const Node& n, const std::string& key, const std::string& where,
-                   size_t count, double* out);
+Status ReadInteger(const Node& n, const std::string& key, const std::string& where, int64_t min,
+                   int64_t max, int64_t* out);
+Status ReadNumbers(const Node& n, const std::string& key, const std::string& where, size_t count,
+                   double* out);
 
 Status NotASection(const Node& n, const std::string& key, const std::string& where);
 Status UnknownKey(const std::string& key, const std::string& where,
@@ -118,8 +118,12 @@ class ApplyVisitor {
  public:
   ApplyVisitor(const Node& map, std::string prefix, const std::string& source,
                const std::vector<std::string>& known_keys, ConfigSources* sources)
-      : map_(map), prefix_(std::move(prefix)), source_(source), known_keys_(known_keys),
-        sources_(sources), used_(map.keys.size(), false) {}
+      : map_(map),
+        prefix_(std::move(prefix)),
+        source_(source),
+        known_keys_(known_keys),
+        sources_(sources),
+        used_(map.keys.size(), false) {}
 
   template <typename T>
   void Field(const char* name, T& value, const Spec&) {
@@ -207,9 +211,9 @@ class DumpVisitor {
       return s + "]";
     }
   }
-  static std::string FormatDouble(double x);       // shortest text that reads back exactly
+  static std::string FormatDouble(double x);              // shortest text that reads back exactly
   static std::string FormatString(const std::string& s);  // plain or double-quoted
-  static std::string Comment(const Spec& spec);    // "[unit] help; one of a | b"
+  static std::string Comment(const Spec& spec);           // "[unit] help; one of a | b"
   std::string Indent() const { return std::string(static_cast<size_t>(indent_), ' '); }
 
   int indent_;
@@ -250,7 +254,8 @@ std::vector<std::string> KnownKeys(const Opts& options) {
 // Applies the mapping `root` to a copy of `options`; on success the copy
 // replaces `options` (a failed file leaves the options untouched).
 template <class Opts>
-Status ApplyNode(Opts& options, const Node& root, const std::string& source, ConfigSources* sources) {
+Status ApplyNode(Opts& options, const Node& root, const std::string& source,
+                 ConfigSources* sources) {
   if (root.kind == Node::Kind::kNull) return Status::Ok();
   RVLIO_CHECK(root.kind == Node::Kind::kMap);
   const std::vector<std::string> known = KnownKeys(options);
@@ -300,7 +305,8 @@ Status ApplyYamlText(Opts& options, const std::string& text, const std::string& 
 // Applies one `--set` argument "a.b=value"; value is a YAML scalar or flow
 // sequence ("extrinsics.imu_T_lidar.translation=[0.1,0,0.05]").
 template <class Opts>
-Status ApplyOverride(Opts& options, const std::string& assignment, ConfigSources* sources = nullptr) {
+Status ApplyOverride(Opts& options, const std::string& assignment,
+                     ConfigSources* sources = nullptr) {
   StatusOr<config_detail::Node> root = config_detail::ParseOverride(assignment);
   if (!root.ok()) return root.status();
   return config_detail::ApplyNode(options, *root, "--set", sources);

@@ -86,6 +86,7 @@ struct BagTopicInfo {
 struct BagInfo {
   std::string path;
   double start_s = 0.0, end_s = 0.0;
+  TimeNs start_ns = 0, end_ns = 0;  // the same, exact
   int64_t messages = 0;
   std::vector<BagTopicInfo> topics;
 };

@@ -6,10 +6,11 @@
 // A voxel keeps at most max_points_per_voxel points; a new point closer than
 // min_point_distance to a point already in its voxel is skipped. Voxels are
 // found through an open-addressing hash table (linear probing, power-of-two
-// capacity, load <= 1/2); each voxel owns a fixed block of float storage laid
-// out as x[cap], y[cap], z[cap] so that the distance loop of a query
-// vectorizes. Memory is reused: removed voxels return their block to a free
-// list, and queries allocate nothing.
+// capacity, load <= 1/2) whose slots hold the voxel records. Each voxel owns a
+// block of float storage laid out as x[c], y[c], z[c] (so the distance loop
+// of a query vectorizes); block capacities c grow 4, 8, 16, ... up to
+// max_points_per_voxel, so sparse voxels stay small. Memory is reused: freed
+// blocks go to per-capacity free lists, and queries allocate nothing.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -65,18 +66,22 @@ class VoxelMap {
   template <class F>
   void ForEachPoint(F&& f) const {
     for (const Slot& s : slots_) {
-      if (s.block < 0) continue;
-      const float* x = BlockData(s.block);
-      const int n = counts_[s.block];
-      for (int i = 0; i < n; ++i) f(Eigen::Vector3d(x[i], x[i + cap_], x[i + 2 * cap_]));
+      if (s.offset < 0) continue;
+      const float* x = pool_.data() + s.offset;
+      for (int i = 0; i < s.count; ++i)
+        f(Eigen::Vector3d(x[i], x[i + s.capacity], x[i + 2 * s.capacity]));
     }
   }
   std::vector<Eigen::Vector3d> Points() const;
 
  private:
+  // One voxel: its key and its block x[capacity], y[capacity], z[capacity]
+  // at pool_[offset].
   struct Slot {
     VoxelKey key;
-    int32_t block = -1;  // -1: empty slot
+    int32_t offset = -1;  // -1: empty slot
+    int32_t count = 0;
+    int32_t capacity = 0;
   };
   struct Offset {
     int8_t dx, dy, dz;
@@ -84,14 +89,15 @@ class VoxelMap {
   class Candidates;
 
   int FindSlot(const VoxelKey& key) const;  // slot index, or -1
-  int FindOrCreateBlock(const VoxelKey& key);
-  int AllocateBlock();
-  void InsertSlot(const Slot& s);  // key must be absent; no growth check
+  int CreateSlot(const VoxelKey& key);      // key must be absent; returns its slot
+  void InsertSlot(const Slot& s);           // key must be absent; no growth check
   void Rebuild(size_t capacity, const std::vector<Slot>& slots);
-  const float* BlockData(int block) const { return pool_.data() + block * stride_; }
-  float* BlockData(int block) { return pool_.data() + block * stride_; }
+  int CapacityClass(int capacity) const;
+  int32_t AllocateBlock(int capacity);
+  void FreeBlock(int32_t offset, int capacity);
+  void GrowBlock(Slot* s);
 
-  void ScanBlock(int block, const float q[3], Candidates* c) const;
+  void ScanBlock(const Slot& s, const float q[3], Candidates* c) const;
   void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
                    const float q[3], Candidates* c) const;
   void VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
@@ -101,15 +107,13 @@ class VoxelMap {
   MapOptions options_;
   double inv_voxel_size_ = 1.0;
   float min_d2_ = 0.0f;
-  int cap_ = 1;     // points per voxel block
-  int stride_ = 3;  // floats per block (3 * cap_)
+  int max_points_ = 1;  // max_points_per_voxel
 
   std::vector<Slot> slots_;
   size_t mask_ = 0;
-  std::vector<float> pool_;        // blocks of x[cap], y[cap], z[cap]
-  std::vector<int32_t> counts_;    // points in each block
-  std::vector<int32_t> free_blocks_;
-  std::vector<Slot> scratch_slots_;  // reused by RemoveFar / growth
+  std::vector<float> pool_;                       // blocks of x[c], y[c], z[c]
+  std::vector<std::vector<int32_t>> free_blocks_;  // freed offsets per capacity class
+  std::vector<Slot> scratch_slots_;               // reused by RemoveFar / growth
   size_t num_voxels_ = 0;
   size_t num_points_ = 0;
 

@@ -21,9 +21,9 @@ namespace rvlio {
 struct PoseBlock {
   static constexpr int kNumParams = 7;
   static constexpr int kTangentDim = 6;
-  static constexpr int kQuat = 0;  // parameter offset of [qx qy qz qw]
-  static constexpr int kPos = 4;   // parameter offset of [px py pz]
-  static constexpr int kRot = 0;   // tangent offset of d_rot
+  static constexpr int kQuat = 0;   // parameter offset of [qx qy qz qw]
+  static constexpr int kPos = 4;    // parameter offset of [px py pz]
+  static constexpr int kRot = 0;    // tangent offset of d_rot
   static constexpr int kTrans = 3;  // tangent offset of d_pos
   using Tangent = Eigen::Matrix<double, 6, 1>;
   using PlusJacobianMatrix = Eigen::Matrix<double, 7, 6, Eigen::RowMajor>;
@@ -37,7 +37,7 @@ struct PoseBlock {
   explicit PoseBlock(const Pose3& T_world_imu);
 
   Pose3 ToPose3() const { return Pose3(q_world_imu, p_world_imu); }
-  void ToArray(double* params) const;               // writes 7 doubles
+  void ToArray(double* params) const;                // writes 7 doubles
   static PoseBlock FromArray(const double* params);  // reads 7 doubles
 
   // Raw-array forms of Plus / Minus / their Jacobians (for ceres::Manifold).
@@ -59,7 +59,7 @@ struct SpeedBiasBlock {
   Eigen::Vector3d bg = Eigen::Vector3d::Zero();
   Eigen::Vector3d ba = Eigen::Vector3d::Zero();
 
-  void ToArray(double* params) const;                    // writes 9 doubles
+  void ToArray(double* params) const;                     // writes 9 doubles
   static SpeedBiasBlock FromArray(const double* params);  // reads 9 doubles
 };
 

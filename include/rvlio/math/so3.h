@@ -22,9 +22,11 @@ namespace so3 {
 // Skew-symmetric matrix: Hat(w) v = w x v.
 inline Eigen::Matrix3d Hat(const Eigen::Vector3d& w) {
   Eigen::Matrix3d W;
+  // clang-format off
   W << 0.0, -w.z(), w.y(),
        w.z(), 0.0, -w.x(),
        -w.y(), w.x(), 0.0;
+  // clang-format on
   return W;
 }
 

@@ -47,7 +47,7 @@ class IeskfOdometry : public Odometry {
   std::deque<Scan> scans_;
   int scans_since_trim_ = 0;
   // Per-scan workspaces, reused to avoid allocation in the hot path.
-  std::vector<LidarPoint> kept_points_;
+  Scan downsampled_;
   std::vector<Eigen::Vector3d> p_lidar_end_;
   std::vector<Eigen::Vector3d> p_world_;
 };

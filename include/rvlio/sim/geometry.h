@@ -70,6 +70,9 @@ struct Face {
   int UAxis() const { return (axis + 1) % 3; }
   int VAxis() const { return (axis + 2) % 3; }
   bool Covers(double u, double v) const;
+  // The part [t0, t1] of [t_min, t_max] in which the ray is inside the slab
+  // |p[axis] - offset| <= amplitude bound that contains the surface.
+  bool Slab(const Ray& ray, double t_min, double t_max, double* t0, double* t1) const;
   // The first crossing of the ray with the (unbounded) height field in
   // [t_min, t_max]; true (and *t) when it lies inside the face.
   bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;

@@ -23,6 +23,7 @@ struct RayHit {
 
 class World {
  public:
+  static constexpr size_t kMaxFaces = 32;
   void AddFace(Face face, float reflectivity);
   void AddBox(const Box& box, float reflectivity);
   void AddCylinder(const Cylinder& cylinder, float reflectivity);

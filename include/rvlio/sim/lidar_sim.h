@@ -1,0 +1,46 @@
+#pragma once
+// Spinning multi-beam LiDAR (Ouster-like). Row r (ring, 0 = top beam) has
+// elevation vfov_max - r (vfov_max - vfov_min) / (beams - 1); column c has
+// azimuth -2 pi c / columns (clockwise seen from above, column 0 along +x) and
+// fires at scan start + c * period / columns, from the sensor pose at that
+// time (real motion distortion).
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rvlio/common/types.h"
+#include "rvlio/math/pose.h"
+#include "rvlio/sim/options.h"
+#include "rvlio/sim/random.h"
+#include "rvlio/sim/trajectory.h"
+#include "rvlio/sim/world.h"
+
+namespace rvlio::sim {
+
+class LidarModel {
+ public:
+  explicit LidarModel(const SimLidarOptions& options);
+  int rows() const { return rows_; }
+  int cols() const { return cols_; }
+  TimeNs period_ns() const { return period_ns_; }
+  TimeNs ColumnOffsetNs(int col) const { return static_cast<TimeNs>(col) * period_ns_ / cols_; }
+  // Unit beam direction in the LiDAR frame.
+  Eigen::Vector3d Direction(int row, int col) const {
+    return Eigen::Vector3d(cos_el_[row] * cos_az_[col], cos_el_[row] * sin_az_[col], sin_el_[row]);
+  }
+
+ private:
+  int rows_, cols_;
+  TimeNs period_ns_;
+  std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
+};
+
+// Casts one organized scan: rows x cols points, row-major by ring
+// (index = row * cols + col), p_lidar = 0 for no return, every point stamped
+// with its column time (also for no return).
+Scan CastScan(const World& world, const FlightTrajectory& trajectory, const LidarModel& model,
+              const SimLidarOptions& options, const Pose3& T_imu_lidar, TimeNs t_start_ns,
+              Rng& rng);
+
+}  // namespace rvlio::sim

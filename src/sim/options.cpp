@@ -1,0 +1,60 @@
+#include "rvlio/sim/options.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "rvlio/sim/trajectory.h"
+#include "rvlio/sim/world_builder.h"
+
+namespace rvlio {
+
+namespace {
+
+std::string Fmt(const Eigen::Vector3d& p) {
+  std::ostringstream os;
+  os << "[" << p.x() << ", " << p.y() << ", " << p.z() << "]";
+  return os.str();
+}
+
+// The flight must stay inside the shell, and start at the world origin.
+Status CheckWaypoints(const SimOptions& o) {
+  StatusOr<std::vector<Eigen::Vector3d>> wps = sim::ParseWaypoints(o.trajectory.waypoints);
+  if (!wps.ok()) return wps.status();
+  if (wps->front().norm() > 1e-9)
+    return Status::InvalidInput("trajectory.waypoints: the first waypoint must be 0,0,0 "
+                                "(the world origin is the start pose), got " + Fmt(wps->front()));
+  const sim::WorldLayout L = sim::MakeLayout(o.world);
+  const double far_x = o.world.end_wall ? L.x_end : L.x_end + 1e4;
+  for (const Eigen::Vector3d& p : *wps) {
+    const bool inside = p.x() > L.x_entrance + 0.3 && p.x() < far_x - 0.3 &&
+                        std::abs(p.y() - L.y_center) < L.half_width - 0.3 &&
+                        p.z() >= L.z_floor + 0.05 && p.z() < L.z_ceiling - 0.3;
+    if (!inside)
+      return Status::InvalidInput("trajectory.waypoints: " + Fmt(p) +
+                                  " is not inside the world (keep 0.3 m from every wall)");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status SimOptions::Validate() {
+  Status s = ValidateFields(*this);
+  if (!s.ok()) return s;
+  s = extrinsics.Validate();
+  if (!s.ok()) return s;
+  if (lidar.beams > 1 && !(lidar.vfov_max > lidar.vfov_min))
+    return Status::InvalidInput("lidar.vfov_max must be greater than lidar.vfov_min");
+  if (!(lidar.max_range > lidar.min_range))
+    return Status::InvalidInput("lidar.max_range must be greater than lidar.min_range");
+  if (duration * lidar.rate < 1.0)
+    return Status::InvalidInput("duration must cover at least one scan (1 / lidar.rate)");
+  if (world.roughness_wavelength_max < world.roughness_wavelength_min)
+    return Status::InvalidInput("world.roughness_wavelength_max must not be below "
+                                "world.roughness_wavelength_min");
+  if (world.start_height >= world.height - 0.3)
+    return Status::InvalidInput("world.start_height must be below world.height - 0.3");
+  return CheckWaypoints(*this);
+}
+
+}  // namespace rvlio

@@ -1,0 +1,160 @@
+#include "rvlio/lidar/preprocess.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <tuple>
+
+#include <gtest/gtest.h>
+
+namespace rvlio {
+namespace {
+
+Scan RandomScan(std::mt19937* rng, int n, double extent) {
+  std::uniform_real_distribution<float> u(-extent, extent);
+  Scan scan;
+  scan.t_start_ns = 1000;
+  scan.t_end_ns = 1000 + 100000000;
+  for (int i = 0; i < n; ++i) {
+    LidarPoint p;
+    p.p_lidar = Eigen::Vector3f(u(*rng), u(*rng), u(*rng));
+    p.t_ns = scan.t_start_ns + i * 1000;
+    p.ring = static_cast<uint16_t>(i % 32);
+    p.intensity = static_cast<float>(i);
+    scan.points.push_back(p);
+  }
+  return scan;
+}
+
+using Key = std::tuple<int, int, int>;
+Key KeyOfPoint(const Eigen::Vector3f& p, double s) {
+  const Eigen::Vector3d q = p.cast<double>();
+  return Key(static_cast<int>(std::floor(q.x() / s)), static_cast<int>(std::floor(q.y() / s)),
+             static_cast<int>(std::floor(q.z() / s)));
+}
+
+// Reference: the point nearest each voxel centre among strided, in-range points.
+TEST(Preprocess, OnePointPerVoxelNearestTheCentre) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  LidarOptions options;
+  for (int trial = 0; trial < 60; ++trial) {
+    options.voxel_size = 0.1 + 2.0 * unit(rng);
+    options.min_range = 2.0 * unit(rng);
+    options.max_range = options.min_range + 1.0 + 20.0 * unit(rng);
+    options.point_stride = 1 + trial % 3;
+    ScanPreprocessor p(options);
+    const Scan scan = RandomScan(&rng, 200 + static_cast<int>(20000 * unit(rng)), 25.0);
+    // The workspace is reused: a previous scan must leave nothing behind.
+    std::vector<int> indices;
+    p.SelectIndices(RandomScan(&rng, 5000, 25.0), &indices);
+
+    std::map<Key, int> best;
+    int in_range = 0;
+    for (int i = 0; i < static_cast<int>(scan.points.size()); ++i) {
+      if (i % options.point_stride != 0) continue;
+      const double r = scan.points[i].p_lidar.cast<double>().norm();
+      if (r < options.min_range || r > options.max_range) continue;
+      ++in_range;
+      const Key k = KeyOfPoint(scan.points[i].p_lidar, options.voxel_size);
+      const Eigen::Vector3d centre =
+          (Eigen::Vector3d(std::get<0>(k), std::get<1>(k), std::get<2>(k)).array() + 0.5) *
+          options.voxel_size;
+      auto dist = [&](int j) { return (scan.points[j].p_lidar.cast<double>() - centre).norm(); };
+      auto it = best.find(k);
+      if (it == best.end() || dist(i) < dist(it->second) - 1e-6) best[k] = i;
+    }
+
+    p.SelectIndices(scan, &indices);
+    ASSERT_EQ(indices.size(), best.size()) << "trial " << trial;
+    EXPECT_TRUE(std::is_sorted(indices.begin(), indices.end()));
+    std::map<Key, int> got;
+    for (const int i : indices) {
+      const double r = scan.points[i].p_lidar.cast<double>().norm();
+      EXPECT_GE(r, options.min_range);
+      EXPECT_LE(r, options.max_range);
+      EXPECT_EQ(i % options.point_stride, 0);
+      EXPECT_TRUE(got.emplace(KeyOfPoint(scan.points[i].p_lidar, options.voxel_size), i).second)
+          << "two points in one voxel";
+    }
+    for (const auto& [k, i] : best) {
+      ASSERT_TRUE(got.count(k));
+      // Same point, or one equally near the centre (float ties).
+      const Eigen::Vector3d centre =
+          (Eigen::Vector3d(std::get<0>(k), std::get<1>(k), std::get<2>(k)).array() + 0.5) *
+          options.voxel_size;
+      EXPECT_NEAR((scan.points[got[k]].p_lidar.cast<double>() - centre).norm(),
+                  (scan.points[i].p_lidar.cast<double>() - centre).norm(), 1e-5);
+    }
+    const PreprocessStats& s = p.stats();
+    EXPECT_EQ(s.num_input, static_cast<int>(scan.points.size()));
+    EXPECT_EQ(s.num_output, static_cast<int>(indices.size()));
+    EXPECT_EQ(s.num_input - s.num_strided_out - s.num_invalid - s.num_out_of_range, in_range);
+  }
+}
+
+TEST(Preprocess, VoxelSizeZeroKeepsEveryPointInRange) {
+  std::mt19937 rng(2);
+  LidarOptions options;
+  options.voxel_size = 0.0;
+  options.min_range = 5.0;
+  options.max_range = 15.0;
+  ScanPreprocessor pre(options);
+  const Scan scan = RandomScan(&rng, 5000, 20.0);
+  std::vector<int> indices;
+  pre.SelectIndices(scan, &indices);
+  int expected = 0;
+  for (const auto& p : scan.points) {
+    const double r = p.p_lidar.cast<double>().norm();
+    expected += (r >= 5.0 && r <= 15.0);
+  }
+  EXPECT_EQ(static_cast<int>(indices.size()), expected);
+  EXPECT_GT(expected, 500);
+}
+
+TEST(Preprocess, DownsampleCopiesPointsWithTheirTimes) {
+  std::mt19937 rng(3);
+  Scan scan = RandomScan(&rng, 3000, 10.0);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  scan.points[5].p_lidar.x() = nan;
+  scan.points[6].p_lidar.y() = std::numeric_limits<float>::infinity();
+  LidarOptions options;
+  options.voxel_size = 1.0;
+  options.min_range = 0.0;
+  ScanPreprocessor pre(options);
+  Scan out;
+  pre.Downsample(scan, &out);
+  std::vector<int> indices;
+  pre.SelectIndices(scan, &indices);
+  ASSERT_EQ(out.points.size(), indices.size());
+  EXPECT_EQ(out.t_start_ns, scan.t_start_ns);
+  EXPECT_EQ(out.t_end_ns, scan.t_end_ns);
+  EXPECT_EQ(pre.stats().num_invalid, 2);
+  for (size_t j = 0; j < indices.size(); ++j) {
+    const LidarPoint& a = out.points[j];
+    const LidarPoint& b = scan.points[indices[j]];
+    EXPECT_EQ(a.p_lidar, b.p_lidar);
+    EXPECT_EQ(a.t_ns, b.t_ns);
+    EXPECT_EQ(a.ring, b.ring);
+    EXPECT_EQ(a.intensity, b.intensity);
+    EXPECT_TRUE(a.p_lidar.allFinite());
+  }
+  // Repeated use of the same preprocessor gives the same answer.
+  Scan again;
+  pre.Downsample(scan, &again);
+  ASSERT_EQ(again.points.size(), out.points.size());
+  for (size_t j = 0; j < out.points.size(); ++j) EXPECT_EQ(again.points[j].t_ns, out.points[j].t_ns);
+}
+
+TEST(Preprocess, EmptyScan) {
+  ScanPreprocessor pre{LidarOptions()};
+  std::vector<int> indices = {1, 2, 3};
+  pre.SelectIndices(Scan(), &indices);
+  EXPECT_TRUE(indices.empty());
+  EXPECT_EQ(pre.stats().num_output, 0);
+}
+
+}  // namespace
+}  // namespace rvlio

@@ -1,0 +1,223 @@
+#include "rvlio/map/voxel_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace rvlio {
+namespace {
+
+std::vector<Eigen::Vector3d> RandomCloud(std::mt19937* rng, int n, double half_extent) {
+  std::uniform_real_distribution<double> u(-half_extent, half_extent);
+  std::vector<Eigen::Vector3d> pts(n);
+  for (auto& p : pts) p = Eigen::Vector3d(u(*rng), u(*rng), u(*rng));
+  return pts;
+}
+
+// Squared distances of the k nearest points within max_dist, by brute force.
+std::vector<double> BruteForce(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& q,
+                               int k, double max_dist) {
+  std::vector<double> d2;
+  for (const auto& p : pts) {
+    const double d = (p - q).squaredNorm();
+    if (d <= max_dist * max_dist) d2.push_back(d);
+  }
+  std::sort(d2.begin(), d2.end());
+  if (static_cast<int>(d2.size()) > k) d2.resize(k);
+  return d2;
+}
+
+bool NearBoundary(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& q,
+                  double max_dist) {
+  for (const auto& p : pts)
+    if (std::abs((p - q).norm() - max_dist) < 1e-4) return true;
+  return false;
+}
+
+TEST(VoxelMap, KNearestMatchesBruteForce) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int checked = 0, partial = 0, empty = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    MapOptions options;
+    options.voxel_size = 0.2 + 1.8 * unit(rng);
+    options.max_points_per_voxel = 1 + static_cast<int>(40 * unit(rng));
+    options.min_point_distance = (trial % 3 == 0) ? 0.0 : 0.05 * unit(rng);
+    VoxelMap map(options);
+    const double half_extent = 1.0 + 9.0 * unit(rng);
+    const int n = static_cast<int>(3000 * unit(rng));
+    map.Insert(RandomCloud(&rng, n, half_extent));
+    // The reference is what the map actually stored (capacity and spacing drop points).
+    const std::vector<Eigen::Vector3d> stored = map.Points();
+    ASSERT_EQ(stored.size(), map.Size());
+
+    for (int query = 0; query < 20; ++query) {
+      const double reach = (query % 4 == 0) ? 3.0 * half_extent : 1.2 * half_extent;
+      std::uniform_real_distribution<double> uq(-reach, reach);
+      const Eigen::Vector3d q(uq(rng), uq(rng), uq(rng));
+      const int k = (query % 5 == 0) ? kMaxNeighbors : 1 + static_cast<int>(10 * unit(rng));
+      const double max_dist = (query % 7 == 0) ? 100.0 : 0.05 + 4.0 * unit(rng);
+      if (NearBoundary(stored, q, max_dist)) continue;  // float storage vs the exact bound
+      NeighborBuffer nb;
+      const int found = map.KNearest(q, k, max_dist, &nb);
+      const std::vector<double> expected = BruteForce(stored, q, k, max_dist);
+      ASSERT_EQ(found, static_cast<int>(expected.size()))
+          << "trial " << trial << " query " << query;
+      ASSERT_EQ(nb.size, found);
+      for (int i = 0; i < found; ++i) {
+        EXPECT_NEAR(nb.dist2[i], expected[i], 1e-9 + 1e-6 * expected[i]) << "rank " << i;
+        EXPECT_NEAR((nb.points[i] - q).squaredNorm(), nb.dist2[i], 1e-9);
+        if (i > 0) {
+          EXPECT_LE(nb.dist2[i - 1], nb.dist2[i]);
+        }
+      }
+      ++checked;
+      if (found > 0 && found < k) ++partial;
+      if (found == 0) ++empty;
+    }
+  }
+  // The random setup must exercise full, partial and empty answers.
+  EXPECT_GT(checked, 3500);
+  EXPECT_GT(partial, 100);
+  EXPECT_GT(empty, 100);
+}
+
+// Small voxels, many of them: the shell-by-shell search (not the scan over
+// all voxels) has to go beyond the precomputed shells.
+TEST(VoxelMap, DeepShellSearchMatchesBruteForce) {
+  std::mt19937 rng(5);
+  MapOptions options;
+  options.voxel_size = 0.25;
+  options.min_point_distance = 0.0;
+  VoxelMap map(options);
+  map.Insert(RandomCloud(&rng, 30000, 10.0));
+  const std::vector<Eigen::Vector3d> stored = map.Points();
+  std::uniform_real_distribution<double> uq(-10.0, 10.0);
+  for (int query = 0; query < 200; ++query) {
+    const Eigen::Vector3d q(uq(rng), uq(rng), uq(rng));
+    const int k = 10 + query % 20;
+    const double max_dist = 1.6;
+    if (NearBoundary(stored, q, max_dist)) continue;
+    NeighborBuffer nb;
+    const std::vector<double> expected = BruteForce(stored, q, k, max_dist);
+    ASSERT_EQ(map.KNearest(q, k, max_dist, &nb), static_cast<int>(expected.size()));
+    for (int i = 0; i < nb.size; ++i) EXPECT_NEAR(nb.dist2[i], expected[i], 1e-6 * expected[i]);
+  }
+}
+
+TEST(VoxelMap, EmptyMapAndBadQueries) {
+  VoxelMap map;
+  NeighborBuffer nb;
+  EXPECT_EQ(map.KNearest(Eigen::Vector3d::Zero(), 5, 1.0, &nb), 0);
+  map.Insert({Eigen::Vector3d(0.1, 0.2, 0.3)});
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(map.KNearest(Eigen::Vector3d(nan, 0, 0), 5, 1.0, &nb), 0);
+  EXPECT_EQ(map.KNearest(Eigen::Vector3d::Zero(), 5, 0.0, &nb), 0);
+  EXPECT_EQ(map.KNearest(Eigen::Vector3d::Zero(), 5, 1.0, &nb), 1);
+  EXPECT_NEAR(nb.points[0].y(), 0.2, 1e-6);
+}
+
+TEST(VoxelMap, InsertRespectsCapacityAndSpacing) {
+  MapOptions options;
+  options.voxel_size = 1.0;
+  options.max_points_per_voxel = 4;
+  options.min_point_distance = 0.1;
+  VoxelMap map(options);
+  EXPECT_TRUE(map.InsertPoint(Eigen::Vector3d(0.5, 0.5, 0.5)));
+  EXPECT_FALSE(map.InsertPoint(Eigen::Vector3d(0.55, 0.5, 0.5)));  // 5 cm from a stored point
+  EXPECT_TRUE(map.InsertPoint(Eigen::Vector3d(0.65, 0.5, 0.5)));
+  EXPECT_TRUE(map.InsertPoint(Eigen::Vector3d(0.8, 0.5, 0.5)));
+  EXPECT_TRUE(map.InsertPoint(Eigen::Vector3d(0.95, 0.5, 0.5)));
+  EXPECT_FALSE(map.InsertPoint(Eigen::Vector3d(0.1, 0.1, 0.1)));  // voxel full
+  // Spacing applies within a voxel only: 2 cm away but across the boundary.
+  EXPECT_TRUE(map.InsertPoint(Eigen::Vector3d(1.01, 0.5, 0.5)));
+  EXPECT_FALSE(map.InsertPoint(Eigen::Vector3d(std::numeric_limits<double>::infinity(), 0, 0)));
+  EXPECT_EQ(map.Size(), 5u);
+  EXPECT_EQ(map.NumVoxels(), 2u);
+}
+
+TEST(VoxelMap, GrowthKeepsEveryPoint) {
+  MapOptions options;
+  options.voxel_size = 0.5;
+  options.min_point_distance = 0.0;
+  options.max_points_per_voxel = 1000;
+  VoxelMap map(options);
+  std::mt19937 rng(7);
+  // 20k points on a 200 m line: thousands of voxels, several table growths.
+  std::vector<Eigen::Vector3d> pts;
+  std::uniform_real_distribution<double> u(-100.0, 100.0), v(-0.3, 0.3);
+  for (int i = 0; i < 20000; ++i) pts.emplace_back(u(rng), v(rng), v(rng));
+  map.Insert(pts);
+  EXPECT_EQ(map.Size(), pts.size());
+  NeighborBuffer nb;
+  for (int i = 0; i < 2000; i += 7) {
+    ASSERT_EQ(map.KNearest(pts[i], 1, 0.5, &nb), 1);
+    EXPECT_LT(nb.dist2[0], 1e-10);
+  }
+}
+
+TEST(VoxelMap, RemoveFarKeepsTheWindow) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    MapOptions options;
+    options.voxel_size = 0.3 + unit(rng);
+    options.min_point_distance = 0.0;
+    options.max_points_per_voxel = 1000;
+    VoxelMap map(options);
+    const std::vector<Eigen::Vector3d> pts = RandomCloud(&rng, 5000, 20.0);
+    map.Insert(pts);
+    ASSERT_EQ(map.Size(), pts.size());
+    const Eigen::Vector3d center = 10.0 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    const double radius = 5.0 + 10.0 * unit(rng);
+    map.RemoveFar(center, radius);
+
+    // A point's voxel centre is within half a voxel diagonal of the point.
+    const double half_diag = 0.5 * std::sqrt(3.0) * options.voxel_size;
+    size_t must_keep = 0, may_keep = 0;
+    for (const auto& p : pts) {
+      const double d = (p - center).norm();
+      if (d < radius - half_diag) ++must_keep;
+      if (d <= radius + half_diag) ++may_keep;
+    }
+    EXPECT_GE(map.Size(), must_keep);
+    EXPECT_LE(map.Size(), may_keep);
+    map.ForEachPoint([&](const Eigen::Vector3d& p) {
+      EXPECT_LE((p - center).norm(), radius + half_diag + 1e-6);
+    });
+    // Queries still work after the rebuild and see only the kept points.
+    NeighborBuffer nb;
+    for (const auto& p : pts) {
+      const double d = (p - center).norm();
+      if (d < radius - half_diag) {
+        ASSERT_EQ(map.KNearest(p, 1, 0.01, &nb), 1);
+        EXPECT_LT(nb.dist2[0], 1e-10);
+      } else if (d > radius + half_diag) {
+        EXPECT_EQ(map.KNearest(p, 1, 1e-3, &nb), 0);
+      }
+    }
+    // Freed blocks are reused: re-inserting everything adds every point again.
+    const size_t kept = map.Size();
+    map.Insert(pts);
+    EXPECT_EQ(map.Size(), kept + pts.size());
+  }
+}
+
+TEST(VoxelMap, ClearEmptiesTheMap) {
+  VoxelMap map;
+  std::mt19937 rng(1);
+  map.Insert(RandomCloud(&rng, 1000, 5.0));
+  EXPECT_GT(map.Size(), 0u);
+  map.Clear();
+  EXPECT_EQ(map.Size(), 0u);
+  EXPECT_EQ(map.NumVoxels(), 0u);
+  NeighborBuffer nb;
+  EXPECT_EQ(map.KNearest(Eigen::Vector3d::Zero(), 3, 10.0, &nb), 0);
+}
+
+}  // namespace
+}  // namespace rvlio
