@@ -53,7 +53,7 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
   os.precision(9);
   os << "t,status,raw_points,points,constraints,iterations,rv_active,n_alpha_x,n_alpha_y,"
         "n_alpha_z,scv,coplanar,repaired,K,rv_iterations,coplanar_fraction,localizability,"
-        "ms,x,y,z\n";
+        "ms,x,y,z,acc_x,acc_y,acc_z\n";
   for (const ScanResult& r : results) {
     const RvReport& v = r.rv;
     os << NsToSeconds(r.t_ns) << ',' << ScanStatusName(r.status) << ',' << r.raw_points << ','
@@ -62,7 +62,8 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
        << v.n_alpha.z() << ',' << v.num_scv << ',' << v.num_coplanar << ',' << v.num_repaired
        << ',' << v.K << ',' << v.iterations << ',' << v.coplanar_fraction << ','
        << v.localizability << ',' << r.ms << ',' << r.T_world_imu.t.x() << ','
-       << r.T_world_imu.t.y() << ',' << r.T_world_imu.t.z() << '\n';
+       << r.T_world_imu.t.y() << ',' << r.T_world_imu.t.z() << ',' << r.mean_acc_imu.x() << ','
+       << r.mean_acc_imu.y() << ',' << r.mean_acc_imu.z() << '\n';
   }
   return WriteFileAtomically(path, os.str());
 }

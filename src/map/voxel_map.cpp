@@ -15,8 +15,12 @@ constexpr size_t kInitialCapacity = 1024;  // slots (power of two)
 constexpr int kDistanceChunk = 64;         // points per vectorized distance pass
 constexpr int kFirstBlockCapacity = 4;     // points in a new voxel's block
 
-// Offsets of Chebyshev norm r, faces first, then edges, then corners (by the
-// number of non-zero components) so that queries tighten their bound early.
+// Offsets of Chebyshev norm r, ordered for a query in the upper octant of
+// its voxel (local coordinates in [s/2, s) on every axis): by a lower bound
+// of the squared box distance, then by the number of non-zero components.
+// Queries in other octants mirror the offsets (VisitShell), so the voxels
+// most likely to hold the nearest points come first and tighten the bound
+// before the rest can be pruned without a hash lookup.
 template <class Offset>
 std::vector<Offset> MakeShell(int r) {
   std::vector<Offset> shell;
@@ -26,11 +30,15 @@ std::vector<Offset> MakeShell(int r) {
         if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) == r)
           shell.push_back(Offset{static_cast<int8_t>(dx), static_cast<int8_t>(dy),
                                  static_cast<int8_t>(dz)});
-  auto rank = [](const Offset& o) {
-    return std::abs(o.dx) + std::abs(o.dy) + std::abs(o.dz);
+  auto gap = [](int d) { return d > 0 ? d - 1.0 : (d < 0 ? -d - 0.5 : 0.0); };
+  auto bound = [&](const Offset& o) {
+    return gap(o.dx) * gap(o.dx) + gap(o.dy) * gap(o.dy) + gap(o.dz) * gap(o.dz);
   };
-  std::stable_sort(shell.begin(), shell.end(),
-                   [&](const Offset& a, const Offset& b) { return rank(a) < rank(b); });
+  auto nonzero = [](const Offset& o) { return (o.dx != 0) + (o.dy != 0) + (o.dz != 0); };
+  std::stable_sort(shell.begin(), shell.end(), [&](const Offset& a, const Offset& b) {
+    if (bound(a) != bound(b)) return bound(a) < bound(b);
+    return nonzero(a) < nonzero(b);
+  });
   return shell;
 }
 
@@ -276,7 +284,12 @@ void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const d
 void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
                           Candidates* c) const {
   if (r <= kPrecomputedShells) {
-    for (const Offset& o : shells_[r]) VisitOffset(home, o.dx, o.dy, o.dz, q_local, q, c);
+    const double half = 0.5 * options_.voxel_size;  // mirror into the query's octant
+    const int sx = q_local[0] < half ? -1 : 1;
+    const int sy = q_local[1] < half ? -1 : 1;
+    const int sz = q_local[2] < half ? -1 : 1;
+    for (const Offset& o : shells_[r])
+      VisitOffset(home, sx * o.dx, sy * o.dy, sz * o.dz, q_local, q, c);
     return;
   }
   for (int dx = -r; dx <= r; ++dx) {

@@ -91,7 +91,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   Scan scan = std::move(scans_.front());
   scans_.pop_front();
   const auto start = std::chrono::steady_clock::now();
-  Predict(scan.t_end_ns);
+  const Eigen::Vector3d mean_acc_imu = Predict(scan.t_end_ns);
   preprocessor_.Downsample(scan, &downsampled_);
   if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {
     ++stats_.scans_too_few_points;
@@ -102,6 +102,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
                   scan.t_end_ns, &p_lidar_end_);
   ScanResult r;
   r.raw_points = static_cast<int>(scan.points.size());
+  r.mean_acc_imu = mean_acc_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.status = map_.Empty() ? ScanStatus::kMapInit : Correct(&r);
   InsertIntoMap();
@@ -116,12 +117,17 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
 
 // Propagates with every buffered IMU sample up to the scan end, then to the
 // scan end itself.
-void IeskfOdometry::Predict(TimeNs t_end_ns) {
+Eigen::Vector3d IeskfOdometry::Predict(TimeNs t_end_ns) {
+  Eigen::Vector3d acc_sum = Eigen::Vector3d::Zero();
+  int n = 0;
   while (!imu_buffer_.empty() && imu_buffer_.front().t_ns <= t_end_ns) {
     filter_.Propagate(imu_buffer_.front());
+    acc_sum += imu_buffer_.front().acc_imu;
+    ++n;
     imu_buffer_.pop_front();
   }
   filter_.PropagateTo(t_end_ns);
+  return n > 0 ? Eigen::Vector3d(acc_sum / n) : Eigen::Vector3d::Zero();
 }
 
 // Associate -> RV -> Update, iterated inside the filter (paper Alg. 3).

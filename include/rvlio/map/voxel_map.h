@@ -117,8 +117,8 @@ class VoxelMap {
   size_t num_voxels_ = 0;
   size_t num_points_ = 0;
 
-  // shells_[r]: voxel offsets with Chebyshev norm r, faces before edges before
-  // corners (better pruning), for r <= kPrecomputedShells.
+  // shells_[r]: voxel offsets with Chebyshev norm r in visiting order (see
+  // MakeShell), for r <= kPrecomputedShells.
   static constexpr int kPrecomputedShells = 3;
   std::array<std::vector<Offset>, kPrecomputedShells + 1> shells_;
 };

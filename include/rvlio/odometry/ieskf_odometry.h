@@ -30,7 +30,8 @@ class IeskfOdometry : public Odometry {
  private:
   void TryInitialize(const ImuSample& imu);
   void ProcessFrontScan(std::vector<ScanResult>* out);
-  void Predict(TimeNs t_end_ns);
+  // Returns the mean specific force of the samples used (IMU frame).
+  Eigen::Vector3d Predict(TimeNs t_end_ns);
   ScanStatus Correct(ScanResult* r);
   void InsertIntoMap();
 

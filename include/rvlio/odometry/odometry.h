@@ -35,6 +35,7 @@ struct ScanResult {
   int iterations = 0;
   RvReport rv;
   double ms = 0.0;  // processing time of this scan, wall clock
+  Eigen::Vector3d mean_acc_imu = Eigen::Vector3d::Zero();  // mean specific force over the scan, m/s^2
 };
 
 // Counts of what was skipped or repaired, reported in summary.json.

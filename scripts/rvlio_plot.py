@@ -1,0 +1,630 @@
+#!/usr/bin/env python3
+"""Plots of rvlio run directories (issue 7): trajectories, RV profile, ablations.
+
+Usage:
+  rvlio_plot.py trajectories --gt GT.tum --run LABEL=DIR [--run ...] --out PREFIX
+                             [--align origin|se3|none] [--max-dt S] [--no-z]
+  rvlio_plot.py rv-profile   --run DIR [--gt GT.tum] --out PREFIX
+  rvlio_plot.py ablation     --table CSV --out PREFIX [--metric NAME ...]
+                             [--yscale auto|linear|log]
+  rvlio_plot.py check        (exit 0 when matplotlib is usable)
+
+Inputs follow the run-directory contract of `rvlio run` (DESIGN.md section 6):
+DIR/trajectory.tum (t x y z qx qy qz qw, seconds), DIR/scans.csv (one row per
+scan) and DIR/summary.json. Every plot is written as PREFIX_<kind>.png (150 dpi)
+and PREFIX_<kind>.pdf, atomically (temp file, then rename); the written paths
+and a few figures (matched poses, along-axis error) go to stdout.
+
+Exit status: 0 success; 2 bad input (one line `rvlio_plot: error: ...` on
+stderr, nothing written); 3 matplotlib/numpy not available; 1 internal error.
+
+Matplotlib comes from Debian (python3-matplotlib, Agg backend, no display).
+When the running interpreter lacks it (e.g. a pyenv python3 first on PATH),
+the script re-executes itself once with /usr/bin/python3.
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import sys
+import tempfile
+
+PROG = "rvlio_plot"
+SYSTEM_PYTHON = "/usr/bin/python3"
+REEXEC_ENV = "RVLIO_PLOT_REEXEC"
+DPI = 150
+EXIT_BAD_INPUT = 2
+EXIT_NO_MATPLOTLIB = 3
+
+np = None  # numpy, bound by LoadPlotting()
+plt = None  # matplotlib.pyplot, bound by LoadPlotting()
+
+
+class PlotError(Exception):
+  """Bad input: reported as one line on stderr with exit status 2."""
+
+
+def Fail(message, code):
+  sys.stderr.write("%s: error: %s\n" % (PROG, message))
+  sys.exit(code)
+
+
+# --------------------------------------------------------------------------
+# Environment: matplotlib from Debian, re-exec with the system python if needed
+# --------------------------------------------------------------------------
+
+def ReexecWithSystemPython():
+  """Re-runs this script with /usr/bin/python3 when that is another interpreter."""
+  if os.environ.get(REEXEC_ENV) or not os.path.exists(SYSTEM_PYTHON):
+    return
+  if os.path.realpath(sys.executable) == os.path.realpath(SYSTEM_PYTHON):
+    return
+  env = dict(os.environ, **{REEXEC_ENV: "1"})
+  sys.stdout.flush()
+  os.execve(SYSTEM_PYTHON, [SYSTEM_PYTHON, os.path.abspath(__file__)] + sys.argv[1:], env)
+
+
+def LoadPlotting():
+  """Imports numpy and matplotlib (Agg); exits 3 with a hint when missing."""
+  global np, plt
+  try:
+    import numpy
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as pyplot
+  except ImportError as e:
+    ReexecWithSystemPython()
+    Fail("matplotlib is not available (%s); install python3-matplotlib" % e,
+         EXIT_NO_MATPLOTLIB)
+  np, plt = numpy, pyplot
+  plt.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3,
+                       "legend.fontsize": 8, "figure.dpi": DPI})
+
+
+# --------------------------------------------------------------------------
+# Input files
+# --------------------------------------------------------------------------
+
+def ReadTum(path):
+  """Reads a TUM file -> (t [N], p [N,3], q_xyzw [N,4]); '#' lines are comments."""
+  if not os.path.isfile(path):
+    raise PlotError("cannot read %s: no such file" % path)
+  rows = []
+  with open(path) as f:
+    for number, line in enumerate(f, 1):
+      text = line.strip()
+      if not text or text.startswith("#"):
+        continue
+      fields = text.split()
+      try:
+        values = [float(v) for v in fields]
+      except ValueError:
+        values = []
+      if len(values) != 8 or not all(math.isfinite(v) for v in values):
+        raise PlotError("%s:%d: expected 8 numbers 't x y z qx qy qz qw'" % (path, number))
+      rows.append(values)
+  if not rows:
+    raise PlotError("%s: no poses" % path)
+  data = np.array(rows)
+  order = np.argsort(data[:, 0], kind="stable")
+  data = data[order]
+  return data[:, 0], data[:, 1:4], data[:, 4:8]
+
+
+def ToFloat(text):
+  try:
+    return float(text)
+  except (TypeError, ValueError):
+    return float("nan")
+
+
+def ReadScansCsv(path, required):
+  """Reads scans.csv -> dict column -> numpy array (NaN where not numeric)."""
+  if not os.path.isfile(path):
+    raise PlotError("cannot read %s: no such file" % path)
+  with open(path, newline="") as f:
+    reader = csv.DictReader(f)
+    header = [h.strip() for h in (reader.fieldnames or [])]
+    missing = [c for c in required if c not in header]
+    if missing:
+      raise PlotError("%s: missing column(s) %s" % (path, ", ".join(missing)))
+    rows = list(reader)
+  if not rows:
+    raise PlotError("%s: no scans" % path)
+  columns = {}
+  for name in header:
+    if name == "status":
+      columns[name] = [r.get(name, "") for r in rows]
+    else:
+      columns[name] = np.array([ToFloat(r.get(name)) for r in rows])
+  if not np.all(np.isfinite(columns["t"])):
+    raise PlotError("%s: column t is not numeric in every row" % path)
+  return columns
+
+
+def ReadSummary(run_dir):
+  """summary.json of a run, or {} when absent (it is informational only)."""
+  path = os.path.join(run_dir, "summary.json")
+  if not os.path.isfile(path):
+    return {}
+  try:
+    with open(path) as f:
+      summary = json.load(f)
+  except ValueError as e:
+    raise PlotError("%s: not valid JSON (%s)" % (path, e))
+  return summary if isinstance(summary, dict) else {}
+
+
+def RunTrajectoryPath(run):
+  """A run is a directory holding trajectory.tum or a TUM file itself."""
+  return os.path.join(run, "trajectory.tum") if os.path.isdir(run) else run
+
+
+def ParseRunSpec(spec):
+  """'LABEL=DIR' -> (LABEL, DIR); a bare DIR is labelled by its base name."""
+  if "=" in spec:
+    label, path = spec.split("=", 1)
+    if label and path:
+      return label, path
+    raise PlotError("--run %s: expected LABEL=DIR" % spec)
+  return os.path.basename(os.path.normpath(spec)) or spec, spec
+
+
+# --------------------------------------------------------------------------
+# Trajectory math (numpy)
+# --------------------------------------------------------------------------
+
+def QuatToRot(q_xyzw):
+  """Rotation matrices [N,3,3] of unit quaternions (x, y, z, w)."""
+  q = q_xyzw / np.linalg.norm(q_xyzw, axis=1, keepdims=True)
+  x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+  return np.stack([
+      np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+      np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+      np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+  ], -2)
+
+
+def Associate(t_est, t_gt, max_dt):
+  """Index pairs (i_est, i_gt) of each estimate and its nearest GT stamp within max_dt."""
+  right = np.clip(np.searchsorted(t_gt, t_est), 1, len(t_gt) - 1) if len(t_gt) > 1 else \
+      np.zeros(len(t_est), dtype=int)
+  left = np.maximum(right - 1, 0)
+  pick_left = np.abs(t_est - t_gt[left]) <= np.abs(t_gt[right] - t_est)
+  nearest = np.where(pick_left, left, right)
+  ok = np.abs(t_gt[nearest] - t_est) <= max_dt
+  return np.nonzero(ok)[0], nearest[ok]
+
+
+def UmeyamaSe3(p_est, p_gt):
+  """R, t minimising sum |p_gt - (R p_est + t)|^2 (Umeyama 1991, no scale)."""
+  mu_est, mu_gt = p_est.mean(0), p_gt.mean(0)
+  sigma = (p_gt - mu_gt).T @ (p_est - mu_est) / len(p_est)
+  u, _, vt = np.linalg.svd(sigma)
+  d = np.diag([1.0, 1.0, np.sign(np.linalg.det(u) * np.linalg.det(vt)) or 1.0])
+  r = u @ d @ vt
+  return r, mu_gt - r @ mu_est
+
+
+def Alignment(mode, est, gt, i_est, i_gt):
+  """R, t mapping estimate positions into the GT frame."""
+  if mode == "none":
+    return np.eye(3), np.zeros(3)
+  if mode == "origin":  # T = T_gt0 * T_est0^-1 at the first matched pose
+    r_gt = QuatToRot(gt[2][i_gt[:1]])[0]
+    r_est = QuatToRot(est[2][i_est[:1]])[0]
+    r = r_gt @ r_est.T
+    return r, gt[1][i_gt[0]] - r @ est[1][i_est[0]]
+  if len(i_est) < 3:
+    raise PlotError("se3 alignment needs at least 3 matched poses")
+  return UmeyamaSe3(est[1][i_est], gt[1][i_gt])
+
+
+def TunnelAxis(p_gt):
+  """Unit principal axis of the GT positions, pointing from start to end."""
+  centered = p_gt - p_gt.mean(0)
+  eigenvalues, eigenvectors = np.linalg.eigh(centered.T @ centered)
+  axis = eigenvectors[:, -1] if eigenvalues[-1] > 1e-12 else np.array([1.0, 0.0, 0.0])
+  travel = float(axis @ (p_gt[-1] - p_gt[0]))
+  if travel < 0 or (travel == 0 and axis[np.argmax(np.abs(axis))] < 0):
+    axis = -axis
+  return axis
+
+
+class RunErrors(object):
+  """One run aligned to GT: aligned positions and along-axis error per match."""
+
+  def __init__(self, label, est, gt, align, max_dt, axis):
+    i_est, i_gt = Associate(est[0], gt[0], max_dt)
+    if len(i_est) == 0:
+      raise PlotError("run '%s': no estimate stamp within %g s of a GT stamp" % (label, max_dt))
+    r, t = Alignment(align, est, gt, i_est, i_gt)
+    self.label = label
+    self.num_poses = len(est[0])
+    self.t = est[0]
+    self.p = est[1] @ r.T + t
+    self.t_match = est[0][i_est]
+    self.axis_error = (self.p[i_est] - gt[1][i_gt]) @ axis
+
+  def Describe(self):
+    e = np.abs(self.axis_error)
+    return "run '%s': %d/%d poses matched, along-axis error max %.4f m, final %.4f m" % (
+        self.label, len(e), self.num_poses, e.max(), self.axis_error[-1])
+
+
+# --------------------------------------------------------------------------
+# Output
+# --------------------------------------------------------------------------
+
+def SaveFigure(fig, prefix, kind):
+  """Writes PREFIX_kind.png and .pdf atomically; returns the paths."""
+  directory = os.path.dirname(os.path.abspath(prefix))
+  os.makedirs(directory, exist_ok=True)
+  finals, temps = [], []
+  umask = os.umask(0)
+  os.umask(umask)
+  try:
+    for ext in ("png", "pdf"):
+      final = "%s_%s.%s" % (prefix, kind, ext)
+      fd, temp = tempfile.mkstemp(prefix=".%s." % os.path.basename(final), dir=directory)
+      temps.append(temp)
+      with os.fdopen(fd, "wb") as f:
+        fig.savefig(f, format=ext, dpi=DPI)
+      os.chmod(temp, 0o666 & ~umask)  # mkstemp creates 0600
+      finals.append(final)
+    for temp, final in zip(temps, finals):
+      os.replace(temp, final)
+  except OSError as e:
+    raise PlotError("cannot write %s_%s: %s" % (prefix, kind, e))
+  finally:
+    plt.close(fig)
+    for temp in temps:
+      if os.path.exists(temp):
+        os.remove(temp)
+  for final in finals:
+    print("wrote %s" % final)
+  return finals
+
+
+def ColorCycle():
+  return plt.rcParams["axes.prop_cycle"].by_key()["color"]
+
+
+# --------------------------------------------------------------------------
+# trajectories
+# --------------------------------------------------------------------------
+
+def PlotTopView(ax, gt, runs, colors):
+  ax.plot(gt[1][:, 0], gt[1][:, 1], color="black", lw=2.2, ls="--", label="ground truth",
+          zorder=3)
+  ax.plot(gt[1][0, 0], gt[1][0, 1], "ko", ms=5, zorder=4)
+  for run, color in zip(runs, colors):
+    ax.plot(run.p[:, 0], run.p[:, 1], color=color, lw=1.3, label=run.label)
+    ax.plot(run.p[-1, 0], run.p[-1, 1], "x", color=color, ms=7, mew=2)
+  ax.set_xlabel("x [m]")
+  ax.set_ylabel("y [m]")
+  ax.set_title("(a) Top view (o start, x end of each run)")
+  ax.legend(loc="best")
+
+
+def PlotAxisError(ax, runs, colors, t0, axis):
+  for run, color in zip(runs, colors):
+    ax.plot(run.t_match - t0, run.axis_error, color=color, lw=1.3,
+            label="%s (max |e| %.3g m)" % (run.label, np.abs(run.axis_error).max()))
+  ax.axhline(0.0, color="black", lw=0.8)
+  ax.set_xlabel("time [s]")
+  ax.set_ylabel("along-axis error [m]")
+  ax.set_title("(b) Error along the tunnel axis (%.2f, %.2f, %.2f)" % tuple(axis + 0.0))
+  ax.legend(loc="best")
+
+
+def PlotHeight(ax, gt, runs, colors, t0):
+  ax.plot(gt[0] - t0, gt[1][:, 2], color="black", lw=2.2, ls="--", label="ground truth")
+  for run, color in zip(runs, colors):
+    ax.plot(run.t - t0, run.p[:, 2], color=color, lw=1.3, label=run.label)
+  ax.set_xlabel("time [s]")
+  ax.set_ylabel("z [m]")
+  ax.set_title("(c) Height over time")
+  ax.legend(loc="best")
+
+
+def CmdTrajectories(args):
+  if not args.run:
+    raise PlotError("trajectories: give at least one --run LABEL=DIR")
+  gt = ReadTum(args.gt)
+  axis = TunnelAxis(gt[1])
+  runs = []
+  for spec in args.run:
+    label, path = ParseRunSpec(spec)
+    est = ReadTum(RunTrajectoryPath(path))
+    runs.append(RunErrors(label, est, gt, args.align, args.max_dt, axis))
+  for run in runs:
+    print(run.Describe())
+  t0 = gt[0][0]
+  colors = [ColorCycle()[i % len(ColorCycle())] for i in range(len(runs))]
+  panels = 2 if args.no_z else 3
+  fig, axes = plt.subplots(panels, 1, figsize=(9, 3.1 * panels + 0.6),
+                           gridspec_kw={"height_ratios": [1.3] + [1] * (panels - 1)})
+  PlotTopView(axes[0], gt, runs, colors)
+  PlotAxisError(axes[1], runs, colors, t0, axis)
+  if not args.no_z:
+    PlotHeight(axes[2], gt, runs, colors, t0)
+    axes[2].sharex(axes[1])
+  fig.suptitle("Trajectories vs ground truth %s (alignment: %s)"
+               % (os.path.basename(args.gt), args.align), fontsize=11)
+  fig.tight_layout()
+  SaveFigure(fig, args.out, "trajectories")
+
+
+# --------------------------------------------------------------------------
+# rv-profile
+# --------------------------------------------------------------------------
+
+RV_REQUIRED = ("t", "rv_active", "scv", "constraints")
+
+
+def ShadeActive(ax, t, active, label=None):
+  """Shaded spans where rv_active == 1 (step-wise around each scan stamp)."""
+  ax.fill_between(t, 0, 1, where=active > 0.5, step="mid", color="tab:orange", alpha=0.18,
+                  lw=0, transform=ax.get_xaxis_transform(), label=label)
+
+
+def RunTitle(run_dir, summary):
+  parts = []
+  if "backend" in summary:
+    parts.append("backend %s" % summary["backend"])
+  rv = summary.get("config", {}).get("rv", {}) if isinstance(summary.get("config"), dict) else {}
+  if isinstance(rv, dict) and "enabled" in rv:
+    parts.append("RV %s" % ("on" if rv["enabled"] else "off"))
+  if isinstance(summary.get("real_time_factor"), (int, float)):
+    parts.append("real-time factor %.2f" % summary["real_time_factor"])
+  name = os.path.basename(os.path.normpath(run_dir))
+  return "RV profile of %s" % name + (" (%s)" % ", ".join(parts) if parts else "")
+
+
+def ProfilePanels(scans, run_errors):
+  """(title, ylabel, [(column data, label, style)], log) for each panel drawn."""
+  panels = [("SCVs", "count", [(scans["scv"], "SCVs (special constraint vectors)", "tab:blue")],
+             False),
+            ("Constraints", "count", [(scans["constraints"], "point-to-plane constraints",
+                                       "tab:gray")], False)]
+  if "coplanar_fraction" in scans:
+    panels.append(("Coplanar fraction", "fraction",
+                   [(scans["coplanar_fraction"], "fraction with d_i <= eps0", "tab:green")],
+                   False))
+  if "localizability" in scans:
+    panels.append(("Localizability", "min eigenvalue (log)",
+                   [(scans["localizability"], "localizability", "tab:purple")], True))
+  acc = [(scans[c], c, s) for c, s in (("acc_x", "tab:red"),) if c in scans]
+  if acc:
+    panels.append(("IMU acceleration along x (mean per scan)", "m/s^2", acc, False))
+  if run_errors is not None:
+    panels.append(("Error along the tunnel axis", "m",
+                   [(run_errors, "along-axis error", "black")], False))
+  return panels
+
+
+def CmdRvProfile(args):
+  scans = ReadScansCsv(os.path.join(args.run, "scans.csv"), RV_REQUIRED)
+  summary = ReadSummary(args.run)
+  t0 = scans["t"][0]
+  run_errors = None
+  if args.gt:
+    gt = ReadTum(args.gt)
+    est = ReadTum(RunTrajectoryPath(args.run))
+    run = RunErrors(os.path.basename(os.path.normpath(args.run)), est, gt, "origin",
+                    args.max_dt, TunnelAxis(gt[1]))
+    print(run.Describe())
+    t0 = gt[0][0]
+    run_errors = (run.t_match - t0, run.axis_error)
+  t = scans["t"] - t0
+  active = np.nan_to_num(scans["rv_active"])
+  panels = ProfilePanels(scans, run_errors)
+  fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(9, 1.75 * len(panels) + 0.9))
+  for i, (ax, (title, ylabel, series, log)) in enumerate(zip(axes, panels)):
+    ShadeActive(ax, t, active, label="RV active" if i == 0 else None)
+    for data, label, color in series:
+      x, y = data if isinstance(data, tuple) else (t, data)
+      if log:
+        y = np.where(y > 0, y, np.nan)  # log scale: hide non-positive values
+      ax.plot(x, y, color=color, lw=1.1, label=label)
+      if log and np.any(np.isfinite(y)):
+        ax.set_yscale("log")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9, loc="left")
+    ax.legend(loc="upper right")
+  axes[-1].set_xlabel("time [s]")
+  fig.suptitle(RunTitle(args.run, summary) +
+               "\nshaded: RV active (%d of %d scans)" % (int(np.sum(active > 0.5)), len(t)),
+               fontsize=10)
+  fig.tight_layout()
+  SaveFigure(fig, args.out, "rv_profile")
+
+
+# --------------------------------------------------------------------------
+# ablation
+# --------------------------------------------------------------------------
+
+METRIC_UNITS = (("_ms", "ms"), ("ms_", "ms"), ("_deg", "deg"), ("rtf", "x"),
+                ("real_time", "x"), ("rmse", "m"), ("error", "m"), ("ate", "m"), ("rpe", "m"))
+
+
+def MetricLabel(metric):
+  for key, unit in METRIC_UNITS:
+    if key in metric.lower():
+      return "%s [%s]" % (metric, unit)
+  return metric
+
+
+def ReadAblationTable(path, metrics):
+  """Rows of the table -> {metric: {(sequence, variant): [values]}}, orders kept."""
+  if not os.path.isfile(path):
+    raise PlotError("cannot read %s: no such file" % path)
+  with open(path, newline="") as f:
+    reader = csv.DictReader(f)
+    header = [h.strip() for h in (reader.fieldnames or [])]
+    rows = list(reader)
+  missing = [c for c in ("sequence", "variant") if c not in header]
+  if missing:
+    raise PlotError("%s: missing column(s) %s" % (path, ", ".join(missing)))
+  columns = {}
+  for metric in metrics:
+    if metric in header:
+      columns[metric] = (metric, None)
+    elif metric + "_mean" in header:
+      std = metric + "_std" if metric + "_std" in header else None
+      columns[metric] = (metric + "_mean", std)
+    else:
+      raise PlotError("%s: no column '%s' (have: %s)" % (path, metric, ", ".join(header)))
+  if not rows:
+    raise PlotError("%s: no rows" % path)
+  sequences, variants = [], []
+  for r in rows:
+    if r["sequence"] not in sequences:
+      sequences.append(r["sequence"])
+    if r["variant"] not in variants:
+      variants.append(r["variant"])
+  cells = {m: Aggregate(rows, c[0], c[1]) for m, c in columns.items()}
+  return sequences, variants, cells, "seed" in header
+
+
+def Aggregate(rows, column, std_column):
+  """(sequence, variant) -> (mean, spread, n) over finite values; NaN when none."""
+  values, spreads = {}, {}
+  for r in rows:
+    key = (r["sequence"], r["variant"])
+    values.setdefault(key, [])
+    v = ToFloat(r.get(column))
+    if math.isfinite(v):
+      values[key].append(v)
+      if std_column:
+        spreads.setdefault(key, []).append(ToFloat(r.get(std_column)))
+  cells = {}
+  for key, vs in values.items():
+    if not vs:
+      cells[key] = (float("nan"), 0.0, 0)
+    elif std_column and len(vs) == 1:
+      cells[key] = (vs[0], np.nan_to_num(spreads[key][0]), 1)
+    else:
+      cells[key] = (float(np.mean(vs)), float(np.std(vs, ddof=1)) if len(vs) > 1 else 0.0,
+                    len(vs))
+  return cells
+
+
+def UseLog(yscale, means):
+  positive = [m for m in means if math.isfinite(m) and m > 0]
+  if yscale != "auto":
+    return yscale == "log"
+  return len(positive) >= 2 and max(positive) / min(positive) > 50
+
+
+def PlotBars(ax, sequences, variants, cells, metric, yscale):
+  width = 0.8 / len(variants)
+  x = np.arange(len(sequences))
+  colors = ColorCycle()
+  means = [cells.get((s, v), (float("nan"), 0, 0))[0] for s in sequences for v in variants]
+  log = UseLog(yscale, means)
+  for j, variant in enumerate(variants):
+    stats = [cells.get((s, variant), (float("nan"), 0.0, 0)) for s in sequences]
+    mean = np.array([m for m, _, _ in stats])
+    spread = np.array([d for _, d, _ in stats])
+    xs = x - 0.4 + width * (j + 0.5)
+    bars = ax.bar(xs, np.nan_to_num(mean), width * 0.92, yerr=spread if spread.any() else None,
+                  capsize=3, color=colors[j % len(colors)], label=variant)
+    for bar, m, (_, _, n) in zip(bars, mean, stats):
+      text = "n/a" if not math.isfinite(m) else "%.3g" % m
+      y = m if math.isfinite(m) else 0.0
+      ax.annotate(text, (bar.get_x() + bar.get_width() / 2, y), xytext=(0, 2),
+                  textcoords="offset points", ha="center", va="bottom", fontsize=7,
+                  color="tab:red" if n == 0 else "black")
+  if log:
+    ax.set_yscale("log")
+  ax.set_xticks(x)
+  ax.set_xticklabels(sequences)
+  ax.set_xlabel("sequence")
+  ax.set_ylabel(MetricLabel(metric) + (" (log)" if log else ""))
+  ax.margins(y=0.15)
+
+
+def CmdAblation(args):
+  metrics = args.metric or ["ate_rmse"]
+  sequences, variants, cells, seeded = ReadAblationTable(args.table, metrics)
+  width = max(7.0, 1.2 + 0.45 * len(sequences) * len(variants))
+  fig, axes = plt.subplots(len(metrics), 1, figsize=(width, 3.6 * len(metrics) + 0.8),
+                           squeeze=False)
+  for ax, metric in zip(axes[:, 0], metrics):
+    PlotBars(ax, sequences, variants, cells[metric], metric, args.yscale)
+    ax.set_title(metric, fontsize=9, loc="left")
+  axes[0, 0].legend(title="variant", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+  note = "mean +- std over seeds" if seeded else "one value per cell"
+  fig.suptitle("Ablation: %s (%s; n/a = no result)" % (os.path.basename(args.table), note),
+               fontsize=10)
+  fig.tight_layout()
+  SaveFigure(fig, args.out, "ablation")
+
+
+# --------------------------------------------------------------------------
+# Command line
+# --------------------------------------------------------------------------
+
+class Parser(argparse.ArgumentParser):
+  """argparse with one-line errors and exit status 2."""
+
+  def error(self, message):
+    Fail(message, EXIT_BAD_INPUT)
+
+
+def PositiveFloat(text):
+  v = ToFloat(text)
+  if not (math.isfinite(v) and v > 0):
+    raise argparse.ArgumentTypeError("expected a positive number, got '%s'" % text)
+  return v
+
+
+def BuildParser():
+  parser = Parser(prog=PROG, description=__doc__.split("\n")[0])
+  sub = parser.add_subparsers(dest="command", parser_class=Parser)
+  sub.required = True
+  p = sub.add_parser("trajectories", help="runs vs GT: top view, along-axis error, height")
+  p.add_argument("--gt", required=True, help="ground-truth TUM file")
+  p.add_argument("--run", action="append", default=[], help="LABEL=DIR (repeatable)")
+  p.add_argument("--out", required=True, help="output prefix")
+  p.add_argument("--align", choices=("origin", "se3", "none"), default="origin")
+  p.add_argument("--max-dt", type=PositiveFloat, default=0.01, help="association [s]")
+  p.add_argument("--no-z", action="store_true", help="omit the height panel")
+  p.set_defaults(func=CmdTrajectories)
+  p = sub.add_parser("rv-profile", help="SCVs, constraints, RV activation, IMU acceleration")
+  p.add_argument("--run", required=True, help="run directory")
+  p.add_argument("--gt", help="ground-truth TUM file: adds the along-axis error")
+  p.add_argument("--out", required=True, help="output prefix")
+  p.add_argument("--max-dt", type=PositiveFloat, default=0.01, help="association [s]")
+  p.set_defaults(func=CmdRvProfile)
+  p = sub.add_parser("ablation", help="grouped bar chart of an ablation table")
+  p.add_argument("--table", required=True, help="CSV: sequence,variant[,seed],metrics...")
+  p.add_argument("--out", required=True, help="output prefix")
+  p.add_argument("--metric", action="append", help="metric column (repeatable)")
+  p.add_argument("--yscale", choices=("auto", "linear", "log"), default="auto")
+  p.set_defaults(func=CmdAblation)
+  p = sub.add_parser("check", help="exit 0 when matplotlib is usable")
+  p.set_defaults(func=None)
+  return parser
+
+
+def main(argv):
+  args = BuildParser().parse_args(argv)
+  LoadPlotting()
+  if args.func is None:
+    import matplotlib
+    print("matplotlib %s (%s)" % (matplotlib.__version__, sys.executable))
+    return 0
+  try:
+    args.func(args)
+  except PlotError as e:
+    Fail(str(e), EXIT_BAD_INPUT)
+  return 0
+
+
+if __name__ == "__main__":
+  sys.exit(main(sys.argv[1:]))
