@@ -118,6 +118,11 @@ std::string SensorYaml(const SimOptions& o, const std::string& name) {
     << "    translation: [" << Num(t[0]) << ", " << Num(t[1]) << ", " << Num(t[2]) << "]\n"
     << "    rotation_xyzw: [" << Num(q[0]) << ", " << Num(q[1]) << ", " << Num(q[2]) << ", "
     << Num(q[3]) << "]\n";
+  // The resolved simulator options, as comments, so the sequence can be
+  // reproduced (rvlio simulate --set KEY=VALUE for any of them).
+  y << "\n# Simulator options of this sequence:\n";
+  std::istringstream dump(DumpYaml(o));
+  for (std::string line; std::getline(dump, line);) y << (line.empty() ? "#" : "#   " + line) << "\n";
   return y.str();
 }
 

@@ -235,3 +235,17 @@ BENCHMARK(BM_LookupStdUnorderedMap);
 }  // namespace rvlio
 
 BENCHMARK_MAIN();
+namespace rvlio { namespace {
+void BM_KNearestHot(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  std::vector<Eigen::Vector3d> queries;
+  for (size_t j = 0; j < 16; ++j) queries.push_back(f.T_world_imu * f.scan[j * 7]);
+  NeighborBuffer nb;
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(f.map.KNearest(queries[i], 5, 2.0, &nb));
+    i = (i + 1) % queries.size();
+  }
+}
+BENCHMARK(BM_KNearestHot);
+}}

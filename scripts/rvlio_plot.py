@@ -38,8 +38,8 @@ DPI = 150
 EXIT_BAD_INPUT = 2
 EXIT_NO_MATPLOTLIB = 3
 
-np = None  # numpy, bound by LoadPlotting()
-plt = None  # matplotlib.pyplot, bound by LoadPlotting()
+np = None  # numpy, bound by LoadNumpy()
+_pyplot = []  # matplotlib.pyplot once imported by Pyplot()
 
 
 class PlotError(Exception):
@@ -66,21 +66,31 @@ def ReexecWithSystemPython():
   os.execve(SYSTEM_PYTHON, [SYSTEM_PYTHON, os.path.abspath(__file__)] + sys.argv[1:], env)
 
 
-def LoadPlotting():
-  """Imports numpy and matplotlib (Agg); exits 3 with a hint when missing."""
-  global np, plt
-  try:
-    import numpy
+def LoadNumpy():
+  """Binds numpy; when numpy or matplotlib is missing, re-executes with the
+  system python or exits 3. Matplotlib itself is imported only to draw, so
+  bad input is reported quickly."""
+  global np
+  import importlib.util
+  missing = [m for m in ("numpy", "matplotlib") if importlib.util.find_spec(m) is None]
+  if missing:
+    ReexecWithSystemPython()
+    Fail("%s not available to %s; install python3-matplotlib"
+         % (" and ".join(missing), sys.executable), EXIT_NO_MATPLOTLIB)
+  import numpy
+  np = numpy
+
+
+def Pyplot():
+  """matplotlib.pyplot with the Agg backend (no display) and legible defaults."""
+  if not _pyplot:
     import matplotlib
     matplotlib.use("Agg")
-    import matplotlib.pyplot as pyplot
-  except ImportError as e:
-    ReexecWithSystemPython()
-    Fail("matplotlib is not available (%s); install python3-matplotlib" % e,
-         EXIT_NO_MATPLOTLIB)
-  np, plt = numpy, pyplot
-  plt.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3,
-                       "legend.fontsize": 8, "figure.dpi": DPI})
+    import matplotlib.pyplot
+    matplotlib.pyplot.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3,
+                                       "legend.fontsize": 8, "figure.dpi": DPI})
+    _pyplot.append(matplotlib.pyplot)
+  return _pyplot[0]
 
 
 # --------------------------------------------------------------------------
@@ -159,7 +169,11 @@ def ReadSummary(run_dir):
 
 def RunTrajectoryPath(run):
   """A run is a directory holding trajectory.tum or a TUM file itself."""
-  return os.path.join(run, "trajectory.tum") if os.path.isdir(run) else run
+  if os.path.isdir(run):
+    return os.path.join(run, "trajectory.tum")
+  if not os.path.isfile(run):
+    raise PlotError("run %s: no such directory or TUM file" % run)
+  return run
 
 
 def ParseRunSpec(spec):
@@ -222,6 +236,10 @@ def Alignment(mode, est, gt, i_est, i_gt):
   return UmeyamaSe3(est[1][i_est], gt[1][i_gt])
 
 
+def GtMoves(p_gt):
+  return bool(np.ptp(p_gt, axis=0).max() > 1e-6)
+
+
 def TunnelAxis(p_gt):
   """Unit principal axis of the GT positions, pointing from start to end."""
   centered = p_gt - p_gt.mean(0)
@@ -250,7 +268,7 @@ class RunErrors(object):
 
   def Describe(self):
     e = np.abs(self.axis_error)
-    return "run '%s': %d/%d poses matched, along-axis error max %.4f m, final %.4f m" % (
+    return "run '%s': %d/%d poses matched, along-axis error max %.6f m, final %.6f m" % (
         self.label, len(e), self.num_poses, e.max(), self.axis_error[-1])
 
 
@@ -261,11 +279,11 @@ class RunErrors(object):
 def SaveFigure(fig, prefix, kind):
   """Writes PREFIX_kind.png and .pdf atomically; returns the paths."""
   directory = os.path.dirname(os.path.abspath(prefix))
-  os.makedirs(directory, exist_ok=True)
   finals, temps = [], []
   umask = os.umask(0)
   os.umask(umask)
   try:
+    os.makedirs(directory, exist_ok=True)
     for ext in ("png", "pdf"):
       final = "%s_%s.%s" % (prefix, kind, ext)
       fd, temp = tempfile.mkstemp(prefix=".%s." % os.path.basename(final), dir=directory)
@@ -279,7 +297,7 @@ def SaveFigure(fig, prefix, kind):
   except OSError as e:
     raise PlotError("cannot write %s_%s: %s" % (prefix, kind, e))
   finally:
-    plt.close(fig)
+    Pyplot().close(fig)
     for temp in temps:
       if os.path.exists(temp):
         os.remove(temp)
@@ -289,41 +307,48 @@ def SaveFigure(fig, prefix, kind):
 
 
 def ColorCycle():
-  return plt.rcParams["axes.prop_cycle"].by_key()["color"]
+  return Pyplot().rcParams["axes.prop_cycle"].by_key()["color"]
 
 
 # --------------------------------------------------------------------------
 # trajectories
 # --------------------------------------------------------------------------
 
+def RunWidth(index):
+  """Later runs are drawn thinner, so runs that coincide stay distinguishable."""
+  return max(0.9, 2.4 - 0.5 * index)
+
+
 def PlotTopView(ax, gt, runs, colors):
   ax.plot(gt[1][:, 0], gt[1][:, 1], color="black", lw=2.2, ls="--", label="ground truth",
           zorder=3)
   ax.plot(gt[1][0, 0], gt[1][0, 1], "ko", ms=5, zorder=4)
-  for run, color in zip(runs, colors):
-    ax.plot(run.p[:, 0], run.p[:, 1], color=color, lw=1.3, label=run.label)
+  for i, (run, color) in enumerate(zip(runs, colors)):
+    ax.plot(run.p[:, 0], run.p[:, 1], color=color, lw=RunWidth(i), label=run.label)
     ax.plot(run.p[-1, 0], run.p[-1, 1], "x", color=color, ms=7, mew=2)
   ax.set_xlabel("x [m]")
   ax.set_ylabel("y [m]")
-  ax.set_title("(a) Top view (o start, x end of each run)")
+  ax.set_title("(a) Top view (o start, x end of each run; axes not to scale)")
   ax.legend(loc="best")
 
 
-def PlotAxisError(ax, runs, colors, t0, axis):
-  for run, color in zip(runs, colors):
-    ax.plot(run.t_match - t0, run.axis_error, color=color, lw=1.3,
+def PlotAxisError(ax, runs, colors, t0, axis, moving):
+  for i, (run, color) in enumerate(zip(runs, colors)):
+    ax.plot(run.t_match - t0, run.axis_error, color=color, lw=RunWidth(i),
             label="%s (max |e| %.3g m)" % (run.label, np.abs(run.axis_error).max()))
   ax.axhline(0.0, color="black", lw=0.8)
   ax.set_xlabel("time [s]")
   ax.set_ylabel("along-axis error [m]")
-  ax.set_title("(b) Error along the tunnel axis (%.2f, %.2f, %.2f)" % tuple(axis + 0.0))
+  direction = "(%.2f, %.2f, %.2f)" % tuple(np.round(axis, 2) + 0.0)
+  ax.set_title("(b) Error along the tunnel axis %s%s"
+               % (direction, "" if moving else ": GT does not move, x axis used"))
   ax.legend(loc="best")
 
 
 def PlotHeight(ax, gt, runs, colors, t0):
   ax.plot(gt[0] - t0, gt[1][:, 2], color="black", lw=2.2, ls="--", label="ground truth")
-  for run, color in zip(runs, colors):
-    ax.plot(run.t - t0, run.p[:, 2], color=color, lw=1.3, label=run.label)
+  for i, (run, color) in enumerate(zip(runs, colors)):
+    ax.plot(run.t - t0, run.p[:, 2], color=color, lw=RunWidth(i), label=run.label)
   ax.set_xlabel("time [s]")
   ax.set_ylabel("z [m]")
   ax.set_title("(c) Height over time")
@@ -345,10 +370,10 @@ def CmdTrajectories(args):
   t0 = gt[0][0]
   colors = [ColorCycle()[i % len(ColorCycle())] for i in range(len(runs))]
   panels = 2 if args.no_z else 3
-  fig, axes = plt.subplots(panels, 1, figsize=(9, 3.1 * panels + 0.6),
+  fig, axes = Pyplot().subplots(panels, 1, figsize=(9, 3.1 * panels + 0.6),
                            gridspec_kw={"height_ratios": [1.3] + [1] * (panels - 1)})
   PlotTopView(axes[0], gt, runs, colors)
-  PlotAxisError(axes[1], runs, colors, t0, axis)
+  PlotAxisError(axes[1], runs, colors, t0, axis, GtMoves(gt[1]))
   if not args.no_z:
     PlotHeight(axes[2], gt, runs, colors, t0)
     axes[2].sharex(axes[1])
@@ -363,19 +388,38 @@ def CmdTrajectories(args):
 # --------------------------------------------------------------------------
 
 RV_REQUIRED = ("t", "rv_active", "scv", "constraints")
+ACTIVE_COLOR = "tab:orange"
 
 
-def ShadeActive(ax, t, active, label=None):
-  """Shaded spans where rv_active == 1 (step-wise around each scan stamp)."""
-  ax.fill_between(t, 0, 1, where=active > 0.5, step="mid", color="tab:orange", alpha=0.18,
-                  lw=0, transform=ax.get_xaxis_transform(), label=label)
+def ActiveSpans(t, active):
+  """[(start, end)] time spans of consecutive scans with rv_active == 1; each scan
+  covers half the gap to its neighbours."""
+  if len(t) == 1:
+    edges = np.array([t[0] - 0.05, t[0] + 0.05])
+  else:
+    mid = 0.5 * (t[1:] + t[:-1])
+    edges = np.concatenate([[2 * t[0] - mid[0]], mid, [2 * t[-1] - mid[-1]]])
+  on = np.concatenate([[False], active > 0.5, [False]])
+  starts = np.nonzero(on[1:] & ~on[:-1])[0]
+  ends = np.nonzero(~on[1:] & on[:-1])[0]
+  return [(edges[a], edges[b]) for a, b in zip(starts, ends)]
+
+
+def ShadeSpans(ax, spans):
+  """Full-height shaded spans; they do not change the y limits of the panel."""
+  from matplotlib.collections import PolyCollection
+  boxes = [[(a, 0), (b, 0), (b, 1), (a, 1)] for a, b in spans]
+  ax.add_collection(PolyCollection(boxes, transform=ax.get_xaxis_transform(),
+                                   facecolor=ACTIVE_COLOR, alpha=0.2, lw=0, zorder=0),
+                    autolim=False)
 
 
 def RunTitle(run_dir, summary):
   parts = []
   if "backend" in summary:
     parts.append("backend %s" % summary["backend"])
-  rv = summary.get("config", {}).get("rv", {}) if isinstance(summary.get("config"), dict) else {}
+  config = summary.get("config")
+  rv = config.get("rv", {}) if isinstance(config, dict) else {}
   if isinstance(rv, dict) and "enabled" in rv:
     parts.append("RV %s" % ("on" if rv["enabled"] else "off"))
   if isinstance(summary.get("real_time_factor"), (int, float)):
@@ -384,30 +428,63 @@ def RunTitle(run_dir, summary):
   return "RV profile of %s" % name + (" (%s)" % ", ".join(parts) if parts else "")
 
 
-def ProfilePanels(scans, run_errors):
-  """(title, ylabel, [(column data, label, style)], log) for each panel drawn."""
-  panels = [("SCVs", "count", [(scans["scv"], "SCVs (special constraint vectors)", "tab:blue")],
-             False),
-            ("Constraints", "count", [(scans["constraints"], "point-to-plane constraints",
-                                       "tab:gray")], False)]
+def ProfilePanels(scans, t, run_errors):
+  """[(title, ylabel, x, y, color, log)] for each panel drawn; optional columns
+  (older scans.csv files lack some) and the GT error only when available."""
+  panels = [
+      ("Number of SCVs (special constraint vectors, d_i > eps0)", "count", t, scans["scv"],
+       "tab:blue", False),
+      ("Number of point-to-plane constraints", "count", t, scans["constraints"], "tab:gray",
+       False)]
   if "coplanar_fraction" in scans:
-    panels.append(("Coplanar fraction", "fraction",
-                   [(scans["coplanar_fraction"], "fraction with d_i <= eps0", "tab:green")],
-                   False))
+    panels.append(("Coplanar fraction (constraint vectors with d_i <= eps0)", "fraction", t,
+                   scans["coplanar_fraction"], "tab:green", False))
   if "localizability" in scans:
-    panels.append(("Localizability", "min eigenvalue (log)",
-                   [(scans["localizability"], "localizability", "tab:purple")], True))
-  acc = [(scans[c], c, s) for c, s in (("acc_x", "tab:red"),) if c in scans]
-  if acc:
-    panels.append(("IMU acceleration along x (mean per scan)", "m/s^2", acc, False))
+    panels.append(("Localizability (smallest eigenvalue of sum w u u^T, log scale)",
+                   "eigenvalue", t, scans["localizability"], "tab:purple", True))
+  if "acc_x" in scans:
+    panels.append(("IMU acceleration along x (mean specific force per scan, IMU frame)",
+                   "acc_x [m/s$^2$]", t, scans["acc_x"], "tab:red", False))
   if run_errors is not None:
-    panels.append(("Error along the tunnel axis", "m",
-                   [(run_errors, "along-axis error", "black")], False))
+    panels.append(("Error along the tunnel axis vs ground truth (origin-aligned)",
+                   "error [m]", run_errors[0], run_errors[1], "black", False))
   return panels
+
+
+def DrawPanel(ax, panel, spans):
+  title, ylabel, x, y, color, log = panel
+  if log:
+    y = np.where(y > 0, y, np.nan)  # log scale: hide non-positive values
+  ax.plot(x, y, color=color, lw=1.1)
+  if log and np.any(np.isfinite(y)):
+    ax.set_yscale("log")
+  if ylabel == "count":
+    ax.set_ylim(bottom=0)
+  ShadeSpans(ax, spans)
+  ax.set_ylabel(ylabel)
+  ax.set_title(title, fontsize=9, loc="left")
+
+
+def RepairScanTimes(scans, run_dir):
+  """Scan stamps written with too few digits (e.g. 1.7e+09) collapse to a few
+  values; trajectory.tum has one row per scan in the same order, so its stamps
+  replace them when the counts agree."""
+  t = scans["t"]
+  if len(t) < 2 or len(np.unique(t)) == len(t):
+    return
+  path = os.path.join(run_dir, "trajectory.tum")
+  if not os.path.isfile(path):
+    return
+  stamps = ReadTum(path)[0]
+  if len(stamps) == len(t):
+    print("note: %s: column t has only %d distinct values for %d scans; using the stamps "
+          "of trajectory.tum" % (os.path.join(run_dir, "scans.csv"), len(np.unique(t)), len(t)))
+    scans["t"] = stamps
 
 
 def CmdRvProfile(args):
   scans = ReadScansCsv(os.path.join(args.run, "scans.csv"), RV_REQUIRED)
+  RepairScanTimes(scans, args.run)
   summary = ReadSummary(args.run)
   t0 = scans["t"][0]
   run_errors = None
@@ -421,24 +498,20 @@ def CmdRvProfile(args):
     run_errors = (run.t_match - t0, run.axis_error)
   t = scans["t"] - t0
   active = np.nan_to_num(scans["rv_active"])
-  panels = ProfilePanels(scans, run_errors)
-  fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(9, 1.75 * len(panels) + 0.9))
-  for i, (ax, (title, ylabel, series, log)) in enumerate(zip(axes, panels)):
-    ShadeActive(ax, t, active, label="RV active" if i == 0 else None)
-    for data, label, color in series:
-      x, y = data if isinstance(data, tuple) else (t, data)
-      if log:
-        y = np.where(y > 0, y, np.nan)  # log scale: hide non-positive values
-      ax.plot(x, y, color=color, lw=1.1, label=label)
-      if log and np.any(np.isfinite(y)):
-        ax.set_yscale("log")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=9, loc="left")
-    ax.legend(loc="upper right")
+  spans = ActiveSpans(t, active)
+  panels = ProfilePanels(scans, t, run_errors)
+  for column in ("coplanar_fraction", "localizability", "acc_x"):
+    if column not in scans:
+      print("note: scans.csv has no column %s; its panel is left out" % column)
+  fig, axes = Pyplot().subplots(len(panels), 1, sharex=True, figsize=(9, 1.7 * len(panels) + 1.0))
+  for ax, panel in zip(axes, panels):
+    DrawPanel(ax, panel, spans)
+  from matplotlib.patches import Patch
+  axes[0].legend(handles=[Patch(facecolor=ACTIVE_COLOR, alpha=0.2, label="RV active")],
+                 loc="upper right")
   axes[-1].set_xlabel("time [s]")
-  fig.suptitle(RunTitle(args.run, summary) +
-               "\nshaded: RV active (%d of %d scans)" % (int(np.sum(active > 0.5)), len(t)),
-               fontsize=10)
+  fig.suptitle("%s\nshaded: RV active in %d of %d scans"
+               % (RunTitle(args.run, summary), int(np.sum(active > 0.5)), len(t)), fontsize=10)
   fig.tight_layout()
   SaveFigure(fig, args.out, "rv_profile")
 
@@ -520,6 +593,16 @@ def UseLog(yscale, means):
   return len(positive) >= 2 and max(positive) / min(positive) > 50
 
 
+def LabelBar(ax, x, mean, spread):
+  """Value above the bar (and its error bar); 'n/a' at the bottom when no value."""
+  if math.isfinite(mean):
+    ax.annotate("%.3g" % mean, (x, mean + spread), xytext=(0, 2), textcoords="offset points",
+                ha="center", va="bottom", fontsize=7)
+  else:
+    ax.annotate("n/a", (x, 0.01), xycoords=ax.get_xaxis_transform(), ha="center",
+                va="bottom", fontsize=7, color="tab:red")
+
+
 def PlotBars(ax, sequences, variants, cells, metric, yscale):
   width = 0.8 / len(variants)
   x = np.arange(len(sequences))
@@ -533,12 +616,8 @@ def PlotBars(ax, sequences, variants, cells, metric, yscale):
     xs = x - 0.4 + width * (j + 0.5)
     bars = ax.bar(xs, np.nan_to_num(mean), width * 0.92, yerr=spread if spread.any() else None,
                   capsize=3, color=colors[j % len(colors)], label=variant)
-    for bar, m, (_, _, n) in zip(bars, mean, stats):
-      text = "n/a" if not math.isfinite(m) else "%.3g" % m
-      y = m if math.isfinite(m) else 0.0
-      ax.annotate(text, (bar.get_x() + bar.get_width() / 2, y), xytext=(0, 2),
-                  textcoords="offset points", ha="center", va="bottom", fontsize=7,
-                  color="tab:red" if n == 0 else "black")
+    for bar, m, d in zip(bars, mean, spread):
+      LabelBar(ax, bar.get_x() + bar.get_width() / 2, m, d)
   if log:
     ax.set_yscale("log")
   ax.set_xticks(x)
@@ -552,13 +631,13 @@ def CmdAblation(args):
   metrics = args.metric or ["ate_rmse"]
   sequences, variants, cells, seeded = ReadAblationTable(args.table, metrics)
   width = max(7.0, 1.2 + 0.45 * len(sequences) * len(variants))
-  fig, axes = plt.subplots(len(metrics), 1, figsize=(width, 3.6 * len(metrics) + 0.8),
+  fig, axes = Pyplot().subplots(len(metrics), 1, figsize=(width, 3.6 * len(metrics) + 0.8),
                            squeeze=False)
   for ax, metric in zip(axes[:, 0], metrics):
     PlotBars(ax, sequences, variants, cells[metric], metric, args.yscale)
     ax.set_title(metric, fontsize=9, loc="left")
   axes[0, 0].legend(title="variant", loc="upper left", bbox_to_anchor=(1.01, 1.0))
-  note = "mean +- std over seeds" if seeded else "one value per cell"
+  note = "mean \u00b1 std over seeds" if seeded else "one value per cell"
   fig.suptitle("Ablation: %s (%s; n/a = no result)" % (os.path.basename(args.table), note),
                fontsize=10)
   fig.tight_layout()
@@ -614,8 +693,9 @@ def BuildParser():
 
 def main(argv):
   args = BuildParser().parse_args(argv)
-  LoadPlotting()
-  if args.func is None:
+  LoadNumpy()
+  if args.func is None:  # check: can we draw?
+    Pyplot()
     import matplotlib
     print("matplotlib %s (%s)" % (matplotlib.__version__, sys.executable))
     return 0

@@ -22,6 +22,13 @@ std::string EmptyPcd() {
          "DATA binary\n";
 }
 
+// Absolute stamps need all nine decimals; the stream's precision is for the rest.
+std::string FormatSeconds(TimeNs t_ns) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.9f", NsToSeconds(t_ns));
+  return buf;
+}
+
 }  // namespace
 
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world) {
@@ -56,7 +63,7 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
         "ms,x,y,z,acc_x,acc_y,acc_z\n";
   for (const ScanResult& r : results) {
     const RvReport& v = r.rv;
-    os << NsToSeconds(r.t_ns) << ',' << ScanStatusName(r.status) << ',' << r.raw_points << ','
+    os << FormatSeconds(r.t_ns) << ',' << ScanStatusName(r.status) << ',' << r.raw_points << ','
        << r.downsampled_points << ',' << r.constraints << ',' << r.iterations << ','
        << (v.active ? 1 : 0) << ',' << v.n_alpha.x() << ',' << v.n_alpha.y() << ','
        << v.n_alpha.z() << ',' << v.num_scv << ',' << v.num_coplanar << ',' << v.num_repaired

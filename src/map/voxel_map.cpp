@@ -29,14 +29,16 @@ std::vector<Offset> MakeShell(int r) {
       for (int dz = -r; dz <= r; ++dz)
         if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) == r)
           shell.push_back(Offset{static_cast<int8_t>(dx), static_cast<int8_t>(dy),
-                                 static_cast<int8_t>(dz)});
+                                 static_cast<int8_t>(dz), 0.0f});
+  // Lower bound of the gap along one axis, in voxel edges, for a query in
+  // the upper half of its voxel.
   auto gap = [](int d) { return d > 0 ? d - 1.0 : (d < 0 ? -d - 0.5 : 0.0); };
-  auto bound = [&](const Offset& o) {
-    return gap(o.dx) * gap(o.dx) + gap(o.dy) * gap(o.dy) + gap(o.dz) * gap(o.dz);
-  };
+  for (Offset& o : shell)
+    o.lower_bound2 = static_cast<float>(gap(o.dx) * gap(o.dx) + gap(o.dy) * gap(o.dy) +
+                                        gap(o.dz) * gap(o.dz));
   auto nonzero = [](const Offset& o) { return (o.dx != 0) + (o.dy != 0) + (o.dz != 0); };
   std::stable_sort(shell.begin(), shell.end(), [&](const Offset& a, const Offset& b) {
-    if (bound(a) != bound(b)) return bound(a) < bound(b);
+    if (a.lower_bound2 != b.lower_bound2) return a.lower_bound2 < b.lower_bound2;
     return nonzero(a) < nonzero(b);
   });
   return shell;
@@ -62,18 +64,22 @@ class VoxelMap::Candidates {
 
   float limit() const { return limit_; }
   int size() const { return n_; }
-  const Eigen::Vector3f& point(int i) const { return p_[i]; }
+  // x of candidate i; its y and z are stride(i) and 2 stride(i) floats further.
+  const float* x(int i) const { return x_[i]; }
+  int stride(int i) const { return stride_[i]; }
 
-  void Offer(float d2, float x, float y, float z) {
+  void Offer(float d2, const float* x, int stride) {
     // d2 < limit_ is checked by the caller.
     int i = n_ < k_ ? n_++ : k_ - 1;
     while (i > 0 && d2_[i - 1] > d2) {
       d2_[i] = d2_[i - 1];
-      p_[i] = p_[i - 1];
+      x_[i] = x_[i - 1];
+      stride_[i] = stride_[i - 1];
       --i;
     }
     d2_[i] = d2;
-    p_[i] = Eigen::Vector3f(x, y, z);
+    x_[i] = x;
+    stride_[i] = stride;
     if (n_ == k_) limit_ = d2_[k_ - 1];
   }
 
@@ -82,7 +88,8 @@ class VoxelMap::Candidates {
   int n_ = 0;
   float limit_;
   std::array<float, kMaxNeighbors> d2_;
-  std::array<Eigen::Vector3f, kMaxNeighbors> p_;
+  std::array<const float*, kMaxNeighbors> x_;
+  std::array<int, kMaxNeighbors> stride_;
 };
 
 VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
@@ -261,10 +268,7 @@ void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
       d2[i] = dx * dx + dy * dy + dz * dz;
     }
     for (int i = 0; i < m; ++i)
-      if (d2[i] < c->limit()) {
-        const int j = start + i;
-        c->Offer(d2[i], x[j], y[j], z[j]);
-      }
+      if (d2[i] < c->limit()) c->Offer(d2[i], x + start + i, s.capacity);
   }
 }
 
@@ -283,21 +287,35 @@ void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const d
 
 void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
                           Candidates* c) const {
-  if (r <= kPrecomputedShells) {
-    const double half = 0.5 * options_.voxel_size;  // mirror into the query's octant
-    const int sx = q_local[0] < half ? -1 : 1;
-    const int sy = q_local[1] < half ? -1 : 1;
-    const int sz = q_local[2] < half ? -1 : 1;
-    for (const Offset& o : shells_[r])
-      VisitOffset(home, sx * o.dx, sy * o.dy, sz * o.dz, q_local, q, c);
+  if (r > kPrecomputedShells) {
+    for (int dx = -r; dx <= r; ++dx) {
+      for (int dy = -r; dy <= r; ++dy) {
+        const bool side = std::abs(dx) == r || std::abs(dy) == r;
+        const int dz_step = side ? 1 : 2 * r;  // interior columns: only the two caps
+        for (int dz = -r; dz <= r; dz += dz_step) VisitOffset(home, dx, dy, dz, q_local, q, c);
+      }
+    }
     return;
   }
-  for (int dx = -r; dx <= r; ++dx) {
-    for (int dy = -r; dy <= r; ++dy) {
-      const bool side = std::abs(dx) == r || std::abs(dy) == r;
-      const int dz_step = side ? 1 : 2 * r;  // interior columns: only the two caps
-      for (int dz = -r; dz <= r; dz += dz_step) VisitOffset(home, dx, dy, dz, q_local, q, c);
+  // Mirror the precomputed order into the query's octant; squared gaps per
+  // axis and offset come from small tables instead of per-voxel branches.
+  const double s = options_.voxel_size;
+  int sign[3];
+  double gap2[3][2 * kPrecomputedShells + 1];
+  for (int a = 0; a < 3; ++a) {
+    sign[a] = q_local[a] < 0.5 * s ? -1 : 1;
+    for (int d = -r; d <= r; ++d) {
+      const double g = AxisGap(d, q_local[a], s);
+      gap2[a][d + r] = g * g;
     }
+  }
+  const double s2 = s * s;
+  for (const Offset& o : shells_[r]) {
+    if (o.lower_bound2 * s2 > c->limit()) break;  // sorted: the rest are no closer
+    const int dx = sign[0] * o.dx, dy = sign[1] * o.dy, dz = sign[2] * o.dz;
+    if (gap2[0][dx + r] + gap2[1][dy + r] + gap2[2][dz + r] > c->limit()) continue;
+    const int slot = FindSlot(VoxelKey{home.x + dx, home.y + dy, home.z + dz});
+    if (slot >= 0) ScanBlock(slots_[slot], q, c);
   }
 }
 
@@ -336,8 +354,8 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
   // Shell r lies at least (r - 1) s from any point of the home voxel, so
   // shells up to floor(max_d / s) + 1 can hold points within max_d.
   const int max_shell = static_cast<int>(std::floor(max_d / s)) + 1;
-  const double window = std::pow(2.0 * max_shell + 1.0, 3);
-  if (window > static_cast<double>(slots_.size())) {
+  const double width = 2.0 * max_shell + 1.0;
+  if (width * width * width > static_cast<double>(slots_.size())) {
     ScanAllVoxels(q_world, q, &c);
   } else {
     for (int r = 0; r <= max_shell; ++r) {
@@ -349,7 +367,8 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
 
   out->size = c.size();
   for (int i = 0; i < c.size(); ++i) {
-    out->points[i] = c.point(i).cast<double>();
+    const float* x = c.x(i);
+    out->points[i] = Eigen::Vector3d(x[0], x[c.stride(i)], x[2 * c.stride(i)]);
     out->dist2[i] = (out->points[i] - q_world).squaredNorm();
   }
   return out->size;

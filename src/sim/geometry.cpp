@@ -12,7 +12,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kRootTol = 1e-9;      // m, |g| at which a surface root is accepted
 constexpr double kNewtonBelow = 2e-3;  // m, switch from safe marching to Newton
-constexpr int kMaxSteps = 200;
+constexpr int kMaxSteps = 100000;  // sphere-tracing steps (grazing rays on steep relief need many)
 
 // g(t) = (o_w + t r_w - offset) - h(o_u + t r_u, o_v + t r_v): signed height of
 // the ray point above the rough surface; its roots are the crossings.
@@ -59,7 +59,7 @@ bool FirstRoot(const SurfaceFunction& g, double lipschitz, double t0, double t1,
       *root = t;
       return true;
     }
-    double next = t + std::abs(value) / lipschitz;
+    double next = t + 2.0 * std::abs(value) / lipschitz;
     if (std::abs(value) < kNewtonBelow) {
       double slope = 0.0;
       g.WithSlope(t, &slope);

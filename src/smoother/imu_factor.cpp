@@ -135,18 +135,25 @@ bool ImuFactor::Evaluate(double const* const* parameters, double* residuals,
       Residual(pose_i, sb_i, pose_j, sb_j, want && jacobians[0] ? &J_pose_i : nullptr,
                want && jacobians[1] ? &J_sb_i : nullptr, want && jacobians[2] ? &J_pose_j : nullptr,
                want && jacobians[3] ? &J_sb_j : nullptr);
-  Eigen::Map<Vector15d>(residuals) = sqrt_information_ * r;
+  Eigen::Map<Vector15d> residual(residuals);
+  residual = sqrt_information_ * r;
   if (!want) return true;
   if (jacobians[0] != nullptr) {
     const RowMajor15x6 J = sqrt_information_ * J_pose_i;
     PoseTangentToAmbientJacobian(parameters[0], J, jacobians[0]);
   }
-  if (jacobians[1] != nullptr) Eigen::Map<RowMajor15x9>(jacobians[1]) = sqrt_information_ * J_sb_i;
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<RowMajor15x9> J(jacobians[1]);
+    J = sqrt_information_ * J_sb_i;
+  }
   if (jacobians[2] != nullptr) {
     const RowMajor15x6 J = sqrt_information_ * J_pose_j;
     PoseTangentToAmbientJacobian(parameters[2], J, jacobians[2]);
   }
-  if (jacobians[3] != nullptr) Eigen::Map<RowMajor15x9>(jacobians[3]) = sqrt_information_ * J_sb_j;
+  if (jacobians[3] != nullptr) {
+    Eigen::Map<RowMajor15x9> J(jacobians[3]);
+    J = sqrt_information_ * J_sb_j;
+  }
   return true;
 }
 

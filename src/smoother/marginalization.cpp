@@ -252,7 +252,8 @@ bool MarginalizationFactor::Evaluate(double const* const* parameters, double* re
       d.segment(off, ts) = Eigen::Map<const Eigen::VectorXd>(parameters[k], as) - p.x0[k];
     }
   }
-  Eigen::Map<Eigen::VectorXd>(residuals, p.tangent_dim) = p.S * d + p.r0;
+  Eigen::Map<Eigen::VectorXd> residual(residuals, p.tangent_dim);
+  residual = p.S * d + p.r0;
   if (jacobians == nullptr) return true;
   for (size_t k = 0; k < p.blocks.size(); ++k) {
     if (jacobians[k] == nullptr) continue;

@@ -183,6 +183,34 @@ TEST_F(BagReaderTest, LivoxOffsetTime) {
       "livox_offset.bag");
 }
 
+TEST_F(BagReaderTest, CompressedBagsReadLikeUncompressed) {
+  RawCloud c = OusterCloud();
+  c.stamp_ns = kT0;
+  c.Resize(50);
+  for (uint32_t i = 0; i < 50; ++i) c.SetPoint(i, 1.0 + i, -2.0, 0.5, i, 1000.0 * i, i % 4);
+  for (auto compression : {rosbag::compression::BZ2, rosbag::compression::LZ4}) {
+    const std::string path = Path("compressed.bag");
+    {
+      rosbag::Bag bag;
+      bag.open(path, rosbag::bagmode::Write);
+      bag.setCompression(compression);
+      for (int i = 0; i < 30; ++i) {
+        const TimeNs t = kT0 + i * 5 * kMs;
+        bag.write(kImuTopic, RosTime(t), ImuMsg(t, 0.5, 0, 9.8));
+      }
+      bag.write(kCloudTopic, RosTime(kT0 + 100 * kMs), ToMsg(c));
+      bag.close();
+    }
+    ReadResult r = ReadEverything(path, LidarOn(kCloudTopic), ImuOn(kImuTopic));
+    ASSERT_TRUE(r.error.ok()) << r.error.message();
+    EXPECT_EQ(r.imu.size(), 30u);
+    ASSERT_EQ(r.scans.size(), 1u);
+    ASSERT_EQ(r.scans[0].points.size(), 50u);
+    EXPECT_EQ(r.scans[0].points[49].p_lidar.x(), 50.0f);
+    EXPECT_EQ(r.scans[0].points[49].t_ns, kT0 + 49000);
+  }
+}
+
 TEST_F(BagReaderTest, EmptyScansAreSkippedAndCounted) {
   const std::string path = Path("empty.bag");
   auto writer = SensorBagWriter::Create(path);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/sim/presets.h"
+#include "rvlio/sim/random.h"
 #include "rvlio/sim/simulator.h"
 
 namespace rvlio::sim {
@@ -257,6 +258,50 @@ TEST(WorldLayout, HallHasPillarsStairsAndDoorways) {
   EXPECT_EQ(holes, o.world.openings);
   EXPECT_EQ(stair_steps, 10);
   EXPECT_GE(w.boxes().size(), static_cast<size_t>(o.world.clutter_count / 2));
+}
+
+}  // namespace
+}  // namespace rvlio::sim
+
+namespace rvlio::sim {
+namespace {
+
+// The weak-feature surfaces are rough by a few centimetres, tilting local
+// normals by a few degrees (paper Fig. 1b), and the roughness is seeded.
+TEST(WorldLayout, TunnelSurfacesAreRoughByAFewCentimetresAndDegrees) {
+  const SimOptions o = *PresetOptions("tunnel");
+  auto sim = Simulator::Create(o);
+  ASSERT_TRUE(sim.ok());
+  Rng rng(4);
+  double max_h = 0.0, max_tilt = 0.0, sum_tilt2 = 0.0;
+  int n = 0;
+  for (const Face& f : (*sim)->world().faces()) {
+    ASSERT_FALSE(f.relief.flat());
+    for (int i = 0; i < 2000; ++i) {
+      double hu = 0, hv = 0;
+      const double h = f.relief.Height(rng.Uniform(-50, 50), rng.Uniform(-50, 50), &hu, &hv);
+      const double tilt = std::atan(std::hypot(hu, hv));
+      max_h = std::max(max_h, std::abs(h));
+      max_tilt = std::max(max_tilt, tilt);
+      sum_tilt2 += tilt * tilt;
+      ++n;
+    }
+  }
+  const double rms_tilt_deg = std::sqrt(sum_tilt2 / n) * 180 / M_PI;
+  EXPECT_LE(max_h, o.world.roughness_amplitude + 1e-12);
+  EXPECT_GT(max_h, 0.4 * o.world.roughness_amplitude);
+  EXPECT_GT(rms_tilt_deg, 1.0);
+  EXPECT_LT(rms_tilt_deg, 5.0);
+  EXPECT_LT(max_tilt * 180 / M_PI, 10.0);
+  std::printf("surface roughness: max %.3f m, normal tilt rms %.2f deg, max %.2f deg\n", max_h,
+              rms_tilt_deg, max_tilt * 180 / M_PI);
+  // Another seed gives other surfaces.
+  SimOptions other = o;
+  other.seed = 99;
+  auto sim2 = Simulator::Create(other);
+  ASSERT_TRUE(sim2.ok());
+  EXPECT_NE((*sim)->world().faces()[0].relief.Height(1.0, 2.0),
+            (*sim2)->world().faces()[0].relief.Height(1.0, 2.0));
 }
 
 }  // namespace

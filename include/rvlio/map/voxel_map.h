@@ -85,6 +85,7 @@ class VoxelMap {
   };
   struct Offset {
     int8_t dx, dy, dz;
+    float lower_bound2;  // squared box distance bound, in voxel edges^2 (see MakeShell)
   };
   class Candidates;
 

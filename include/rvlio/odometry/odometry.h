@@ -34,7 +34,7 @@ struct ScanResult {
   int constraints = 0;
   int iterations = 0;
   RvReport rv;
-  double ms = 0.0;  // processing time of this scan, wall clock
+  double ms = 0.0;  // processing time of this scan: CPU time of the calling thread
   Eigen::Vector3d mean_acc_imu = Eigen::Vector3d::Zero();  // mean specific force over the scan, m/s^2
 };
 
