@@ -42,7 +42,8 @@ CommandSpec SimulateSpec() {
           "IMU. Writes DIR/NAME.bag (ROS1: Ouster PointCloud2 + sensor_msgs/Imu), DIR/NAME_gt.tum\n"
           "(true IMU pose in the world frame, 100 Hz) and DIR/NAME.yaml (sensor configuration for\n"
           "`rvlio run --config`). Deterministic: the same options and seed give the same files.\n"
-          "Presets: " + PresetList() + ".",
+          "Presets: " +
+              PresetList() + ".",
           {{"preset", "NAME", "world, sensors and flight (default tunnel)", false, false},
            {"seed", "N", "random seed (default 1)", false, false},
            {"duration", "S", "seconds of data (default: the preset's)", false, false},
@@ -73,8 +74,8 @@ std::string ResolveOptions(const Args& args, SimOptions* options) {
   *options = *preset;
   if (args.Has("seed") && (!ParseInt64(args.Get("seed"), &options->seed) || options->seed < 0))
     return "--seed '" + args.Get("seed") + "' is not a non-negative integer";
-  if (args.Has("duration") && (!ParseDouble(args.Get("duration"), &options->duration) ||
-                               options->duration <= 0.0))
+  if (args.Has("duration") &&
+      (!ParseDouble(args.Get("duration"), &options->duration) || options->duration <= 0.0))
     return "--duration '" + args.Get("duration") + "' is not a positive number of seconds";
   for (const std::string& assignment : args.GetAll("set")) {
     Status s = ApplyOverride(*options, assignment);
@@ -99,7 +100,8 @@ std::string SensorYaml(const SimOptions& o, const std::string& name) {
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
   std::ostringstream y;
   y << "# Sensor configuration of the simulated sequence '" << name << "' (rvlio simulate, seed "
-    << o.seed << ").\n# Use: rvlio run --bag " << name << ".bag --config " << name << ".yaml --out DIR\n"
+    << o.seed << ").\n# Use: rvlio run --bag " << name << ".bag --config " << name
+    << ".yaml --out DIR\n"
     << "lidar:\n"
     << "  topic: " << o.lidar.topic << "\n"
     << "  type: ouster\n"
@@ -122,7 +124,8 @@ std::string SensorYaml(const SimOptions& o, const std::string& name) {
   // reproduced (rvlio simulate --set KEY=VALUE for any of them).
   y << "\n# Simulator options of this sequence:\n";
   std::istringstream dump(DumpYaml(o));
-  for (std::string line; std::getline(dump, line);) y << (line.empty() ? "#" : "#   " + line) << "\n";
+  for (std::string line; std::getline(dump, line);)
+    y << (line.empty() ? "#" : "#   " + line) << "\n";
   return y.str();
 }
 
@@ -171,7 +174,8 @@ int CmdSimulate(int argc, char** argv) {
   // The sensor configuration must be one that `rvlio run` accepts.
   const std::string yaml = SensorYaml(options, name);
   OdometryOptions check;
-  if (Status s = ApplyYamlText(check, yaml, name + ".yaml"); !s.ok() || !(s = check.Validate()).ok())
+  if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
+      !s.ok() || !(s = check.Validate()).ok())
     return Fail(kName, "internal: generated sensor configuration is rejected: " + s.message(), 1);
 
   const auto wall0 = std::chrono::steady_clock::now();
@@ -179,23 +183,28 @@ int CmdSimulate(int argc, char** argv) {
   StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
   if (!simulator.ok()) return Fail(kName, simulator.status().message());
   const std::string bag_path = (dir / (name + ".bag")).string();
-  if (Status s = WriteBag(**simulator, bag_path); !s.ok()) return Fail(kName, s.message(), s.exit_code());
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (Status s = WriteBag(**simulator, bag_path); !s.ok())
+    return Fail(kName, s.message(), s.exit_code());
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
 
   const Trajectory gt = (*simulator)->GroundTruth(kGroundTruthRate);
-  if (Status s = WriteTum((dir / (name + "_gt.tum")).string(), gt, GroundTruthHeader(options, name)); !s.ok())
+  if (Status s =
+          WriteTum((dir / (name + "_gt.tum")).string(), gt, GroundTruthHeader(options, name));
+      !s.ok())
     return Fail(kName, s.message(), s.exit_code());
   if (Status s = WriteFileAtomically((dir / (name + ".yaml")).string(), yaml); !s.ok())
     return Fail(kName, s.message(), s.exit_code());
 
   const double mb = static_cast<double>(std::filesystem::file_size(bag_path, ec)) / 1e6;
-  std::printf("rvlio simulate: %s: %lld scans (%dx%d), %lld IMU samples, %.1f s of data -> %s "
-              "(%.1f MB) in %.1f s (%.1f s CPU)\n",
-              name.c_str(), static_cast<long long>((*simulator)->scan_count()),
-              (*simulator)->lidar().rows(), (*simulator)->lidar().cols(),
-              static_cast<long long>((*simulator)->imu_count()), options.duration,
-              bag_path.c_str(), mb, wall_s, cpu_s);
+  std::printf(
+      "rvlio simulate: %s: %lld scans (%dx%d), %lld IMU samples, %.1f s of data -> %s "
+      "(%.1f MB) in %.1f s (%.1f s CPU)\n",
+      name.c_str(), static_cast<long long>((*simulator)->scan_count()),
+      (*simulator)->lidar().rows(), (*simulator)->lidar().cols(),
+      static_cast<long long>((*simulator)->imu_count()), options.duration, bag_path.c_str(), mb,
+      wall_s, cpu_s);
   return 0;
 }
 

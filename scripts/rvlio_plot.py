@@ -560,7 +560,14 @@ def ReadAblationTable(path, metrics):
     if r["variant"] not in variants:
       variants.append(r["variant"])
   cells = {m: Aggregate(rows, c[0], c[1]) for m, c in columns.items()}
-  return sequences, variants, cells, "seed" in header
+  if any(std for _, std in columns.values()):
+    note = "mean \u00b1 std as given in the table"
+  elif "seed" in header:
+    note = "mean \u00b1 std over seeds"
+  else:
+    note = "one value per cell" if len(rows) == len(set(
+        (r["sequence"], r["variant"]) for r in rows)) else "mean \u00b1 std over repeated rows"
+  return sequences, variants, cells, note
 
 
 def Aggregate(rows, column, std_column):
@@ -604,7 +611,7 @@ def LabelBar(ax, x, mean, spread):
 
 
 def PlotBars(ax, sequences, variants, cells, metric, yscale):
-  width = 0.8 / len(variants)
+  width = min(0.8 / len(variants), 0.25)
   x = np.arange(len(sequences))
   colors = ColorCycle()
   means = [cells.get((s, v), (float("nan"), 0, 0))[0] for s in sequences for v in variants]
@@ -613,7 +620,7 @@ def PlotBars(ax, sequences, variants, cells, metric, yscale):
     stats = [cells.get((s, variant), (float("nan"), 0.0, 0)) for s in sequences]
     mean = np.array([m for m, _, _ in stats])
     spread = np.array([d for _, d, _ in stats])
-    xs = x - 0.4 + width * (j + 0.5)
+    xs = x + width * (j + 0.5 - 0.5 * len(variants))
     bars = ax.bar(xs, np.nan_to_num(mean), width * 0.92, yerr=spread if spread.any() else None,
                   capsize=3, color=colors[j % len(colors)], label=variant)
     for bar, m, d in zip(bars, mean, spread):
@@ -621,6 +628,7 @@ def PlotBars(ax, sequences, variants, cells, metric, yscale):
   if log:
     ax.set_yscale("log")
   ax.set_xticks(x)
+  ax.set_xlim(-0.5, len(sequences) - 0.5)
   ax.set_xticklabels(sequences)
   ax.set_xlabel("sequence")
   ax.set_ylabel(MetricLabel(metric) + (" (log)" if log else ""))
@@ -629,7 +637,7 @@ def PlotBars(ax, sequences, variants, cells, metric, yscale):
 
 def CmdAblation(args):
   metrics = args.metric or ["ate_rmse"]
-  sequences, variants, cells, seeded = ReadAblationTable(args.table, metrics)
+  sequences, variants, cells, note = ReadAblationTable(args.table, metrics)
   width = max(7.0, 1.2 + 0.45 * len(sequences) * len(variants))
   fig, axes = Pyplot().subplots(len(metrics), 1, figsize=(width, 3.6 * len(metrics) + 0.8),
                            squeeze=False)
@@ -637,7 +645,6 @@ def CmdAblation(args):
     PlotBars(ax, sequences, variants, cells[metric], metric, args.yscale)
     ax.set_title(metric, fontsize=9, loc="left")
   axes[0, 0].legend(title="variant", loc="upper left", bbox_to_anchor=(1.01, 1.0))
-  note = "mean \u00b1 std over seeds" if seeded else "one value per cell"
   fig.suptitle("Ablation: %s (%s; n/a = no result)" % (os.path.basename(args.table), note),
                fontsize=10)
   fig.tight_layout()

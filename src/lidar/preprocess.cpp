@@ -22,7 +22,7 @@ void ScanPreprocessor::CollectCandidates(const Scan& scan) {
   stats_.num_input = static_cast<int>(scan.points.size());
   candidates_.clear();
   for (int i = 0; i < stats_.num_input; ++i) {
-    if (i % stride_ != 0) {
+    if (stride_ > 1 && i % stride_ != 0) {
       ++stats_.num_strided_out;
       continue;
     }
@@ -40,15 +40,10 @@ void ScanPreprocessor::CollectCandidates(const Scan& scan) {
   }
 }
 
-// Sizes the table to at least twice the candidates and starts a new stamp
-// (entries of earlier scans become free without clearing the table).
-void ScanPreprocessor::PrepareTable(size_t num_candidates) {
-  size_t capacity = std::max<size_t>(table_.size(), 64);
-  while (capacity < 2 * num_candidates) capacity *= 2;
-  if (capacity != table_.size()) {
-    table_.assign(capacity, Entry());
-    stamp_ = 0;
-  }
+// Starts a new stamp: entries of earlier scans become free without clearing
+// the table. The table keeps its size across scans (it only grows).
+void ScanPreprocessor::BeginScan() {
+  if (table_.empty()) table_.assign(1024, Entry());
   if (++stamp_ == 0) {  // wrapped: really clear once every 2^32 scans
     std::fill(table_.begin(), table_.end(), Entry());
     stamp_ = 1;
@@ -56,17 +51,37 @@ void ScanPreprocessor::PrepareTable(size_t num_candidates) {
   used_.clear();
 }
 
-void ScanPreprocessor::VoxelFilter(const Scan& scan, std::vector<int>* indices) {
-  PrepareTable(candidates_.size());
+size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) {
   const size_t mask = table_.size() - 1;
+  size_t slot = HashVoxelKey(key) & mask;
+  while (table_[slot].stamp == stamp_ && table_[slot].key != key) slot = (slot + 1) & mask;
+  return slot;
+}
+
+// Doubles the table when the load reaches 1/2, moving this scan's entries.
+void ScanPreprocessor::GrowIfNeeded() {
+  if (2 * (used_.size() + 1) <= table_.size()) return;
+  std::vector<Entry> old(2 * table_.size(), Entry());
+  old.swap(table_);
+  for (int32_t& slot : used_) {
+    const Entry e = old[slot];
+    const size_t fresh = FindOrAdd(e.key);
+    table_[fresh] = e;
+    slot = static_cast<int32_t>(fresh);
+  }
+}
+
+void ScanPreprocessor::VoxelFilter(const Scan& scan, std::vector<int>* indices) {
+  BeginScan();
+  const double s = voxel_size_;
   for (const int i : candidates_) {
     const Eigen::Vector3d p = scan.points[i].p_lidar.cast<double>();
     if (!IsKeyable(p.x(), p.y(), p.z(), inv_voxel_size_)) continue;  // beyond int32 voxels
     const VoxelKey key = KeyOf(p, inv_voxel_size_);
-    const Eigen::Vector3d centre = (Eigen::Vector3d(key.x, key.y, key.z).array() + 0.5) * voxel_size_;
+    const Eigen::Vector3d centre((key.x + 0.5) * s, (key.y + 0.5) * s, (key.z + 0.5) * s);
     const float d2 = static_cast<float>((p - centre).squaredNorm());
-    size_t slot = HashVoxelKey(key) & mask;
-    while (table_[slot].stamp == stamp_ && table_[slot].key != key) slot = (slot + 1) & mask;
+    GrowIfNeeded();
+    const size_t slot = FindOrAdd(key);
     Entry& e = table_[slot];
     if (e.stamp != stamp_) {
       e = Entry{key, i, d2, stamp_};

@@ -15,6 +15,45 @@ constexpr size_t kInitialCapacity = 1024;  // slots (power of two)
 constexpr int kDistanceChunk = 64;         // points per vectorized distance pass
 constexpr int kFirstBlockCapacity = 4;     // points in a new voxel's block
 
+// Voxel keys are packed into 64 bits, 21 per axis with a bias; points whose
+// voxel index reaches kKeyLimit in magnitude are not stored (at the smallest
+// voxel size, 0.05 m, that is 52 km from the origin).
+constexpr int kKeyBits = 21;
+constexpr int64_t kKeyBias = int64_t{1} << (kKeyBits - 1);
+constexpr double kKeyLimit = static_cast<double>(kKeyBias - 1024);  // margin for neighbours
+constexpr uint64_t kKeyMask = (uint64_t{1} << kKeyBits) - 1;
+
+uint64_t PackKey(int64_t x, int64_t y, int64_t z) {
+  return (static_cast<uint64_t>(x + kKeyBias) << (2 * kKeyBits)) |
+         (static_cast<uint64_t>(y + kKeyBias) << kKeyBits) | static_cast<uint64_t>(z + kKeyBias);
+}
+VoxelKey UnpackKey(uint64_t key) {
+  return VoxelKey{static_cast<int32_t>(static_cast<int64_t>(key >> (2 * kKeyBits)) - kKeyBias),
+                  static_cast<int32_t>(static_cast<int64_t>((key >> kKeyBits) & kKeyMask) - kKeyBias),
+                  static_cast<int32_t>(static_cast<int64_t>(key & kKeyMask) - kKeyBias)};
+}
+// Packed key of the voxel at offset (dx, dy, dz) from a packed key, valid
+// while every coordinate stays within the biased range (no carries).
+uint64_t OffsetKey(uint64_t key, int dx, int dy, int dz) {
+  return key + (static_cast<uint64_t>(static_cast<int64_t>(dx)) << (2 * kKeyBits)) +
+         (static_cast<uint64_t>(static_cast<int64_t>(dy)) << kKeyBits) +
+         static_cast<uint64_t>(static_cast<int64_t>(dz));
+}
+// splitmix64 finalizer: well-mixed low bits for the power-of-two table.
+uint64_t HashKey(uint64_t h) {
+  h ^= h >> 30;
+  h *= 0xBF58476D1CE4E5B9ull;
+  h ^= h >> 27;
+  h *= 0x94D049BB133111EBull;
+  h ^= h >> 31;
+  return h;
+}
+bool InKeyRange(const Eigen::Vector3d& p, double inv_voxel_size) {
+  return std::abs(p.x() * inv_voxel_size) < kKeyLimit &&
+         std::abs(p.y() * inv_voxel_size) < kKeyLimit &&
+         std::abs(p.z() * inv_voxel_size) < kKeyLimit;  // false for NaN
+}
+
 // Offsets of Chebyshev norm r, ordered for a query in the upper octant of
 // its voxel (local coordinates in [s/2, s) on every axis): by a lower bound
 // of the squared box distance, then by the number of non-zero components.
@@ -94,7 +133,7 @@ class VoxelMap::Candidates {
 
 VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
   RVLIO_CHECK(options.voxel_size > 0.0);
-  RVLIO_CHECK(options.max_points_per_voxel >= 1);
+  RVLIO_CHECK(options.max_points_per_voxel >= 1 && options.max_points_per_voxel <= 65535);
   inv_voxel_size_ = 1.0 / options.voxel_size;
   min_d2_ = static_cast<float>(options.min_point_distance * options.min_point_distance);
   max_points_ = options.max_points_per_voxel;
@@ -112,8 +151,8 @@ void VoxelMap::Clear() {
 
 // ---------------------------------------------------------------- hash table
 
-int VoxelMap::FindSlot(const VoxelKey& key) const {
-  size_t i = HashVoxelKey(key) & mask_;
+int VoxelMap::FindSlot(uint64_t key) const {
+  size_t i = HashKey(key) & mask_;
   while (slots_[i].offset >= 0) {
     if (slots_[i].key == key) return static_cast<int>(i);
     i = (i + 1) & mask_;
@@ -122,7 +161,7 @@ int VoxelMap::FindSlot(const VoxelKey& key) const {
 }
 
 void VoxelMap::InsertSlot(const Slot& s) {
-  size_t i = HashVoxelKey(s.key) & mask_;
+  size_t i = HashKey(s.key) & mask_;
   while (slots_[i].offset >= 0) i = (i + 1) & mask_;
   slots_[i] = s;
 }
@@ -134,7 +173,7 @@ void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
   for (const Slot& s : slots) InsertSlot(s);
 }
 
-int VoxelMap::CreateSlot(const VoxelKey& key) {
+int VoxelMap::CreateSlot(uint64_t key) {
   if (2 * (num_voxels_ + 1) > slots_.size()) {  // keep the load <= 1/2
     scratch_slots_.clear();
     for (const Slot& s : slots_)
@@ -143,7 +182,7 @@ int VoxelMap::CreateSlot(const VoxelKey& key) {
   }
   Slot s;
   s.key = key;
-  s.capacity = std::min(kFirstBlockCapacity, max_points_);
+  s.capacity = static_cast<uint16_t>(std::min(kFirstBlockCapacity, max_points_));
   s.offset = AllocateBlock(s.capacity);
   InsertSlot(s);
   ++num_voxels_;
@@ -185,14 +224,15 @@ void VoxelMap::GrowBlock(Slot* s) {
                 pool_.begin() + new_offset + axis * new_capacity);
   FreeBlock(s->offset, s->capacity);
   s->offset = new_offset;
-  s->capacity = new_capacity;
+  s->capacity = static_cast<uint16_t>(new_capacity);
 }
 
 // ------------------------------------------------------------------ updates
 
 bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
-  if (!IsKeyable(p_world.x(), p_world.y(), p_world.z(), inv_voxel_size_)) return false;
-  const VoxelKey key = KeyOf(p_world, inv_voxel_size_);
+  if (!InKeyRange(p_world, inv_voxel_size_)) return false;
+  const VoxelKey k = KeyOf(p_world, inv_voxel_size_);
+  const uint64_t key = PackKey(k.x, k.y, k.z);
   const float px = static_cast<float>(p_world.x());
   const float py = static_cast<float>(p_world.y());
   const float pz = static_cast<float>(p_world.z());
@@ -230,7 +270,8 @@ void VoxelMap::RemoveFar(const Eigen::Vector3d& center_world, double radius) {
   bool removed = false;
   for (const Slot& s : slots_) {
     if (s.offset < 0) continue;
-    const Eigen::Vector3d c((s.key.x + 0.5) * vs, (s.key.y + 0.5) * vs, (s.key.z + 0.5) * vs);
+    const VoxelKey k = UnpackKey(s.key);
+    const Eigen::Vector3d c((k.x + 0.5) * vs, (k.y + 0.5) * vs, (k.z + 0.5) * vs);
     if ((c - center_world).squaredNorm() > r2) {
       num_points_ -= s.count;
       FreeBlock(s.offset, s.capacity);
@@ -281,7 +322,9 @@ void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const d
   const double gy = AxisGap(dy, q_local[1], s);
   const double gz = AxisGap(dz, q_local[2], s);
   if (gx * gx + gy * gy + gz * gz > c->limit()) return;
-  const int slot = FindSlot(VoxelKey{home.x + dx, home.y + dy, home.z + dz});
+  const int64_t x = int64_t{home.x} + dx, y = int64_t{home.y} + dy, z = int64_t{home.z} + dz;
+  if (std::max({std::abs(x), std::abs(y), std::abs(z)}) >= kKeyBias) return;  // never stored
+  const int slot = FindSlot(PackKey(x, y, z));
   if (slot >= 0) ScanBlock(slots_[slot], q, c);
 }
 
@@ -310,11 +353,12 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
     }
   }
   const double s2 = s * s;
+  const uint64_t home_key = PackKey(home.x, home.y, home.z);  // |home| < kKeyLimit: no carries
   for (const Offset& o : shells_[r]) {
     if (o.lower_bound2 * s2 > c->limit()) break;  // sorted: the rest are no closer
     const int dx = sign[0] * o.dx, dy = sign[1] * o.dy, dz = sign[2] * o.dz;
     if (gap2[0][dx + r] + gap2[1][dy + r] + gap2[2][dz + r] > c->limit()) continue;
-    const int slot = FindSlot(VoxelKey{home.x + dx, home.y + dy, home.z + dz});
+    const int slot = FindSlot(OffsetKey(home_key, dx, dy, dz));
     if (slot >= 0) ScanBlock(slots_[slot], q, c);
   }
 }
@@ -326,7 +370,8 @@ void VoxelMap::ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3],
   const double s = options_.voxel_size;
   for (const Slot& slot : slots_) {
     if (slot.offset < 0) continue;
-    const Eigen::Vector3d lo(slot.key.x * s, slot.key.y * s, slot.key.z * s);
+    const VoxelKey k = UnpackKey(slot.key);
+    const Eigen::Vector3d lo(k.x * s, k.y * s, k.z * s);
     const Eigen::Vector3d gap =
         (lo - q_world).cwiseMax(q_world - lo - Eigen::Vector3d::Constant(s)).cwiseMax(0.0);
     if (gap.squaredNorm() > c->limit()) continue;
@@ -340,7 +385,7 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
   RVLIO_CHECK(out != nullptr);
   out->size = 0;
   if (num_points_ == 0 || !(max_dist > 0.0)) return 0;
-  if (!IsKeyable(q_world.x(), q_world.y(), q_world.z(), inv_voxel_size_)) return 0;
+  if (!InKeyRange(q_world, inv_voxel_size_)) return 0;
 
   const double s = options_.voxel_size;
   const double max_d = std::min(max_dist, 1.0e6 * s);

@@ -10,8 +10,7 @@ namespace rvlio::sim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kRootTol = 1e-9;      // m, |g| at which a surface root is accepted
-constexpr double kNewtonBelow = 2e-3;  // m, switch from safe marching to Newton
+constexpr double kRootTol = 1e-9;  // m, |g| at which a surface root is accepted
 constexpr int kMaxSteps = 100000;  // sphere-tracing steps (grazing rays on steep relief need many)
 
 // g(t) = (o_w + t r_w - offset) - h(o_u + t r_u, o_v + t r_v): signed height of
@@ -39,46 +38,50 @@ double RefineBracket(const SurfaceFunction& g, double a, double b, double sa, do
     double slope = 0.0;
     const double value = g.WithSlope(t, &slope);
     if (std::abs(value) < kRootTol || b - a < 1e-12) return t;
-    if ((value > 0) == (sa > 0)) a = t; else b = t;
+    if ((value > 0) == (sa > 0))
+      a = t;
+    else
+      b = t;
     const double newton = slope != 0.0 ? t - value / slope : kInf;
     t = (newton > a && newton < b) ? newton : 0.5 * (a + b);
   }
   return t;
 }
 
-// First root of g in [t0, t1]. Sphere tracing with the Lipschitz bound L of g
-// never steps over a root: |g(t + s) - g(t)| <= L s, so g keeps its sign for
-// s < |g(t)| / L. Near the surface Newton takes over; a sign change brackets
-// the root for RefineBracket.
-bool FirstRoot(const SurfaceFunction& g, double lipschitz, double t0, double t1, double* root) {
+// First root of g in [t0, t1] for any ray (also grazing ones that may dip
+// under a crest and come out again). Every step is provably shorter than the
+// distance to the next root: with G = sign * g > 0, |g'| <= L and |g''| <= K,
+//   G(t + d) >= G(t) - L d                      (Lipschitz)
+//   G(t + d) >= G(t) + G'(t) d - K d^2 / 2      (Taylor with the curvature bound)
+// so G stays positive for d < max(G / L, (G' + sqrt(G'^2 + 2 K G)) / K). The
+// second bound makes the steps Newton-like near a transversal crossing
+// (quadratic convergence); the march stops within kRootTol of the surface,
+// still on the ray's side of it.
+bool FirstRoot(const SurfaceFunction& g, double lipschitz, double curvature, double t0, double t1,
+               double* root) {
   double t = t0;
-  double value = g(t);
-  const double s0 = value >= 0 ? 1.0 : -1.0;
+  double slope = 0.0;
+  double value = g.WithSlope(t, &slope);
+  const double sign = value >= 0 ? 1.0 : -1.0;
   for (int i = 0; i < kMaxSteps; ++i) {
-    if (std::abs(value) < kRootTol) {
+    const double G = sign * value, dG = sign * slope;
+    if (G < kRootTol) {
       *root = t;
       return true;
     }
-    double next = t + 2.0 * std::abs(value) / lipschitz;
-    if (std::abs(value) < kNewtonBelow) {
-      double slope = 0.0;
-      g.WithSlope(t, &slope);
-      const double newton = slope != 0.0 ? t - value / slope : kInf;
-      if (newton > t && newton <= t1 + 1e-9) next = std::max(next, newton);
+    double step = G / lipschitz;
+    if (curvature > 0.0) {
+      step = std::max(step, (dG + std::sqrt(dG * dG + 2.0 * curvature * G)) / curvature);
+    } else if (dG < 0.0) {
+      step = std::max(step, G / -dG);
     }
-    if (next > t1) {
-      // No root up to the slab's end unless Newton jumped across one.
-      if (t1 <= t) return false;
-      next = t1;
-    }
-    const double next_value = g(next);
-    if ((next_value >= 0 ? 1.0 : -1.0) != s0) {
-      *root = std::abs(next_value) < kRootTol ? next : RefineBracket(g, t, next, s0, next);
+    if (t >= t1) return false;
+    t = std::min(t + step, t1);
+    value = g.WithSlope(t, &slope);
+    if (sign * value < 0.0) {  // only reachable through rounding at a root
+      *root = t;
       return true;
     }
-    if (next >= t1) return false;
-    t = next;
-    value = next_value;
   }
   return false;
 }
@@ -94,13 +97,19 @@ bool MonotonicRoot(const SurfaceFunction& g, double t0, double t1, bool clipped0
   double s0 = entry_sign;
   if (clipped0) {
     const double g0 = g(t0);
-    if (std::abs(g0) < kRootTol) { *root = t0; return true; }
+    if (std::abs(g0) < kRootTol) {
+      *root = t0;
+      return true;
+    }
     s0 = g0 >= 0 ? 1.0 : -1.0;
     if (s0 != entry_sign) return false;  // already beyond the only root
   }
   if (clipped1) {
     const double g1 = g(t1);
-    if (std::abs(g1) < kRootTol) { *root = t1; return true; }
+    if (std::abs(g1) < kRootTol) {
+      *root = t1;
+      return true;
+    }
     if ((g1 >= 0 ? 1.0 : -1.0) == s0) return false;  // the root lies beyond t1
   }
   *root = RefineBracket(g, t0, t1, s0, (g.face.offset - g.ow) / g.rw);
@@ -119,15 +128,38 @@ inline void SinCos(double x, double* s, double* c) {
   const double q = std::floor(x * kTwoOverPi + 0.5);
   const double r = ((x - q * kP1) - q * kP2) - q * kP3;
   const double r2 = r * r;
-  const double sr = r * (1.0 + r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 + r2 * (1.0 / 362880 +
-                    r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800.0 + r2 * (-1.0 / 1307674368000.0))))))));
-  const double cr = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 +
-                    r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600 + r2 * (-1.0 / 87178291200.0)))))));
+  const double sr =
+      r * (1.0 +
+           r2 * (-1.0 / 6 +
+                 r2 * (1.0 / 120 +
+                       r2 * (-1.0 / 5040 +
+                             r2 * (1.0 / 362880 + r2 * (-1.0 / 39916800 +
+                                                        r2 * (1.0 / 6227020800.0 +
+                                                              r2 * (-1.0 / 1307674368000.0))))))));
+  const double cr =
+      1.0 +
+      r2 * (-0.5 + r2 * (1.0 / 24 +
+                         r2 * (-1.0 / 720 +
+                               r2 * (1.0 / 40320 +
+                                     r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600 +
+                                                                  r2 * (-1.0 / 87178291200.0)))))));
   switch (static_cast<int64_t>(q) & 3) {
-    case 0: *s = sr; *c = cr; break;
-    case 1: *s = cr; *c = -sr; break;
-    case 2: *s = -sr; *c = -cr; break;
-    default: *s = -cr; *c = sr; break;
+    case 0:
+      *s = sr;
+      *c = cr;
+      break;
+    case 1:
+      *s = cr;
+      *c = -sr;
+      break;
+    case 2:
+      *s = -sr;
+      *c = -cr;
+      break;
+    default:
+      *s = -cr;
+      *c = sr;
+      break;
   }
 }
 
@@ -137,6 +169,7 @@ HeightField::HeightField(std::vector<Wave> waves) : waves_(std::move(waves)) {
   for (const Wave& w : waves_) {
     amplitude_bound_ += std::abs(w.amplitude);
     slope_bound_ += std::abs(w.amplitude) * std::hypot(w.ku, w.kv);
+    curvature_bound_ += std::abs(w.amplitude) * (w.ku * w.ku + w.kv * w.kv);
   }
 }
 
@@ -153,8 +186,8 @@ HeightField HeightField::Random(Rng& rng, int components, double amplitude, doub
   for (double l : lambdas) {
     const double dir = rng.Uniform(0.0, 2.0 * M_PI);
     const double k = 2.0 * M_PI / l;
-    waves.push_back({amplitude * l / sum, k * std::cos(dir), k * std::sin(dir),
-                     rng.Uniform(0.0, 2.0 * M_PI)});
+    waves.push_back(
+        {amplitude * l / sum, k * std::cos(dir), k * std::sin(dir), rng.Uniform(0.0, 2.0 * M_PI)});
   }
   return HeightField(std::move(waves));
 }
@@ -203,8 +236,13 @@ bool Face::Slab(const Ray& ray, double t_min, double t_max, double* t0, double* 
 }
 
 bool Face::Intersect(const Ray& ray, double t_min, double t_max, double* t) const {
-  const SurfaceFunction g{*this, ray.origin[axis], ray.dir[axis], ray.origin[UAxis()],
-                          ray.dir[UAxis()], ray.origin[VAxis()], ray.dir[VAxis()]};
+  const SurfaceFunction g{*this,
+                          ray.origin[axis],
+                          ray.dir[axis],
+                          ray.origin[UAxis()],
+                          ray.dir[UAxis()],
+                          ray.origin[VAxis()],
+                          ray.dir[VAxis()]};
   double t0 = 0.0, t1 = 0.0;
   if (!Slab(ray, t_min, t_max, &t0, &t1)) return false;
   double root = 0.0;
@@ -214,7 +252,8 @@ bool Face::Intersect(const Ray& ray, double t_min, double t_max, double* t) cons
     const double slope_rate = relief.slope_bound() * std::hypot(g.ru, g.rv);
     if (std::abs(g.rw) > 1.001 * slope_rate) {
       if (!MonotonicRoot(g, t0, t1, t0 == t_min, t1 == t_max, &root)) return false;
-    } else if (!FirstRoot(g, std::abs(g.rw) + slope_rate, t0, t1, &root)) {
+    } else if (!FirstRoot(g, std::abs(g.rw) + slope_rate,
+                          relief.curvature_bound() * (g.ru * g.ru + g.rv * g.rv), t0, t1, &root)) {
       return false;
     }
   }
@@ -301,7 +340,8 @@ double Cylinder::Distance(const Eigen::Vector3d& p) const {
 Eigen::AlignedBox3d Cylinder::Bounds() const {
   Eigen::Vector3d extent;
   for (int i = 0; i < 3; ++i)
-    extent[i] = std::abs(axis[i]) * half_length + radius * std::sqrt(std::max(0.0, 1.0 - axis[i] * axis[i]));
+    extent[i] = std::abs(axis[i]) * half_length +
+                radius * std::sqrt(std::max(0.0, 1.0 - axis[i] * axis[i]));
   return Eigen::AlignedBox3d(center - extent, center + extent);
 }
 

@@ -49,11 +49,13 @@ ImuSample ImuSimulator::Next() {
   m.gyro_imu += bg_ + NormalVector(rng_, options_.gyro_noise_density * sqrt_rate);
   m.acc_imu += ba_ + NormalVector(rng_, options_.accel_noise_density * sqrt_rate);
   if (options_.vibration_accel > 0.0 || options_.vibration_gyro > 0.0) {
-    const double arg = 2.0 * M_PI * options_.vibration_frequency *
-                       NsToSeconds(m.t_ns - trajectory_.t0_ns());
+    const double arg =
+        2.0 * M_PI * options_.vibration_frequency * NsToSeconds(m.t_ns - trajectory_.t0_ns());
     for (int i = 0; i < 3; ++i) {
-      m.acc_imu[i] += options_.vibration_accel * kVibrationAxis[i] * std::sin(arg + vibration_phase_[i]);
-      m.gyro_imu[i] += options_.vibration_gyro * kVibrationAxis[2 - i] * std::sin(arg + vibration_phase_[3 + i]);
+      m.acc_imu[i] +=
+          options_.vibration_accel * kVibrationAxis[i] * std::sin(arg + vibration_phase_[i]);
+      m.gyro_imu[i] +=
+          options_.vibration_gyro * kVibrationAxis[2 - i] * std::sin(arg + vibration_phase_[3 + i]);
     }
   }
   bg_next_ = bg_ + NormalVector(rng_, options_.gyro_bias_random_walk * std::sqrt(dt));

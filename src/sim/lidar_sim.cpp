@@ -16,7 +16,8 @@ float Intensity(float reflectivity, double range) {
 }  // namespace
 
 LidarModel::LidarModel(const SimLidarOptions& options)
-    : rows_(options.beams), cols_(options.columns),
+    : rows_(options.beams),
+      cols_(options.columns),
       period_ns_(static_cast<TimeNs>(std::llround(1e9 / options.rate))) {
   RVLIO_CHECK(rows_ > 0 && cols_ > 0);
   for (int r = 0; r < rows_; ++r) {
@@ -53,7 +54,8 @@ Scan CastScan(const World& world, const FlightTrajectory& trajectory, const Lida
         continue;
       if (hit.range < options.min_range) continue;
       if (options.dropout > 0.0 && rng.Uniform() < options.dropout) continue;
-      const double range = hit.range + (options.range_noise > 0.0 ? rng.Normal(options.range_noise) : 0.0);
+      const double range =
+          hit.range + (options.range_noise > 0.0 ? rng.Normal(options.range_noise) : 0.0);
       pt.p_lidar = (d_lidar * range).cast<float>();
       pt.intensity = Intensity(hit.reflectivity, hit.range);
     }

@@ -21,8 +21,10 @@ Status CheckWaypoints(const SimOptions& o) {
   StatusOr<std::vector<Eigen::Vector3d>> wps = sim::ParseWaypoints(o.trajectory.waypoints);
   if (!wps.ok()) return wps.status();
   if (wps->front().norm() > 1e-9)
-    return Status::InvalidInput("trajectory.waypoints: the first waypoint must be 0,0,0 "
-                                "(the world origin is the start pose), got " + Fmt(wps->front()));
+    return Status::InvalidInput(
+        "trajectory.waypoints: the first waypoint must be 0,0,0 "
+        "(the world origin is the start pose), got " +
+        Fmt(wps->front()));
   const sim::WorldLayout L = sim::MakeLayout(o.world);
   const double far_x = o.world.end_wall ? L.x_end : L.x_end + 1e4;
   for (const Eigen::Vector3d& p : *wps) {
@@ -50,8 +52,9 @@ Status SimOptions::Validate() {
   if (duration * lidar.rate < 1.0)
     return Status::InvalidInput("duration must cover at least one scan (1 / lidar.rate)");
   if (world.roughness_wavelength_max < world.roughness_wavelength_min)
-    return Status::InvalidInput("world.roughness_wavelength_max must not be below "
-                                "world.roughness_wavelength_min");
+    return Status::InvalidInput(
+        "world.roughness_wavelength_max must not be below "
+        "world.roughness_wavelength_min");
   if (world.start_height >= world.height - 0.3)
     return Status::InvalidInput("world.start_height must be below world.height - 0.3");
   return CheckWaypoints(*this);

@@ -24,14 +24,14 @@ StatusOr<std::unique_ptr<Simulator>> Simulator::Create(const SimOptions& options
   return std::unique_ptr<Simulator>(new Simulator(copy));
 }
 
-Simulator::Simulator(const SimOptions& options)
-    : options_(options), lidar_(options.lidar) {
+Simulator::Simulator(const SimOptions& options) : options_(options), lidar_(options.lidar) {
   const uint64_t seed = static_cast<uint64_t>(options.seed);
   t0_ns_ = SecondsToNs(options.start_time);
   t_end_ns_ = t0_ns_ + SecondsToNs(options.duration);
   T_imu_lidar_ = ExtrinsicPose(options.extrinsics.imu_T_lidar);
-  trajectory_ = std::make_unique<FlightTrajectory>(*ParseWaypoints(options.trajectory.waypoints),
-                                                   options.trajectory, options.imu.gravity, t0_ns_, seed);
+  trajectory_ =
+      std::make_unique<FlightTrajectory>(*ParseWaypoints(options.trajectory.waypoints),
+                                         options.trajectory, options.imu.gravity, t0_ns_, seed);
   layout_ = MakeLayout(options.world);
   world_ = BuildWorld(options.world, trajectory_->SamplePath(0.1), seed);
   scan_count_ = (t_end_ns_ - t0_ns_) / lidar_.period_ns();
@@ -40,8 +40,10 @@ Simulator::Simulator(const SimOptions& options)
 }
 
 Scan Simulator::SimulateScan(int64_t k) const {
-  Rng rng = Rng::Stream(static_cast<uint64_t>(options_.seed), kScanStreamBase + static_cast<uint64_t>(k));
-  return CastScan(world_, *trajectory_, lidar_, options_.lidar, T_imu_lidar_, ScanStartTime(k), rng);
+  Rng rng =
+      Rng::Stream(static_cast<uint64_t>(options_.seed), kScanStreamBase + static_cast<uint64_t>(k));
+  return CastScan(world_, *trajectory_, lidar_, options_.lidar, T_imu_lidar_, ScanStartTime(k),
+                  rng);
 }
 
 bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan) const {

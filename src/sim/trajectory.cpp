@@ -11,17 +11,21 @@ namespace rvlio::sim {
 
 namespace {
 
-constexpr double kYawEnvelope = 2.0;               // s over which the yaw motion fades in
-constexpr double kYawFreq[2] = {0.05, 0.13};       // Hz
+constexpr double kYawEnvelope = 2.0;          // s over which the yaw motion fades in
+constexpr double kYawFreq[2] = {0.05, 0.13};  // Hz
 constexpr double kYawWeight[2] = {0.7, 0.3};
 
 // Septic smoothstep and its derivatives / integral on [0, 1].
 double S(double x) { return x * x * x * x * (35.0 + x * (-84.0 + x * (70.0 - 20.0 * x))); }
-double S1(double x) { const double y = x * (1.0 - x); return 140.0 * y * y * y; }
-double S2(double x) { const double y = x * (1.0 - x); return 420.0 * y * y * (1.0 - 2.0 * x); }
-double SInt(double x) {
-  return x * x * x * x * x * (7.0 + x * (-14.0 + x * (10.0 - 2.5 * x)));
+double S1(double x) {
+  const double y = x * (1.0 - x);
+  return 140.0 * y * y * y;
 }
+double S2(double x) {
+  const double y = x * (1.0 - x);
+  return 420.0 * y * y * (1.0 - 2.0 * x);
+}
+double SInt(double x) { return x * x * x * x * x * (7.0 + x * (-14.0 + x * (10.0 - 2.5 * x))); }
 
 std::string Trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t\n\r");
@@ -89,8 +93,8 @@ FlightTrajectory::FlightTrajectory(std::vector<Eigen::Vector3d> waypoints,
   for (double& phase : yaw_phase_) phase = rng.Uniform(0.0, 2.0 * M_PI);
 }
 
-void FlightTrajectory::AlongSegment(const Segment& s, double tau, double* d, double* v,
-                                    double* a, double* j) const {
+void FlightTrajectory::AlongSegment(const Segment& s, double tau, double* d, double* v, double* a,
+                                    double* j) const {
   const double local = tau - s.t_begin, V = s.speed, r = s.ramp;
   const double total = 2.0 * r + s.cruise;
   if (local < r) {

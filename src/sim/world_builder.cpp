@@ -18,12 +18,17 @@ constexpr double kBackdrop = 8.0;      // m, hall: distance of the walls seen th
 constexpr double kSink = 0.1;          // m, objects reach this far into floor/walls (no gaps)
 constexpr int kAttempts = 40;
 
-Eigen::Matrix3d RotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).matrix(); }
+Eigen::Matrix3d RotZ(double yaw) {
+  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).matrix();
+}
 
 class Builder {
  public:
   Builder(const SimWorldOptions& o, const std::vector<Eigen::Vector3d>& path, uint64_t seed)
-      : o_(o), path_(path), L_(MakeLayout(o)), shell_rng_(Rng::Stream(seed, 11)),
+      : o_(o),
+        path_(path),
+        L_(MakeLayout(o)),
+        shell_rng_(Rng::Stream(seed, 11)),
         feature_rng_(Rng::Stream(seed, 13)) {}
 
   World Build() {
@@ -79,14 +84,22 @@ class Builder {
     const double x0 = L_.x_entrance, x1 = o_.end_wall ? L_.x_end : L_.x_end + kFar;
     const double yc = L_.y_center, hw = L_.half_width, zf = L_.z_floor, zc = L_.z_ceiling;
     const double out = backdrop ? kBackdrop + m : 0.0;  // hall ceiling covers the backdrop
-    std::vector<std::vector<Rect2>> holes = hall ? MakeOpenings() : std::vector<std::vector<Rect2>>(4);
+    std::vector<std::vector<Rect2>> holes =
+        hall ? MakeOpenings() : std::vector<std::vector<Rect2>>(4);
 
     // Floor (u = x, v = y): continues outside an open entrance.
-    world_.AddFace(MakeFace(2, zf, {open ? x0 - kFar : x0 - m - out, x1 + m + out, yc - hw - kFar, yc + hw + kFar}, true), 40.f);
-    world_.AddFace(MakeFace(2, zc, {x0 - m - out, x1 + m + out, yc - hw - m - out, yc + hw + m + out}, true), 60.f);
+    world_.AddFace(
+        MakeFace(2, zf,
+                 {open ? x0 - kFar : x0 - m - out, x1 + m + out, yc - hw - kFar, yc + hw + kFar},
+                 true),
+        40.f);
+    world_.AddFace(
+        MakeFace(2, zc, {x0 - m - out, x1 + m + out, yc - hw - m - out, yc + hw + m + out}, true),
+        60.f);
     // Side walls (u = z, v = x).
     for (int side = 0; side < 2; ++side) {
-      Face f = MakeFace(1, side == 0 ? yc - hw : yc + hw, {zf - m, zc + m, x0 - (open ? 0.0 : m), x1 + m}, true);
+      Face f = MakeFace(1, side == 0 ? yc - hw : yc + hw,
+                        {zf - m, zc + m, x0 - (open ? 0.0 : m), x1 + m}, true);
       f.holes = holes[side];
       world_.AddFace(std::move(f), 80.f);
     }
@@ -107,7 +120,8 @@ class Builder {
   // Flat walls kBackdrop outside the hall, seen through its doorways.
   void AddBackdrop(double m) {
     const double bx0 = L_.x_entrance - kBackdrop, bx1 = L_.x_end + kBackdrop;
-    const double by0 = L_.y_center - L_.half_width - kBackdrop, by1 = L_.y_center + L_.half_width + kBackdrop;
+    const double by0 = L_.y_center - L_.half_width - kBackdrop,
+                 by1 = L_.y_center + L_.half_width + kBackdrop;
     const double zf = L_.z_floor, zc = L_.z_ceiling;
     world_.AddFace(MakeFace(1, by0, {zf - m, zc + m, bx0 - m, bx1 + m}, false), 120.f);
     world_.AddFace(MakeFace(1, by1, {zf - m, zc + m, bx0 - m, bx1 + m}, false), 120.f);
@@ -120,7 +134,9 @@ class Builder {
     for (const Eigen::Vector3d& p : path_) d = std::min(d, box.exteriorDistance(p));
     return d;
   }
-  bool Clear(const Eigen::AlignedBox3d& box) const { return PathDistance(box) >= o_.path_clearance; }
+  bool Clear(const Eigen::AlignedBox3d& box) const {
+    return PathDistance(box) >= o_.path_clearance;
+  }
 
   float FeatureReflectivity() { return static_cast<float>(feature_rng_.Uniform(90.0, 250.0)); }
 
@@ -150,30 +166,34 @@ class Builder {
     const double H = L_.z_ceiling - L_.z_floor;
     const int kind = r.UniformInt(0, 99);
     if (kind < 40) {
-      const Eigen::Vector3d half(r.Uniform(0.2, 1.0), r.Uniform(0.2, 1.0), r.Uniform(0.15, std::min(1.25, 0.3 * H)));
+      const Eigen::Vector3d half(r.Uniform(0.2, 1.0), r.Uniform(0.2, 1.0),
+                                 r.Uniform(0.15, std::min(1.25, 0.3 * H)));
       return TryBox(FloorBox(x, y, half, RotZ(r.Uniform(-0.6, 0.6))));
     }
     if (kind < 65) {
       Cylinder c;
       c.radius = r.Uniform(0.15, 0.5);
-      const double top = r.Uniform(0.0, 1.0) < 0.5 ? L_.z_ceiling + kSink : L_.z_floor + r.Uniform(1.0, 0.7 * H);
+      const double top =
+          r.Uniform(0.0, 1.0) < 0.5 ? L_.z_ceiling + kSink : L_.z_floor + r.Uniform(1.0, 0.7 * H);
       c.half_length = 0.5 * (top - (L_.z_floor - kSink));
       c.center = Eigen::Vector3d(x, y, L_.z_floor - kSink + c.half_length);
       return TryCylinder(c);
     }
     if (kind < 85) {  // irregular block: tilted, partly sunk into the floor
       const Eigen::Vector3d half(r.Uniform(0.3, 1.2), r.Uniform(0.3, 1.2), r.Uniform(0.3, 1.0));
-      const Eigen::Matrix3d R = (Eigen::AngleAxisd(r.Uniform(-M_PI, M_PI), Eigen::Vector3d::UnitZ()) *
-                                 Eigen::AngleAxisd(r.Uniform(-0.5, 0.5), Eigen::Vector3d::UnitY()) *
-                                 Eigen::AngleAxisd(r.Uniform(-0.5, 0.5), Eigen::Vector3d::UnitX()))
-                                    .matrix();
+      const Eigen::Matrix3d R =
+          (Eigen::AngleAxisd(r.Uniform(-M_PI, M_PI), Eigen::Vector3d::UnitZ()) *
+           Eigen::AngleAxisd(r.Uniform(-0.5, 0.5), Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(r.Uniform(-0.5, 0.5), Eigen::Vector3d::UnitX()))
+              .matrix();
       Box b = FloorBox(x, y, half, R);
       b.center.z() = L_.z_floor + 0.3 * half.z();
       return TryBox(b);
     }
     // A stack: a base box and a smaller one on top.
     const Eigen::Vector3d base(r.Uniform(0.4, 0.9), r.Uniform(0.4, 0.9), r.Uniform(0.3, 0.6));
-    const Eigen::Vector3d top(base.x() * r.Uniform(0.4, 0.8), base.y() * r.Uniform(0.4, 0.8), r.Uniform(0.2, 0.5));
+    const Eigen::Vector3d top(base.x() * r.Uniform(0.4, 0.8), base.y() * r.Uniform(0.4, 0.8),
+                              r.Uniform(0.2, 0.5));
     const Eigen::Matrix3d R = RotZ(r.Uniform(-0.4, 0.4));
     Box b0 = FloorBox(x, y, base, R), b1 = b0;
     b1.half = top;
@@ -193,7 +213,8 @@ class Builder {
     for (int k = 0; k < o_.clutter_count; ++k) {
       for (int attempt = 0; attempt < kAttempts; ++attempt) {
         const double x = feature_rng_.Uniform(x_lo, x_hi);
-        const double y = feature_rng_.Uniform(L_.y_center - L_.half_width + 0.2, L_.y_center + L_.half_width - 0.2);
+        const double y = feature_rng_.Uniform(L_.y_center - L_.half_width + 0.2,
+                                              L_.y_center + L_.half_width - 0.2);
         if (TryClutter(x, y)) break;
       }
     }
@@ -221,7 +242,8 @@ class Builder {
     c.axis = Eigen::Vector3d::UnitX();
     c.radius = r.Uniform(0.08, 0.2);
     c.half_length = r.Uniform(1.0, 3.0);
-    c.center = Eigen::Vector3d(x, yc + side * (hw - c.radius - 0.1), L_.z_floor + r.Uniform(0.3, 0.85) * H);
+    c.center = Eigen::Vector3d(x, yc + side * (hw - c.radius - 0.1),
+                               L_.z_floor + r.Uniform(0.3, 0.85) * H);
     return TryCylinder(c);
   }
 
@@ -240,7 +262,8 @@ class Builder {
     const double s = o_.pillar_spacing;
     if (s <= 0.0) return;
     for (double x = L_.x_entrance + 0.5 * s; x < L_.x_end; x += s)
-      for (double y = L_.y_center - L_.half_width + 0.5 * s; y < L_.y_center + L_.half_width; y += s) {
+      for (double y = L_.y_center - L_.half_width + 0.5 * s; y < L_.y_center + L_.half_width;
+           y += s) {
         Cylinder c;
         c.radius = 0.35;
         c.half_length = 0.5 * (L_.z_ceiling - L_.z_floor) + kSink;
@@ -262,7 +285,10 @@ class Builder {
         b.half = Eigen::Vector3d(0.15, 0.75, 0.5 * h + 0.5 * kSink);
         b.center = Eigen::Vector3d(x0 + 0.3 * i, y, L_.z_floor - kSink + b.half.z());
         steps.push_back(b);
-        if (i == 0) all = b.Bounds(); else all.extend(b.Bounds());
+        if (i == 0)
+          all = b.Bounds();
+        else
+          all.extend(b.Bounds());
       }
       if (!Clear(all)) continue;
       for (const Box& b : steps) world_.AddBox(b, 150.f);

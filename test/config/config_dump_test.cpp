@@ -11,6 +11,7 @@
 
 #include "config_test_util.h"
 #include "rvlio/io/config.h"
+#include "rvlio/sim/options.h"
 
 namespace rvlio {
 namespace {
@@ -187,6 +188,26 @@ TEST(ConfigDump, RoundTripRestoresRandomOptionsExactly) {
     ASSERT_TRUE(ApplyYamlText(toy_back, DumpYaml(toy), "dump").ok()) << DumpYaml(toy);
     ASSERT_EQ(ToJson(toy_back), ToJson(toy)) << "seed " << seed << "\n" << DumpYaml(toy);
   }
+}
+
+// The simulator's options go through the same templates.
+TEST(ConfigDump, SimOptionsRoundTripAndLoad) {
+  for (uint32_t seed = 1; seed <= 50; ++seed) {
+    const SimOptions original = RandomOptions<SimOptions>(seed);
+    SimOptions back;
+    Status s = ApplyYamlText(back, DumpYaml(original), "dump");
+    ASSERT_TRUE(s.ok()) << s.message();
+    ASSERT_EQ(ToJson(back), ToJson(original)) << "seed " << seed;
+  }
+  const SimOptions defaults;
+  const nlohmann::json j = ToJson(defaults);
+  for (const auto& key : ListKeys(defaults))
+    EXPECT_TRUE(j.contains(nlohmann::json::json_pointer(JsonPointer(key)))) << key;
+  StatusOr<SimOptions> r = LoadOptions<SimOptions>({}, {"seed=5"});
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->seed, 5);
+  EXPECT_TRUE(test::IsConfigError(LoadOptions<SimOptions>({}, {"sed=5"}).status(),
+                                  {"sed: unknown key in --set", "did you mean seed?"}));
 }
 
 TEST(ConfigDump, RoundTripThroughAFileOfTheResolvedConfig) {

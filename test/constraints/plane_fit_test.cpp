@@ -4,6 +4,7 @@
 #include <random>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
@@ -197,6 +198,46 @@ TEST(PlaneFit, UncertainNormalIsRejectedOnlyWhenAsked) {
   const LocalPlane p_wide = FitLocalPlane(wide, on);
   EXPECT_TRUE(p_wide.valid()) << ToString(p_wide.status);
   EXPECT_NEAR(p_wide.normal_std / p_small.normal_std, 0.1, 0.005);  // ~ 1 / extent
+}
+
+// The fit's eigen-decomposition agrees with Eigen's iterative solver on
+// neighbourhoods of every shape: planar, line-like, blobs, near-degenerate.
+TEST(PlaneFit, EigenvaluesAndNormalMatchAReferenceSolver) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int trial = 0; trial < 3000; ++trial) {
+    // Random anisotropic Gaussian cloud: axis scales spanning 6 decades.
+    const Eigen::Matrix3d R = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng))
+                                  .normalized().toRotationMatrix();
+    const Eigen::Vector3d scale(std::pow(10.0, -4.0 + 3.0 * unit(rng)),
+                                std::pow(10.0, -3.0 + 3.0 * unit(rng)),
+                                std::pow(10.0, -1.0 + 1.0 * unit(rng)));
+    const int n = 3 + trial % 18;
+    std::vector<Eigen::Vector3d> pts;
+    const Eigen::Vector3d origin = 100.0 * Eigen::Vector3d(g(rng), g(rng), g(rng));
+    for (int i = 0; i < n; ++i)
+      pts.push_back(origin + R * scale.cwiseProduct(Eigen::Vector3d(g(rng), g(rng), g(rng))));
+    const LocalPlane plane = FitLocalPlane(pts, PlaneThresholds{0.0, 1.0, 1e9, 0.0, 0.0});
+
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (const auto& p : pts) c += p;
+    c /= n;
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (const auto& p : pts) C += (p - c) * (p - c).transpose();
+    C /= n;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> ref(C);
+    const Eigen::Vector3d lambda = ref.eigenvalues();
+    const double tol = 1e-9 * lambda(2);
+    EXPECT_NEAR(plane.eigenvalues(2), lambda(2), tol) << "trial " << trial;
+    EXPECT_NEAR(plane.eigenvalues(1), lambda(1), tol + 1e-6 * lambda(1)) << "trial " << trial;
+    EXPECT_NEAR(plane.eigenvalues(0), std::max(0.0, lambda(0)), tol) << "trial " << trial;
+    // The normal is defined when lambda_min is separated from lambda_mid.
+    if (lambda(0) < 0.5 * lambda(1) && lambda(1) > 1e-6 * lambda(2)) {
+      EXPECT_LT(AngleDeg(plane.normal, ref.eigenvectors().col(0)), 1e-3) << "trial " << trial;
+    }
+    EXPECT_NEAR(plane.normal.norm(), 1.0, 1e-12);
+  }
 }
 
 TEST(PlaneFit, TooFewAndDegenerate) {

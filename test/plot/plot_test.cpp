@@ -31,6 +31,7 @@ const std::string kScript = std::string(RVLIO_SOURCE_DIR) + "/scripts/rvlio_plot
 constexpr double kT0 = 1700000000.0;  // absolute stamps, as in real bags [s]
 constexpr double kGtPeriod = 0.01;    // 100 Hz ground truth [s]
 constexpr double kStampOffset = 0.004;  // estimate stamp - its GT stamp [s], < 0.01
+const Eigen::Vector3d kZero = Eigen::Vector3d::Zero();
 
 struct Pose {
   double t = 0.0;  // s
@@ -341,7 +342,7 @@ TEST_F(PlotScriptTest, RvProfileWithGroundTruth) {
   const std::vector<Pose> gt = GroundTruth(1.0, false);
   const Eigen::Vector3d axis(std::cos(1.0), std::sin(1.0), 0.0);
   const std::string run =
-      MakeRun("rv_on", Estimate(gt, axis, 0.002, Eigen::Quaterniond::Identity(), {}));
+      MakeRun("rv_on", Estimate(gt, axis, 0.002, Eigen::Quaterniond::Identity(), kZero));
   const Result r = Plot("rv-profile --run " + run + " --gt " + WriteGt(gt) + " " + Out());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NEAR(ParseRun(r.out, "rv_on").final_error, ExpectedFinalError(gt, 0.002), 2e-6)
@@ -356,7 +357,7 @@ TEST_F(PlotScriptTest, RvProfileWithGroundTruth) {
 TEST_F(PlotScriptTest, RvProfileOfAnOlderScansFile) {
   const std::vector<Pose> gt = GroundTruth(0.0, false);
   const std::string run = MakeRun(
-      "old", Estimate(gt, Eigen::Vector3d::UnitX(), 0.0, Eigen::Quaterniond::Identity(), {}),
+      "old", Estimate(gt, Eigen::Vector3d::UnitX(), 0.0, Eigen::Quaterniond::Identity(), kZero),
       /*with_acc=*/false, /*coarse_t=*/true);
   const Result r = Plot("rv-profile --run " + run + " " + Out());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -397,7 +398,7 @@ TEST_F(PlotScriptTest, BadInputIsOneErrorLineAndNoOutput) {
   const std::vector<Pose> gt = GroundTruth(0.0, false);
   const std::string gt_path = WriteGt(gt);
   const std::string run = MakeRun(
-      "ok", Estimate(gt, Eigen::Vector3d::UnitX(), 0.0, Eigen::Quaterniond::Identity(), {}));
+      "ok", Estimate(gt, Eigen::Vector3d::UnitX(), 0.0, Eigen::Quaterniond::Identity(), kZero));
   ExpectBadInput("trajectories --gt " + dir_ + "/none.tum --run a=" + run + " " + Out(),
                  "none.tum");
   ExpectBadInput("trajectories --gt " + gt_path + " --run a=" + dir_ + "/nothing " + Out(),

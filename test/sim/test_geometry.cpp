@@ -98,7 +98,10 @@ TEST(Face, RoughIntersectionIsTheFirstCrossing) {
     const double slab_in = (r.origin.z() - (f.offset + amp)) / -r.dir.z();
     double first = kInf;
     for (double s = std::max(0.001, slab_in); s < end - 0.002; s += 0.001)
-      if (Above(f, r, s) <= 0.0) { first = s; break; }
+      if (Above(f, r, s) <= 0.0) {
+        first = s;
+        break;
+      }
     EXPECT_EQ(first, kInf) << "crossing at " << first << " before reported hit " << end;
     if (hit) {
       ++hits;
@@ -159,7 +162,10 @@ void CheckAgainstMarching(const Shape& shape, Inside inside, Rng& rng, int* hits
     const bool hit = shape.Intersect(r, 0.0, 50.0, &t);
     double first = kInf;
     for (double s = 0.0005; s < 20.0; s += 0.0005)
-      if (inside(r.origin + s * r.dir)) { first = s; break; }
+      if (inside(r.origin + s * r.dir)) {
+        first = s;
+        break;
+      }
     if (!hit) {
       EXPECT_EQ(first, kInf);
       continue;
@@ -178,7 +184,8 @@ TEST(Box, IntersectionMatchesMarchingForOrientedBoxes) {
     b.center = Eigen::Vector3d(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(-3, 3));
     b.R_world_box = Eigen::AngleAxisd(rng.Uniform(0, M_PI), RandomUnit(rng)).toRotationMatrix();
     b.half = Eigen::Vector3d(rng.Uniform(0.1, 1.5), rng.Uniform(0.1, 1.5), rng.Uniform(0.1, 1.5));
-    CheckAgainstMarching(b, [&](const Eigen::Vector3d& p) { return InsideBox(b, p); }, rng, &hits);
+    CheckAgainstMarching(
+        b, [&](const Eigen::Vector3d& p) { return InsideBox(b, p); }, rng, &hits);
     // The axis-aligned bounds contain sampled surface points.
     const Eigen::AlignedBox3d bounds = b.Bounds();
     for (int k = 0; k < 20; ++k) {
@@ -198,7 +205,8 @@ TEST(Cylinder, IntersectionMatchesMarchingIncludingCaps) {
     c.axis = RandomUnit(rng);
     c.radius = rng.Uniform(0.1, 1.0);
     c.half_length = rng.Uniform(0.2, 2.0);
-    CheckAgainstMarching(c, [&](const Eigen::Vector3d& p) { return InsideCylinder(c, p); }, rng, &hits);
+    CheckAgainstMarching(
+        c, [&](const Eigen::Vector3d& p) { return InsideCylinder(c, p); }, rng, &hits);
     const Eigen::AlignedBox3d bounds = c.Bounds();
     const Eigen::Vector3d n = c.axis.unitOrthogonal(), m = c.axis.cross(n);
     for (int k = 0; k < 20; ++k) {
@@ -222,20 +230,26 @@ TEST(World, BucketedRaycastEqualsBruteForce) {
     Rng rng(17);
     int hits = 0;
     for (int i = 0; i < 20000; ++i) {
-      const Eigen::Vector3d o(rng.Uniform(L.x_entrance + 0.5, std::min(L.x_end, L.clutter_end + 60.0)),
-                              rng.Uniform(L.y_center - L.half_width + 0.5, L.y_center + L.half_width - 0.5),
-                              rng.Uniform(L.z_floor + 0.5, L.z_ceiling - 0.5));
+      const Eigen::Vector3d o(
+          rng.Uniform(L.x_entrance + 0.5, std::min(L.x_end, L.clutter_end + 60.0)),
+          rng.Uniform(L.y_center - L.half_width + 0.5, L.y_center + L.half_width - 0.5),
+          rng.Uniform(L.z_floor + 0.5, L.z_ceiling - 0.5));
       const Eigen::Vector3d d = RandomUnit(rng);
       double best = 120.0;
-      for (const Face& f : w.faces()) { double t; if (f.Intersect({o, d}, 1e-9, best, &t)) best = t; }
+      for (const Face& f : w.faces()) {
+        double t;
+        if (f.Intersect({o, d}, 1e-9, best, &t)) best = t;
+      }
       bool inside_feature = false;
       for (const Box& b : w.boxes()) {
         inside_feature |= InsideBox(b, o);
-        double t; if (b.Intersect({o, d}, 0.0, best, &t)) best = t;
+        double t;
+        if (b.Intersect({o, d}, 0.0, best, &t)) best = t;
       }
       for (const Cylinder& c : w.cylinders()) {
         inside_feature |= InsideCylinder(c, o);
-        double t; if (c.Intersect({o, d}, 0.0, best, &t)) best = t;
+        double t;
+        if (c.Intersect({o, d}, 0.0, best, &t)) best = t;
       }
       if (inside_feature) continue;
       RayHit hit;

@@ -4,8 +4,8 @@
 // depends on nothing but the simulator.
 #include <cmath>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "rvlio/sim/imu_sim.h"
 #include "rvlio/sim/presets.h"
@@ -20,9 +20,7 @@ Eigen::Matrix3d Exp(const Eigen::Vector3d& phi) {
   return Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix();
 }
 
-double RotationAngle(const Eigen::Matrix3d& R) {
-  return Eigen::AngleAxisd(R).angle();
-}
+double RotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 
 SimOptions NoiseFree(SimOptions o, double imu_rate) {
   o.imu.rate = imu_rate;
@@ -63,7 +61,8 @@ OracleResult IntegrateAndCompare(const SimOptions& o) {
     const TruthState t = traj.At(cur.t_ns);
     r.max_position_error = std::max(r.max_position_error, (p - t.T_world_imu.t).norm());
     r.max_velocity_error = std::max(r.max_velocity_error, (v - t.v_world_imu).norm());
-    r.max_rotation_error = std::max(r.max_rotation_error, RotationAngle(t.T_world_imu.R.transpose() * R));
+    r.max_rotation_error =
+        std::max(r.max_rotation_error, RotationAngle(t.T_world_imu.R.transpose() * R));
   }
   return r;
 }
@@ -75,8 +74,9 @@ TEST(ImuOracle, NoiseFreeImuReproducesTunnelFlightOver60s) {
   EXPECT_LT(r.max_position_error, 0.01);
   EXPECT_LT(r.max_rotation_error, 1e-4);
   RecordProperty("max_position_error_m", std::to_string(r.max_position_error));
-  std::printf("tunnel 60 s @1 kHz: max position error %.3g m, rotation %.3g rad, velocity %.3g m/s\n",
-              r.max_position_error, r.max_rotation_error, r.max_velocity_error);
+  std::printf(
+      "tunnel 60 s @1 kHz: max position error %.3g m, rotation %.3g rad, velocity %.3g m/s\n",
+      r.max_position_error, r.max_rotation_error, r.max_velocity_error);
 }
 
 TEST(ImuOracle, NoiseFreeImuReproducesHallFlightWithTurns) {
@@ -95,7 +95,8 @@ TEST(ImuOracle, DefaultRateIsIntegrableToCentimetres) {
   SimOptions o = NoiseFree(*PresetOptions("tunnel"), 200.0);
   const OracleResult r = IntegrateAndCompare(o);
   EXPECT_LT(r.max_position_error, 0.05);
-  std::printf("tunnel %.0f s @200 Hz: max position error %.3g m\n", o.duration, r.max_position_error);
+  std::printf("tunnel %.0f s @200 Hz: max position error %.3g m\n", o.duration,
+              r.max_position_error);
 }
 
 // The midpoint scheme is (at least) second order: halving the step divides

@@ -51,7 +51,8 @@ TEST(LidarOracle, NoiseFreeTunnelPointsLieOnTheWorldSurfaces) {
   ASSERT_TRUE(sim.ok()) << sim.status().message();
   const FlightTrajectory& traj = (*sim)->trajectory();
   const double rate = (*sim)->options().lidar.rate;
-  for (double t : {0.0, traj.ArrivalTime(1) + 1.6, traj.ArrivalTime(2) - 3.0, traj.ArrivalTime(4)}) {
+  for (double t :
+       {0.0, traj.ArrivalTime(1) + 1.6, traj.ArrivalTime(2) - 3.0, traj.ArrivalTime(4)}) {
     const ScanCheck c = CheckScanOnSurfaces(**sim, static_cast<int64_t>(t * rate));
     EXPECT_GT(c.returns, 25000) << "t = " << t;
     EXPECT_LT(c.max_distance, 1e-3) << "t = " << t;
@@ -101,9 +102,11 @@ TEST(LidarOracle, RangeNoiseHasTheConfiguredStd) {
   for (size_t i = 0; i < sn.points.size(); ++i) {
     ASSERT_EQ(sn.points[i].p_lidar.isZero(), sq.points[i].p_lidar.isZero());
     if (sq.points[i].p_lidar.isZero()) continue;
-    const double d = sn.points[i].p_lidar.cast<double>().norm() - sq.points[i].p_lidar.cast<double>().norm();
+    const double d =
+        sn.points[i].p_lidar.cast<double>().norm() - sq.points[i].p_lidar.cast<double>().norm();
     // Noise is along the beam: the direction does not change.
-    EXPECT_NEAR(sn.points[i].p_lidar.normalized().dot(sq.points[i].p_lidar.normalized()), 1.0, 1e-6);
+    EXPECT_NEAR(sn.points[i].p_lidar.normalized().dot(sq.points[i].p_lidar.normalized()), 1.0,
+                1e-6);
     sum += d;
     sum2 += d * d;
     ++n;

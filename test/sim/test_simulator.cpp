@@ -55,8 +55,12 @@ TEST(Options, CrossFieldRulesNameTheKey) {
       {[](SimOptions& o) { o.lidar.beams = 0; }, "lidar.beams"},
       {[](SimOptions& o) { o.imu.rate = -1.0; }, "imu.rate"},
       {[](SimOptions& o) { o.world.layout = "cave"; }, "world.layout"},
-      {[](SimOptions& o) { o.world.roughness_wavelength_max = 0.5; }, "world.roughness_wavelength_max"},
-      {[](SimOptions& o) { o.extrinsics.imu_T_lidar.rotation_xyzw = {0, 0, 0, 0.5}; }, "extrinsics"},
+      {[](SimOptions& o) { o.world.roughness_wavelength_max = 0.5; },
+       "world.roughness_wavelength_max"},
+      {[](SimOptions& o) {
+         o.extrinsics.imu_T_lidar.rotation_xyzw = {0, 0, 0, 0.5};
+       },
+       "extrinsics"},
       {[](SimOptions& o) { o.duration = 0.05; }, "duration"},
   };
   for (const Case& c : cases) {
@@ -75,8 +79,15 @@ TEST(Determinism, SameSeedSameDataDifferentSeedDifferentNoise) {
   auto collect = [](const SimOptions& opts, std::vector<ImuSample>* imu, std::vector<Scan>* scans) {
     auto sim = Simulator::Create(opts);
     ASSERT_TRUE(sim.ok());
-    (*sim)->Run([&](const ImuSample& m) { imu->push_back(m); return true; },
-                [&](const Scan& s, int, int) { scans->push_back(s); return true; });
+    (*sim)->Run(
+        [&](const ImuSample& m) {
+          imu->push_back(m);
+          return true;
+        },
+        [&](const Scan& s, int, int) {
+          scans->push_back(s);
+          return true;
+        });
   };
   std::vector<ImuSample> i1, i2, i3;
   std::vector<Scan> s1, s2, s3;
@@ -107,7 +118,8 @@ TEST(Determinism, SameSeedSameDataDifferentSeedDifferentNoise) {
   // Run's k-th scan is SimulateScan(k).
   auto sim = Simulator::Create(*PresetOptions("tunnel"));
   const Scan again = (*sim)->SimulateScan(2);
-  for (size_t j = 0; j < again.points.size(); ++j) ASSERT_EQ(again.points[j].p_lidar, s1[2].points[j].p_lidar);
+  for (size_t j = 0; j < again.points.size(); ++j)
+    ASSERT_EQ(again.points[j].p_lidar, s1[2].points[j].p_lidar);
 }
 
 // IMU samples on their grid, scans on the 10 Hz grid, each scan after all
@@ -214,7 +226,8 @@ TEST(WorldLayout, FeaturesKeepClearOfTheFlightPath) {
         ASSERT_GE(b.exteriorDistance(p), o.world.path_clearance - 1e-9) << name;
     // The whole flight stays inside the shell.
     for (double tau = 0.0; tau < o.duration; tau += 0.1) {
-      const Eigen::Vector3d p = (*sim)->TruthAt((*sim)->start_time_ns() + SecondsToNs(tau)).T_world_imu.t;
+      const Eigen::Vector3d p =
+          (*sim)->TruthAt((*sim)->start_time_ns() + SecondsToNs(tau)).T_world_imu.t;
       EXPECT_TRUE((*sim)->layout().Inside(p, 0.0)) << name << " t=" << tau;
     }
   }
@@ -236,7 +249,8 @@ TEST(WorldLayout, FeaturelessHasNoFeaturesAndNoVisibleEnds) {
   const Scan s = (*sim)->SimulateScan(200);
   for (const LidarPoint& p : s.points) {
     if (p.p_lidar.isZero()) continue;
-    const Eigen::Vector3d q = ((*sim)->TruthAt(p.t_ns).T_world_imu * (*sim)->T_imu_lidar()) * p.p_lidar.cast<double>();
+    const Eigen::Vector3d q =
+        ((*sim)->TruthAt(p.t_ns).T_world_imu * (*sim)->T_imu_lidar()) * p.p_lidar.cast<double>();
     const double d = std::min({std::abs(std::abs(q.y() - L.y_center) - L.half_width),
                                std::abs(q.z() - L.z_floor), std::abs(q.z() - L.z_ceiling)});
     ASSERT_LT(d, 0.2);  // within the range noise of a wall

@@ -3,8 +3,8 @@
 // differences of the pose.
 #include <cmath>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "rvlio/sim/imu_sim.h"
 #include "rvlio/sim/presets.h"
@@ -17,7 +17,8 @@ namespace {
 constexpr TimeNs kT0 = 1700000000LL * kNsPerSecond;
 
 FlightTrajectory Make(const SimOptions& o, uint64_t seed = 1) {
-  return FlightTrajectory(*ParseWaypoints(o.trajectory.waypoints), o.trajectory, o.imu.gravity, kT0, seed);
+  return FlightTrajectory(*ParseWaypoints(o.trajectory.waypoints), o.trajectory, o.imu.gravity, kT0,
+                          seed);
 }
 
 TimeNs At(double tau) { return kT0 + SecondsToNs(tau); }
@@ -91,8 +92,10 @@ TEST(Trajectory, AnalyticDerivativesMatchFiniteDifferences) {
       const double h = 1e-4;
       const TruthState s = traj.At(At(tau));
       const TruthState sp = traj.At(At(tau + h)), sm = traj.At(At(tau - h));
-      EXPECT_LT((s.v_world_imu - (sp.T_world_imu.t - sm.T_world_imu.t) / (2 * h)).norm(), 1e-5) << preset << tau;
-      EXPECT_LT((s.a_world_imu - (sp.v_world_imu - sm.v_world_imu) / (2 * h)).norm(), 1e-4) << preset << tau;
+      EXPECT_LT((s.v_world_imu - (sp.T_world_imu.t - sm.T_world_imu.t) / (2 * h)).norm(), 1e-5)
+          << preset << tau;
+      EXPECT_LT((s.a_world_imu - (sp.v_world_imu - sm.v_world_imu) / (2 * h)).norm(), 1e-4)
+          << preset << tau;
       const Eigen::Vector3d w_num = Log(sm.T_world_imu.R.transpose() * sp.T_world_imu.R) / (2 * h);
       EXPECT_LT((s.w_imu - w_num).norm(), 1e-5) << preset << tau;
       Eigen::Vector3d p, v, a, j, pp, vp, ap, jp, pm, vm, am, jm;
@@ -157,7 +160,8 @@ TEST(Trajectory, LoopbackReturnsToTheStartPose) {
   const TruthState end = traj.At(At(o.duration));
   EXPECT_LT(end.T_world_imu.t.norm(), 1e-9);
   double farthest = 0.0;
-  for (double tau = 0; tau < o.duration; tau += 0.5) farthest = std::max(farthest, traj.At(At(tau)).T_world_imu.t.x());
+  for (double tau = 0; tau < o.duration; tau += 0.5)
+    farthest = std::max(farthest, traj.At(At(tau)).T_world_imu.t.x());
   EXPECT_GT(farthest, 40.0);
 }
 
@@ -173,7 +177,8 @@ TEST(Trajectory, ShortSegmentsStayBetweenTheirWaypoints) {
     EXPECT_GE(p.x(), -1e-12);
     EXPECT_LE(p.x(), 0.3 + 1e-12);
   }
-  EXPECT_LT((traj.At(At(traj.MotionEnd())).T_world_imu.t - Eigen::Vector3d(0.3, 0, 0.2)).norm(), 1e-12);
+  EXPECT_LT((traj.At(At(traj.MotionEnd())).T_world_imu.t - Eigen::Vector3d(0.3, 0, 0.2)).norm(),
+            1e-12);
 }
 
 }  // namespace

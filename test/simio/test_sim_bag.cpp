@@ -1,12 +1,12 @@
 // A short simulated sequence written as a ROS1 bag: Debian's python3-rosbag
 // reads it (message counts, cloud layout), and the library's own reader
 // returns exactly the simulated IMU samples and scans.
+#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -46,17 +46,18 @@ Written WriteSimulatedBag(const SimOptions& o, const std::string& path) {
   auto writer = SensorBagWriter::Create(path);
   EXPECT_TRUE(writer.ok()) << writer.status().message();
   Status error;
-  (*simulator)->Run(
-      [&](const ImuSample& m) {
-        w.imu.push_back(m);
-        error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
-        return error.ok();
-      },
-      [&](const Scan& s, int rows, int cols) {
-        w.scans.push_back(s);
-        error = (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, s, rows, cols);
-        return error.ok();
-      });
+  (*simulator)
+      ->Run(
+          [&](const ImuSample& m) {
+            w.imu.push_back(m);
+            error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
+            return error.ok();
+          },
+          [&](const Scan& s, int rows, int cols) {
+            w.scans.push_back(s);
+            error = (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, s, rows, cols);
+            return error.ok();
+          });
   EXPECT_TRUE(error.ok()) << error.message();
   EXPECT_TRUE((*writer)->Close().ok());
   return w;
@@ -95,19 +96,23 @@ TEST_F(SimulatedBag, Python3RosbagReadsIt) {
   ASSERT_EQ(w.imu.size(), 501u);
   const std::string out = RunPython(
       "import rosbag\n"
-      "bag = rosbag.Bag('" + path + "')\n"
+      "bag = rosbag.Bag('" +
+      path +
+      "')\n"
       "counts = {}\n"
       "for topic, msg, t in bag.read_messages():\n"
       "    counts[topic] = counts.get(topic, 0) + 1\n"
       "    if topic == '/os_cloud_node/points' and counts[topic] == 1:\n"
-      "        print('cloud', msg.height, msg.width, msg.point_step, ','.join(f.name for f in msg.fields))\n"
+      "        print('cloud', msg.height, msg.width, msg.point_step, ','.join(f.name for f in "
+      "msg.fields))\n"
       "    if topic == '/imu/data' and counts[topic] == 1:\n"
       "        print('imu_z', repr(msg.linear_acceleration.z))\n"
       "for k in sorted(counts): print(k, counts[k])\n");
   EXPECT_NE(out.find("/imu/data 501"), std::string::npos) << out;
   EXPECT_NE(out.find("/os_cloud_node/points 25"), std::string::npos) << out;
   EXPECT_NE(out.find("cloud 32 128"), std::string::npos) << out;
-  EXPECT_NE(out.find("x,y,z,intensity,t,reflectivity,ring,ambient,range"), std::string::npos) << out;
+  EXPECT_NE(out.find("x,y,z,intensity,t,reflectivity,ring,ambient,range"), std::string::npos)
+      << out;
   // At rest the accelerometer reads gravity plus the configured bias (plus
   // white noise of std accel_noise_density * sqrt(rate) = 0.03 m/s^2).
   const size_t at = out.find("imu_z ");

@@ -77,9 +77,12 @@ Status ReadField(const Node& n, const std::string& key, const std::string& where
     if (s.ok()) *out = static_cast<T>(x);
     return s;
   } else if constexpr (std::is_integral_v<T>) {
+    using Limits = std::numeric_limits<T>;
+    constexpr int64_t kMin = static_cast<int64_t>(Limits::min());  // 0 for unsigned types
+    constexpr int64_t kMax = Limits::digits >= 63 ? std::numeric_limits<int64_t>::max()
+                                                  : static_cast<int64_t>(Limits::max());
     int64_t x = 0;
-    Status s = ReadInteger(n, key, where, static_cast<int64_t>(std::numeric_limits<T>::min()),
-                           static_cast<int64_t>(std::numeric_limits<T>::max()), &x);
+    Status s = ReadInteger(n, key, where, kMin, kMax, &x);
     if (s.ok()) *out = static_cast<T>(x);
     return s;
   } else {

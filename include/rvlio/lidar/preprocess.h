@@ -46,7 +46,9 @@ class ScanPreprocessor {
 
   void CollectCandidates(const Scan& scan);
   void VoxelFilter(const Scan& scan, std::vector<int>* indices);
-  void PrepareTable(size_t num_candidates);
+  void BeginScan();
+  size_t FindOrAdd(const VoxelKey& key);  // the key's slot, or the free slot for it
+  void GrowIfNeeded();
 
   double min_range2_;
   double max_range2_;

@@ -2,7 +2,8 @@
 // The working map of the odometry (DESIGN.md section 1, map/): an
 // incremental voxel-hash map with exact k-nearest-neighbour search.
 //
-// Points (world frame, m) live in cubic voxels of edge MapOptions::voxel_size.
+// Points (world frame, m) live in cubic voxels of edge MapOptions::voxel_size
+// (within about 10^6 voxels of the origin; farther points are not stored).
 // A voxel keeps at most max_points_per_voxel points; a new point closer than
 // min_point_distance to a point already in its voxel is skipped. Voxels are
 // found through an open-addressing hash table (linear probing, power-of-two
@@ -78,10 +79,10 @@ class VoxelMap {
   // One voxel: its key and its block x[capacity], y[capacity], z[capacity]
   // at pool_[offset].
   struct Slot {
-    VoxelKey key;
+    uint64_t key = 0;     // packed voxel coordinates (voxel_map.cpp)
     int32_t offset = -1;  // -1: empty slot
-    int32_t count = 0;
-    int32_t capacity = 0;
+    uint16_t count = 0;
+    uint16_t capacity = 0;
   };
   struct Offset {
     int8_t dx, dy, dz;
@@ -89,8 +90,8 @@ class VoxelMap {
   };
   class Candidates;
 
-  int FindSlot(const VoxelKey& key) const;  // slot index, or -1
-  int CreateSlot(const VoxelKey& key);      // key must be absent; returns its slot
+  int FindSlot(uint64_t key) const;  // slot index, or -1
+  int CreateSlot(uint64_t key);      // key must be absent; returns its slot
   void InsertSlot(const Slot& s);           // key must be absent; no growth check
   void Rebuild(size_t capacity, const std::vector<Slot>& slots);
   int CapacityClass(int capacity) const;

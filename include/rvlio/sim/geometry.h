@@ -19,8 +19,10 @@ struct Ray {
 };
 
 // Smooth deterministic displacement h(u, v) = sum_k A_k sin(a_k u + b_k v + phi_k)
-// (m). Its magnitude is bounded by amplitude_bound() = sum |A_k| and its
-// gradient norm by slope_bound() = sum |A_k| |(a_k, b_k)|.
+// (m). Its magnitude is bounded by amplitude_bound() = sum |A_k|, its
+// gradient norm by slope_bound() = sum |A_k| |(a_k, b_k)| and its second
+// directional derivative along a unit (u, v) direction by curvature_bound() =
+// sum |A_k| |(a_k, b_k)|^2.
 class HeightField {
  public:
   struct Wave {
@@ -40,6 +42,7 @@ class HeightField {
   double Height(double u, double v, double* dh_du, double* dh_dv) const;
   double amplitude_bound() const { return amplitude_bound_; }
   double slope_bound() const { return slope_bound_; }
+  double curvature_bound() const { return curvature_bound_; }
   bool flat() const { return waves_.empty(); }
   const std::vector<Wave>& waves() const { return waves_; }
 
@@ -47,6 +50,7 @@ class HeightField {
   std::vector<Wave> waves_;
   double amplitude_bound_ = 0.0;
   double slope_bound_ = 0.0;
+  double curvature_bound_ = 0.0;
 };
 
 // Axis-aligned rectangle in the (u, v) coordinates of a face.

@@ -27,10 +27,10 @@ struct SimWorldOptions {
   double start_lateral = 0.0;     // m, start pose y offset from the centre line
   bool open_entrance = true;      // tunnel entrance open (hall: false, a wall with openings)
   bool end_wall = true;           // closed far end
-  double roughness_amplitude = 0.04;   // m, bound of the surface displacement (sum of waves)
+  double roughness_amplitude = 0.04;      // m, bound of the surface displacement (sum of waves)
   double roughness_wavelength_min = 0.8;  // m
   double roughness_wavelength_max = 4.0;  // m
-  int roughness_components = 4;       // seeded sinusoids per surface
+  int roughness_components = 4;           // seeded sinusoids per surface
   double clutter_length = 15.0;  // m, feature-rich region from the entrance (hall: whole room)
   int clutter_count = 40;        // boxes, pillars and irregular blocks in that region
   double sparse_spacing = 20.0;  // m between sparse features after it (0: none)
@@ -45,29 +45,31 @@ struct SimWorldOptions {
     v.Field("width", width, Spec().Unit("m").Range(2.0, 200.0).Help("extent along y"));
     v.Field("height", height, Spec().Unit("m").Range(2.0, 100.0).Help("floor to ceiling"));
     v.Field("length", length, Spec().Unit("m").Range(5.0, 20000.0).Help("extent along x"));
-    v.Field("start_depth", start_depth, Spec().Unit("m").Min(0.5)
-                                            .Help("start pose behind the entrance along x"));
-    v.Field("start_height", start_height, Spec().Unit("m").Range(0.05, 100.0)
-                                              .Help("IMU height above the floor at start"));
-    v.Field("start_lateral", start_lateral, Spec().Unit("m").Range(-100.0, 100.0)
-                                                .Help("start y offset from the centre line"));
+    v.Field("start_depth", start_depth,
+            Spec().Unit("m").Min(0.5).Help("start pose behind the entrance along x"));
+    v.Field("start_height", start_height,
+            Spec().Unit("m").Range(0.05, 100.0).Help("IMU height above the floor at start"));
+    v.Field("start_lateral", start_lateral,
+            Spec().Unit("m").Range(-100.0, 100.0).Help("start y offset from the centre line"));
     v.Field("open_entrance", open_entrance, Spec().Help("tunnel entrance open"));
     v.Field("end_wall", end_wall, Spec().Help("closed far end"));
-    v.Field("roughness_amplitude", roughness_amplitude, Spec().Unit("m").Range(0.0, 0.5)
-                                        .Help("bound of the surface height field"));
-    v.Field("roughness_wavelength_min", roughness_wavelength_min, Spec().Unit("m").Range(0.1, 100.0));
-    v.Field("roughness_wavelength_max", roughness_wavelength_max, Spec().Unit("m").Range(0.1, 100.0));
-    v.Field("roughness_components", roughness_components, Spec().Range(1, 16)
-                                        .Help("sinusoids per surface"));
-    v.Field("clutter_length", clutter_length, Spec().Unit("m").Range(0.0, 20000.0)
-                                                  .Help("feature-rich region from the entrance"));
+    v.Field("roughness_amplitude", roughness_amplitude,
+            Spec().Unit("m").Range(0.0, 0.5).Help("bound of the surface height field"));
+    v.Field("roughness_wavelength_min", roughness_wavelength_min,
+            Spec().Unit("m").Range(0.1, 100.0));
+    v.Field("roughness_wavelength_max", roughness_wavelength_max,
+            Spec().Unit("m").Range(0.1, 100.0));
+    v.Field("roughness_components", roughness_components,
+            Spec().Range(1, 16).Help("sinusoids per surface"));
+    v.Field("clutter_length", clutter_length,
+            Spec().Unit("m").Range(0.0, 20000.0).Help("feature-rich region from the entrance"));
     v.Field("clutter_count", clutter_count, Spec().Range(0, 5000).Help("objects in that region"));
-    v.Field("sparse_spacing", sparse_spacing, Spec().Unit("m").Range(0.0, 20000.0)
-                                                  .Help("spacing of sparse features (0: none)"));
-    v.Field("path_clearance", path_clearance, Spec().Unit("m").Range(0.0, 10.0)
-                                                  .Help("free space around the flight path"));
-    v.Field("pillar_spacing", pillar_spacing, Spec().Unit("m").Range(0.0, 1000.0)
-                                                  .Help("pillar grid spacing (0: none)"));
+    v.Field("sparse_spacing", sparse_spacing,
+            Spec().Unit("m").Range(0.0, 20000.0).Help("spacing of sparse features (0: none)"));
+    v.Field("path_clearance", path_clearance,
+            Spec().Unit("m").Range(0.0, 10.0).Help("free space around the flight path"));
+    v.Field("pillar_spacing", pillar_spacing,
+            Spec().Unit("m").Range(0.0, 1000.0).Help("pillar grid spacing (0: none)"));
     v.Field("openings", openings, Spec().Range(0, 32).Help("doorways in the hall walls"));
     v.Field("stairs", stairs, Spec().Help("a flight of stairs (hall)"));
   }
@@ -77,15 +79,15 @@ struct SimWorldOptions {
 struct SimLidarOptions {
   std::string topic = "/os_cloud_node/points";
   std::string frame_id = "os_lidar";
-  int beams = 32;                 // rows (rings), row 0 = top beam
-  double vfov_min = -22.5;        // deg, lowest beam elevation
-  double vfov_max = 22.5;         // deg, highest beam elevation
-  int columns = 1024;             // azimuth columns per revolution
-  double rate = 10.0;             // Hz, revolutions per second
-  double range_noise = 0.03;      // m, std of the Gaussian range noise
-  double min_range = 0.5;         // m, closer returns are dropped
-  double max_range = 100.0;       // m, farther returns are dropped
-  double dropout = 0.0;           // probability of a random missing return
+  int beams = 32;             // rows (rings), row 0 = top beam
+  double vfov_min = -22.5;    // deg, lowest beam elevation
+  double vfov_max = 22.5;     // deg, highest beam elevation
+  int columns = 1024;         // azimuth columns per revolution
+  double rate = 10.0;         // Hz, revolutions per second
+  double range_noise = 0.03;  // m, std of the Gaussian range noise
+  double min_range = 0.5;     // m, closer returns are dropped
+  double max_range = 100.0;   // m, farther returns are dropped
+  double dropout = 0.0;       // probability of a random missing return
 
   template <class V>
   void Visit(V& v) {
@@ -109,34 +111,40 @@ struct SimLidarOptions {
 struct SimImuOptions {
   std::string topic = "/imu/data";
   std::string frame_id = "imu";
-  double rate = 200.0;                     // Hz
-  double gyro_noise_density = 2.0e-4;      // rad/s/sqrt(Hz)
-  double accel_noise_density = 2.0e-3;     // m/s^2/sqrt(Hz)
-  double gyro_bias_random_walk = 2.0e-5;   // rad/s^2/sqrt(Hz)
-  double accel_bias_random_walk = 2.0e-4;  // m/s^3/sqrt(Hz)
+  double rate = 200.0;                                        // Hz
+  double gyro_noise_density = 2.0e-4;                         // rad/s/sqrt(Hz)
+  double accel_noise_density = 2.0e-3;                        // m/s^2/sqrt(Hz)
+  double gyro_bias_random_walk = 2.0e-5;                      // rad/s^2/sqrt(Hz)
+  double accel_bias_random_walk = 2.0e-4;                     // m/s^3/sqrt(Hz)
   std::array<double, 3> gyro_bias = {0.002, -0.0015, 0.001};  // rad/s, initial bias
   std::array<double, 3> accel_bias = {0.04, -0.03, 0.05};     // m/s^2, initial bias
-  double gravity = 9.81;                   // m/s^2
-  double vibration_accel = 0.0;            // m/s^2, motor vibration amplitude (0: off)
-  double vibration_gyro = 0.0;             // rad/s, motor vibration amplitude (0: off)
-  double vibration_frequency = 87.0;       // Hz
+  double gravity = 9.81;                                      // m/s^2
+  double vibration_accel = 0.0;       // m/s^2, motor vibration amplitude (0: off)
+  double vibration_gyro = 0.0;        // rad/s, motor vibration amplitude (0: off)
+  double vibration_frequency = 87.0;  // Hz
 
   template <class V>
   void Visit(V& v) {
     v.Field("topic", topic, Spec().Help("sensor_msgs/Imu topic written"));
     v.Field("frame_id", frame_id, Spec().Help("header frame of the IMU messages"));
     v.Field("rate", rate, Spec().Unit("Hz").Range(10.0, 100000.0));
-    v.Field("gyro_noise_density", gyro_noise_density, Spec().Unit("rad/s/sqrt(Hz)").Range(0.0, 1.0));
-    v.Field("accel_noise_density", accel_noise_density, Spec().Unit("m/s^2/sqrt(Hz)").Range(0.0, 10.0));
-    v.Field("gyro_bias_random_walk", gyro_bias_random_walk, Spec().Unit("rad/s^2/sqrt(Hz)").Range(0.0, 1.0));
-    v.Field("accel_bias_random_walk", accel_bias_random_walk, Spec().Unit("m/s^3/sqrt(Hz)").Range(0.0, 10.0));
-    v.Field("gyro_bias", gyro_bias, Spec().Unit("rad/s").Range(-1.0, 1.0).Help("initial gyro bias"));
-    v.Field("accel_bias", accel_bias, Spec().Unit("m/s^2").Range(-5.0, 5.0).Help("initial accel bias"));
+    v.Field("gyro_noise_density", gyro_noise_density,
+            Spec().Unit("rad/s/sqrt(Hz)").Range(0.0, 1.0));
+    v.Field("accel_noise_density", accel_noise_density,
+            Spec().Unit("m/s^2/sqrt(Hz)").Range(0.0, 10.0));
+    v.Field("gyro_bias_random_walk", gyro_bias_random_walk,
+            Spec().Unit("rad/s^2/sqrt(Hz)").Range(0.0, 1.0));
+    v.Field("accel_bias_random_walk", accel_bias_random_walk,
+            Spec().Unit("m/s^3/sqrt(Hz)").Range(0.0, 10.0));
+    v.Field("gyro_bias", gyro_bias,
+            Spec().Unit("rad/s").Range(-1.0, 1.0).Help("initial gyro bias"));
+    v.Field("accel_bias", accel_bias,
+            Spec().Unit("m/s^2").Range(-5.0, 5.0).Help("initial accel bias"));
     v.Field("gravity", gravity, Spec().Unit("m/s^2").Range(9.0, 10.5));
-    v.Field("vibration_accel", vibration_accel, Spec().Unit("m/s^2").Range(0.0, 50.0)
-                                                  .Help("motor vibration amplitude (0: off)"));
-    v.Field("vibration_gyro", vibration_gyro, Spec().Unit("rad/s").Range(0.0, 10.0)
-                                                .Help("motor vibration amplitude (0: off)"));
+    v.Field("vibration_accel", vibration_accel,
+            Spec().Unit("m/s^2").Range(0.0, 50.0).Help("motor vibration amplitude (0: off)"));
+    v.Field("vibration_gyro", vibration_gyro,
+            Spec().Unit("rad/s").Range(0.0, 10.0).Help("motor vibration amplitude (0: off)"));
     v.Field("vibration_frequency", vibration_frequency, Spec().Unit("Hz").Positive());
   }
 };
@@ -160,8 +168,8 @@ struct SimTrajectoryOptions {
     v.Field("static_duration", static_duration, Spec().Unit("s").Range(0.0, 3600.0));
     v.Field("cruise_speed", cruise_speed, Spec().Unit("m/s").Range(0.05, 30.0));
     v.Field("climb_speed", climb_speed, Spec().Unit("m/s").Range(0.05, 30.0));
-    v.Field("ramp_time", ramp_time, Spec().Unit("s").Range(0.05, 60.0)
-                                        .Help("duration of each speed ramp"));
+    v.Field("ramp_time", ramp_time,
+            Spec().Unit("s").Range(0.05, 60.0).Help("duration of each speed ramp"));
     v.Field("hover_time", hover_time, Spec().Unit("s").Range(0.0, 3600.0));
     v.Field("yaw_amplitude", yaw_amplitude, Spec().Unit("rad").Range(0.0, 1.5));
   }
@@ -181,8 +189,8 @@ struct SimOptions {
   void Visit(V& v) {
     v.Field("seed", seed, Spec().Min(0).Help("random seed"));
     v.Field("duration", duration, Spec().Unit("s").Range(0.2, 36000.0));
-    v.Field("start_time", start_time, Spec().Unit("s").Range(1.0, 4.0e9)
-                                          .Help("absolute time of the first sample"));
+    v.Field("start_time", start_time,
+            Spec().Unit("s").Range(1.0, 4.0e9).Help("absolute time of the first sample"));
     v.Section("world", world);
     v.Section("lidar", lidar);
     v.Section("imu", imu);

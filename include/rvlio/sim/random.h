@@ -15,10 +15,10 @@ class Rng {
   // that, e.g., changing the LiDAR options does not change the IMU noise).
   static Rng Stream(uint64_t seed, uint64_t stream);
 
-  double Uniform();                       // [0, 1)
-  double Uniform(double lo, double hi);   // [lo, hi)
-  int UniformInt(int lo, int hi);         // [lo, hi]
-  double Normal();                        // N(0, 1)
+  double Uniform();                      // [0, 1)
+  double Uniform(double lo, double hi);  // [lo, hi)
+  int UniformInt(int lo, int hi);        // [lo, hi]
+  double Normal();                       // N(0, 1)
   double Normal(double stddev) { return stddev * Normal(); }
   uint64_t NextU64() { return engine_(); }
 

@@ -58,17 +58,16 @@ class FlightTrajectory {
 
  private:
   struct Segment {
-    double t_begin = 0.0;      // s after t0
-    double ramp = 0.0;         // s per ramp
-    double cruise = 0.0;       // s at constant speed
-    double speed = 0.0;        // m/s
-    double length = 0.0;       // m
+    double t_begin = 0.0;  // s after t0
+    double ramp = 0.0;     // s per ramp
+    double cruise = 0.0;   // s at constant speed
+    double speed = 0.0;    // m/s
+    double length = 0.0;   // m
     Eigen::Vector3d from = Eigen::Vector3d::Zero();
     Eigen::Vector3d dir = Eigen::Vector3d::UnitX();
     double t_end() const { return t_begin + 2.0 * ramp + cruise; }
   };
-  void AlongSegment(const Segment& s, double tau, double* d, double* v, double* a,
-                    double* j) const;
+  void AlongSegment(const Segment& s, double tau, double* d, double* v, double* a, double* j) const;
 
   std::vector<Eigen::Vector3d> waypoints_;
   std::vector<Segment> segments_;

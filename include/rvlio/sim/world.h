@@ -18,7 +18,7 @@ struct RayHit {
   double range = 0.0;         // m along the unit direction
   float reflectivity = 0.0f;  // of the surface hit, 0..255
   ShapeKind kind = ShapeKind::kFace;
-  int index = -1;             // into faces(), boxes() or cylinders()
+  int index = -1;  // into faces(), boxes() or cylinders()
 };
 
 class World {
