@@ -293,13 +293,15 @@ std::vector<Eigen::Vector3d> VoxelMap::Points() const {
 // ------------------------------------------------------------------ queries
 
 // Squared distances of a whole block in a branch-free pass (vectorized by the
-// compiler), then a scalar pass over the few that beat the current limit.
+// compiler), a branch-free compaction of the points that beat the current
+// limit, then the insertion of those few (the limit may tighten meanwhile).
 void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
   const float* x = pool_.data() + s.offset;
   const float* y = x + s.capacity;
   const float* z = y + s.capacity;
   const int n = s.count;
   float d2[kDistanceChunk];
+  int hits[kDistanceChunk];
   for (int start = 0; start < n; start += kDistanceChunk) {
     const int m = std::min(kDistanceChunk, n - start);
     for (int i = 0; i < m; ++i) {
@@ -308,8 +310,16 @@ void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
       const float dz = z[start + i] - q[2];
       d2[i] = dx * dx + dy * dy + dz * dz;
     }
-    for (int i = 0; i < m; ++i)
+    const float limit = c->limit();
+    int num_hits = 0;
+    for (int i = 0; i < m; ++i) {
+      hits[num_hits] = i;
+      num_hits += d2[i] < limit ? 1 : 0;
+    }
+    for (int h = 0; h < num_hits; ++h) {
+      const int i = hits[h];
       if (d2[i] < c->limit()) c->Offer(d2[i], x + start + i, s.capacity);
+    }
   }
 }
 

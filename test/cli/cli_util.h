@@ -1,0 +1,51 @@
+#pragma once
+// Helpers for end-to-end tests that run the built `rvlio` as a process.
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace rvlio::testing_cli {
+
+struct ToolRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Runs `rvlio ARGS` with stdout/stderr captured into files under `scratch`.
+inline ToolRun RunTool(const std::string& args, const std::string& scratch) {
+  const std::string out = scratch + "/stdout.txt", err = scratch + "/stderr.txt";
+  const std::string cmd = std::string(RVLIO_BIN) + " " + args + " >" + out + " 2>" + err;
+  const int status = std::system(cmd.c_str());
+  ToolRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadFile(out);
+  r.err = ReadFile(err);
+  return r;
+}
+
+inline std::string MakeTempDir(const std::string& stem) {
+  std::string tmpl = std::filesystem::temp_directory_path().string() + "/" + stem + "_XXXXXX";
+  if (::mkdtemp(tmpl.data()) == nullptr) return "";
+  return tmpl;
+}
+
+// `rvlio eval --json` of an estimate against ground truth.
+inline nlohmann::json EvalJson(const std::string& gt, const std::string& est,
+                               const std::string& scratch) {
+  const ToolRun r = RunTool("eval --gt " + gt + " --est " + est + " --json", scratch);
+  if (r.exit_code != 0) return nlohmann::json();
+  return nlohmann::json::parse(r.out, nullptr, false);
+}
+
+}  // namespace rvlio::testing_cli
