@@ -88,17 +88,17 @@ CriterionResult EvaluateCriterion(const RvOptions& options, const ConstraintList
                                   RvWorkspace* ws) {
   RVLIO_CHECK(ws != nullptr);
   CriterionResult result;
-  ws->Load(constraints);                                      // Alg. 1 steps 1-2
-  result.S = NormalScatter(*ws, VectorClass::kCoplanar);       // all usable vectors
-  result.fit = FitPlane(result.S);                             // steps 3-5
+  ws->Load(constraints);                                  // Alg. 1 steps 1-2
+  result.S = NormalScatter(*ws, VectorClass::kCoplanar);  // all usable vectors
+  result.fit = FitPlane(result.S);                        // steps 3-5
   result.num_usable = ws->num_usable;
   const Eigen::Vector3d n = result.fit.n_alpha;
   for (int i = 0; i < ws->size(); ++i) {
     if (ws->cls[i] != VectorClass::kCoplanar) continue;
-    const double d = CoplanarityDistance(ws->u[i], n);         // step 6, Eq. (15)
+    const double d = CoplanarityDistance(ws->u[i], n);  // step 6, Eq. (15)
     ws->d[i] = d;
     if (d > options.eps0) {
-      ws->cls[i] = VectorClass::kScv;                          // step 8
+      ws->cls[i] = VectorClass::kScv;  // step 8
     } else {
       ++result.num_within_eps0;
     }

@@ -42,9 +42,9 @@ RefitResult RefitPlane(const RvOptions& options, const Eigen::Matrix3d& S_all,
       result.converged = false;
       break;
     }
-    result.fit = FitPlane(S);                   // Alg. 2 step 6 (Alg. 1 steps 3-5)
+    result.fit = FitPlane(S);  // Alg. 2 step 6 (Alg. 1 steps 3-5)
     ++result.iterations;
-    ComputeDistances(result.fit.n_alpha, ws);   // step 4, Eq. (15) for all vectors
+    ComputeDistances(result.fit.n_alpha, ws);  // step 4, Eq. (15) for all vectors
     num_new = DropNewScvs(options.eps0, /*only_marked=*/false, ws, &S, &num_coplanar);
   }
   result.num_coplanar = num_coplanar;

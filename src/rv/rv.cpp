@@ -34,8 +34,8 @@ double SmallestEigenvalue(const Eigen::Matrix3d& symmetric) {
   return solver.eigenvalues()(0);
 }
 
-RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar,
-                 ConstraintList* constraints, RvWorkspace* ws) {
+RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar, ConstraintList* constraints,
+                 RvWorkspace* ws) {
   RVLIO_CHECK(constraints != nullptr && ws != nullptr);
   RvReport report;
   report.num_constraints = static_cast<int>(constraints->size());
@@ -58,9 +58,9 @@ RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar,
       if (options.reinforce && refit.num_scv > 0) {
         report.num_reinforced = ReinforceScv(report.K, *ws, constraints);
       }
-      if (options.repair) {                                                              // Alg. 3
-        report.num_repaired = RepairCoplanar(options, T_world_lidar, refit.fit.n_alpha, *ws,
-                                             constraints);
+      if (options.repair) {  // Alg. 3
+        report.num_repaired =
+            RepairCoplanar(options, T_world_lidar, refit.fit.n_alpha, *ws, constraints);
       }
     }
   }

@@ -143,6 +143,59 @@ TEST(Associate, KeepsPointOrderAndRejectsOutliers) {
   }
 }
 
+void ExpectSame(const ConstraintList& a, const ConstraintList& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].p_lidar, b[i].p_lidar);
+    EXPECT_EQ(a[i].normal_world, b[i].normal_world);
+    EXPECT_EQ(a[i].q_world, b[i].q_world);
+    EXPECT_NEAR(a[i].residual, b[i].residual, 1e-12);
+  }
+}
+
+TEST(Associate, CacheReusesPlanesOfPointsThatBarelyMoved) {
+  RoomFixture f(5);
+  const ConstraintOptions options;
+  AssociationCache cache(0.05);
+  ConstraintList first, fresh, cached;
+  AssociationStats stats;
+  Associate(f.p_lidar, f.T_world_imu, f.T_imu_lidar, f.map, options, &first, &stats, &cache);
+  EXPECT_EQ(stats.num_reused, 0);  // a new scan: everything searched
+  Associate(f.p_lidar, f.T_world_imu, f.T_imu_lidar, f.map, options, &fresh, nullptr);
+  ExpectSame(first, fresh);
+
+  // Same pose: every point reuses its search, same output.
+  Associate(f.p_lidar, f.T_world_imu, f.T_imu_lidar, f.map, options, &cached, &stats, &cache);
+  EXPECT_EQ(stats.num_reused, 3000);
+  ExpectSame(cached, fresh);
+
+  // 2 cm away: still reused; residuals are those of the kept planes at the
+  // new pose, and nearly every constraint equals a fresh search's.
+  Pose3 moved = f.T_world_imu;
+  moved.t += Eigen::Vector3d(0.015, -0.01, 0.008);
+  Associate(f.p_lidar, moved, f.T_imu_lidar, f.map, options, &cached, &stats, &cache);
+  EXPECT_EQ(stats.num_reused, 3000);
+  for (const Constraint& c : cached)
+    EXPECT_NEAR(c.residual, PointToPlaneResidual(c, moved, f.T_imu_lidar), 1e-9);
+  Associate(f.p_lidar, moved, f.T_imu_lidar, f.map, options, &fresh, nullptr);
+  EXPECT_NEAR(static_cast<double>(cached.size()), static_cast<double>(fresh.size()), 30.0);
+
+  // 20 cm away: searched again, identical to a fresh association there.
+  moved.t += Eigen::Vector3d(0.2, 0.0, 0.0);
+  Associate(f.p_lidar, moved, f.T_imu_lidar, f.map, options, &cached, &stats, &cache);
+  EXPECT_EQ(stats.num_reused, 0);
+  Associate(f.p_lidar, moved, f.T_imu_lidar, f.map, options, &fresh, nullptr);
+  ExpectSame(cached, fresh);
+
+  // Another scan size resets the cache; so does Reset().
+  std::vector<Eigen::Vector3d> shorter(f.p_lidar.begin(), f.p_lidar.begin() + 100);
+  Associate(shorter, moved, f.T_imu_lidar, f.map, options, &cached, &stats, &cache);
+  EXPECT_EQ(stats.num_reused, 0);
+  cache.Reset();
+  Associate(shorter, moved, f.T_imu_lidar, f.map, options, &cached, &stats, &cache);
+  EXPECT_EQ(stats.num_reused, 0);
+}
+
 TEST(Associate, EmptyMapGivesNoConstraints) {
   RoomFixture f(4);
   VoxelMap empty;

@@ -42,12 +42,14 @@ struct Motion {
 
 // A filter whose prior is uncertain enough for the update to move it.
 Ieskf MakeFilter(int max_iterations = 5) {
+  RvOptions rv;
+  rv.enabled = false;  // the plain filter; RV has its own tests
   IeskfOptions o;
   o.max_iterations = max_iterations;
   o.init_pos_std = 0.5;
   o.init_rot_std = 0.05;
   o.convergence_eps = 1e-6;
-  return Ieskf(o, ImuOptions(), ConstraintOptions(), RvOptions());
+  return Ieskf(o, ImuOptions(), ConstraintOptions(), rv);
 }
 
 TEST(IeskfPropagation, MatchesAnalyticMotionAt1kHz) {
@@ -105,24 +107,27 @@ TEST(IeskfPropagation, PoseHistoryCoversTheIntervalInOrder) {
 }
 
 // Points on planes of an axis-aligned room (world frame), sampled on a grid
-// with some jitter so neighbourhoods are planar patches, not lines.
+// with in-plane jitter so neighbourhoods are planar patches, not lines. Each
+// plane stops one grid step short of its neighbours: no patch straddles an
+// edge, so every normal is exact.
 std::vector<Eigen::Vector3d> RoomPoints(double half_x, double half_y, double height,
                                         bool with_end_walls, std::mt19937_64* rng) {
   std::uniform_real_distribution<double> jitter(-0.03, 0.03);
+  const double step = 0.15, m = 0.2;  // grid step and edge margin, m
   std::vector<Eigen::Vector3d> pts;
-  for (double u = -half_x; u <= half_x; u += 0.15)
-    for (double s = 0.0; s <= height; s += 0.15) {
+  for (double u = -half_x; u <= half_x; u += step)
+    for (double s = m; s <= height - m; s += step) {
       pts.emplace_back(u + jitter(*rng), -half_y, s + jitter(*rng));
       pts.emplace_back(u + jitter(*rng), half_y, s + jitter(*rng));
     }
-  for (double u = -half_x; u <= half_x; u += 0.15)
-    for (double s = -half_y; s <= half_y; s += 0.15) {
+  for (double u = -half_x; u <= half_x; u += step)
+    for (double s = -half_y + m; s <= half_y - m; s += step) {
       pts.emplace_back(u + jitter(*rng), s + jitter(*rng), 0.0);
       pts.emplace_back(u + jitter(*rng), s + jitter(*rng), height);
     }
   if (with_end_walls)
-    for (double s = -half_y; s <= half_y; s += 0.15)
-      for (double z = 0.0; z <= height; z += 0.15) {
+    for (double s = -half_y + m; s <= half_y - m; s += step)
+      for (double z = m; z <= height - m; z += step) {
         pts.emplace_back(-half_x, s + jitter(*rng), z + jitter(*rng));
         pts.emplace_back(half_x, s + jitter(*rng), z + jitter(*rng));
       }
@@ -149,11 +154,13 @@ RoomSetup MakeRoom(bool with_end_walls, uint64_t seed) {
   return s;
 }
 
+// The room's planes are exact, so a tight plane test rejects neighbourhoods
+// that straddle two planes at an edge (their normals would be tilted).
 AssociateFn AssociateAgainst(const RoomSetup& room) {
   return [&room](const FilterState& x, ConstraintList* out) {
     AssociationStats stats;
     ConstraintOptions co;
-    co.max_plane_distance = 0.1;
+    co.max_plane_distance = 0.005;
     Associate(room.scan_lidar, x.T_world_imu(), x.T_imu_lidar(), room.map, co, out, &stats);
   };
 }

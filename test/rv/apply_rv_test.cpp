@@ -159,7 +159,8 @@ TEST(ApplyRvTest, PositionInformationIsTheWeightedScatter) {
   std::mt19937 rng(57);
   const test::TunnelSet set = DefaultTunnel(rng);
   Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
-  for (const Constraint& c : set.list) expected += c.weight * c.normal_world * c.normal_world.transpose();
+  for (const Constraint& c : set.list)
+    expected += c.weight * c.normal_world * c.normal_world.transpose();
   EXPECT_LT((PositionInformation(set.list) - expected).norm(), 1e-9);
   EXPECT_LT((PositionInformation(set.list, 0.05) - expected / 0.0025).norm(), 1e-6);
   EXPECT_EQ(PositionInformation(ConstraintList()), Eigen::Matrix3d::Zero());

@@ -3,8 +3,8 @@
 #include <limits>
 #include <random>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "rv_test_util.h"
 #include "rvlio/rv/criterion.h"

@@ -1,8 +1,8 @@
 // Paper Section 3.2: the observability conditions behind Proposition 1.
 #include <random>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "rv_test_util.h"
 #include "rvlio/rv/criterion.h"
@@ -140,8 +140,8 @@ TEST(ObservabilityTest, OnePlaneOnlyGivesRotationRank2WithTheNormalInTheNullSpac
     const std::vector<Eigen::Vector3d> points = PointsOnPlane(rng, R.transpose() * u, 2.5, 20);
     const std::vector<Eigen::Vector3d> normals(points.size(), u);
     const Eigen::MatrixXd O = RotationBlock(normals, points, R);
-    EXPECT_EQ(Rank(O), 2);              // Eq. (10)
-    EXPECT_LT((O * u).norm(), 1e-9);    // Eq. (12): u_alpha spans the null space
+    EXPECT_EQ(Rank(O), 2);            // Eq. (10)
+    EXPECT_LT((O * u).norm(), 1e-9);  // Eq. (12): u_alpha spans the null space
   }
 }
 

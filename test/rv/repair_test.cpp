@@ -109,8 +109,8 @@ TEST(RepairTest, ResidualIsRecomputedAtTheGivenPoseNotCopied) {
   for (size_t i = 0; i < a.size(); ++i) {
     if (a[i].role != RvRole::kRepaired) continue;
     ASSERT_EQ(b[i].role, RvRole::kRepaired);
-    EXPECT_NEAR(b[i].residual - a[i].residual, a[i].normal_world.dot(Eigen::Vector3d(0.3, -0.2, 0.1)),
-                1e-9);
+    EXPECT_NEAR(b[i].residual - a[i].residual,
+                a[i].normal_world.dot(Eigen::Vector3d(0.3, -0.2, 0.1)), 1e-9);
     ++checked;
   }
   EXPECT_GT(checked, 250);

@@ -55,8 +55,8 @@ struct TunnelSet {
 struct TunnelSpec {
   int num_coplanar = 1000;
   int num_scv = 40;
-  double axial_noise = 0.02;    // std of the axial component of wall normals
-  double scv_min_axial = 0.7;   // SCVs have |axial component| in [scv_min_axial, 1]
+  double axial_noise = 0.02;   // std of the axial component of wall normals
+  double scv_min_axial = 0.7;  // SCVs have |axial component| in [scv_min_axial, 1]
   // > 0: SCVs come from one structure (their in-plane direction has this
   // spread around one azimuth and their axial components one sign), so they
   // tilt the Alg. 1 plane; <= 0: uniform azimuth and random sign.
@@ -89,7 +89,8 @@ inline TunnelSet MakeTunnelSet(std::mt19937& rng, const TunnelSpec& spec) {
       u = a * set.axis + std::sqrt(1.0 - a * a) * (std::cos(f) * e1 + std::sin(f) * e2);
     } else {
       const double theta = wall(rng) * M_PI / 2.0 + spread(rng);
-      const double a = std::max(-3.0 * spec.axial_noise, std::min(3.0 * spec.axial_noise, axial(rng)));
+      const double a =
+          std::max(-3.0 * spec.axial_noise, std::min(3.0 * spec.axial_noise, axial(rng)));
       u = (std::cos(theta) * e1 + std::sin(theta) * e2 + a * set.axis).normalized();
     }
     if (coin(rng)) u = -u;  // a normal's sign is arbitrary

@@ -39,6 +39,7 @@ struct AssociationStats {
   int num_far_from_plane = 0;
   int num_uncertain = 0;
   int num_large_residual = 0;
+  int num_reused = 0;              // points answered from an AssociationCache (no search)
   double mean_abs_residual = 0.0;  // over accepted constraints, m
 
   void Count(AssociationOutcome outcome);
@@ -52,10 +53,40 @@ AssociationOutcome AssociatePoint(const Eigen::Vector3d& p_lidar, const Pose3& T
                                   const VoxelMap& map, const ConstraintOptions& options,
                                   NeighborBuffer* neighbors, Constraint* out);
 
+// The local plane (or the rejection) found for each point of one scan, so
+// that the later iterations of one update search the map again only for the
+// points that moved more than reuse_distance (m, world) since their last
+// search; the others keep their plane and get a fresh residual. (FAST-LIO2
+// likewise re-searches only after an iteration converged.) The search is the
+// expensive part of association (k-NN + plane fit); the reuse is ~20 ns.
+// Reset() for every new scan or after the map changed. reuse_distance 0
+// searches every time (the cache then only holds memory).
+class AssociationCache {
+ public:
+  explicit AssociationCache(double reuse_distance = 0.05) : reuse_distance_(reuse_distance) {}
+  void Reset() { entries_.clear(); }
+  double reuse_distance() const { return reuse_distance_; }
+
+  struct Entry {
+    Eigen::Vector3d p_world = Eigen::Vector3d::Zero();  // where the point was searched
+    Eigen::Vector3d normal_world = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d q_world = Eigen::Vector3d::Zero();
+    AssociationOutcome outcome = AssociationOutcome::kTooFewNeighbors;  // of the plane search
+  };
+  std::vector<Entry>& entries() { return entries_; }
+
+ private:
+  double reuse_distance_;
+  std::vector<Entry> entries_;  // one per scan point, or empty
+};
+
 // Associates every point of a scan (LiDAR frame, deskewed). *out is cleared
 // and refilled in point order (its capacity is reused); stats may be null.
+// With a cache (may be null), points that moved less than its reuse_distance
+// since their last search reuse that search; a cache of another scan size is
+// reset first.
 void Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
                const Pose3& T_imu_lidar, const VoxelMap& map, const ConstraintOptions& options,
-               ConstraintList* out, AssociationStats* stats);
+               ConstraintList* out, AssociationStats* stats, AssociationCache* cache = nullptr);
 
 }  // namespace rvlio

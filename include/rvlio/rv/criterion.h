@@ -43,7 +43,7 @@ struct RvWorkspace {
 
 // Plane alpha through the origin fitted to a set of directions.
 struct PlaneFit {
-  Eigen::Vector3d n_alpha = Eigen::Vector3d::UnitZ();      // unit normal of alpha
+  Eigen::Vector3d n_alpha = Eigen::Vector3d::UnitZ();     // unit normal of alpha
   Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // of S, ascending
 };
 
@@ -68,11 +68,11 @@ PlaneFit FitPlane(const Eigen::Matrix3d& S);
 void ComputeDistances(const Eigen::Vector3d& n_alpha, RvWorkspace* ws);
 
 struct CriterionResult {
-  bool active = false;       // Proposition 1 holds (see EvaluateCriterion)
-  PlaneFit fit;              // Alg. 1 plane on all usable vectors
+  bool active = false;                          // Proposition 1 holds (see EvaluateCriterion)
+  PlaneFit fit;                                 // Alg. 1 plane on all usable vectors
   Eigen::Matrix3d S = Eigen::Matrix3d::Zero();  // sum u_i u_i^T over usable vectors
   int num_usable = 0;
-  int num_within_eps0 = 0;   // d_i <= eps0
+  int num_within_eps0 = 0;         // d_i <= eps0
   double coplanar_fraction = 0.0;  // num_within_eps0 / num_usable (0 when none)
 };
 

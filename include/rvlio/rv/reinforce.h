@@ -9,8 +9,8 @@
 namespace rvlio {
 
 struct RefitResult {
-  PlaneFit fit;         // final plane alpha (fitted on the coplanar vectors only)
-  int iterations = 0;   // number of refits performed (0: Alg. 1 found no SCV)
+  PlaneFit fit;        // final plane alpha (fitted on the coplanar vectors only)
+  int iterations = 0;  // number of refits performed (0: Alg. 1 found no SCV)
   int num_scv = 0;
   int num_coplanar = 0;
   bool converged = true;  // false when max_iterations stopped the loop early

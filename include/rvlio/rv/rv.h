@@ -12,18 +12,18 @@
 namespace rvlio {
 
 struct RvReport {
-  bool active = false;            // criterion fired (and rv.enabled)
+  bool active = false;                                 // criterion fired (and rv.enabled)
   Eigen::Vector3d n_alpha = Eigen::Vector3d::UnitZ();  // final plane alpha normal
-  int num_constraints = 0;        // list size (usable or not)
-  int num_usable = 0;             // finite, non-zero normals
-  int num_scv = 0;                // special constraint vectors (final set)
-  int num_coplanar = 0;           // usable, not SCV
-  int num_reinforced = 0;         // SCVs whose weight was scaled (0 if reinforce is off)
+  int num_constraints = 0;                             // list size (usable or not)
+  int num_usable = 0;                                  // finite, non-zero normals
+  int num_scv = 0;                                     // special constraint vectors (final set)
+  int num_coplanar = 0;                                // usable, not SCV
+  int num_reinforced = 0;  // SCVs whose weight was scaled (0 if reinforce is off)
   int num_repaired = 0;
-  double K = 0.0;                 // Eq. (19) after the clamp (computed when active; applied
-                                  // to the SCV weights only with rv.reinforce); 0 if inactive
-  int iterations = 0;             // Alg. 2 refits
-  double coplanar_fraction = 0.0; // Alg. 1 fraction of d_i <= eps0
+  double K = 0.0;                  // Eq. (19) after the clamp (computed when active; applied
+                                   // to the SCV weights only with rv.reinforce); 0 if inactive
+  int iterations = 0;              // Alg. 2 refits
+  double coplanar_fraction = 0.0;  // Alg. 1 fraction of d_i <= eps0
   // Eigenvalues of S = sum u_i u_i^T over all usable normals (Alg. 1),
   // ascending; s_eigenvalues[0] is the smallest.
   Eigen::Vector3d s_eigenvalues = Eigen::Vector3d::Zero();
@@ -48,9 +48,8 @@ double SmallestEigenvalue(const Eigen::Matrix3d& symmetric);
 // only switches the weight change and rv.repair the normal repair. The list is
 // expected to be freshly associated: calling twice compounds the weights.
 // The list never changes size; with finite input every output is finite.
-RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar,
-                 ConstraintList* constraints, RvWorkspace* workspace);
-RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar,
-                 ConstraintList* constraints);
+RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar, ConstraintList* constraints,
+                 RvWorkspace* workspace);
+RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar, ConstraintList* constraints);
 
 }  // namespace rvlio
