@@ -217,7 +217,10 @@ std::vector<VoxelKey> LookupKeys(std::vector<VoxelKey>* stored) {
 void BM_LookupOpenAddressing(benchmark::State& state) {
   std::vector<VoxelKey> stored;
   const std::vector<VoxelKey> keys = LookupKeys(&stored);
-  struct Slot { VoxelKey key; int32_t value = -1; };
+  struct Slot {
+    VoxelKey key;
+    int32_t value = -1;
+  };
   size_t cap = 1024;
   while (cap < 2 * stored.size()) cap *= 2;
   std::vector<Slot> table(cap);
@@ -256,7 +259,8 @@ BENCHMARK(BM_LookupStdUnorderedMap);
 }  // namespace rvlio
 
 BENCHMARK_MAIN();
-namespace rvlio { namespace {
+namespace rvlio {
+namespace {
 void BM_KNearestHot(benchmark::State& state) {
   const Fixture& f = GetFixture();
   std::vector<Eigen::Vector3d> queries;
@@ -269,4 +273,5 @@ void BM_KNearestHot(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_KNearestHot);
-}}
+}  // namespace
+}  // namespace rvlio

@@ -12,13 +12,20 @@ namespace {
 
 AssociationOutcome FromPlaneStatus(PlaneStatus status) {
   switch (status) {
-    case PlaneStatus::kValid: return AssociationOutcome::kAccepted;
-    case PlaneStatus::kTooFewPoints: return AssociationOutcome::kTooFewNeighbors;
-    case PlaneStatus::kDegenerate: return AssociationOutcome::kDegenerate;
-    case PlaneStatus::kLineLike: return AssociationOutcome::kLineLike;
-    case PlaneStatus::kNotFlat: return AssociationOutcome::kNotFlat;
-    case PlaneStatus::kFarFromPlane: return AssociationOutcome::kFarFromPlane;
-    case PlaneStatus::kUncertain: return AssociationOutcome::kUncertain;
+    case PlaneStatus::kValid:
+      return AssociationOutcome::kAccepted;
+    case PlaneStatus::kTooFewPoints:
+      return AssociationOutcome::kTooFewNeighbors;
+    case PlaneStatus::kDegenerate:
+      return AssociationOutcome::kDegenerate;
+    case PlaneStatus::kLineLike:
+      return AssociationOutcome::kLineLike;
+    case PlaneStatus::kNotFlat:
+      return AssociationOutcome::kNotFlat;
+    case PlaneStatus::kFarFromPlane:
+      return AssociationOutcome::kFarFromPlane;
+    case PlaneStatus::kUncertain:
+      return AssociationOutcome::kUncertain;
   }
   return AssociationOutcome::kDegenerate;
 }
@@ -27,14 +34,22 @@ AssociationOutcome FromPlaneStatus(PlaneStatus status) {
 
 const char* ToString(AssociationOutcome outcome) {
   switch (outcome) {
-    case AssociationOutcome::kAccepted: return "accepted";
-    case AssociationOutcome::kTooFewNeighbors: return "too_few_neighbors";
-    case AssociationOutcome::kDegenerate: return "degenerate";
-    case AssociationOutcome::kLineLike: return "line_like";
-    case AssociationOutcome::kNotFlat: return "not_flat";
-    case AssociationOutcome::kFarFromPlane: return "far_from_plane";
-    case AssociationOutcome::kUncertain: return "uncertain";
-    case AssociationOutcome::kLargeResidual: return "large_residual";
+    case AssociationOutcome::kAccepted:
+      return "accepted";
+    case AssociationOutcome::kTooFewNeighbors:
+      return "too_few_neighbors";
+    case AssociationOutcome::kDegenerate:
+      return "degenerate";
+    case AssociationOutcome::kLineLike:
+      return "line_like";
+    case AssociationOutcome::kNotFlat:
+      return "not_flat";
+    case AssociationOutcome::kFarFromPlane:
+      return "far_from_plane";
+    case AssociationOutcome::kUncertain:
+      return "uncertain";
+    case AssociationOutcome::kLargeResidual:
+      return "large_residual";
   }
   return "unknown";
 }
@@ -42,14 +57,30 @@ const char* ToString(AssociationOutcome outcome) {
 void AssociationStats::Count(AssociationOutcome outcome) {
   ++num_points;
   switch (outcome) {
-    case AssociationOutcome::kAccepted: ++num_accepted; break;
-    case AssociationOutcome::kTooFewNeighbors: ++num_too_few_neighbors; break;
-    case AssociationOutcome::kDegenerate: ++num_degenerate; break;
-    case AssociationOutcome::kLineLike: ++num_line_like; break;
-    case AssociationOutcome::kNotFlat: ++num_not_flat; break;
-    case AssociationOutcome::kFarFromPlane: ++num_far_from_plane; break;
-    case AssociationOutcome::kUncertain: ++num_uncertain; break;
-    case AssociationOutcome::kLargeResidual: ++num_large_residual; break;
+    case AssociationOutcome::kAccepted:
+      ++num_accepted;
+      break;
+    case AssociationOutcome::kTooFewNeighbors:
+      ++num_too_few_neighbors;
+      break;
+    case AssociationOutcome::kDegenerate:
+      ++num_degenerate;
+      break;
+    case AssociationOutcome::kLineLike:
+      ++num_line_like;
+      break;
+    case AssociationOutcome::kNotFlat:
+      ++num_not_flat;
+      break;
+    case AssociationOutcome::kFarFromPlane:
+      ++num_far_from_plane;
+      break;
+    case AssociationOutcome::kUncertain:
+      ++num_uncertain;
+      break;
+    case AssociationOutcome::kLargeResidual:
+      ++num_large_residual;
+      break;
   }
 }
 
@@ -136,9 +167,9 @@ void Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world
       found = SearchPlane(p_world, T_world_lidar.t, map, options, &neighbors, &u, &q);
       if (e != nullptr) *e = AssociationCache::Entry{p_world, u, q, found};
     }
-    const AssociationOutcome outcome =
-        found == AssociationOutcome::kAccepted ? Accept(p_lidar[i], p_world, u, q, options, &c)
-                                               : found;
+    const AssociationOutcome outcome = found == AssociationOutcome::kAccepted
+                                           ? Accept(p_lidar[i], p_world, u, q, options, &c)
+                                           : found;
     local.Count(outcome);
     if (outcome != AssociationOutcome::kAccepted) continue;
     sum_abs_residual += std::abs(c.residual);

@@ -113,13 +113,20 @@ PlaneStatus Classify(const LocalPlane& plane, const PlaneThresholds& t) {
 
 const char* ToString(PlaneStatus status) {
   switch (status) {
-    case PlaneStatus::kValid: return "valid";
-    case PlaneStatus::kTooFewPoints: return "too_few_points";
-    case PlaneStatus::kDegenerate: return "degenerate";
-    case PlaneStatus::kLineLike: return "line_like";
-    case PlaneStatus::kNotFlat: return "not_flat";
-    case PlaneStatus::kFarFromPlane: return "far_from_plane";
-    case PlaneStatus::kUncertain: return "uncertain";
+    case PlaneStatus::kValid:
+      return "valid";
+    case PlaneStatus::kTooFewPoints:
+      return "too_few_points";
+    case PlaneStatus::kDegenerate:
+      return "degenerate";
+    case PlaneStatus::kLineLike:
+      return "line_like";
+    case PlaneStatus::kNotFlat:
+      return "not_flat";
+    case PlaneStatus::kFarFromPlane:
+      return "far_from_plane";
+    case PlaneStatus::kUncertain:
+      return "uncertain";
   }
   return "unknown";
 }

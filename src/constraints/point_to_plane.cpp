@@ -14,8 +14,8 @@ namespace rvlio {
 //     dr/dphi = (p_l x (R_il^T R_wi^T u))^T.
 // * Extrinsic translation: dr/dt = u^T R_wi = (R_wi^T u)^T.
 
-double PointToPlaneResidual(const Constraint& c, const Pose3& T_world_imu,
-                            const Pose3& T_imu_lidar, Eigen::Matrix<double, 1, 6>* J) {
+double PointToPlaneResidual(const Constraint& c, const Pose3& T_world_imu, const Pose3& T_imu_lidar,
+                            Eigen::Matrix<double, 1, 6>* J) {
   const Eigen::Vector3d p_imu = T_imu_lidar * c.p_lidar;
   const Eigen::Vector3d p_world = T_world_imu * p_imu;
   const Eigen::Vector3d& u = c.normal_world;

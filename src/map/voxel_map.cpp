@@ -28,9 +28,10 @@ uint64_t PackKey(int64_t x, int64_t y, int64_t z) {
          (static_cast<uint64_t>(y + kKeyBias) << kKeyBits) | static_cast<uint64_t>(z + kKeyBias);
 }
 VoxelKey UnpackKey(uint64_t key) {
-  return VoxelKey{static_cast<int32_t>(static_cast<int64_t>(key >> (2 * kKeyBits)) - kKeyBias),
-                  static_cast<int32_t>(static_cast<int64_t>((key >> kKeyBits) & kKeyMask) - kKeyBias),
-                  static_cast<int32_t>(static_cast<int64_t>(key & kKeyMask) - kKeyBias)};
+  return VoxelKey{
+      static_cast<int32_t>(static_cast<int64_t>(key >> (2 * kKeyBits)) - kKeyBias),
+      static_cast<int32_t>(static_cast<int64_t>((key >> kKeyBits) & kKeyMask) - kKeyBias),
+      static_cast<int32_t>(static_cast<int64_t>(key & kKeyMask) - kKeyBias)};
 }
 // Packed key of the voxel at offset (dx, dy, dz) from a packed key, valid
 // while every coordinate stays within the biased range (no carries).
@@ -73,8 +74,8 @@ std::vector<Offset> MakeShell(int r) {
   // the upper half of its voxel.
   auto gap = [](int d) { return d > 0 ? d - 1.0 : (d < 0 ? -d - 0.5 : 0.0); };
   for (Offset& o : shell)
-    o.lower_bound2 = static_cast<float>(gap(o.dx) * gap(o.dx) + gap(o.dy) * gap(o.dy) +
-                                        gap(o.dz) * gap(o.dz));
+    o.lower_bound2 =
+        static_cast<float>(gap(o.dx) * gap(o.dx) + gap(o.dy) * gap(o.dy) + gap(o.dz) * gap(o.dz));
   auto nonzero = [](const Offset& o) { return (o.dx != 0) + (o.dy != 0) + (o.dz != 0); };
   std::stable_sort(shell.begin(), shell.end(), [&](const Offset& a, const Offset& b) {
     if (a.lower_bound2 != b.lower_bound2) return a.lower_bound2 < b.lower_bound2;

@@ -1,42 +1,22 @@
 // The IESKF backend of the odometry pipeline (paper-exact mode).
 #include "rvlio/odometry/ieskf_odometry.h"
 
-#include <ctime>
-#include <cmath>
 #include <utility>
 
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/constraints/associate.h"
-#include "rvlio/imu/static_init.h"
 #include "rvlio/lidar/deskew.h"
 
 namespace rvlio {
-namespace {
-
-constexpr int kMinScanPoints = 50;          // fewer after preprocessing: scan skipped
-constexpr int kRemoveFarEveryScans = 10;    // working-map trimming period
-constexpr TimeNs kNominalScanPeriodNs = 100000000;  // 10 Hz, for the IMU-gap warning
-
-// CPU time of the calling thread, ms: the cost of a scan, unaffected by other
-// processes competing for the cores (wall time is reported per run).
-double ThreadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
-}  // namespace
 
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
     : options_(options),
       filter_(options.ieskf, options.imu, options.constraints, options.rv),
       map_(options.map),
       output_map_(options.map.output_resolution),
-      preprocessor_(options.lidar) {
-  const auto& e = options.extrinsics.imu_T_lidar;
-  T_imu_lidar_ = Pose3(Eigen::Quaterniond(e.rotation_xyzw[3], e.rotation_xyzw[0],
-                                          e.rotation_xyzw[1], e.rotation_xyzw[2]),
-                       Eigen::Vector3d(e.translation[0], e.translation[1], e.translation[2]));
-}
+      preprocessor_(options.lidar),
+      T_imu_lidar_(ImuTLidar(options.extrinsics)),
+      initializer_(options.imu.init_duration) {}
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {
   if (!imu_buffer_.empty() && imu.t_ns - imu_buffer_.back().t_ns > kNominalScanPeriodNs)
@@ -50,24 +30,18 @@ void IeskfOdometry::AddImu(const ImuSample& imu) {
 
 // Static alignment once imu.init_duration of samples has been collected.
 void IeskfOdometry::TryInitialize(const ImuSample& imu) {
-  init_samples_.push_back(imu);
-  const TimeNs span = imu.t_ns - init_samples_.front().t_ns;
-  if (span < SecondsToNs(options_.imu.init_duration)) return;
-  const StaticAlignment a = AlignStatic(init_samples_);
+  const std::optional<StaticAlignment> a = initializer_.Add(imu);
+  if (!a) return;
   FilterState x0;
-  x0.R_world_imu = a.R_world_imu;
-  x0.g_world = a.g_world;
-  x0.bg = a.gyro_bias;
+  x0.R_world_imu = a->R_world_imu;
+  x0.g_world = a->g_world;
+  x0.bg = a->gyro_bias;
   x0.R_imu_lidar = T_imu_lidar_.R;
   x0.t_imu_lidar = T_imu_lidar_.t;
   filter_.Initialize(x0, imu.t_ns, imu);
   stats_.initialized = true;
-  stats_.started_moving = a.moving;
-  if (a.moving)
-    warnings_.push_back("the sequence starts moving (acc std " + std::to_string(a.acc_std) +
-                        " m/s^2, gyro std " + std::to_string(a.gyro_std) +
-                        " rad/s); initialized from the mean IMU values");
-  init_samples_.clear();
+  stats_.started_moving = a->moving;
+  if (a->moving) warnings_.push_back(MovingStartWarning(*a));
 }
 
 void IeskfOdometry::AddScan(Scan scan) {
@@ -137,7 +111,7 @@ Eigen::Vector3d IeskfOdometry::Predict(TimeNs t_end_ns) {
 ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   const AssociateFn associate = [this](const FilterState& x, ConstraintList* constraints) {
     AssociationStats stats;
-    Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_, options_.constraints,
+    Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_.map(), options_.constraints,
               constraints, &stats);
   };
   const IeskfUpdateResult u = filter_.Update(associate);
@@ -157,14 +131,9 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
 
 void IeskfOdometry::InsertIntoMap() {
   const Pose3 T_world_lidar = filter_.state().T_world_lidar();
-  p_world_.resize(p_lidar_end_.size());
-  for (size_t i = 0; i < p_lidar_end_.size(); ++i) p_world_[i] = T_world_lidar * p_lidar_end_[i];
-  map_.Insert(p_world_);
+  TransformPoints(T_world_lidar, p_lidar_end_, &p_world_);
+  map_.Insert(p_world_, T_world_lidar.t);
   output_map_.Insert(p_world_);
-  if (++scans_since_trim_ >= kRemoveFarEveryScans) {
-    map_.RemoveFar(T_world_lidar.t, options_.map.working_radius);
-    scans_since_trim_ = 0;
-  }
 }
 
 }  // namespace rvlio

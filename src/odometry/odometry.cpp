@@ -1,6 +1,7 @@
 #include "rvlio/odometry/odometry.h"
 
 #include "rvlio/odometry/ieskf_odometry.h"
+#include "rvlio/odometry/smoother_odometry.h"
 
 namespace rvlio {
 
@@ -18,9 +19,11 @@ StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& opti
   OdometryOptions checked = options;
   if (Status s = checked.Validate(); !s.ok()) return s;
   if (options.backend == "ieskf") return std::unique_ptr<Odometry>(new IeskfOdometry(options));
+  if (options.backend == "smoother")
+    return std::unique_ptr<Odometry>(new SmootherOdometry(options));
   return Status::InvalidInput("backend '" + options.backend +
-                              "' is not in this build yet (the smoother lands with issue 6); "
-                              "use backend=ieskf");
+                              "' is not in this build; use backend=ieskf or "
+                              "backend=smoother");
 }
 
 }  // namespace rvlio

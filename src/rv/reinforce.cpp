@@ -60,7 +60,12 @@ double ReinforcementCoefficient(const RvOptions& options, int num_scv, int num_c
                  ? options.k0 * static_cast<double>(num_scv) / static_cast<double>(num_coplanar)
                  : 1.0;
   if (options.clamp) K = std::min(K, 1.0);
-  return K;
+  // Our addition (not in the paper): a floor on K caps the information gain of
+  // one SCV at 1 / min_K. Without it a handful of SCVs among a thousand wall
+  // vectors get K ~ 0.01, i.e. 100x weight, and one mis-associated feature
+  // normal can then drag the estimate along the unobservable axis (measured on
+  // the corridor and loopback presets, README "RV defaults").
+  return std::max(K, options.min_K);
 }
 
 int ReinforceScv(double K, const RvWorkspace& ws, ConstraintList* constraints) {

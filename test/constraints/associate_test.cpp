@@ -4,8 +4,8 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/math/so3.h"
@@ -66,8 +66,8 @@ TEST(Associate, ShiftedPoseGivesResidualsEqualToTheOffset) {
     EXPECT_EQ(stats.num_accepted, static_cast<int>(constraints.size()));
     EXPECT_EQ(stats.num_points, stats.num_accepted + stats.num_too_few_neighbors +
                                     stats.num_degenerate + stats.num_line_like +
-                                    stats.num_not_flat + stats.num_far_from_plane + stats.num_uncertain +
-                                    stats.num_large_residual);
+                                    stats.num_not_flat + stats.num_far_from_plane +
+                                    stats.num_uncertain + stats.num_large_residual);
     EXPECT_GT(stats.num_accepted, 2700);  // only points near edges may fail
 
     Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
@@ -95,8 +95,8 @@ TEST(Associate, ShiftedPoseGivesResidualsEqualToTheOffset) {
     }
     EXPECT_GT(tight, 0.98 * constraints.size());
     const Eigen::Vector3d delta_hat = H.ldlt().solve(b);
-    EXPECT_LT((delta_hat - delta).norm(), 1e-3) << delta_hat.transpose() << " vs "
-                                                 << delta.transpose();
+    EXPECT_LT((delta_hat - delta).norm(), 1e-3)
+        << delta_hat.transpose() << " vs " << delta.transpose();
   }
 }
 

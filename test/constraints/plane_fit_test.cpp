@@ -4,9 +4,9 @@
 #include <random>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
 
 namespace rvlio {
 namespace {
@@ -86,7 +86,7 @@ TEST(PlaneFit, RingLineIsRejected) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> noise(0.0, 0.01);
   for (int trial = 0; trial < 500; ++trial) {
-    const double wall = 3.0 + 7.0 * unit(rng);                          // y = wall
+    const double wall = 3.0 + 7.0 * unit(rng);  // y = wall
     const double elevation = (-22.5 + 45.0 * unit(rng)) * M_PI / 180.0;
     const double azimuth0 = (30.0 + 120.0 * unit(rng)) * M_PI / 180.0;  // facing the wall
     const double step = (0.35 + 1.0 * unit(rng)) * M_PI / 180.0;
@@ -161,8 +161,9 @@ TEST(PlaneFit, NormalStdPredictsTheNormalSpread) {
   const double sigma = 0.01;
   std::normal_distribution<double> noise(0.0, sigma);
   const std::vector<Eigen::Vector3d> layout = {
-      Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.1, 0.0, 0.0), Eigen::Vector3d(0.2, 0.0, 0.0),
-      Eigen::Vector3d(0.05, 0.15, 0.0), Eigen::Vector3d(0.15, 0.15, 0.0)};
+      Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.1, 0.0, 0.0),
+      Eigen::Vector3d(0.2, 0.0, 0.0), Eigen::Vector3d(0.05, 0.15, 0.0),
+      Eigen::Vector3d(0.15, 0.15, 0.0)};
   PlaneThresholds t{0.0, 1.0, 1.0, 0.0, sigma};
   double sum_tilt2 = 0.0, sum_predicted = 0.0;
   const int trials = 4000;
@@ -208,8 +209,8 @@ TEST(PlaneFit, EigenvaluesAndNormalMatchAReferenceSolver) {
   std::normal_distribution<double> g(0.0, 1.0);
   for (int trial = 0; trial < 3000; ++trial) {
     // Random anisotropic Gaussian cloud: axis scales spanning 6 decades.
-    const Eigen::Matrix3d R = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng))
-                                  .normalized().toRotationMatrix();
+    const Eigen::Matrix3d R =
+        Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
     const Eigen::Vector3d scale(std::pow(10.0, -4.0 + 3.0 * unit(rng)),
                                 std::pow(10.0, -3.0 + 3.0 * unit(rng)),
                                 std::pow(10.0, -1.0 + 1.0 * unit(rng)));

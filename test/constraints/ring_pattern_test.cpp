@@ -103,8 +103,7 @@ NormalQuality Evaluate(const WallScene& scene, const MapOptions& map_options, Ma
                        const ConstraintOptions& options, double bound_deg, uint32_t seed) {
   std::mt19937 rng(seed);
   const VoxelMap map = BuildMap(scene, map_options, kind, &rng);
-  const Pose3 T_scan(so3::Exp(Eigen::Vector3d(0.01, -0.02, 0.05)),
-                     Eigen::Vector3d(0.4, 0.1, 1.57));
+  const Pose3 T_scan(so3::Exp(Eigen::Vector3d(0.01, -0.02, 0.05)), Eigen::Vector3d(0.4, 0.1, 1.57));
   std::vector<Eigen::Vector3d> scan = scene.Sweep(T_scan, &rng);
   if (kind == MapKind::kAccumulated) scan = Downsample(scan, 0.5);
   ConstraintList constraints;
@@ -136,7 +135,8 @@ TEST(RingPattern, LineTestKeepsWallNormals) {
     NormalQuality with_test, without_test;
     for (double wall : {3.0, 5.0, 7.0, 10.0}) {
       const WallScene scene{wall, 0.005};
-      const NormalQuality q = Evaluate(scene, MapOptions(), kind, ConstraintOptions(), kBoundDeg, kSeed);
+      const NormalQuality q =
+          Evaluate(scene, MapOptions(), kind, ConstraintOptions(), kBoundDeg, kSeed);
       EXPECT_GE(q.fraction_within(), 0.90) << "wall " << wall;
       EXPECT_GE(q.num_accepted, 0.3 * q.num_points) << "wall " << wall;  // not starved
       with_test.Add(q);
@@ -172,7 +172,8 @@ TEST(RingPattern, NormalUncertaintyTestKeepsNoisyWallNormals) {
     EXPECT_GE(q.num_accepted, 0.25 * q.num_points) << "wall " << wall;
     with_test.Add(q);
     options.max_normal_std_deg = 0.0;
-    without_test.Add(Evaluate(scene, sparse_map, MapKind::kAccumulated, options, kBoundDeg, kSeed + 1));
+    without_test.Add(
+        Evaluate(scene, sparse_map, MapKind::kAccumulated, options, kBoundDeg, kSeed + 1));
   }
   EXPECT_GE(with_test.fraction_within(), 0.98);
   EXPECT_LT(with_test.max_axis_component, 0.15);

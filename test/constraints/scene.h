@@ -45,8 +45,16 @@ struct BoxRoom {
     double best = std::numeric_limits<double>::infinity();
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
     for (int a = 0; a < 3; ++a) {
-      if (std::abs(p(a) - lo(a)) < best) { best = std::abs(p(a) - lo(a)); n.setZero(); n(a) = 1; }
-      if (std::abs(p(a) - hi(a)) < best) { best = std::abs(p(a) - hi(a)); n.setZero(); n(a) = -1; }
+      if (std::abs(p(a) - lo(a)) < best) {
+        best = std::abs(p(a) - lo(a));
+        n.setZero();
+        n(a) = 1;
+      }
+      if (std::abs(p(a) - hi(a)) < best) {
+        best = std::abs(p(a) - hi(a));
+        n.setZero();
+        n(a) = -1;
+      }
     }
     return n;
   }

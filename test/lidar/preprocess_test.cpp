@@ -145,7 +145,8 @@ TEST(Preprocess, DownsampleCopiesPointsWithTheirTimes) {
   Scan again;
   pre.Downsample(scan, &again);
   ASSERT_EQ(again.points.size(), out.points.size());
-  for (size_t j = 0; j < out.points.size(); ++j) EXPECT_EQ(again.points[j].t_ns, out.points[j].t_ns);
+  for (size_t j = 0; j < out.points.size(); ++j)
+    EXPECT_EQ(again.points[j].t_ns, out.points[j].t_ns);
 }
 
 TEST(Preprocess, EmptyScan) {

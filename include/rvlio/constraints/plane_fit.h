@@ -39,20 +39,20 @@ namespace rvlio {
 
 enum class PlaneStatus : uint8_t {
   kValid = 0,
-  kTooFewPoints,   // fewer than 3 points
-  kDegenerate,     // all points (numerically) coincide or are non-finite
-  kLineLike,       // lambda_mid / lambda_max below planarity_min_ratio
-  kNotFlat,        // lambda_min / lambda_mid above planarity_max_ratio
-  kFarFromPlane,   // a point farther than max_plane_distance from the plane
-  kUncertain,      // normal's predicted tilt std above max_normal_std
+  kTooFewPoints,  // fewer than 3 points
+  kDegenerate,    // all points (numerically) coincide or are non-finite
+  kLineLike,      // lambda_mid / lambda_max below planarity_min_ratio
+  kNotFlat,       // lambda_min / lambda_mid above planarity_max_ratio
+  kFarFromPlane,  // a point farther than max_plane_distance from the plane
+  kUncertain,     // normal's predicted tilt std above max_normal_std
 };
 
 const char* ToString(PlaneStatus status);
 
 struct LocalPlane {
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();     // unit normal u (sign arbitrary)
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();    // point q on the plane, m
-  Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero(); // covariance, ascending, m^2
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();      // unit normal u (sign arbitrary)
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();     // point q on the plane, m
+  Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();  // covariance, ascending, m^2
   double max_distance = 0.0;  // largest |u . (p_i - q)| over the points, m
   double normal_std = 0.0;    // predicted 1-sigma tilt of the normal, rad
   PlaneStatus status = PlaneStatus::kTooFewPoints;

@@ -22,8 +22,8 @@
 namespace rvlio {
 
 // r of Eq. (3) at the given poses; J (optional) = dr / [dtheta, dp].
-double PointToPlaneResidual(const Constraint& c, const Pose3& T_world_imu,
-                            const Pose3& T_imu_lidar, Eigen::Matrix<double, 1, 6>* J = nullptr);
+double PointToPlaneResidual(const Constraint& c, const Pose3& T_world_imu, const Pose3& T_imu_lidar,
+                            Eigen::Matrix<double, 1, 6>* J = nullptr);
 
 // r of Eq. (3); J (optional) = dr / [dtheta, dp, dphi, dt] (extrinsics estimated).
 double PointToPlaneResidualWithExtrinsics(const Constraint& c, const Pose3& T_world_imu,

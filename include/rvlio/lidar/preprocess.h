@@ -39,9 +39,9 @@ class ScanPreprocessor {
  private:
   struct Entry {
     VoxelKey key;
-    int32_t best = -1;    // index of the point kept so far
-    float d2 = 0.0f;      // its squared distance to the voxel centre, m^2
-    uint32_t stamp = 0;   // entry is in use for the current scan iff stamp == stamp_
+    int32_t best = -1;   // index of the point kept so far
+    float d2 = 0.0f;     // its squared distance to the voxel centre, m^2
+    uint32_t stamp = 0;  // entry is in use for the current scan iff stamp == stamp_
   };
 
   void CollectCandidates(const Scan& scan);

@@ -48,8 +48,7 @@ class VoxelMap {
   // Exact k nearest stored points of q_world among those within max_dist (m),
   // sorted by distance into *out. Returns out->size (< k when fewer points are
   // within max_dist). 1 <= k <= kMaxNeighbors. No heap allocation.
-  int KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
-               NeighborBuffer* out) const;
+  int KNearest(const Eigen::Vector3d& q_world, int k, double max_dist, NeighborBuffer* out) const;
 
   // Removes every voxel whose centre is farther than radius (m) from
   // center_world (the sensor position: keeps a working window).
@@ -92,7 +91,7 @@ class VoxelMap {
 
   int FindSlot(uint64_t key) const;  // slot index, or -1
   int CreateSlot(uint64_t key);      // key must be absent; returns its slot
-  void InsertSlot(const Slot& s);           // key must be absent; no growth check
+  void InsertSlot(const Slot& s);    // key must be absent; no growth check
   void Rebuild(size_t capacity, const std::vector<Slot>& slots);
   int CapacityClass(int capacity) const;
   int32_t AllocateBlock(int capacity);
@@ -113,9 +112,9 @@ class VoxelMap {
 
   std::vector<Slot> slots_;
   size_t mask_ = 0;
-  std::vector<float> pool_;                       // blocks of x[c], y[c], z[c]
+  std::vector<float> pool_;                        // blocks of x[c], y[c], z[c]
   std::vector<std::vector<int32_t>> free_blocks_;  // freed offsets per capacity class
-  std::vector<Slot> scratch_slots_;               // reused by RemoveFar / growth
+  std::vector<Slot> scratch_slots_;                // reused by RemoveFar / growth
   size_t num_voxels_ = 0;
   size_t num_points_ = 0;
 

@@ -7,8 +7,8 @@
 #include "rvlio/ieskf/ieskf.h"
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/map/output_map.h"
-#include "rvlio/map/voxel_map.h"
 #include "rvlio/odometry/odometry.h"
+#include "rvlio/odometry/scan_frontend.h"
 
 namespace rvlio {
 
@@ -37,16 +37,15 @@ class IeskfOdometry : public Odometry {
 
   OdometryOptions options_;
   Ieskf filter_;
-  VoxelMap map_;
+  WorkingMap map_;
   OutputMap output_map_;
   ScanPreprocessor preprocessor_;
   Pose3 T_imu_lidar_;
   OdometryStats stats_;
   std::vector<std::string> warnings_;
-  std::vector<ImuSample> init_samples_;
+  StaticInitializer initializer_;
   std::deque<ImuSample> imu_buffer_;
   std::deque<Scan> scans_;
-  int scans_since_trim_ = 0;
   // Per-scan workspaces, reused to avoid allocation in the hot path.
   Scan downsampled_;
   std::vector<Eigen::Vector3d> p_lidar_end_;

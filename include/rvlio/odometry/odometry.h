@@ -49,6 +49,14 @@ struct OdometryStats {
   int64_t imu_gaps_over_scan = 0;     // IMU gaps longer than the scan period
   bool initialized = false;
   bool started_moving = false;        // static initialization saw motion
+  // Sliding-window smoother (backend: smoother); zero for the IESKF.
+  int64_t imu_factors_skipped = 0;       // window states added without an IMU factor (IMU gap)
+  int64_t marginalization_failures = 0;  // replaced by a prior at the next state's estimate
+  int64_t scans_out_of_order = 0;        // ending before the newest window state: skipped
+  int64_t imu_non_finite = 0;            // non-finite IMU samples dropped
+  double association_ms = 0.0;           // CPU ms in association, RV and robust weights (total)
+  double solve_ms = 0.0;                 // CPU ms in building and solving the window (total)
+  double marginalization_ms = 0.0;       // CPU ms in marginalization (total)
 };
 
 class Odometry {

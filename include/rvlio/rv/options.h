@@ -14,6 +14,7 @@ struct RvOptions {
   double activation_ratio = 0.9;  // active when this fraction of d_i <= eps0
   int max_iterations = 10;        // cap of the Alg. 2 refit loop
   bool clamp = true;              // never let K weaken an SCV: K = min(K, 1)
+  double min_K = 0.2;             // floor on K: an SCV's information grows at most 1/min_K times
   int min_constraints = 20;       // fewer constraints: criterion not evaluated
 
   template <class V>
@@ -28,6 +29,8 @@ struct RvOptions {
                                                    .Help("fraction of coplanar vectors that activates RV"));
     v.Field("max_iterations", max_iterations, Spec().Range(1, 100).Help("Alg. 2 iteration cap"));
     v.Field("clamp", clamp, Spec().Help("K = min(K, 1): reinforcement never weakens an SCV"));
+    v.Field("min_K", min_K, Spec().Range(1e-6, 1.0)
+                                .Help("floor on K (ours): SCV information grows at most 1/min_K times"));
     v.Field("min_constraints", min_constraints, Spec().Range(3, 100000));
   }
   Status Validate() {

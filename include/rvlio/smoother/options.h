@@ -15,6 +15,10 @@ struct SmootherOptions {
   int refine_chunk_scans = 2000;     // scans per refine chunk (long sequences)
   int refine_solver_iterations = 10; // Ceres iterations per refine round (and chunk)
   int refine_threads = 0;            // threads of `rvlio refine` (association, Ceres); 0: all cores
+  // Sliding-window backend (backend: smoother).
+  std::string linear_solver = "dense_schur";  // Ceres linear solver of the window solve
+  std::string map_update = "marginalized";    // when a window scan enters the working map
+  double reassociate_min_motion = 0.01;       // m, re-associate a window scan that moved more
 
   template <class V>
   void Visit(V& v) {
@@ -26,6 +30,13 @@ struct SmootherOptions {
     v.Field("refine_chunk_scans", refine_chunk_scans, Spec().Range(10, 1000000));
     v.Field("refine_solver_iterations", refine_solver_iterations, Spec().Range(1, 200));
     v.Field("refine_threads", refine_threads, Spec().Range(0, 256));
+    v.Field("linear_solver", linear_solver,
+            Spec().Choices({"dense_schur", "dense_normal_cholesky", "sparse_normal_cholesky", "dense_qr"})
+                .Help("Ceres linear solver of the sliding-window solve"));
+    v.Field("map_update", map_update, Spec().Choices({"marginalized", "newest"})
+                .Help("a scan enters the working map when marginalized (final estimate) or right after its first solve"));
+    v.Field("reassociate_min_motion", reassociate_min_motion, Spec().Unit("m").Range(0.0, 10.0)
+                .Help("re-associate a window scan when it moved more than this (translation + 10 m x rotation in rad)"));
   }
   Status Validate() { return ValidateFields(*this, "smoother"); }
 };

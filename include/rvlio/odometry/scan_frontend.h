@@ -1,0 +1,79 @@
+#pragma once
+// Pieces of the odometry pipeline shared by its backends (ieskf_odometry.h,
+// smoother_odometry.h): the extrinsics, static initialization, the IMU pose
+// samples that deskew needs, and the working map with its periodic trim.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rvlio/common/types.h"
+#include "rvlio/imu/integrator.h"
+#include "rvlio/imu/options.h"
+#include "rvlio/imu/static_init.h"
+#include "rvlio/lidar/deskew.h"
+#include "rvlio/map/options.h"
+#include "rvlio/map/voxel_map.h"
+#include "rvlio/math/pose.h"
+
+namespace rvlio {
+
+constexpr int kMinScanPoints = 50;                  // fewer after preprocessing: scan skipped
+constexpr TimeNs kNominalScanPeriodNs = 100000000;  // 10 Hz, for the IMU-gap warning
+
+// T_imu_lidar of the configuration (LiDAR pose in the IMU frame).
+Pose3 ImuTLidar(const ExtrinsicsSection& extrinsics);
+
+// Collects IMU samples until they span init_duration_s, then aligns them
+// (imu/static_init.h).
+class StaticInitializer {
+ public:
+  explicit StaticInitializer(double init_duration_s) : duration_ns_(SecondsToNs(init_duration_s)) {}
+
+  // Adds one sample. Once the collected samples span the init duration,
+  // returns their alignment and forgets them; before that, nothing.
+  std::optional<StaticAlignment> Add(const ImuSample& imu);
+
+ private:
+  TimeNs duration_ns_;
+  std::vector<ImuSample> samples_;
+};
+
+// The warning for a start that does not look static (a.moving).
+std::string MovingStartWarning(const StaticAlignment& a);
+
+// Pose samples for deskew (lidar/deskew.h) from the states of
+// IntegrateTrajectory() (imu/integrator.h) over `samples` with biases bg, ba:
+// sample i carries the motion of the integration scheme up to knot i + 1,
+// rate (w_i + w_i+1)/2 - b_g and world acceleration
+// (R_i (a_i - b_a) + R_i+1 (a_i+1 - b_a))/2 + g, so InterpolateImuPose()
+// reproduces every knot exactly. The last one holds its own signal.
+std::vector<ImuPoseSample> ImuPoseSamplesFromKnots(const std::vector<ImuKinematics>& knots,
+                                                   const std::vector<ImuSample>& samples,
+                                                   const Eigen::Vector3d& bg,
+                                                   const Eigen::Vector3d& ba,
+                                                   const Eigen::Vector3d& g_world);
+
+// p_world[i] = T_world_lidar * p_lidar[i].
+void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector3d>& p_lidar,
+                     std::vector<Eigen::Vector3d>* p_world);
+
+// The map scans are associated against: a VoxelMap whose voxels farther than
+// map.working_radius from the sensor are removed every few insertions.
+class WorkingMap {
+ public:
+  explicit WorkingMap(const MapOptions& options) : map_(options) {}
+
+  // Inserts one scan's points (world); sensor_world: the LiDAR position.
+  void Insert(const std::vector<Eigen::Vector3d>& p_world, const Eigen::Vector3d& sensor_world);
+
+  const VoxelMap& map() const { return map_; }
+  bool Empty() const { return map_.Empty(); }
+
+ private:
+  VoxelMap map_;
+  int scans_since_trim_ = 0;
+};
+
+}  // namespace rvlio

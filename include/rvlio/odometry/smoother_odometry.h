@@ -1,0 +1,94 @@
+#pragma once
+// The sliding-window smoother backend of the odometry pipeline (see
+// odometry.h; DESIGN.md section 5; the window itself: smoother/window.h).
+//
+// Per scan: Predict (IMU integration from the newest window state) ->
+// Downsample -> Deskew (with the predicted motion) -> add the state with the
+// IMU preintegration from the newest one -> Optimize the window (association
+// rounds, RV, Ceres) -> Insert -> Marginalize the oldest state when the
+// window is full.
+//
+// Output: a scan's result is emitted right after its first solve, as the
+// newest state of the window (online, like a filter); later refinements of
+// that state inside the window are not re-emitted. The map written to
+// map.pcd holds every scan at its final estimate (when marginalized, and the
+// states still in the window at Finish()).
+//
+// Working map (what association sees), smoother.map_update:
+//   marginalized: a scan enters when it is marginalized, at its final
+//     estimate. The first scan starts the map at its initial pose and, until
+//     the window is full for the first time, each newest scan is also
+//     inserted right after its first solve, so association works while the
+//     window fills.
+//   newest: every scan enters right after its first solve (as the IESKF
+//     inserts it); window scans then also match their own points.
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rvlio/imu/integrator.h"
+#include "rvlio/imu/noise.h"
+#include "rvlio/lidar/preprocess.h"
+#include "rvlio/map/output_map.h"
+#include "rvlio/odometry/odometry.h"
+#include "rvlio/odometry/scan_frontend.h"
+#include "rvlio/smoother/window.h"
+
+namespace rvlio {
+
+class SmootherOdometry : public Odometry {
+ public:
+  explicit SmootherOdometry(const OdometryOptions& options);
+
+  void AddImu(const ImuSample& imu) override;
+  void AddScan(Scan scan) override;
+  void Poll(std::vector<ScanResult>* out) override;
+  void Finish(std::vector<ScanResult>* out) override;
+
+  const OdometryStats& stats() const override { return stats_; }
+  std::vector<std::string> warnings() const override;
+  std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
+
+  // Null before static initialization.
+  const SlidingWindow* window() const { return window_.get(); }
+
+ private:
+  void TryInitialize(const ImuSample& imu);
+  void ProcessFrontScan(std::vector<ScanResult>* out);
+  // The buffered samples from the last one at or before t0_ns to the first
+  // one at or after t1_ns.
+  std::vector<ImuSample> ImuCovering(TimeNs t0_ns, TimeNs t1_ns) const;
+  bool HasImuGap(const std::vector<ImuSample>& samples, TimeNs t0_ns, TimeNs t1_ns) const;
+  void DropImuBefore(TimeNs t_ns);
+  ScanStatus UpdateWindow(TimeNs t_ns, const ImuKinematics& predicted,
+                          const std::vector<ImuSample>& samples, ScanResult* r);
+  void InsertIntoWorkingMap(const WindowState& s, const std::vector<Eigen::Vector3d>& p_lidar);
+  void MarginalizeIfFull();
+  void SetNewestFromWindow();
+
+  OdometryOptions options_;
+  WindowOptions window_options_;
+  std::unique_ptr<SlidingWindow> window_;
+  WorkingMap map_;
+  OutputMap output_map_;
+  ScanPreprocessor preprocessor_;
+  StaticInitializer initializer_;
+  Pose3 T_imu_lidar_;
+  OdometryStats stats_;
+  std::vector<std::string> warnings_;
+  std::deque<ImuSample> imu_buffer_;
+  std::deque<Scan> scans_;
+  // The newest estimate: where the next prediction starts.
+  ImuKinematics newest_;
+  Eigen::Vector3d bg_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d ba_ = Eigen::Vector3d::Zero();
+  bool window_filled_ = false;  // a state has been marginalized
+  bool flushed_ = false;        // window states written to the output map
+  // Per-scan workspaces, reused.
+  Scan downsampled_;
+  std::vector<Eigen::Vector3d> p_lidar_end_;
+  std::vector<Eigen::Vector3d> p_world_;
+};
+
+}  // namespace rvlio

@@ -1,0 +1,176 @@
+#pragma once
+// The sliding window of the smoother backend (DESIGN.md section 5).
+//
+// One state per scan, at the scan's end time: a PoseBlock (7, PoseManifold)
+// and a SpeedBiasBlock (9) (math/smoother_blocks.h). The cost of a solve:
+//   - an ImuFactor between consecutive states (imu_factor.h), preintegrated
+//     from the IMU samples between their times and re-integrated when the
+//     bias estimate of the earlier state moved far from its linearization
+//     point; across an IMU gap (no preintegration) a weak
+//     SpeedBiasContinuityFactor instead (prior_factor.h);
+//   - one PlaneFactor per state with that scan's point-to-plane constraints
+//     (plane_factor.h). Per-point information = Constraint::weight / sigma^2
+//     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
+//     min(1, huber_delta / |r|) at the pose of association);
+//   - the prior on the oldest state: a StatePriorFactor on the first state of
+//     the run, then the marginalization prior (marginalization.h), whose
+//     Jacobian stays at its linearization point (first-estimate Jacobians).
+//
+// Optimize() runs smoother.association_rounds rounds of
+//   associate (every state that moved more than reassociate_min_motion since
+//   its last association, and every state never associated) -> RV -> Huber
+//   weights -> Ceres solve (max_solver_iterations).
+// A round whose solve fails or yields non-finite (or absurd) values restores
+// the states from before that round and ends Optimize (counted).
+// MarginalizeIfFull() removes the oldest state through the Schur complement
+// once the window holds window_size states and hands its final estimate and
+// points back (for the map).
+//
+// The window owns no map: association is a callback, so the window can be
+// driven by the odometry's voxel map or by an exact synthetic world.
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <ceres/types.h>
+
+#include "rvlio/common/time.h"
+#include "rvlio/constraints/constraint.h"
+#include "rvlio/imu/noise.h"
+#include "rvlio/imu/preintegration.h"
+#include "rvlio/math/pose.h"
+#include "rvlio/math/smoother_blocks.h"
+#include "rvlio/rv/options.h"
+#include "rvlio/rv/rv.h"
+#include "rvlio/smoother/manifolds.h"
+#include "rvlio/smoother/marginalization.h"
+#include "rvlio/smoother/options.h"
+#include "rvlio/smoother/prior_factor.h"
+
+namespace rvlio {
+
+class ImuFactor;
+class PlaneFactor;
+
+struct WindowOptions {
+  SmootherOptions smoother;          // window_size, rounds, iterations, huber_delta, ...
+  RvOptions rv;                      // the same switches and parameters as the filter
+  ImuNoise imu_noise;                // preintegration noise (for re-integration)
+  double lidar_noise = 0.03;         // m, sigma of one point-to-plane residual
+  int min_constraints = 6;           // fewer: the scan gets no plane factor
+  Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);  // m/s^2
+  Pose3 T_imu_lidar;                 // fixed extrinsics
+  StatePriorStd first_prior;         // prior of the first state of the run
+  // Weak continuity across an IMU gap (SpeedBiasContinuityFactor).
+  double gap_vel_std = 1.0;          // m/s
+  double gap_bg_std = 1e-3;          // rad/s
+  double gap_ba_std = 1e-2;          // m/s^2
+  // Re-integration thresholds of the preintegration's linearization biases.
+  double repropagate_bg = 2e-3;      // rad/s
+  double repropagate_ba = 2e-2;      // m/s^2
+  // A solution with a speed above this is treated as diverged.
+  double max_speed = 100.0;          // m/s
+};
+
+// Ceres' solver type for smoother.linear_solver (a validated choice).
+ceres::LinearSolverType WindowLinearSolver(const std::string& name);
+
+// Fills *out (cleared first) with the point-to-plane constraints of the
+// deskewed points p_lidar (LiDAR frame at the state's time) at T_world_imu:
+// the association against the map (constraints/associate.h).
+using ScanAssociateFn = std::function<void(const std::vector<Eigen::Vector3d>& p_lidar,
+                                           const Pose3& T_world_imu, ConstraintList* out)>;
+
+// A state's current estimate.
+struct WindowState {
+  TimeNs t_ns = 0;
+  PoseBlock pose;             // T_world_imu
+  SpeedBiasBlock speed_bias;  // v_world_imu, b_g, b_a
+};
+
+struct WindowSolveReport {
+  bool ok = true;               // false: a round failed; the states were restored
+  int rounds = 0;               // rounds solved successfully
+  int iterations = 0;           // Ceres iterations over all rounds
+  int associations = 0;         // scans (re-)associated over all rounds
+  int newest_constraints = 0;   // constraints of the newest state (last association)
+  RvReport newest_rv;           // RV report of the newest state (last association)
+  double association_ms = 0.0;  // thread CPU time in association, RV and weights
+  double solve_ms = 0.0;        // thread CPU time in problem building and Ceres
+};
+
+struct WindowStats {
+  int64_t imu_factors_skipped = 0;       // states added without an IMU factor
+  int64_t solve_failures = 0;            // rounds restored to the last good states
+  int64_t marginalizations = 0;
+  int64_t marginalization_failures = 0;  // replaced by a StatePriorFactor
+  int64_t repropagations = 0;            // preintegrations re-integrated
+};
+
+// The oldest state leaving the window, at its final estimate.
+struct MarginalizedScan {
+  WindowState state;
+  std::vector<Eigen::Vector3d> p_lidar;  // the scan's deskewed points
+};
+
+class SlidingWindow {
+ public:
+  explicit SlidingWindow(const WindowOptions& options);
+  ~SlidingWindow();
+  SlidingWindow(const SlidingWindow&) = delete;
+  SlidingWindow& operator=(const SlidingWindow&) = delete;
+
+  // Clears the window and starts it with the first state of a run, held by
+  // a StatePriorFactor at the given values (options.first_prior).
+  void Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
+             std::vector<Eigen::Vector3d> p_lidar);
+
+  // Appends the newest state at t_ns >= newest time, initialized at
+  // (pose, speed_bias) (the IMU prediction). imu: the preintegration from
+  // the newest state's time to t_ns; nullopt, dt = 0 or non-finite values
+  // add the state without an IMU factor (weak continuity prior, counted).
+  void Add(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
+           std::optional<ImuPreintegration> imu, std::vector<Eigen::Vector3d> p_lidar);
+
+  // Association rounds and solves (see the header comment).
+  WindowSolveReport Optimize(const ScanAssociateFn& associate);
+
+  // With window_size states: marginalizes the oldest one and returns it.
+  std::optional<MarginalizedScan> MarginalizeIfFull();
+
+  int size() const { return static_cast<int>(nodes_.size()); }
+  bool empty() const { return nodes_.empty(); }
+  // k = 0 is the oldest, size() - 1 the newest.
+  WindowState state(int k) const;
+  const std::vector<Eigen::Vector3d>& points(int k) const;
+  const ConstraintList& constraints(int k) const;
+  bool has_imu_factor(int k) const;  // between states k - 1 and k
+  const WindowStats& stats() const { return stats_; }
+  const WindowOptions& options() const { return options_; }
+
+ private:
+  struct Node;
+
+  void AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
+  void AssociateNode(const ScanAssociateFn& associate, Node* node);
+  void RefreshImuFactors();
+  bool SolveRound(WindowSolveReport* report);
+  bool Healthy() const;
+  void Backup();
+  void Restore();
+
+  WindowOptions options_;
+  PoseManifold pose_manifold_;
+  std::deque<std::unique_ptr<Node>> nodes_;
+  std::unique_ptr<StatePriorFactor> state_prior_;        // on nodes_[0], or null
+  std::unique_ptr<MarginalizationFactor> marginal_prior_;  // on nodes_[0], or null
+  std::vector<double> backup_;
+  RvWorkspace rv_workspace_;
+  WindowStats stats_;
+};
+
+}  // namespace rvlio

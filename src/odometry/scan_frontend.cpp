@@ -1,0 +1,69 @@
+#include "rvlio/odometry/scan_frontend.h"
+
+namespace rvlio {
+namespace {
+
+constexpr int kRemoveFarEveryScans = 10;  // working-map trimming period
+
+}  // namespace
+
+Pose3 ImuTLidar(const ExtrinsicsSection& extrinsics) {
+  const auto& e = extrinsics.imu_T_lidar;
+  return Pose3(Eigen::Quaterniond(e.rotation_xyzw[3], e.rotation_xyzw[0], e.rotation_xyzw[1],
+                                  e.rotation_xyzw[2]),
+               Eigen::Vector3d(e.translation[0], e.translation[1], e.translation[2]));
+}
+
+std::optional<StaticAlignment> StaticInitializer::Add(const ImuSample& imu) {
+  samples_.push_back(imu);
+  if (imu.t_ns - samples_.front().t_ns < duration_ns_) return std::nullopt;
+  const StaticAlignment a = AlignStatic(samples_);
+  samples_.clear();
+  return a;
+}
+
+std::string MovingStartWarning(const StaticAlignment& a) {
+  if (!a.moving) return "";
+  return "the sequence starts moving (acc std " + std::to_string(a.acc_std) + " m/s^2, gyro std " +
+         std::to_string(a.gyro_std) + " rad/s); initialized from the mean IMU values";
+}
+
+std::vector<ImuPoseSample> ImuPoseSamplesFromKnots(const std::vector<ImuKinematics>& knots,
+                                                   const std::vector<ImuSample>& samples,
+                                                   const Eigen::Vector3d& bg,
+                                                   const Eigen::Vector3d& ba,
+                                                   const Eigen::Vector3d& g_world) {
+  std::vector<ImuPoseSample> out(knots.size());
+  std::vector<ImuSample> signal(knots.size());
+  for (size_t i = 0; i < knots.size(); ++i) signal[i] = InterpolateImu(samples, knots[i].t_ns);
+  for (size_t i = 0; i < knots.size(); ++i) {
+    const size_t j = i + 1 < knots.size() ? i + 1 : i;
+    ImuPoseSample& s = out[i];
+    s.t_ns = knots[i].t_ns;
+    s.R_world_imu = knots[i].R_world_imu;
+    s.p_world_imu = knots[i].p_world_imu;
+    s.v_world_imu = knots[i].v_world_imu;
+    s.gyro_imu = 0.5 * (signal[i].gyro_imu + signal[j].gyro_imu) - bg;
+    s.acc_world = 0.5 * (knots[i].R_world_imu * (signal[i].acc_imu - ba) +
+                         knots[j].R_world_imu * (signal[j].acc_imu - ba)) +
+                  g_world;
+  }
+  return out;
+}
+
+void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector3d>& p_lidar,
+                     std::vector<Eigen::Vector3d>* p_world) {
+  p_world->resize(p_lidar.size());
+  for (size_t i = 0; i < p_lidar.size(); ++i) (*p_world)[i] = T_world_lidar * p_lidar[i];
+}
+
+void WorkingMap::Insert(const std::vector<Eigen::Vector3d>& p_world,
+                        const Eigen::Vector3d& sensor_world) {
+  map_.Insert(p_world);
+  if (++scans_since_trim_ >= kRemoveFarEveryScans) {
+    map_.RemoveFar(sensor_world, map_.options().working_radius);
+    scans_since_trim_ = 0;
+  }
+}
+
+}  // namespace rvlio

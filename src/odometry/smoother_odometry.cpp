@@ -1,0 +1,275 @@
+// The sliding-window smoother backend of the odometry pipeline.
+#include "rvlio/odometry/smoother_odometry.h"
+
+#include <utility>
+
+#include "rvlio/common/cpu_time.h"
+#include "rvlio/constraints/associate.h"
+#include "rvlio/imu/preintegration.h"
+#include "rvlio/lidar/deskew.h"
+
+namespace rvlio {
+namespace {
+
+constexpr int kMinConstraints = 6;  // as the IESKF: fewer, the scan adds no plane factor
+
+bool IsFinite(const ImuSample& s) {
+  return s.acc_imu.allFinite() && s.gyro_imu.allFinite();
+}
+
+// The window's configuration: smoother.*, rv.*, the IMU noise densities, the
+// point-to-plane sigma, the extrinsics, and the first state's prior from the
+// IESKF's initial standard deviations (the same static initialization).
+WindowOptions MakeWindowOptions(const OdometryOptions& o) {
+  WindowOptions w;
+  w.smoother = o.smoother;
+  w.rv = o.rv;
+  w.imu_noise = ImuNoise::FromOptions(o.imu);
+  w.lidar_noise = o.constraints.lidar_noise;
+  w.min_constraints = kMinConstraints;
+  w.T_imu_lidar = ImuTLidar(o.extrinsics);
+  w.first_prior.rot = o.ieskf.init_rot_std;
+  w.first_prior.pos = o.ieskf.init_pos_std;
+  w.first_prior.vel = o.ieskf.init_vel_std;
+  w.first_prior.bg = o.ieskf.init_bias_gyro_std;
+  w.first_prior.ba = o.ieskf.init_bias_acc_std;
+  return w;
+}
+
+Eigen::Vector3d MeanAcc(const std::vector<ImuSample>& samples, TimeNs t0_ns, TimeNs t1_ns) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const ImuSample& s : samples) {
+    if (s.t_ns <= t0_ns || s.t_ns > t1_ns) continue;
+    sum += s.acc_imu;
+    ++n;
+  }
+  return n > 0 ? Eigen::Vector3d(sum / n) : Eigen::Vector3d::Zero();
+}
+
+}  // namespace
+
+SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
+    : options_(options),
+      window_options_(MakeWindowOptions(options)),
+      map_(options.map),
+      output_map_(options.map.output_resolution),
+      preprocessor_(options.lidar),
+      initializer_(options.imu.init_duration),
+      T_imu_lidar_(ImuTLidar(options.extrinsics)) {}
+
+void SmootherOdometry::AddImu(const ImuSample& imu) {
+  if (!IsFinite(imu)) {
+    ++stats_.imu_non_finite;
+    return;
+  }
+  if (!imu_buffer_.empty() && imu.t_ns - imu_buffer_.back().t_ns > kNominalScanPeriodNs)
+    ++stats_.imu_gaps_over_scan;
+  if (!stats_.initialized) {
+    TryInitialize(imu);
+    return;
+  }
+  imu_buffer_.push_back(imu);
+}
+
+// Static alignment as in the IESKF backend: gravity, gyro bias, zero
+// velocity, identity yaw at the origin.
+void SmootherOdometry::TryInitialize(const ImuSample& imu) {
+  const std::optional<StaticAlignment> a = initializer_.Add(imu);
+  if (!a) return;
+  newest_.t_ns = imu.t_ns;
+  newest_.R_world_imu = a->R_world_imu;
+  bg_ = a->gyro_bias;
+  window_options_.g_world = a->g_world;
+  window_ = std::make_unique<SlidingWindow>(window_options_);
+  imu_buffer_.push_back(imu);  // the signal at the start of the first interval
+  stats_.initialized = true;
+  stats_.started_moving = a->moving;
+  if (a->moving) warnings_.push_back(MovingStartWarning(*a));
+}
+
+void SmootherOdometry::AddScan(Scan scan) {
+  ++stats_.scans_received;
+  if (!stats_.initialized || scan.t_start_ns < newest_.t_ns) {
+    ++stats_.scans_before_imu;  // no IMU state covers this scan
+    return;
+  }
+  scans_.push_back(std::move(scan));
+}
+
+void SmootherOdometry::Poll(std::vector<ScanResult>* out) {
+  while (!scans_.empty() && !imu_buffer_.empty() &&
+         imu_buffer_.back().t_ns >= scans_.front().t_end_ns) {
+    ProcessFrontScan(out);
+  }
+}
+
+// The remaining scans, then the states still in the window enter the
+// output map at their final estimates.
+void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
+  while (!scans_.empty()) ProcessFrontScan(out);
+  if (flushed_ || !window_) return;
+  flushed_ = true;
+  for (int k = 0; k < window_->size(); ++k) {
+    const WindowState s = window_->state(k);
+    TransformPoints(s.pose.ToPose3() * T_imu_lidar_, window_->points(k), &p_world_);
+    output_map_.Insert(p_world_);
+  }
+}
+
+// Predict -> Downsample -> Deskew -> Add + Optimize -> Insert -> Marginalize.
+void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
+  Scan scan = std::move(scans_.front());
+  scans_.pop_front();
+  const double start_ms = ThreadCpuMs();
+  if (scan.t_end_ns < newest_.t_ns) {
+    ++stats_.scans_out_of_order;
+    return;
+  }
+  const Eigen::Vector3d& g = window_options_.g_world;
+  const std::vector<ImuSample> samples = ImuCovering(newest_.t_ns, scan.t_end_ns);
+  const std::vector<ImuKinematics> knots =
+      IntegrateTrajectory(newest_, samples, scan.t_end_ns, bg_, ba_, g);
+  preprocessor_.Downsample(scan, &downsampled_);
+  if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {
+    ++stats_.scans_too_few_points;  // the next state's IMU factor spans this scan
+    return;
+  }
+  DeskewToScanEnd(ImuPoseSamplesFromKnots(knots, samples, bg_, ba_, g), T_imu_lidar_,
+                  downsampled_.points, scan.t_end_ns, &p_lidar_end_);
+  ScanResult r;
+  r.raw_points = static_cast<int>(scan.points.size());
+  r.downsampled_points = static_cast<int>(p_lidar_end_.size());
+  r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
+  if (window_->empty()) {
+    const ImuKinematics& x = knots.back();
+    window_->Start(scan.t_end_ns, PoseBlock(Eigen::Quaterniond(x.R_world_imu), x.p_world_imu),
+                   SpeedBiasBlock{x.v_world_imu, bg_, ba_}, p_lidar_end_);
+    InsertIntoWorkingMap(window_->state(0), p_lidar_end_);
+    r.status = ScanStatus::kMapInit;
+  } else {
+    r.status = UpdateWindow(scan.t_end_ns, knots.back(), samples, &r);
+  }
+  SetNewestFromWindow();
+  MarginalizeIfFull();
+  DropImuBefore(scan.t_end_ns);
+  r.t_ns = scan.t_end_ns;
+  r.T_world_imu = Pose3(newest_.R_world_imu, newest_.p_world_imu);
+  r.v_world_imu = newest_.v_world_imu;
+  r.ms = ThreadCpuMs() - start_ms;
+  ++stats_.scans_processed;
+  out->push_back(std::move(r));
+}
+
+std::vector<ImuSample> SmootherOdometry::ImuCovering(TimeNs t0_ns, TimeNs t1_ns) const {
+  std::vector<ImuSample> samples;
+  for (const ImuSample& s : imu_buffer_) {
+    if (!samples.empty() && s.t_ns <= t0_ns) samples.clear();  // keep the last one <= t0
+    samples.push_back(s);
+    if (s.t_ns >= t1_ns) break;
+  }
+  return samples;
+}
+
+// A knot spacing (t0, the samples inside (t0, t1), t1) above imu.max_gap:
+// the preintegration would bridge a stretch without measurements.
+bool SmootherOdometry::HasImuGap(const std::vector<ImuSample>& samples, TimeNs t0_ns,
+                                 TimeNs t1_ns) const {
+  const TimeNs max_gap_ns = SecondsToNs(options_.imu.max_gap);
+  TimeNs last = t0_ns;
+  for (const ImuSample& s : samples) {
+    if (s.t_ns <= t0_ns || s.t_ns >= t1_ns) continue;
+    if (s.t_ns - last > max_gap_ns) return true;
+    last = s.t_ns;
+  }
+  return t1_ns - last > max_gap_ns;
+}
+
+void SmootherOdometry::DropImuBefore(TimeNs t_ns) {
+  while (imu_buffer_.size() >= 2 && imu_buffer_[1].t_ns <= t_ns) imu_buffer_.pop_front();
+}
+
+// Adds the scan's state (IMU factor from the newest state unless the interval
+// is empty or has a gap) and optimizes the window.
+ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& predicted,
+                                          const std::vector<ImuSample>& samples, ScanResult* r) {
+  std::optional<ImuPreintegration> imu;
+  if (t_ns > newest_.t_ns && !HasImuGap(samples, newest_.t_ns, t_ns))
+    imu = ImuPreintegration::FromSamples(samples, newest_.t_ns, t_ns, window_options_.imu_noise,
+                                         bg_, ba_);
+  window_->Add(t_ns, PoseBlock(Eigen::Quaterniond(predicted.R_world_imu), predicted.p_world_imu),
+               SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, std::move(imu), p_lidar_end_);
+  const ScanAssociateFn associate = [this](const std::vector<Eigen::Vector3d>& p_lidar,
+                                           const Pose3& T_world_imu, ConstraintList* out) {
+    Associate(p_lidar, T_world_imu, T_imu_lidar_, map_.map(), options_.constraints, out, nullptr);
+  };
+  const WindowSolveReport report = window_->Optimize(associate);
+  stats_.association_ms += report.association_ms;
+  stats_.solve_ms += report.solve_ms;
+  stats_.imu_factors_skipped = window_->stats().imu_factors_skipped;
+  r->constraints = report.newest_constraints;
+  r->iterations = report.iterations;
+  r->rv = report.newest_rv;
+  if (options_.smoother.map_update == "newest" || !window_filled_)
+    InsertIntoWorkingMap(window_->state(window_->size() - 1), p_lidar_end_);
+  if (!report.ok) {
+    ++stats_.diverged_resets;
+    return ScanStatus::kDiverged;
+  }
+  if (report.newest_constraints < kMinConstraints) {
+    ++stats_.predict_only;
+    return ScanStatus::kPredictOnly;
+  }
+  return ScanStatus::kUpdated;
+}
+
+void SmootherOdometry::InsertIntoWorkingMap(const WindowState& s,
+                                            const std::vector<Eigen::Vector3d>& p_lidar) {
+  const Pose3 T_world_lidar = s.pose.ToPose3() * T_imu_lidar_;
+  TransformPoints(T_world_lidar, p_lidar, &p_world_);
+  map_.Insert(p_world_, T_world_lidar.t);
+}
+
+// The oldest state leaves the window: its points enter the output map (and,
+// with map_update = marginalized, the working map) at its final estimate.
+void SmootherOdometry::MarginalizeIfFull() {
+  const double start_ms = ThreadCpuMs();
+  std::optional<MarginalizedScan> m = window_->MarginalizeIfFull();
+  if (!m) return;
+  window_filled_ = true;
+  const Pose3 T_world_lidar = m->state.pose.ToPose3() * T_imu_lidar_;
+  TransformPoints(T_world_lidar, m->p_lidar, &p_world_);
+  output_map_.Insert(p_world_);
+  if (options_.smoother.map_update == "marginalized") map_.Insert(p_world_, T_world_lidar.t);
+  stats_.marginalization_failures = window_->stats().marginalization_failures;
+  stats_.marginalization_ms += ThreadCpuMs() - start_ms;
+}
+
+void SmootherOdometry::SetNewestFromWindow() {
+  const WindowState s = window_->state(window_->size() - 1);
+  newest_.t_ns = s.t_ns;
+  newest_.R_world_imu = s.pose.q_world_imu.normalized().toRotationMatrix();
+  newest_.p_world_imu = s.pose.p_world_imu;
+  newest_.v_world_imu = s.speed_bias.v_world_imu;
+  bg_ = s.speed_bias.bg;
+  ba_ = s.speed_bias.ba;
+}
+
+std::vector<std::string> SmootherOdometry::warnings() const {
+  std::vector<std::string> w = warnings_;
+  const auto count = [&w](int64_t n, const std::string& what) {
+    if (n > 0) w.push_back(std::to_string(n) + " " + what);
+  };
+  count(stats_.imu_factors_skipped,
+        "window states without an IMU factor (IMU gap longer than imu.max_gap or a zero "
+        "interval): a weak velocity/bias continuity prior was used instead");
+  count(stats_.diverged_resets,
+        "window solves failed or diverged: the last good window state was restored");
+  count(stats_.marginalization_failures,
+        "marginalizations failed: the window was re-anchored with a prior at its oldest state");
+  count(stats_.scans_out_of_order, "scans ended before the newest window state and were skipped");
+  count(stats_.imu_non_finite, "non-finite IMU samples were dropped");
+  return w;
+}
+
+}  // namespace rvlio

@@ -1,0 +1,354 @@
+#include "rvlio/smoother/window.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include "rvlio/common/check.h"
+#include "rvlio/common/cpu_time.h"
+#include "rvlio/constraints/point_to_plane.h"
+#include "rvlio/math/so3.h"
+#include "rvlio/smoother/imu_factor.h"
+#include "rvlio/smoother/plane_factor.h"
+
+namespace rvlio {
+
+struct SlidingWindow::Node {
+  TimeNs t_ns = 0;
+  double pose[PoseBlock::kNumParams] = {0, 0, 0, 1, 0, 0, 0};
+  double sb[SpeedBiasBlock::kNumParams] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+  std::vector<Eigen::Vector3d> p_lidar;
+  ConstraintList constraints;  // of the last association, RV and Huber weights applied
+  RvReport rv;
+  Pose3 associated_at;  // T_world_imu of the last association
+  bool associated = false;
+  std::unique_ptr<PlaneFactor> plane;                // null: too few constraints
+  std::unique_ptr<ImuFactor> imu;                    // from the previous node, or null
+  std::unique_ptr<SpeedBiasContinuityFactor> gap;    // from the previous node when imu is null
+
+  Pose3 T_world_imu() const { return PoseBlock::FromArray(pose).ToPose3(); }
+};
+
+namespace {
+
+constexpr int kBlockSize = PoseBlock::kNumParams + SpeedBiasBlock::kNumParams;
+// Lever arm that turns a rotation into a point displacement for the
+// re-association test: a point 10 m away moves by about 10 m x angle.
+constexpr double kReassociationLeverArm = 10.0;  // m
+
+ceres::Problem::Options ProblemOptions() {
+  ceres::Problem::Options o;
+  o.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  o.enable_fast_removal = false;
+  return o;
+}
+
+bool IsFinite(const ImuPreintegration& p) {
+  return p.dR().allFinite() && p.dv().allFinite() && p.dp().allFinite() &&
+         p.covariance().allFinite() && p.bias_jacobian().allFinite();
+}
+
+// Translation plus lever arm times rotation angle between two poses (m).
+double Motion(const Pose3& a, const Pose3& b) {
+  return (a.t - b.t).norm() + kReassociationLeverArm * so3::Log(a.R.transpose() * b.R).norm();
+}
+
+void RemoveNonFinite(ConstraintList* constraints) {
+  constraints->erase(std::remove_if(constraints->begin(), constraints->end(),
+                                    [](const Constraint& c) {
+                                      return !c.p_lidar.allFinite() || !c.normal_world.allFinite() ||
+                                             !c.q_world.allFinite() || !std::isfinite(c.weight);
+                                    }),
+                     constraints->end());
+}
+
+// Iteratively reweighted Huber kernel: the gradient of the Huber cost of the
+// residual r equals that of the weighted square w r^2 / 2 with
+// w = min(1, delta / |r|) (r at the current pose, with the possibly repaired
+// normal). The weight multiplies the RV weight already in the record.
+void ApplyHuberWeights(double delta, const Pose3& T_world_imu, const Pose3& T_imu_lidar,
+                       ConstraintList* constraints) {
+  for (Constraint& c : *constraints) {
+    const double r = std::abs(PointToPlaneResidual(c, T_world_imu, T_imu_lidar));
+    c.residual = r;
+    if (r > delta) c.weight *= delta / r;
+  }
+}
+
+}  // namespace
+
+ceres::LinearSolverType WindowLinearSolver(const std::string& name) {
+  if (name == "dense_normal_cholesky") return ceres::DENSE_NORMAL_CHOLESKY;
+  if (name == "sparse_normal_cholesky") return ceres::SPARSE_NORMAL_CHOLESKY;
+  if (name == "dense_qr") return ceres::DENSE_QR;
+  RVLIO_CHECK_MSG(name == "dense_schur", "unknown smoother.linear_solver");
+  return ceres::DENSE_SCHUR;
+}
+
+SlidingWindow::SlidingWindow(const WindowOptions& options) : options_(options) {
+  RVLIO_CHECK(options_.smoother.window_size >= 2);
+  RVLIO_CHECK(options_.lidar_noise > 0.0 && options_.smoother.huber_delta > 0.0);
+}
+
+SlidingWindow::~SlidingWindow() = default;
+
+void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
+                          std::vector<Eigen::Vector3d> p_lidar) {
+  nodes_.clear();
+  marginal_prior_.reset();
+  state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, options_.first_prior);
+  auto node = std::make_unique<Node>();
+  node->t_ns = t_ns;
+  pose.ToArray(node->pose);
+  speed_bias.ToArray(node->sb);
+  node->p_lidar = std::move(p_lidar);
+  nodes_.push_back(std::move(node));
+}
+
+void SlidingWindow::Add(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
+                        std::optional<ImuPreintegration> imu,
+                        std::vector<Eigen::Vector3d> p_lidar) {
+  RVLIO_CHECK_MSG(!nodes_.empty(), "SlidingWindow::Start() first");
+  RVLIO_CHECK_MSG(t_ns >= nodes_.back()->t_ns, "window states must be added in time order");
+  auto node = std::make_unique<Node>();
+  node->t_ns = t_ns;
+  pose.ToArray(node->pose);
+  speed_bias.ToArray(node->sb);
+  node->p_lidar = std::move(p_lidar);
+  if (imu && imu->dt() > 0.0 && IsFinite(*imu)) {
+    node->imu = std::make_unique<ImuFactor>(std::move(*imu), options_.g_world);
+  } else {
+    ++stats_.imu_factors_skipped;
+    node->gap = std::make_unique<SpeedBiasContinuityFactor>(
+        options_.gap_vel_std, options_.gap_bg_std, options_.gap_ba_std);
+  }
+  nodes_.push_back(std::move(node));
+}
+
+WindowState SlidingWindow::state(int k) const {
+  RVLIO_CHECK(k >= 0 && k < size());
+  const Node& n = *nodes_[k];
+  return {n.t_ns, PoseBlock::FromArray(n.pose), SpeedBiasBlock::FromArray(n.sb)};
+}
+
+const std::vector<Eigen::Vector3d>& SlidingWindow::points(int k) const {
+  RVLIO_CHECK(k >= 0 && k < size());
+  return nodes_[k]->p_lidar;
+}
+
+const ConstraintList& SlidingWindow::constraints(int k) const {
+  RVLIO_CHECK(k >= 0 && k < size());
+  return nodes_[k]->constraints;
+}
+
+bool SlidingWindow::has_imu_factor(int k) const {
+  RVLIO_CHECK(k >= 0 && k < size());
+  return nodes_[k]->imu != nullptr;
+}
+
+WindowSolveReport SlidingWindow::Optimize(const ScanAssociateFn& associate) {
+  WindowSolveReport report;
+  if (nodes_.empty()) return report;
+  for (int round = 0; round < options_.smoother.association_rounds; ++round) {
+    const double t0 = ThreadCpuMs();
+    AssociateRound(associate, &report);
+    const double t1 = ThreadCpuMs();
+    report.association_ms += t1 - t0;
+    const bool ok = SolveRound(&report);
+    report.solve_ms += ThreadCpuMs() - t1;
+    if (!ok) {
+      report.ok = false;
+      break;
+    }
+    ++report.rounds;
+  }
+  report.newest_constraints = static_cast<int>(nodes_.back()->constraints.size());
+  report.newest_rv = nodes_.back()->rv;
+  return report;
+}
+
+// Every state never associated, or moved by more than reassociate_min_motion
+// since its last association (its constraints would be stale).
+void SlidingWindow::AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report) {
+  for (auto& node : nodes_) {
+    if (node->associated &&
+        Motion(node->associated_at, node->T_world_imu()) <= options_.smoother.reassociate_min_motion)
+      continue;
+    AssociateNode(associate, node.get());
+    ++report->associations;
+  }
+}
+
+// Associate -> RV (Alg. 1-3 on this scan's list) -> Huber weights -> factor.
+void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) {
+  const Pose3 T_world_imu = node->T_world_imu();
+  associate(node->p_lidar, T_world_imu, &node->constraints);
+  RemoveNonFinite(&node->constraints);
+  node->rv = ApplyRv(options_.rv, T_world_imu * options_.T_imu_lidar, &node->constraints,
+                     &rv_workspace_);
+  ApplyHuberWeights(options_.smoother.huber_delta, T_world_imu, options_.T_imu_lidar,
+                    &node->constraints);
+  node->plane.reset();
+  if (static_cast<int>(node->constraints.size()) >= options_.min_constraints)
+    node->plane = std::make_unique<PlaneFactor>(node->constraints, options_.T_imu_lidar,
+                                                options_.lidar_noise);
+  node->associated_at = T_world_imu;
+  node->associated = true;
+}
+
+// Re-integrates a preintegration whose linearization biases are far from the
+// current estimate of the earlier state (first-order correction no longer
+// accurate).
+void SlidingWindow::RefreshImuFactors() {
+  for (size_t k = 1; k < nodes_.size(); ++k) {
+    Node& n = *nodes_[k];
+    if (!n.imu) continue;
+    const SpeedBiasBlock sb = SpeedBiasBlock::FromArray(nodes_[k - 1]->sb);
+    const ImuPreintegration& pre = n.imu->preintegration();
+    if ((sb.bg - pre.bg_lin()).norm() <= options_.repropagate_bg &&
+        (sb.ba - pre.ba_lin()).norm() <= options_.repropagate_ba)
+      continue;
+    ImuPreintegration again = pre;
+    again.Repropagate(sb.bg, sb.ba);
+    if (!IsFinite(again)) continue;
+    n.imu = std::make_unique<ImuFactor>(std::move(again), options_.g_world);
+    ++stats_.repropagations;
+  }
+}
+
+bool SlidingWindow::SolveRound(WindowSolveReport* report) {
+  RefreshImuFactors();
+  Backup();
+  ceres::Problem problem(ProblemOptions());
+  std::vector<bool> pose_used(nodes_.size(), false);
+  for (size_t k = 0; k < nodes_.size(); ++k) {
+    Node& n = *nodes_[k];
+    problem.AddParameterBlock(n.pose, PoseBlock::kNumParams, &pose_manifold_);
+    problem.AddParameterBlock(n.sb, SpeedBiasBlock::kNumParams);
+    if (n.plane) {
+      problem.AddResidualBlock(n.plane.get(), nullptr, n.pose);
+      pose_used[k] = true;
+    }
+    if (k == 0) continue;
+    Node& p = *nodes_[k - 1];
+    if (n.imu) {
+      problem.AddResidualBlock(n.imu.get(), nullptr, p.pose, p.sb, n.pose, n.sb);
+      pose_used[k] = pose_used[k - 1] = true;
+    } else {
+      problem.AddResidualBlock(n.gap.get(), nullptr, p.sb, n.sb);
+    }
+  }
+  Node& first = *nodes_.front();
+  if (state_prior_) {
+    problem.AddResidualBlock(state_prior_.get(), nullptr, first.pose, first.sb);
+    pose_used[0] = true;
+  }
+  if (marginal_prior_) {
+    const std::vector<double*>& blocks = marginal_prior_->prior().blocks;
+    problem.AddResidualBlock(marginal_prior_.get(), nullptr, blocks);
+    if (std::find(blocks.begin(), blocks.end(), first.pose) != blocks.end()) pose_used[0] = true;
+  }
+  // A pose no factor touches (IMU gap and no scan constraints) keeps its
+  // prediction.
+  for (size_t k = 0; k < nodes_.size(); ++k)
+    if (!pose_used[k]) problem.SetParameterBlockConstant(nodes_[k]->pose);
+
+  ceres::Solver::Options so;
+  so.linear_solver_type = WindowLinearSolver(options_.smoother.linear_solver);
+  so.max_num_iterations = options_.smoother.max_solver_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  report->iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
+  if (summary.IsSolutionUsable() && Healthy()) return true;
+  Restore();
+  ++stats_.solve_failures;
+  return false;
+}
+
+bool SlidingWindow::Healthy() const {
+  for (const auto& n : nodes_) {
+    const Eigen::Map<const Eigen::Matrix<double, 7, 1>> pose(n->pose);
+    const Eigen::Map<const Eigen::Matrix<double, 9, 1>> sb(n->sb);
+    if (!pose.allFinite() || !sb.allFinite()) return false;
+    if (std::abs(pose.head<4>().norm() - 1.0) > 1e-3) return false;
+    if (sb.head<3>().norm() > options_.max_speed) return false;
+  }
+  return true;
+}
+
+void SlidingWindow::Backup() {
+  backup_.resize(nodes_.size() * kBlockSize);
+  double* out = backup_.data();
+  for (const auto& n : nodes_) {
+    out = std::copy(n->pose, n->pose + PoseBlock::kNumParams, out);
+    out = std::copy(n->sb, n->sb + SpeedBiasBlock::kNumParams, out);
+  }
+}
+
+void SlidingWindow::Restore() {
+  RVLIO_CHECK(backup_.size() == nodes_.size() * kBlockSize);
+  const double* in = backup_.data();
+  for (auto& n : nodes_) {
+    std::copy(in, in + PoseBlock::kNumParams, n->pose);
+    in += PoseBlock::kNumParams;
+    std::copy(in, in + SpeedBiasBlock::kNumParams, n->sb);
+    in += SpeedBiasBlock::kNumParams;
+  }
+}
+
+// Schur complement of the oldest state over every factor that touches it:
+// the previous prior, its plane factor and the IMU (or continuity) factor to
+// the next state. The new prior is linearized here, at the final estimate of
+// the oldest state, and keeps that linearization point (marginalization.h).
+std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
+  if (size() < options_.smoother.window_size || size() < 2) return std::nullopt;
+  Node& old = *nodes_[0];
+  Node& next = *nodes_[1];
+  MarginalizationInfo info;
+  info.SetManifold(old.pose, &pose_manifold_);
+  info.SetManifold(next.pose, &pose_manifold_);
+  const auto dropped = [&old](const std::vector<double*>& blocks) {
+    std::vector<int> indices;
+    for (size_t i = 0; i < blocks.size(); ++i)
+      if (blocks[i] == old.pose || blocks[i] == old.sb) indices.push_back(static_cast<int>(i));
+    return indices;
+  };
+  if (marginal_prior_) {
+    const std::vector<double*>& blocks = marginal_prior_->prior().blocks;
+    info.AddResidualBlock(marginal_prior_.get(), nullptr, blocks, dropped(blocks));
+  }
+  if (state_prior_) info.AddResidualBlock(state_prior_.get(), nullptr, {old.pose, old.sb}, {0, 1});
+  if (old.plane) info.AddResidualBlock(old.plane.get(), nullptr, {old.pose}, {0});
+  if (next.imu)
+    info.AddResidualBlock(next.imu.get(), nullptr, {old.pose, old.sb, next.pose, next.sb}, {0, 1});
+  else
+    info.AddResidualBlock(next.gap.get(), nullptr, {old.sb, next.sb}, {0});
+  const Status status = info.Marginalize();
+
+  MarginalizedScan out{state(0), std::move(old.p_lidar)};
+  state_prior_.reset();
+  marginal_prior_.reset();
+  if (status.ok() && info.prior()->rank > 0) {
+    marginal_prior_ = std::make_unique<MarginalizationFactor>(info.prior());
+  } else {
+    // Keep the window anchored: a prior at the next state's estimate.
+    ++stats_.marginalization_failures;
+    state_prior_ = std::make_unique<StatePriorFactor>(PoseBlock::FromArray(next.pose),
+                                                      SpeedBiasBlock::FromArray(next.sb),
+                                                      options_.first_prior);
+  }
+  ++stats_.marginalizations;
+  next.imu.reset();
+  next.gap.reset();
+  nodes_.pop_front();
+  return out;
+}
+
+}  // namespace rvlio
