@@ -235,6 +235,7 @@ void SmootherOdometry::InsertIntoWorkingMap(const WindowState& s,
 void SmootherOdometry::MarginalizeIfFull() {
   const double start_ms = ThreadCpuMs();
   std::optional<MarginalizedScan> m = window_->MarginalizeIfFull();
+  stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   if (!m) return;
   window_filled_ = true;
   const Pose3 T_world_lidar = m->state.pose.ToPose3() * T_imu_lidar_;
@@ -242,7 +243,6 @@ void SmootherOdometry::MarginalizeIfFull() {
   output_map_.Insert(p_world_);
   if (options_.smoother.map_update == "marginalized") map_.Insert(p_world_, T_world_lidar.t);
   stats_.marginalization_failures = window_->stats().marginalization_failures;
-  stats_.marginalization_ms += ThreadCpuMs() - start_ms;
 }
 
 void SmootherOdometry::SetNewestFromWindow() {

@@ -12,7 +12,7 @@
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/math/so3.h"
 #include "rvlio/smoother/imu_factor.h"
-#include "rvlio/smoother/plane_factor.h"
+#include "rvlio/smoother/plane_summary_factor.h"
 
 namespace rvlio {
 
@@ -25,7 +25,7 @@ struct SlidingWindow::Node {
   RvReport rv;
   Pose3 associated_at;  // T_world_imu of the last association
   bool associated = false;
-  std::unique_ptr<PlaneFactor> plane;                // null: too few constraints
+  std::unique_ptr<PlaneSummaryFactor> plane;         // null: too few constraints
   std::unique_ptr<ImuFactor> imu;                    // from the previous node, or null
   std::unique_ptr<SpeedBiasContinuityFactor> gap;    // from the previous node when imu is null
 
@@ -195,8 +195,8 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
                     &node->constraints);
   node->plane.reset();
   if (static_cast<int>(node->constraints.size()) >= options_.min_constraints)
-    node->plane = std::make_unique<PlaneFactor>(node->constraints, options_.T_imu_lidar,
-                                                options_.lidar_noise);
+    node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, options_.T_imu_lidar,
+                                                       options_.lidar_noise, T_world_imu.t);
   node->associated_at = T_world_imu;
   node->associated = true;
 }

@@ -14,7 +14,7 @@ struct RvOptions {
   double activation_ratio = 0.9;  // active when this fraction of d_i <= eps0
   int max_iterations = 10;        // cap of the Alg. 2 refit loop
   bool clamp = true;              // never let K weaken an SCV: K = min(K, 1)
-  double min_K = 0.2;             // floor on K: an SCV's information grows at most 1/min_K times
+  double min_K = 0.5;             // floor on K: an SCV's information grows at most 1/min_K times
   int min_constraints = 20;       // fewer constraints: criterion not evaluated
 
   template <class V>

@@ -8,8 +8,9 @@
 //     bias estimate of the earlier state moved far from its linearization
 //     point; across an IMU gap (no preintegration) a weak
 //     SpeedBiasContinuityFactor instead (prior_factor.h);
-//   - one PlaneFactor per state with that scan's point-to-plane constraints
-//     (plane_factor.h). Per-point information = Constraint::weight / sigma^2
+//   - one plane factor per state with that scan's point-to-plane constraints
+//     (PlaneSummaryFactor: PlaneFactor's cost in 13 exact residuals,
+//     plane_summary_factor.h). Per-point information = Constraint::weight / sigma^2
 //     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
 //     min(1, huber_delta / |r|) at the pose of association);
 //   - the prior on the oldest state: a StatePriorFactor on the first state of
@@ -54,7 +55,7 @@
 namespace rvlio {
 
 class ImuFactor;
-class PlaneFactor;
+class PlaneSummaryFactor;
 
 struct WindowOptions {
   SmootherOptions smoother;          // window_size, rounds, iterations, huber_delta, ...

@@ -1,0 +1,52 @@
+#pragma once
+// All point-to-plane constraints of one scan summarized exactly in 13
+// residuals: the same cost, gradient and Gauss-Newton Hessian as PlaneFactor
+// (plane_factor.h) at every pose, at a cost independent of the number of
+// points. The sliding window (window.h) uses it for speed.
+//
+// With p_i = R_imu_lidar p_lidar,i + t_imu_lidar, s_i = sqrt(weight_i) / sigma
+// and a centre c (world; the pose's position at construction keeps the
+// numbers small), the weighted residual of paper Eq. (3) is linear in
+//   z = [vec(R_world_imu) (9, column-major); t_world_imu - c (3); 1]:
+//   s_i u_i^T (R p_i + t - q_i) = a_i^T z,
+//   a_i = s_i [p_i (x) u_i ; u_i ; -u_i^T (q_i - c)]   ((x): Kronecker, a[j + 3k] = u_j p_k),
+// so the scan's cost is sum_i (a_i^T z)^2 = z^T M z with M = sum_i a_i a_i^T
+// (13 x 13, positive semi-definite). With M = V L V^T (eigenvalues below a
+// relative floor set to zero) the residual is
+//   r = L^1/2 V^T z,   |r|^2 = z^T M z,
+// and its tangent Jacobian (pose: R Exp(d_rot), t + d_pos) is
+//   d r / d d_rot,k = L^1/2 V^T [vec(R Hat(e_k)); 0; 0],   d r / d d_pos = L^1/2 V^T [0; I; 0],
+// reported in the ambient form of smoother/manifolds.h. Then J^T J and J^T r
+// equal those of PlaneFactor, so Ceres takes the same steps.
+#include <Eigen/Core>
+#include <ceres/sized_cost_function.h>
+
+#include "rvlio/constraints/constraint.h"
+#include "rvlio/math/pose.h"
+
+namespace rvlio {
+
+class PlaneSummaryFactor final : public ceres::SizedCostFunction<13, 7> {
+ public:
+  using Matrix13d = Eigen::Matrix<double, 13, 13>;
+  using Vector13d = Eigen::Matrix<double, 13, 1>;
+
+  // constraints: weights >= 0 (may be empty: zero cost). sigma_m > 0.
+  // center_world: any point, ideally near the scan (conditioning only).
+  PlaneSummaryFactor(const ConstraintList& constraints, const Pose3& T_imu_lidar, double sigma_m,
+                     const Eigen::Vector3d& center_world);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+  int num_constraints() const { return num_constraints_; }
+  const Matrix13d& information() const { return M_; }  // M above
+
+ private:
+  Eigen::Vector3d center_;
+  Matrix13d M_;
+  Matrix13d sqrt_M_;  // L^1/2 V^T
+  int num_constraints_ = 0;
+};
+
+}  // namespace rvlio
