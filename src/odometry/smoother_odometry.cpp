@@ -171,18 +171,18 @@ std::vector<ImuSample> SmootherOdometry::ImuCovering(TimeNs t0_ns, TimeNs t1_ns)
   return samples;
 }
 
-// A knot spacing (t0, the samples inside (t0, t1), t1) above imu.max_gap:
-// the preintegration would bridge a stretch without measurements.
+// Consecutive samples around or inside [t0, t1] farther apart than
+// imu.max_gap (or [t0, t1] not covered): the preintegration would bridge a
+// stretch without measurements. `samples`: from ImuCovering(t0, t1).
 bool SmootherOdometry::HasImuGap(const std::vector<ImuSample>& samples, TimeNs t0_ns,
                                  TimeNs t1_ns) const {
   const TimeNs max_gap_ns = SecondsToNs(options_.imu.max_gap);
-  TimeNs last = t0_ns;
-  for (const ImuSample& s : samples) {
-    if (s.t_ns <= t0_ns || s.t_ns >= t1_ns) continue;
-    if (s.t_ns - last > max_gap_ns) return true;
-    last = s.t_ns;
-  }
-  return t1_ns - last > max_gap_ns;
+  if (samples.empty()) return true;
+  if (samples.front().t_ns - t0_ns > max_gap_ns || t1_ns - samples.back().t_ns > max_gap_ns)
+    return true;
+  for (size_t i = 1; i < samples.size(); ++i)
+    if (samples[i].t_ns - samples[i - 1].t_ns > max_gap_ns) return true;
+  return false;
 }
 
 void SmootherOdometry::DropImuBefore(TimeNs t_ns) {
@@ -212,10 +212,8 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
   r->rv = report.newest_rv;
   if (options_.smoother.map_update == "newest" || !window_filled_)
     InsertIntoWorkingMap(window_->state(window_->size() - 1), p_lidar_end_);
-  if (!report.ok) {
-    ++stats_.diverged_resets;
-    return ScanStatus::kDiverged;
-  }
+  stats_.diverged_resets += report.failures;  // each failed round was restored
+  if (!report.ok) return ScanStatus::kDiverged;
   if (report.newest_constraints < kMinConstraints) {
     ++stats_.predict_only;
     return ScanStatus::kPredictOnly;
@@ -235,8 +233,8 @@ void SmootherOdometry::InsertIntoWorkingMap(const WindowState& s,
 void SmootherOdometry::MarginalizeIfFull() {
   const double start_ms = ThreadCpuMs();
   std::optional<MarginalizedScan> m = window_->MarginalizeIfFull();
-  stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   if (!m) return;
+  stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   window_filled_ = true;
   const Pose3 T_world_lidar = m->state.pose.ToPose3() * T_imu_lidar_;
   TransformPoints(T_world_lidar, m->p_lidar, &p_world_);

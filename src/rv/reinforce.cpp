@@ -65,7 +65,7 @@ double ReinforcementCoefficient(const RvOptions& options, int num_scv, int num_c
   // vectors get K ~ 0.01, i.e. 100x weight, and one mis-associated feature
   // normal can then drag the estimate along the unobservable axis (measured on
   // the corridor and loopback presets, README "RV defaults").
-  return std::max(K, options.min_K);
+  return num_scv > 0 ? std::max(K, options.min_K) : K;
 }
 
 int ReinforceScv(double K, const RvWorkspace& ws, ConstraintList* constraints) {

@@ -25,6 +25,7 @@
 #include "rvlio/smoother/manifolds.h"
 #include "rvlio/smoother/plane_factor.h"
 #include "rvlio/smoother/refine_map.h"
+#include "rvlio/smoother/refine_pair_factor.h"
 #include "rvlio/smoother/refine_states.h"
 
 namespace rvlio {
@@ -85,6 +86,21 @@ std::vector<std::pair<int, int>> MakeChunks(int n, int chunk_scans) {
   return chunks;
 }
 
+// The plane factors of one scan: world-fixed planes, and planes attached to
+// their source scans (refine_pair_factor.h).
+struct ScanFactors {
+  std::unique_ptr<PlaneFactor> fixed;
+  std::vector<std::pair<int, std::unique_ptr<ScanPairPlaneFactor>>> pairs;  // source scan, factor
+};
+
+// Per-thread scratch of association.
+struct AssociationWorkspace {
+  ConstraintList list, fixed;
+  std::vector<int32_t> sources;
+  std::vector<std::pair<int32_t, int>> attached;  // source scan, constraint index
+  RvWorkspace rv;
+};
+
 class BatchRefiner {
  public:
   BatchRefiner(const RefineConfig& config, RefineInput input)
@@ -115,8 +131,9 @@ class BatchRefiner {
   void DeskewAll();
   void BuildMap();
   void SolveChunk(int begin, int end, RefineRound* report);
-  std::unique_ptr<PlaneFactor> AssociateOne(int k, ConstraintList* list, RvWorkspace* rv,
-                                            AssociationStats* stats, bool* rv_active) const;
+  ScanFactors AssociateOne(int k, int begin, int end, AssociationWorkspace* w,
+                           AssociationStats* stats, bool* rv_active) const;
+  ScanFactors SplitFactors(int k, int begin, int end, AssociationWorkspace* w) const;
   void AddImuFactors(int begin, int end, ceres::Problem* problem);
   ceres::Solver::Options SolverOptions(int iterations) const;
   void Finish();
@@ -133,6 +150,7 @@ class BatchRefiner {
   std::vector<int> kept_;                          // input scan index per refined scan
   std::vector<RefineState> states_;                // per refined scan
   std::vector<std::vector<Eigen::Vector3d>> p_lidar_end_;  // deskewed, per refined scan
+  std::vector<Pose3> map_poses_;  // T_world_imu of each scan when the map was built
   RefineResult result_;
 };
 
@@ -289,9 +307,11 @@ void BatchRefiner::DeskewAll() {
 
 void BatchRefiner::BuildMap() {
   map_.Clear();
+  map_poses_.resize(states_.size());
   std::vector<Eigen::Vector3d> p_world;
   for (size_t k = 0; k < states_.size(); ++k) {
-    const Pose3 T_world_lidar = states_[k].T_world_imu() * config_.T_imu_lidar;
+    map_poses_[k] = states_[k].T_world_imu();
+    const Pose3 T_world_lidar = map_poses_[k] * config_.T_imu_lidar;
     p_world.resize(p_lidar_end_[k].size());
     for (size_t i = 0; i < p_world.size(); ++i) p_world[i] = T_world_lidar * p_lidar_end_[k][i];
     map_.Insert(static_cast<int32_t>(k), p_world);
@@ -299,36 +319,75 @@ void BatchRefiner::BuildMap() {
   result_.stats.map_entries = map_.stats().entries;
 }
 
-// Associate -> RV -> Huber weights -> the scan's PlaneFactor (null when no
-// constraint survived).
-std::unique_ptr<PlaneFactor> BatchRefiner::AssociateOne(int k, ConstraintList* list,
-                                                        RvWorkspace* rv, AssociationStats* stats,
-                                                        bool* rv_active) const {
+// Associate -> RV -> Huber weights -> the scan's plane factors.
+ScanFactors BatchRefiner::AssociateOne(int k, int begin, int end, AssociationWorkspace* w,
+                                       AssociationStats* stats, bool* rv_active) const {
   const Pose3 T_world_lidar = states_[k].T_world_imu() * config_.T_imu_lidar;
-  AssociateScan(p_lidar_end_[k], T_world_lidar, k, map_, config_.constraints, list, stats);
+  AssociateScan(p_lidar_end_[k], T_world_lidar, k, map_, config_.constraints, &w->list, stats,
+                &w->sources);
   *rv_active = false;
-  if (list->empty()) return nullptr;
-  *rv_active = ApplyRv(config_.rv, T_world_lidar, list, rv).active;
+  if (w->list.empty()) return ScanFactors();
+  *rv_active = ApplyRv(config_.rv, T_world_lidar, &w->list, &w->rv).active;
   // Huber IRLS weight at the association estimate, min(1, delta / |r|): a
   // ceres::LossFunction would act on the whole scan's squared norm.
   const double delta = config_.smoother.huber_delta;
-  for (Constraint& c : *list)
+  for (Constraint& c : w->list)
     if (std::abs(c.residual) > delta) c.weight *= delta / std::abs(c.residual);
-  return std::make_unique<PlaneFactor>(*list, config_.T_imu_lidar, config_.constraints.lidar_noise);
+  return SplitFactors(k, begin, end, w);
+}
+
+// A plane whose source scan j is in the chunk and within refine_plane_window
+// scans of k moves with j (expressed in j's IMU frame at the map's pose);
+// any other plane is world-fixed, at the current estimate of its source (a
+// source in an earlier chunk has already moved in this round).
+ScanFactors BatchRefiner::SplitFactors(int k, int begin, int end,
+                                       AssociationWorkspace* w) const {
+  const int window = config_.smoother.refine_plane_window;
+  const double sigma = config_.constraints.lidar_noise;
+  w->fixed.clear();
+  w->attached.clear();
+  for (size_t i = 0; i < w->list.size(); ++i) {
+    const int j = w->sources[i];
+    if (window > 0 && j >= begin && j < end && std::abs(j - k) <= window) {
+      w->attached.emplace_back(j, static_cast<int>(i));
+      continue;
+    }
+    Constraint c = w->list[i];
+    if (j < begin) {  // T_j,now T_j,map^-1 carries the plane along
+      const Pose3 moved = states_[j].T_world_imu() * map_poses_[j].Inverse();
+      c.normal_world = moved.R * c.normal_world;
+      c.q_world = moved * c.q_world;
+    }
+    w->fixed.push_back(c);
+  }
+  ScanFactors f;
+  if (!w->fixed.empty())
+    f.fixed = std::make_unique<PlaneFactor>(w->fixed, config_.T_imu_lidar, sigma);
+  std::sort(w->attached.begin(), w->attached.end());
+  for (size_t a = 0; a < w->attached.size(); ++a) {
+    const int j = w->attached[a].first;
+    if (a == 0 || w->attached[a - 1].first != j)
+      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>());
+    const Constraint& c = w->list[w->attached[a].second];
+    const Pose3& T_j = map_poses_[j];
+    f.pairs.back().second->Add(config_.T_imu_lidar * c.p_lidar, T_j.R.transpose() * c.normal_world,
+                               T_j.Inverse() * c.q_world, c.weight, sigma);
+  }
+  for (auto& [j, pair] : f.pairs) pair->Finalize();
+  return f;
 }
 
 void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
   // Associate the chunk's scans (threads over scans, one workspace each).
   auto t0 = Clock::now();
   const int n = end - begin;
-  std::vector<std::unique_ptr<PlaneFactor>> factors(n);
+  std::vector<ScanFactors> factors(n);
   std::vector<AssociationStats> stats(n);
   std::vector<char> active(n, 0);
-  std::vector<ConstraintList> lists(threads_);
-  std::vector<RvWorkspace> workspaces(threads_);
+  std::vector<AssociationWorkspace> workspaces(threads_);
   ParallelFor(begin, end, threads_, [&](int k, int t) {
     bool a = false;
-    factors[k - begin] = AssociateOne(k, &lists[t], &workspaces[t], &stats[k - begin], &a);
+    factors[k - begin] = AssociateOne(k, begin, end, &workspaces[t], &stats[k - begin], &a);
     active[k - begin] = a;
   });
   for (int i = 0; i < n; ++i) {
@@ -344,8 +403,13 @@ void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
   for (int k = begin; k < end; ++k) {
     problem.AddParameterBlock(states_[k].pose.data(), 7, &pose_manifold_);
     problem.AddParameterBlock(states_[k].speed_bias.data(), 9);
-    if (factors[k - begin])
-      problem.AddResidualBlock(factors[k - begin].release(), nullptr, states_[k].pose.data());
+  }
+  for (int k = begin; k < end; ++k) {
+    ScanFactors& f = factors[k - begin];
+    if (f.fixed) problem.AddResidualBlock(f.fixed.release(), nullptr, states_[k].pose.data());
+    for (auto& [j, pair] : f.pairs)
+      problem.AddResidualBlock(pair.release(), nullptr, states_[k].pose.data(),
+                               states_[j].pose.data());
   }
   AddImuFactors(begin, end, &problem);
   problem.SetParameterBlockConstant(states_[begin].pose.data());  // gauge / previous chunk

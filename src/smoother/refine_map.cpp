@@ -209,14 +209,31 @@ AssociationOutcome AssociateOne(const Eigen::Vector3d& p_lidar, const Pose3& T_w
   return AssociationOutcome::kAccepted;
 }
 
+// The scan contributing most neighbours; ties go to the nearer one (the
+// neighbours are sorted by distance).
+int32_t MajorityScan(const ScanNeighbors& nb) {
+  int32_t best = nb.scan_ids[0];
+  int best_count = 0;
+  for (int i = 0; i < nb.size; ++i) {
+    int count = 0;
+    for (int j = 0; j < nb.size; ++j) count += nb.scan_ids[j] == nb.scan_ids[i] ? 1 : 0;
+    if (count > best_count) {
+      best_count = count;
+      best = nb.scan_ids[i];
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 void AssociateScan(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_lidar,
                    int32_t scan_id, const RefineMap& map, const ConstraintOptions& options,
-                   ConstraintList* out, AssociationStats* stats) {
+                   ConstraintList* out, AssociationStats* stats, std::vector<int32_t>* sources) {
   RVLIO_CHECK(out != nullptr);
   out->clear();
   out->reserve(p_lidar.size());
+  if (sources != nullptr) sources->clear();
   const PlaneThresholds planes = PlaneThresholds::From(options);
   AssociationStats local;
   double sum_abs = 0.0;
@@ -229,6 +246,7 @@ void AssociateScan(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_w
     if (o != AssociationOutcome::kAccepted) continue;
     sum_abs += std::abs(c.residual);
     out->push_back(c);
+    if (sources != nullptr) sources->push_back(MajorityScan(nb));
   }
   if (local.num_accepted > 0) local.mean_abs_residual = sum_abs / local.num_accepted;
   if (stats != nullptr) *stats = local;

@@ -97,17 +97,23 @@ SlidingWindow::SlidingWindow(const WindowOptions& options) : options_(options) {
 
 SlidingWindow::~SlidingWindow() = default;
 
-void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
-                          std::vector<Eigen::Vector3d> p_lidar) {
-  nodes_.clear();
-  marginal_prior_.reset();
-  state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, options_.first_prior);
+std::unique_ptr<SlidingWindow::Node> SlidingWindow::MakeNode(
+    TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
+    std::vector<Eigen::Vector3d> p_lidar) {
   auto node = std::make_unique<Node>();
   node->t_ns = t_ns;
   pose.ToArray(node->pose);
   speed_bias.ToArray(node->sb);
   node->p_lidar = std::move(p_lidar);
-  nodes_.push_back(std::move(node));
+  return node;
+}
+
+void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
+                          std::vector<Eigen::Vector3d> p_lidar) {
+  nodes_.clear();
+  marginal_prior_.reset();
+  state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, options_.first_prior);
+  nodes_.push_back(MakeNode(t_ns, pose, speed_bias, std::move(p_lidar)));
 }
 
 void SlidingWindow::Add(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
@@ -115,11 +121,7 @@ void SlidingWindow::Add(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock
                         std::vector<Eigen::Vector3d> p_lidar) {
   RVLIO_CHECK_MSG(!nodes_.empty(), "SlidingWindow::Start() first");
   RVLIO_CHECK_MSG(t_ns >= nodes_.back()->t_ns, "window states must be added in time order");
-  auto node = std::make_unique<Node>();
-  node->t_ns = t_ns;
-  pose.ToArray(node->pose);
-  speed_bias.ToArray(node->sb);
-  node->p_lidar = std::move(p_lidar);
+  std::unique_ptr<Node> node = MakeNode(t_ns, pose, speed_bias, std::move(p_lidar));
   if (imu && imu->dt() > 0.0 && IsFinite(*imu)) {
     node->imu = std::make_unique<ImuFactor>(std::move(*imu), options_.g_world);
   } else {
@@ -154,6 +156,7 @@ bool SlidingWindow::has_imu_factor(int k) const {
 WindowSolveReport SlidingWindow::Optimize(const ScanAssociateFn& associate) {
   WindowSolveReport report;
   if (nodes_.empty()) return report;
+  bool retried = false;
   for (int round = 0; round < options_.smoother.association_rounds; ++round) {
     const double t0 = ThreadCpuMs();
     AssociateRound(associate, &report);
@@ -161,15 +164,34 @@ WindowSolveReport SlidingWindow::Optimize(const ScanAssociateFn& associate) {
     report.association_ms += t1 - t0;
     const bool ok = SolveRound(&report);
     report.solve_ms += ThreadCpuMs() - t1;
-    if (!ok) {
+    if (ok) {
+      ++report.rounds;
+      continue;
+    }
+    ++report.failures;
+    // The newest IMU interval is the likeliest culprit (a corrupt burst of
+    // samples): redo the round once without it, else give up on this scan.
+    if (retried || !DropNewestImuFactor()) {
       report.ok = false;
       break;
     }
-    ++report.rounds;
+    retried = true;
+    report.dropped_newest_imu = true;
+    --round;
   }
   report.newest_constraints = static_cast<int>(nodes_.back()->constraints.size());
   report.newest_rv = nodes_.back()->rv;
   return report;
+}
+
+bool SlidingWindow::DropNewestImuFactor() {
+  Node& n = *nodes_.back();
+  if (nodes_.size() < 2 || !n.imu) return false;
+  n.imu.reset();
+  n.gap = std::make_unique<SpeedBiasContinuityFactor>(options_.gap_vel_std, options_.gap_bg_std,
+                                                      options_.gap_ba_std);
+  ++stats_.imu_factors_skipped;
+  return true;
 }
 
 // Every state never associated, or moved by more than reassociate_min_motion
@@ -193,12 +215,21 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
                      &rv_workspace_);
   ApplyHuberWeights(options_.smoother.huber_delta, T_world_imu, options_.T_imu_lidar,
                     &node->constraints);
-  node->plane.reset();
-  if (static_cast<int>(node->constraints.size()) >= options_.min_constraints)
-    node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, options_.T_imu_lidar,
-                                                       options_.lidar_noise, T_world_imu.t);
   node->associated_at = T_world_imu;
   node->associated = true;
+  node->plane.reset();
+  if (static_cast<int>(node->constraints.size()) < options_.min_constraints) return;
+  node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, options_.T_imu_lidar,
+                                                     options_.lidar_noise, T_world_imu.t);
+  // Finite but absurd records (a plane 1e300 m away) overflow the summary:
+  // such a scan contributes nothing (and is associated again next round)
+  // rather than a cost Ceres cannot evaluate.
+  if (!node->plane->information().allFinite()) {
+    node->plane.reset();
+    node->constraints.clear();
+    node->associated = false;
+    ++stats_.rejected_scans;
+  }
 }
 
 // Re-integrates a preintegration whose linearization biases are far from the
@@ -269,6 +300,9 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   if (summary.IsSolutionUsable() && Healthy()) return true;
   Restore();
   ++stats_.solve_failures;
+  // This round's associations may be what broke the solve, and the restored
+  // poses equal the poses they were made at: re-associate everything next.
+  for (auto& node : nodes_) node->associated = false;
   return false;
 }
 

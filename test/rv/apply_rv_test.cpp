@@ -126,7 +126,7 @@ TEST(ApplyRvTest, ReportIsConsistent) {
     EXPECT_LE(r.s_eigenvalues(0), r.s_eigenvalues(1));
     EXPECT_LE(r.s_eigenvalues(1), r.s_eigenvalues(2));
     EXPECT_NEAR(r.s_eigenvalues.sum(), 1050.0, 1e-8);  // trace of sum u u^T, unit u
-    EXPECT_DOUBLE_EQ(r.K, std::min(1.0, options.k0 * 50.0 / 1000.0));
+    EXPECT_DOUBLE_EQ(r.K, std::max(options.min_K, std::min(1.0, options.k0 * 50.0 / 1000.0)));
     int scv = 0, repaired = 0;
     for (const Constraint& c : list) {
       scv += c.role == RvRole::kScv;

@@ -125,6 +125,7 @@ TEST(ReinforceTest, IncrementalScatterMatchesRecomputation) {
 TEST(ReinforceTest, CoefficientFollowsEq19) {
   RvOptions options;
   options.clamp = false;
+  options.min_K = 1e-6;  // paper mode: no floor (our min_K is tested below)
   for (double k0 : {0.053, 1.0, 695.07}) {
     options.k0 = k0;
     for (int scv : {0, 1, 7, 100}) {
@@ -141,6 +142,20 @@ TEST(ReinforceTest, CoefficientFollowsEq19) {
   EXPECT_DOUBLE_EQ(ReinforcementCoefficient(options, 10, 1000), 0.053 * 10 / 1000);
 }
 
+// Our addition: K never drops below rv.min_K, so one SCV's information grows
+// at most 1/min_K times; above the floor Eq. (19) is untouched.
+TEST(ReinforceTest, MinKBoundsTheGainOfOneScv) {
+  RvOptions options;
+  options.k0 = 0.053;
+  for (double min_K : {1e-6, 0.1, 0.5, 1.0}) {
+    options.min_K = min_K;
+    for (int scv : {1, 10, 100}) {
+      const double eq19 = std::min(1.0, 0.053 * scv / 1000.0);
+      EXPECT_DOUBLE_EQ(ReinforcementCoefficient(options, scv, 1000), std::max(eq19, min_K));
+    }
+  }
+}
+
 TEST(ReinforceTest, ApplyRvScalesExactlyTheScvWeightsByOneOverK) {
   std::mt19937 rng(34);
   for (int trial = 0; trial < 200; ++trial) {
@@ -150,6 +165,7 @@ TEST(ReinforceTest, ApplyRvScalesExactlyTheScvWeightsByOneOverK) {
     const test::TunnelSet set = test::MakeTunnelSet(rng, spec);
     RvOptions options = PaperSimOptions();
     options.repair = false;
+    options.min_K = 1e-6;  // paper mode: Eq. (19) without our floor
     options.clamp = trial % 2 == 0;
     options.k0 = trial % 3 == 0 ? 0.053 : 695.07;
     ConstraintList list = set.list;

@@ -191,15 +191,19 @@ TEST(SlidingWindowMarginalization, MatchesABatchSolveOverTheSameData) {
   const StateError diff = Difference(w, b);
   const StateError err = Difference(b, {b.t_ns, test::TruePose(b.t_ns),
                                         test::TrueSpeedBias(b.t_ns, seq.bg, seq.ba)});
-  // The batch estimate carries the noise (error: mm and mrad level); the
-  // marginalized window agrees with it far more closely than either with the
-  // truth. Measured: diff rot 1.1e-6 rad, pos 7e-6 m, vel 2.4e-5 m/s.
-  EXPECT_LT(diff.rot, 1e-5);
-  EXPECT_LT(diff.pos, 1e-4);
+  // The batch estimate carries the noise (errors: rot 5.7e-4 rad, pos 1.6e-3 m,
+  // vel 1.3e-2 m/s); the marginalized window agrees with it two orders of
+  // magnitude more closely (measured: rot 3.4e-6 rad, pos 7.0e-6 m, vel
+  // 5.1e-5 m/s, bg 2.1e-6 rad/s, ba 7.7e-5 m/s^2; not zero because the prior
+  // keeps the Jacobians of its linearization point).
+  EXPECT_LT(diff.rot, 2e-5);
+  EXPECT_LT(diff.pos, 5e-5);
   EXPECT_LT(diff.vel, 3e-4);
-  EXPECT_LT(diff.bg, 1e-4);
-  EXPECT_LT(diff.ba, 2e-3);
-  EXPECT_LT(diff.pos, 0.1 * err.pos);
+  EXPECT_LT(diff.bg, 2e-5);
+  EXPECT_LT(diff.ba, 5e-4);
+  EXPECT_LT(diff.rot, 0.05 * err.rot);
+  EXPECT_LT(diff.pos, 0.05 * err.pos);
+  EXPECT_LT(diff.vel, 0.05 * err.vel);
   EXPECT_GT(err.pos, 1e-4);  // the noise does move the estimate: the comparison means something
 }
 
@@ -220,9 +224,10 @@ TEST(SlidingWindowMarginalization, EvenAWindowOfTwoMatchesTheBatch) {
   batch.window().Optimize(batch.associate());
   EXPECT_EQ(small.window().size(), 1);
   const StateError diff = Difference(small.newest(), batch.newest());
-  EXPECT_LT(diff.pos, 2e-4);
-  EXPECT_LT(diff.rot, 2e-5);
-  EXPECT_LT(diff.vel, 1e-3);
+  // Measured: pos 3.2e-5 m, rot 1.2e-6 rad, vel 8.9e-5 m/s.
+  EXPECT_LT(diff.pos, 1.5e-4);
+  EXPECT_LT(diff.rot, 1e-5);
+  EXPECT_LT(diff.vel, 5e-4);
 }
 
 TEST(SlidingWindowGaps, StatesWithoutAnImuFactorStaySolvable) {
@@ -234,7 +239,9 @@ TEST(SlidingWindowGaps, StatesWithoutAnImuFactorStaySolvable) {
     const bool gap = (k == 3);
     const WindowSolveReport r = d.Step(k, !gap);
     ASSERT_TRUE(r.ok) << k;
-    if (k == 3) EXPECT_FALSE(d.window().has_imu_factor(d.window().size() - 1));
+    if (gap) {
+      EXPECT_FALSE(d.window().has_imu_factor(d.window().size() - 1));
+    }
     const StateError e = Difference(d.newest(), {0, test::TruePose(d.newest().t_ns), {}});
     EXPECT_LT(e.pos, 0.01) << k;  // the box room pins every pose
     EXPECT_LT(e.rot, 2e-3) << k;
@@ -268,7 +275,7 @@ void ExpectSameStates(const std::vector<WindowState>& a, const std::vector<Windo
   }
 }
 
-TEST(SlidingWindowFailure, FailedSolveRestoresTheLastGoodState) {
+TEST(SlidingWindowFailure, AbsurdAssociationsNeverReachTheSolution) {
   constexpr int kStates = 8;
   const Sequence seq = MakeSequence(kStates, 9, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
   WindowOptions options = TestOptions(5, kImuLidar);
@@ -276,9 +283,8 @@ TEST(SlidingWindowFailure, FailedSolveRestoresTheLastGoodState) {
   Driver d(options, seq);
   d.Start();
   for (int k = 1; k < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);
-  const std::vector<WindowState> good = Snapshot(d.window());
   // A corrupt association (finite numbers): a plane point 1e300 m away; its
-  // squared residual overflows, so Ceres cannot evaluate the cost.
+  // squared residual overflows the scan's summary.
   int corrupted = 0;
   const ScanAssociateFn corrupt = [&](const std::vector<Vector3d>& p, const Pose3& T,
                                       ConstraintList* out) {
@@ -288,45 +294,87 @@ TEST(SlidingWindowFailure, FailedSolveRestoresTheLastGoodState) {
   };
   const WindowSolveReport r = d.window().Optimize(corrupt);
   ASSERT_GT(corrupted, 0);  // the solves moved the states: they are re-associated
-  EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.rounds, 0);
-  EXPECT_EQ(d.window().stats().solve_failures, 1);
-  ExpectSameStates(Snapshot(d.window()), good);
-  // The window recovers with sane data.
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(d.window().stats().rejected_scans, corrupted);
+  EXPECT_EQ(d.window().stats().solve_failures, 0);
+  // Without their scans the states rest on the IMU and the prior: finite, close.
+  for (const WindowState& s : Snapshot(d.window())) {
+    EXPECT_TRUE(s.pose.p_world_imu.allFinite() && s.speed_bias.v_world_imu.allFinite());
+    EXPECT_LT(Minus(s.pose, test::TruePose(s.t_ns)).tail<3>().norm(), 0.05);
+  }
+  // Rejected scans are associated again: with sane data the window is back.
   EXPECT_TRUE(d.window().Optimize(d.associate()).ok);
+  for (int k = 0; k < d.window().size(); ++k)
+    EXPECT_EQ(d.window().constraints(k).size(), seq.scans[0].size()) << k;
   for (const WindowState& s : Snapshot(d.window()))
     EXPECT_LT(Minus(s.pose, test::TruePose(s.t_ns)).tail<3>().norm(), 0.01);
 }
 
-TEST(SlidingWindowFailure, DivergedSolveRestoresTheLastGoodState) {
-  constexpr int kStates = 6;
-  const Sequence seq = MakeSequence(kStates, 13, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
-  WindowOptions options = TestOptions(10, kImuLidar);
-  Driver d(options, seq);
-  d.Start();
-  for (int k = 1; k + 1 < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);
-  // A burst of corrupt (finite) accelerometer samples in the newest interval:
-  // the IMU factor asks for a speed of ~1000 m/s, above max_speed.
-  const WindowState last = d.newest();
+// Adds state t = newest + 100 ms with a preintegration of `imu` (initial
+// values from the clean samples).
+void AddState(Driver* d, const Sequence& seq, const std::vector<ImuSample>& imu,
+              const std::vector<Vector3d>& scan) {
+  const WindowState last = d->newest();
   const TimeNs t = last.t_ns + kScanNs;
-  std::vector<ImuSample> corrupt = seq.imu;
-  for (ImuSample& m : corrupt)
-    if (m.t_ns > last.t_ns && m.t_ns < t) m.acc_imu.x() += 1e4;
   const ImuKinematics pred = Integrate({last.t_ns, last.pose.q_world_imu.toRotationMatrix(),
                                         last.pose.p_world_imu, last.speed_bias.v_world_imu},
-                                       seq.imu, t, Vector3d::Zero(), Vector3d::Zero(),
+                                       seq.imu, t, last.speed_bias.bg, last.speed_bias.ba,
                                        test::Gravity());
-  d.window().Add(t, PoseBlock(Eigen::Quaterniond(pred.R_world_imu), pred.p_world_imu),
-                 SpeedBiasBlock{pred.v_world_imu, last.speed_bias.bg, last.speed_bias.ba},
-                 ImuPreintegration::FromSamples(corrupt, last.t_ns, t, options.imu_noise,
-                                                last.speed_bias.bg, last.speed_bias.ba),
-                 seq.scans[kStates - 1]);
+  d->window().Add(t, PoseBlock(Eigen::Quaterniond(pred.R_world_imu), pred.p_world_imu),
+                  SpeedBiasBlock{pred.v_world_imu, last.speed_bias.bg, last.speed_bias.ba},
+                  ImuPreintegration::FromSamples(imu, last.t_ns, t, d->window().options().imu_noise,
+                                                 last.speed_bias.bg, last.speed_bias.ba),
+                  scan);
+}
+
+// A burst of corrupt (finite) accelerometer samples in (t0, t1): the IMU
+// factor over it asks for a speed of ~1000 m/s, above max_speed.
+std::vector<ImuSample> WithAccBurst(std::vector<ImuSample> imu, TimeNs t0, TimeNs t1) {
+  for (ImuSample& m : imu)
+    if (m.t_ns > t0 && m.t_ns < t1) m.acc_imu.x() += 1e4;
+  return imu;
+}
+
+TEST(SlidingWindowFailure, DivergedSolveIsRedoneWithoutTheNewestImuFactor) {
+  constexpr int kStates = 6;
+  const Sequence seq = MakeSequence(kStates, 13, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
+  Driver d(TestOptions(10, kImuLidar), seq);
+  d.Start();
+  for (int k = 1; k + 1 < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);
+  const TimeNs t0 = d.newest().t_ns;
+  AddState(&d, seq, WithAccBurst(seq.imu, t0, t0 + kScanNs), seq.scans[kStates - 1]);
+  ASSERT_TRUE(d.window().has_imu_factor(d.window().size() - 1));
+  const WindowSolveReport r = d.window().Optimize(d.associate());
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.failures, 1);
+  EXPECT_TRUE(r.dropped_newest_imu);
+  EXPECT_EQ(d.window().stats().solve_failures, 1);
+  EXPECT_EQ(d.window().stats().imu_factors_skipped, 1);
+  EXPECT_FALSE(d.window().has_imu_factor(d.window().size() - 1));
+  for (const WindowState& s : Snapshot(d.window())) {
+    EXPECT_LT(s.speed_bias.v_world_imu.norm(), 5.0);
+    EXPECT_LT(Minus(s.pose, test::TruePose(s.t_ns)).tail<3>().norm(), 0.01);
+  }
+}
+
+TEST(SlidingWindowFailure, RepeatedDivergenceRestoresTheLastGoodState) {
+  constexpr int kStates = 7;
+  const Sequence seq = MakeSequence(kStates, 14, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
+  Driver d(TestOptions(10, kImuLidar), seq);
+  d.Start();
+  for (int k = 1; k + 2 < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);
+  // Two corrupt intervals: dropping the newest one is not enough.
+  const TimeNs t0 = d.newest().t_ns;
+  const std::vector<ImuSample> corrupt = WithAccBurst(seq.imu, t0, t0 + 2 * kScanNs);
+  AddState(&d, seq, corrupt, seq.scans[kStates - 2]);
+  AddState(&d, seq, corrupt, seq.scans[kStates - 1]);
   const std::vector<WindowState> before = Snapshot(d.window());
   const WindowSolveReport r = d.window().Optimize(d.associate());
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(d.window().stats().solve_failures, 1);
+  EXPECT_EQ(r.failures, 2);
+  EXPECT_EQ(d.window().stats().solve_failures, 2);
   ExpectSameStates(Snapshot(d.window()), before);
-  for (const WindowState& s : before) EXPECT_LT(s.speed_bias.v_world_imu.norm(), 5.0);
+  for (const WindowState& s : Snapshot(d.window())) EXPECT_TRUE(s.speed_bias.v_world_imu.allFinite());
 }
 
 TEST(SlidingWindowShortSequence, FewerStatesThanTheWindowNeverMarginalize) {
@@ -352,8 +400,9 @@ TEST(SlidingWindowImu, BiasesAreEstimatedAndPreintegrationsReintegrated) {
   for (int k = 1; k < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);
   EXPECT_GT(d.window().stats().repropagations, 0);
   const WindowState s = d.newest();
-  EXPECT_LT((s.speed_bias.bg - bg).norm(), 3e-3);
-  EXPECT_LT((s.speed_bias.ba - ba).norm(), 0.1);
+  // Measured: |bg error| 2.2e-4 rad/s, |ba error| 2.2e-3 m/s^2.
+  EXPECT_LT((s.speed_bias.bg - bg).norm(), 1e-3);
+  EXPECT_LT((s.speed_bias.ba - ba).norm(), 1e-2);
 }
 
 TEST(SlidingWindowRv, RvEditsTheConstraintsOfEveryScanInACorridor) {
@@ -389,7 +438,7 @@ TEST(SlidingWindowRv, RvEditsTheConstraintsOfEveryScanInACorridor) {
   for (const Constraint& c : d.window().constraints(0)) {
     if (c.role != RvRole::kRepaired) continue;
     ++repaired;
-    EXPECT_LT(std::abs(c.normal_world.x()), 1e-9);  // back in the plane alpha
+    EXPECT_LT(std::abs(c.normal_world.dot(r.newest_rv.n_alpha)), 1e-9);  // in the plane alpha
   }
   EXPECT_EQ(repaired, r.newest_rv.num_repaired);
 }

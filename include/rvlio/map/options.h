@@ -5,7 +5,7 @@
 namespace rvlio {
 
 struct MapOptions {
-  double voxel_size = 1.0;          // m, edge of one hash voxel of the working map
+  double voxel_size = 0.5;          // m, edge of one hash voxel of the working map (chosen by measurement, README)
   int max_points_per_voxel = 20;    // points kept per voxel
   double min_point_distance = 0.1;  // m, a new point closer than this to a stored one is skipped
   double working_radius = 60.0;     // m, voxels farther from the sensor are removed

@@ -112,8 +112,11 @@ class RefineMap {
 // fit, validity test, normal orientation and residual gate as
 // constraints/associate.h (DESIGN.md section 3), with the k nearest points
 // drawn only from other scans. *out is cleared and refilled in point order.
+// sources (may be null) receives, per constraint, the scan that contributed
+// most of the plane's neighbours (ties: the nearest neighbour's scan).
 void AssociateScan(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_lidar,
                    int32_t scan_id, const RefineMap& map, const ConstraintOptions& options,
-                   ConstraintList* out, AssociationStats* stats);
+                   ConstraintList* out, AssociationStats* stats,
+                   std::vector<int32_t>* sources = nullptr);
 
 }  // namespace rvlio

@@ -21,8 +21,12 @@
 //   associate (every state that moved more than reassociate_min_motion since
 //   its last association, and every state never associated) -> RV -> Huber
 //   weights -> Ceres solve (max_solver_iterations).
-// A round whose solve fails or yields non-finite (or absurd) values restores
-// the states from before that round and ends Optimize (counted).
+// A round whose solve fails or yields non-finite (or absurd: speed above
+// max_speed) values restores the states from before that round (counted) and
+// invalidates the associations. The round is then redone once without the
+// newest state's IMU factor (a corrupt burst of IMU samples is the usual
+// culprit; the weak continuity prior replaces it, counted as skipped); if it
+// fails again, Optimize ends with the last good states.
 // MarginalizeIfFull() removes the oldest state through the Schur complement
 // once the window holds window_size states and hands its final estimate and
 // points back (for the map).
@@ -94,8 +98,10 @@ struct WindowState {
 };
 
 struct WindowSolveReport {
-  bool ok = true;               // false: a round failed; the states were restored
+  bool ok = true;               // false: the states were restored to the last good ones
   int rounds = 0;               // rounds solved successfully
+  int failures = 0;             // rounds whose solve failed or diverged (each restored)
+  bool dropped_newest_imu = false;  // a failed round was redone without the newest IMU factor
   int iterations = 0;           // Ceres iterations over all rounds
   int associations = 0;         // scans (re-)associated over all rounds
   int newest_constraints = 0;   // constraints of the newest state (last association)
@@ -105,11 +111,12 @@ struct WindowSolveReport {
 };
 
 struct WindowStats {
-  int64_t imu_factors_skipped = 0;       // states added without an IMU factor
+  int64_t imu_factors_skipped = 0;       // states without an IMU factor (gap, or dropped)
   int64_t solve_failures = 0;            // rounds restored to the last good states
   int64_t marginalizations = 0;
   int64_t marginalization_failures = 0;  // replaced by a StatePriorFactor
   int64_t repropagations = 0;            // preintegrations re-integrated
+  int64_t rejected_scans = 0;            // associations whose summary overflowed: no plane factor
 };
 
 // The oldest state leaving the window, at its final estimate.
@@ -156,9 +163,13 @@ class SlidingWindow {
  private:
   struct Node;
 
+  static std::unique_ptr<Node> MakeNode(TimeNs t_ns, const PoseBlock& pose,
+                                        const SpeedBiasBlock& speed_bias,
+                                        std::vector<Eigen::Vector3d> p_lidar);
   void AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
   void AssociateNode(const ScanAssociateFn& associate, Node* node);
   void RefreshImuFactors();
+  bool DropNewestImuFactor();
   bool SolveRound(WindowSolveReport* report);
   bool Healthy() const;
   void Backup();
