@@ -15,7 +15,7 @@ struct SmootherOptions {
   int refine_chunk_scans = 2000;     // scans per refine chunk (long sequences)
   int refine_solver_iterations = 10; // Ceres iterations per refine round (and chunk)
   int refine_threads = 0;            // threads of `rvlio refine` (association, Ceres); 0: all cores
-  int refine_plane_window = 100000;  // scans: a plane moves with its source scan within this distance
+  int refine_plane_window = 100;     // scans: a plane moves with its source scan within this distance
   // Sliding-window backend (backend: smoother).
   std::string linear_solver = "dense_schur";  // Ceres linear solver of the window solve
   std::string map_update = "marginalized";    // when a window scan enters the working map
