@@ -102,6 +102,7 @@ nlohmann::json StatsJson(const RefineStats& s, const SensorReaderStats& r, int64
           {"scans_outside_init", s.scans_outside_init},
           {"scans_without_imu", s.scans_without_imu},
           {"scans_too_few_points", s.scans_too_few_points},
+          {"scans_out_of_order", s.scans_out_of_order},
           {"imu_samples", s.imu_samples},
           {"raw_points", raw_points},
           {"map_entries", s.map_entries},

@@ -175,9 +175,10 @@ Status BatchRefiner::SelectScans() {
       ++st.scans_too_few_points;
     } else if (s.t_end_ns < init0 || s.t_end_ns > init1) {
       ++st.scans_outside_init;
-    } else if (s.t_start_ns < imu0 || s.t_end_ns > imu1 ||
-               (!kept_.empty() && s.t_end_ns <= input_.scans[kept_.back()].t_end_ns)) {
+    } else if (s.t_start_ns < imu0 || s.t_end_ns > imu1) {
       ++st.scans_without_imu;
+    } else if (!kept_.empty() && s.t_end_ns <= input_.scans[kept_.back()].t_end_ns) {
+      ++st.scans_out_of_order;
     } else {
       kept_.push_back(static_cast<int>(i));
     }
