@@ -141,15 +141,8 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.raw_points = static_cast<int>(scan.points.size());
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
-  if (window_->empty()) {
-    const ImuKinematics& x = knots.back();
-    window_->Start(scan.t_end_ns, PoseBlock(Eigen::Quaterniond(x.R_world_imu), x.p_world_imu),
-                   SpeedBiasBlock{x.v_world_imu, bg_, ba_}, p_lidar_end_);
-    InsertIntoWorkingMap(window_->state(0), p_lidar_end_);
-    r.status = ScanStatus::kMapInit;
-  } else {
-    r.status = UpdateWindow(scan.t_end_ns, knots.back(), samples, &r);
-  }
+  r.status = window_->empty() ? StartWindow(scan.t_end_ns, knots.back())
+                              : UpdateWindow(scan.t_end_ns, knots.back(), samples, &r);
   SetNewestFromWindow();
   MarginalizeIfFull();
   DropImuBefore(scan.t_end_ns);
@@ -187,6 +180,15 @@ bool SmootherOdometry::HasImuGap(const std::vector<ImuSample>& samples, TimeNs t
 
 void SmootherOdometry::DropImuBefore(TimeNs t_ns) {
   while (imu_buffer_.size() >= 2 && imu_buffer_[1].t_ns <= t_ns) imu_buffer_.pop_front();
+}
+
+// The first scan: the first window state (with the prior of the static
+// initialization) at the predicted pose; its points start the map.
+ScanStatus SmootherOdometry::StartWindow(TimeNs t_ns, const ImuKinematics& predicted) {
+  window_->Start(t_ns, PoseBlock(Eigen::Quaterniond(predicted.R_world_imu), predicted.p_world_imu),
+                 SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, p_lidar_end_);
+  InsertIntoWorkingMap(window_->state(0), p_lidar_end_);
+  return ScanStatus::kMapInit;
 }
 
 // Adds the scan's state (IMU factor from the newest state unless the interval

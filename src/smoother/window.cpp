@@ -92,7 +92,7 @@ ceres::LinearSolverType WindowLinearSolver(const std::string& name) {
 
 SlidingWindow::SlidingWindow(const WindowOptions& options) : options_(options) {
   RVLIO_CHECK(options_.smoother.window_size >= 2);
-  RVLIO_CHECK(options_.lidar_noise > 0.0 && options_.smoother.huber_delta > 0.0);
+  RVLIO_CHECK(options_.lidar_noise > 0.0 && options_.smoother.online_huber_delta > 0.0);
 }
 
 SlidingWindow::~SlidingWindow() = default;
@@ -213,7 +213,7 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   RemoveNonFinite(&node->constraints);
   node->rv = ApplyRv(options_.rv, T_world_imu * options_.T_imu_lidar, &node->constraints,
                      &rv_workspace_);
-  ApplyHuberWeights(options_.smoother.huber_delta, T_world_imu, options_.T_imu_lidar,
+  ApplyHuberWeights(options_.smoother.online_huber_delta, T_world_imu, options_.T_imu_lidar,
                     &node->constraints);
   node->associated_at = T_world_imu;
   node->associated = true;

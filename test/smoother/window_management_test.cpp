@@ -81,7 +81,7 @@ WindowOptions TestOptions(int window_size, const Pose3& T_imu_lidar) {
   o.smoother.window_size = window_size;
   o.smoother.association_rounds = 1;
   o.smoother.max_solver_iterations = 30;
-  o.smoother.huber_delta = 1e3;  // no robust reweighting: the cost is one fixed function
+  o.smoother.online_huber_delta = 1e3;  // no robust reweighting: the cost is one fixed function
   o.smoother.reassociate_min_motion = 0.0;
   o.smoother.linear_solver = "dense_schur";
   o.rv.enabled = false;
@@ -279,7 +279,7 @@ TEST(SlidingWindowFailure, AbsurdAssociationsNeverReachTheSolution) {
   constexpr int kStates = 8;
   const Sequence seq = MakeSequence(kStates, 9, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
   WindowOptions options = TestOptions(5, kImuLidar);
-  options.smoother.huber_delta = 1e300;  // let an absurd residual through unweighted
+  options.smoother.online_huber_delta = 1e300;  // let an absurd residual through unweighted
   Driver d(options, seq);
   d.Start();
   for (int k = 1; k < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);

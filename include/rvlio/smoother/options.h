@@ -20,6 +20,7 @@ struct SmootherOptions {
   std::string linear_solver = "dense_schur";  // Ceres linear solver of the window solve
   std::string map_update = "marginalized";    // when a window scan enters the working map
   double reassociate_min_motion = 0.01;       // m, re-associate a window scan that moved more
+  double online_huber_delta = 0.03;           // m, Huber width of the window (huber_delta: refine)
 
   template <class V>
   void Visit(V& v) {
@@ -39,6 +40,8 @@ struct SmootherOptions {
                 .Help("a scan enters the working map when marginalized (final estimate) or right after its first solve"));
     v.Field("reassociate_min_motion", reassociate_min_motion, Spec().Unit("m").Range(0.0, 10.0)
                 .Help("re-associate a window scan when it moved more than this (translation + 10 m x rotation in rad)"));
+    v.Field("online_huber_delta", online_huber_delta, Spec().Unit("m").Positive()
+                .Help("Huber width on the point-to-plane residuals of the sliding window (backend: smoother)"));
   }
   Status Validate() { return ValidateFields(*this, "smoother"); }
 };

@@ -12,7 +12,7 @@
 //     (PlaneSummaryFactor: PlaneFactor's cost in 13 exact residuals,
 //     plane_summary_factor.h). Per-point information = Constraint::weight / sigma^2
 //     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
-//     min(1, huber_delta / |r|) at the pose of association);
+//     min(1, online_huber_delta / |r|) at the pose of association);
 //   - the prior on the oldest state: a StatePriorFactor on the first state of
 //     the run, then the marginalization prior (marginalization.h), whose
 //     Jacobian stays at its linearization point (first-estimate Jacobians).
@@ -62,7 +62,7 @@ class ImuFactor;
 class PlaneSummaryFactor;
 
 struct WindowOptions {
-  SmootherOptions smoother;          // window_size, rounds, iterations, huber_delta, ...
+  SmootherOptions smoother;          // window_size, rounds, iterations, online_huber_delta, ...
   RvOptions rv;                      // the same switches and parameters as the filter
   ImuNoise imu_noise;                // preintegration noise (for re-integration)
   double lidar_noise = 0.03;         // m, sigma of one point-to-plane residual
