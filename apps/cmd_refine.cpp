@@ -109,15 +109,7 @@ nlohmann::json StatsJson(const RefineStats& s, const SensorReaderStats& r, int64
           {"chunks", s.chunks},
           {"gravity_from_static", s.gravity_from_static},
           {"started_moving", s.started_moving},
-          {"reader",
-           {{"scans", r.scans},
-            {"imu_samples", r.imu_samples},
-            {"empty_scans", r.empty_scans},
-            {"invalid_points", r.invalid_points},
-            {"imu_duplicates", r.imu_duplicates},
-            {"imu_non_monotonic", r.imu_non_monotonic},
-            {"imu_gaps", r.imu_gaps},
-            {"imu_max_gap_s", r.imu_max_gap_s}}}};
+          {"reader", ReaderStatsJson(r)}};
 }
 
 struct Request {

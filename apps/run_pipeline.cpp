@@ -72,15 +72,7 @@ nlohmann::json StatsJson(const OdometryStats& o, const SensorReaderStats& r) {
            {{"association", o.association_ms},
             {"solve", o.solve_ms},
             {"marginalization", o.marginalization_ms}}},
-          {"reader",
-           {{"scans", r.scans},
-            {"imu_samples", r.imu_samples},
-            {"empty_scans", r.empty_scans},
-            {"invalid_points", r.invalid_points},
-            {"imu_duplicates", r.imu_duplicates},
-            {"imu_non_monotonic", r.imu_non_monotonic},
-            {"imu_gaps", r.imu_gaps},
-            {"imu_max_gap_s", r.imu_max_gap_s}}}};
+          {"reader", ReaderStatsJson(r)}};
 }
 
 int RvActiveScans(const std::vector<ScanResult>& results) {
@@ -132,6 +124,17 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
 }
 
 }  // namespace
+
+nlohmann::json ReaderStatsJson(const SensorReaderStats& r) {
+  return {{"scans", r.scans},
+          {"imu_samples", r.imu_samples},
+          {"empty_scans", r.empty_scans},
+          {"invalid_points", r.invalid_points},
+          {"imu_duplicates", r.imu_duplicates},
+          {"imu_non_monotonic", r.imu_non_monotonic},
+          {"imu_gaps", r.imu_gaps},
+          {"imu_max_gap_s", r.imu_max_gap_s}};
+}
 
 double PeakMemoryMb() {
   rusage usage{};

@@ -3,6 +3,10 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "rvlio/io/sensor_bag.h"
+
 namespace rvlio::cli {
 
 struct RunRequest {
@@ -25,6 +29,9 @@ int RunOdometryOnBag(const RunRequest& request, RunOutcome* outcome);
 
 // Creates `dir` if needed and proves it writable; false with a message if not.
 bool PrepareOutputDir(const std::string& command, const std::string& dir);
+
+// The reader's counts of what it skipped or repaired, for summary.json.
+nlohmann::json ReaderStatsJson(const SensorReaderStats& stats);
 
 // Peak resident memory of this process, MB.
 double PeakMemoryMb();
