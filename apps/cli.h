@@ -10,7 +10,7 @@ namespace rvlio::cli {
 
 struct OptionSpec {
   std::string name;   // without the leading dashes
-  std::string value;  // value placeholder for the usage line, empty for a flag
+  std::string value;  // value name shown in the usage line, empty for a flag
   std::string help;
   bool required = false;
   bool repeatable = false;
