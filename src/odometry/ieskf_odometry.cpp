@@ -45,19 +45,11 @@ void IeskfOdometry::TryInitialize(const ImuSample& imu) {
 }
 
 void IeskfOdometry::AddScan(Scan scan) {
-  ++stats_.scans_received;
-  if (!stats_.initialized || scan.t_start_ns < filter_.time_ns()) {
-    ++stats_.scans_before_imu;  // no IMU state covers this scan
-    return;
-  }
-  scans_.push_back(std::move(scan));
+  scans_.Add(std::move(scan), stats_.initialized, filter_.time_ns(), &stats_);
 }
 
 void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
-  while (!scans_.empty() && !imu_buffer_.empty() &&
-         imu_buffer_.back().t_ns >= scans_.front().t_end_ns) {
-    ProcessFrontScan(out);
-  }
+  while (scans_.FrontReady(imu_buffer_)) ProcessFrontScan(out);
 }
 
 void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
@@ -65,8 +57,7 @@ void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
 }
 
 void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
-  Scan scan = std::move(scans_.front());
-  scans_.pop_front();
+  Scan scan = scans_.PopFront();
   const double start_ms = ThreadCpuMs();
   const Eigen::Vector3d mean_acc_imu = Predict(scan.t_end_ns);
   preprocessor_.Downsample(scan, &downsampled_);

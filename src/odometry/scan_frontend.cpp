@@ -1,5 +1,7 @@
 #include "rvlio/odometry/scan_frontend.h"
 
+#include <utility>
+
 namespace rvlio {
 namespace {
 
@@ -64,6 +66,21 @@ void WorkingMap::Insert(const std::vector<Eigen::Vector3d>& p_world,
     map_.RemoveFar(sensor_world, map_.options().working_radius);
     scans_since_trim_ = 0;
   }
+}
+
+void ScanQueue::Add(Scan scan, bool initialized, TimeNs state_time_ns, OdometryStats* stats) {
+  ++stats->scans_received;
+  if (!initialized || scan.t_start_ns < state_time_ns) {
+    ++stats->scans_before_imu;  // no IMU state covers this scan
+    return;
+  }
+  scans_.push_back(std::move(scan));
+}
+
+Scan ScanQueue::PopFront() {
+  Scan scan = std::move(scans_.front());
+  scans_.pop_front();
+  return scan;
 }
 
 }  // namespace rvlio

@@ -89,19 +89,11 @@ void SmootherOdometry::TryInitialize(const ImuSample& imu) {
 }
 
 void SmootherOdometry::AddScan(Scan scan) {
-  ++stats_.scans_received;
-  if (!stats_.initialized || scan.t_start_ns < newest_.t_ns) {
-    ++stats_.scans_before_imu;  // no IMU state covers this scan
-    return;
-  }
-  scans_.push_back(std::move(scan));
+  scans_.Add(std::move(scan), stats_.initialized, newest_.t_ns, &stats_);
 }
 
 void SmootherOdometry::Poll(std::vector<ScanResult>* out) {
-  while (!scans_.empty() && !imu_buffer_.empty() &&
-         imu_buffer_.back().t_ns >= scans_.front().t_end_ns) {
-    ProcessFrontScan(out);
-  }
+  while (scans_.FrontReady(imu_buffer_)) ProcessFrontScan(out);
 }
 
 // The remaining scans, then the states still in the window enter the
@@ -119,8 +111,7 @@ void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
 
 // Predict -> Downsample -> Deskew -> Add + Optimize -> Insert -> Marginalize.
 void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
-  Scan scan = std::move(scans_.front());
-  scans_.pop_front();
+  Scan scan = scans_.PopFront();
   const double start_ms = ThreadCpuMs();
   if (scan.t_end_ns < newest_.t_ns) {
     ++stats_.scans_out_of_order;

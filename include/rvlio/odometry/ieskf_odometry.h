@@ -45,7 +45,7 @@ class IeskfOdometry : public Odometry {
   std::vector<std::string> warnings_;
   StaticInitializer initializer_;
   std::deque<ImuSample> imu_buffer_;
-  std::deque<Scan> scans_;
+  ScanQueue scans_;
   // Per-scan workspaces, reused to avoid allocation in the hot path.
   Scan downsampled_;
   std::vector<Eigen::Vector3d> p_lidar_end_;

@@ -2,6 +2,7 @@
 // Pieces of the odometry pipeline shared by its backends (ieskf_odometry.h,
 // smoother_odometry.h): the extrinsics, static initialization, the IMU pose
 // samples that deskew needs, and the working map with its periodic trim.
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "rvlio/map/options.h"
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
+#include "rvlio/odometry/odometry.h"
 
 namespace rvlio {
 
@@ -74,6 +76,25 @@ class WorkingMap {
  private:
   VoxelMap map_;
   int scans_since_trim_ = 0;
+};
+
+// Scans waiting for the IMU data that covers them: both backends hand a scan
+// to the estimator only once an IMU sample at or after its end has arrived.
+class ScanQueue {
+ public:
+  // Queues a scan unless no IMU state covers it yet (not initialized, or it
+  // starts before the estimator's current time); counts either way.
+  void Add(Scan scan, bool initialized, TimeNs state_time_ns, OdometryStats* stats);
+  // True when the oldest scan's end is covered by the buffered IMU samples.
+  bool FrontReady(const std::deque<ImuSample>& imu_buffer) const {
+    return !scans_.empty() && !imu_buffer.empty() &&
+           imu_buffer.back().t_ns >= scans_.front().t_end_ns;
+  }
+  bool empty() const { return scans_.empty(); }
+  Scan PopFront();
+
+ private:
+  std::deque<Scan> scans_;
 };
 
 }  // namespace rvlio

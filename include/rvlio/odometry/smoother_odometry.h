@@ -93,7 +93,7 @@ class SmootherOdometry : public Odometry {
   OdometryStats stats_;
   std::vector<std::string> warnings_;
   std::deque<ImuSample> imu_buffer_;
-  std::deque<Scan> scans_;
+  ScanQueue scans_;
   // The newest estimate: where the next prediction starts.
   ImuKinematics newest_;
   Eigen::Vector3d bg_ = Eigen::Vector3d::Zero();
