@@ -8,6 +8,7 @@
 #include <iterator>
 #include <string>
 
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 namespace rvlio::testing_cli {
@@ -47,5 +48,29 @@ inline nlohmann::json EvalJson(const std::string& gt, const std::string& est,
   if (r.exit_code != 0) return nlohmann::json();
   return nlohmann::json::parse(r.out, nullptr, false);
 }
+
+// A suite sharing one seeded 14 s, 512-column simulated tunnel (tunnel.bag,
+// tunnel.yaml, tunnel_gt.tum under dir_/data), made once per suite.
+class SimulatedTunnelSuite : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = MakeTempDir("rvlio_cli");
+    ASSERT_FALSE(dir_.empty());
+    const ToolRun sim = RunTool("simulate --preset tunnel --seed 3 --duration 14 --out " + dir_ +
+                                    "/data --set lidar.columns=512", dir_);
+    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+
+  static std::string Bag() { return dir_ + "/data/tunnel.bag"; }
+  static std::string Sensors() { return dir_ + "/data/tunnel.yaml"; }
+  static std::string Truth() { return dir_ + "/data/tunnel_gt.tum"; }
+  // `rvlio run` on the suite's bag with its sensor configuration.
+  static ToolRun Run(const std::string& out, const std::string& extra = "") {
+    return RunTool("run --bag " + Bag() + " --config " + Sensors() + " --out " + out + " " + extra,
+                   dir_);
+  }
+  static inline std::string dir_;
+};
 
 }  // namespace rvlio::testing_cli

@@ -18,27 +18,7 @@ using testing_cli::ToolRun;
 // Short sequences keep the suite fast: 512 columns, a few seconds of flight.
 const char* kShortLidar = " --set lidar.columns=512";
 
-class RunCliTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = testing_cli::MakeTempDir("rvlio_run_cli");
-    ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 3 --duration 14 --out " + dir_ +
-                                    "/data" + kShortLidar, dir_);
-    ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  }
-  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
-
-  static std::string Bag() { return dir_ + "/data/tunnel.bag"; }
-  static std::string Sensors() { return dir_ + "/data/tunnel.yaml"; }
-  static std::string Truth() { return dir_ + "/data/tunnel_gt.tum"; }
-  static ToolRun Run(const std::string& out, const std::string& extra = "") {
-    return RunTool("run --bag " + Bag() + " --config " + Sensors() + " --out " + out + " " + extra,
-                   dir_);
-  }
-  static std::string dir_;
-};
-std::string RunCliTest::dir_;
+class RunCliTest : public testing_cli::SimulatedTunnelSuite {};
 
 TEST_F(RunCliTest, IeskfWritesTheOutputContractAndMeetsTheRegressionBound) {
   const std::string out = dir_ + "/ieskf";
