@@ -19,8 +19,7 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
       initializer_(options.imu.init_duration) {}
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {
-  if (!imu_buffer_.empty() && imu.t_ns - imu_buffer_.back().t_ns > kNominalScanPeriodNs)
-    ++stats_.imu_gaps_over_scan;
+  if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
   if (!stats_.initialized) {
     TryInitialize(imu);
     return;

@@ -68,6 +68,16 @@ void WorkingMap::Insert(const std::vector<Eigen::Vector3d>& p_world,
   }
 }
 
+bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats) {
+  if (!imu.acc_imu.allFinite() || !imu.gyro_imu.allFinite()) {
+    ++stats->imu_non_finite;
+    return false;
+  }
+  if (!buffer.empty() && imu.t_ns - buffer.back().t_ns > kNominalScanPeriodNs)
+    ++stats->imu_gaps_over_scan;
+  return true;
+}
+
 void ScanQueue::Add(Scan scan, bool initialized, TimeNs state_time_ns, OdometryStats* stats) {
   ++stats->scans_received;
   if (!initialized || scan.t_start_ns < state_time_ns) {

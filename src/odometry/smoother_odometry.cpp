@@ -13,10 +13,6 @@ namespace {
 
 constexpr int kMinConstraints = 6;  // as the IESKF: fewer, the scan adds no plane factor
 
-bool IsFinite(const ImuSample& s) {
-  return s.acc_imu.allFinite() && s.gyro_imu.allFinite();
-}
-
 // The window's configuration: smoother.*, rv.*, the IMU noise densities, the
 // point-to-plane sigma, the extrinsics, and the first state's prior from the
 // IESKF's initial standard deviations (the same static initialization).
@@ -59,12 +55,7 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
       T_imu_lidar_(ImuTLidar(options.extrinsics)) {}
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
-  if (!IsFinite(imu)) {
-    ++stats_.imu_non_finite;
-    return;
-  }
-  if (!imu_buffer_.empty() && imu.t_ns - imu_buffer_.back().t_ns > kNominalScanPeriodNs)
-    ++stats_.imu_gaps_over_scan;
+  if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
   if (!stats_.initialized) {
     TryInitialize(imu);
     return;

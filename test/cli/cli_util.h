@@ -49,6 +49,18 @@ inline nlohmann::json EvalJson(const std::string& gt, const std::string& est,
   return nlohmann::json::parse(r.out, nullptr, false);
 }
 
+// Simulates a 10 s, 512-column hall without sensor noise, wall roughness or
+// IMU biases into `dir` (hall.bag, hall.yaml, hall_gt.tum): the oracle case.
+inline ToolRun SimulateNoiseFreeHall(const std::string& dir) {
+  return RunTool("simulate --preset hall --seed 5 --duration 10 --out " + dir +
+                     " --set lidar.columns=512 --set lidar.range_noise=0"
+                     " --set world.roughness_amplitude=0"
+                     " --set imu.gyro_noise_density=0 --set imu.accel_noise_density=0"
+                     " --set imu.gyro_bias_random_walk=0 --set imu.accel_bias_random_walk=0"
+                     " --set imu.gyro_bias=[0,0,0] --set imu.accel_bias=[0,0,0]",
+                 dir);
+}
+
 // A suite sharing one seeded 14 s, 512-column simulated tunnel (tunnel.bag,
 // tunnel.yaml, tunnel_gt.tum under dir_/data), made once per suite.
 class SimulatedTunnelSuite : public ::testing::Test {

@@ -15,9 +15,6 @@ using testing_cli::ReadFile;
 using testing_cli::RunTool;
 using testing_cli::ToolRun;
 
-// Short sequences keep the suite fast: 512 columns, a few seconds of flight.
-const char* kShortLidar = " --set lidar.columns=512";
-
 class RunCliTest : public testing_cli::SimulatedTunnelSuite {};
 
 TEST_F(RunCliTest, IeskfWritesTheOutputContractAndMeetsTheRegressionBound) {
@@ -79,13 +76,7 @@ TEST_F(RunCliTest, BadInputIsOneLineAndExitTwo) {
 // filter recovers the true trajectory to below a centimetre.
 TEST(RunCliNoiseFree, RecoversTheTrueTrajectory) {
   const std::string dir = testing_cli::MakeTempDir("rvlio_noise_free");
-  const std::string noise_free =
-      " --set lidar.range_noise=0 --set world.roughness_amplitude=0"
-      " --set imu.gyro_noise_density=0 --set imu.accel_noise_density=0"
-      " --set imu.gyro_bias_random_walk=0 --set imu.accel_bias_random_walk=0"
-      " --set imu.gyro_bias=[0,0,0] --set imu.accel_bias=[0,0,0]";
-  const ToolRun sim = RunTool("simulate --preset hall --seed 5 --duration 10 --out " + dir +
-                                  kShortLidar + noise_free, dir);
+  const ToolRun sim = testing_cli::SimulateNoiseFreeHall(dir);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   const ToolRun run = RunTool("run --bag " + dir + "/hall.bag --config " + dir +
                                   "/hall.yaml --set rv.enabled=false --out " + dir + "/out", dir);

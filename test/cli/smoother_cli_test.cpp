@@ -143,13 +143,7 @@ TEST_F(SmootherCliTest, AnImuGapInsideTheWindowIsBridged) {
 TEST(SmootherCliNoiseFree, RecoversTheTrueTrajectory) {
   const std::string dir = testing_cli::MakeTempDir("rvlio_smoother_noise_free");
   ASSERT_FALSE(dir.empty());
-  const std::string noise_free =
-      " --set lidar.range_noise=0 --set world.roughness_amplitude=0"
-      " --set imu.gyro_noise_density=0 --set imu.accel_noise_density=0"
-      " --set imu.gyro_bias_random_walk=0 --set imu.accel_bias_random_walk=0"
-      " --set imu.gyro_bias=[0,0,0] --set imu.accel_bias=[0,0,0]";
-  const ToolRun sim = RunTool("simulate --preset hall --seed 5 --duration 10 --out " + dir +
-                                  kShortLidar + noise_free, dir);
+  const ToolRun sim = testing_cli::SimulateNoiseFreeHall(dir);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   const ToolRun run = RunTool("run --bag " + dir + "/hall.bag --config " + dir +
                                   "/hall.yaml --set backend=smoother --out " + dir + "/out", dir);

@@ -78,6 +78,10 @@ class WorkingMap {
   int scans_since_trim_ = 0;
 };
 
+// Screens one IMU sample for the buffer: false (and counted) for a non-finite
+// sample; a gap to the previous sample longer than a scan period is counted.
+bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats);
+
 // Scans waiting for the IMU data that covers them: both backends hand a scan
 // to the estimator only once an IMU sample at or after its end has arrived.
 class ScanQueue {
