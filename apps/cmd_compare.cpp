@@ -1,17 +1,40 @@
+// `rvlio compare`: argument parsing only; the workflow is compare_engine.h.
+#include "cli.h"
 #include "commands.h"
 #include "common_options.h"
+#include "compare_engine.h"
 
 namespace rvlio::cli {
 
 int CmdCompare(int argc, char** argv) {
-  CommandSpec spec{"compare",
-                   "Runs the standard variants (IESKF/smoother, RV off/on, refine) on one "
-                   "sequence and tabulates ATE, RPE and speed.",
-                   {{"bag", "FILE", "ROS1 bag", true},
-                    {"gt", "TUM", "ground-truth trajectory", true},
-                    ConfigOption(),
-                    {"out", "DIR", "output folder", true}}};
-  return EngineComesLater(spec, argc, argv, "comparison workflow (issue 7)");
+  CommandSpec spec{
+      "compare",
+      "Runs the standard variants on one sequence - IESKF and smoother, each with the RV modules\n"
+      "off and on - then `refine` from the best of them by ATE; evaluates each against the\n"
+      "ground truth (se3 alignment) and writes OUT/<variant>/ (run outputs), OUT/compare.csv,\n"
+      "compare.md, compare.json and OUT/plots/ (trajectories, RV profile, bar chart; needs\n"
+      "python3 with matplotlib). Exit 0 when at least one variant ran, 1 when all failed,\n"
+      "2 on bad input (before any run).",
+      {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
+       {"gt", "TUM", "ground-truth trajectory (TUM or KITTI, as rvlio eval)", true},
+       ConfigOption(),
+       SetOption(),
+       {"out", "DIR", "output folder", true},
+       {"no-refine", "", "skip the refine step"},
+       {"no-plots", "", "do not draw plots"},
+       {"quiet", "", "no step lines or progress; the table is still printed"}}};
+  Args args;
+  if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  CompareRequest req;
+  req.bag = args.Get("bag");
+  req.gt = args.Get("gt");
+  req.out_dir = args.Get("out");
+  req.config_files = args.GetAll("config");
+  req.overrides = args.GetAll("set");
+  req.refine = !args.Has("no-refine");
+  req.plots = !args.Has("no-plots");
+  req.quiet = args.Has("quiet");
+  return RunCompare(req);
 }
 
 }  // namespace rvlio::cli

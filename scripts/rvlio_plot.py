@@ -7,13 +7,16 @@ Usage:
   rvlio_plot.py rv-profile   --run DIR [--gt GT.tum] --out PREFIX
   rvlio_plot.py ablation     --table CSV --out PREFIX [--metric NAME ...]
                              [--yscale auto|linear|log]
+  rvlio_plot.py compare-bars --table CSV --out PREFIX [--metric NAME ...]
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
 
 Inputs follow the run-directory contract of `rvlio run` (DESIGN.md section 6):
 DIR/trajectory.tum (t x y z qx qy qz qw, seconds), DIR/scans.csv (one row per
 scan) and DIR/summary.json. Every plot is written as PREFIX_<kind>.png (150 dpi)
-and PREFIX_<kind>.pdf, atomically (temp file, then rename); the written paths
-and a few figures (matched poses, along-axis error) go to stdout.
+and PREFIX_<kind>.pdf, atomically (temp file, then rename); a PREFIX ending in
+'/' is a folder and gives FOLDER/<kind>.png and .pdf. The written paths and a
+few figures (matched poses, along-axis error) go to stdout. compare-bars reads
+the compare.csv of `rvlio compare` (one row per variant, status ok|failed).
 
 Exit status: 0 success; 2 bad input (one line `rvlio_plot: error: ...` on
 stderr, nothing written); 3 matplotlib/numpy not available; 1 internal error.
@@ -276,16 +279,24 @@ class RunErrors(object):
 # Output
 # --------------------------------------------------------------------------
 
+def OutputStem(prefix, kind):
+  """PREFIX_kind, or FOLDER/kind when the prefix ends with a path separator."""
+  if prefix.endswith("/") or prefix.endswith(os.sep):
+    return os.path.join(prefix, kind)
+  return "%s_%s" % (prefix, kind)
+
+
 def SaveFigure(fig, prefix, kind):
   """Writes PREFIX_kind.png and .pdf atomically; returns the paths."""
-  directory = os.path.dirname(os.path.abspath(prefix))
+  stem = OutputStem(prefix, kind)
+  directory = os.path.dirname(os.path.abspath(stem))
   finals, temps = [], []
   umask = os.umask(0)
   os.umask(umask)
   try:
     os.makedirs(directory, exist_ok=True)
     for ext in ("png", "pdf"):
-      final = "%s_%s.%s" % (prefix, kind, ext)
+      final = "%s.%s" % (stem, ext)
       fd, temp = tempfile.mkstemp(prefix=".%s." % os.path.basename(final), dir=directory)
       temps.append(temp)
       with os.fdopen(fd, "wb") as f:
@@ -295,7 +306,7 @@ def SaveFigure(fig, prefix, kind):
     for temp, final in zip(temps, finals):
       os.replace(temp, final)
   except OSError as e:
-    raise PlotError("cannot write %s_%s: %s" % (prefix, kind, e))
+    raise PlotError("cannot write %s: %s" % (stem, e))
   finally:
     Pyplot().close(fig)
     for temp in temps:
@@ -652,6 +663,74 @@ def CmdAblation(args):
 
 
 # --------------------------------------------------------------------------
+# compare-bars
+# --------------------------------------------------------------------------
+
+COMPARE_METRICS = ("ate_rmse_m", "rpe_rmse_m", "axis_max_m")
+COMPARE_TITLES = {"ate_rmse_m": ("ATE (RMSE)", "ATE [m]"),
+                  "rpe_rmse_m": ("RPE (1-frame RMSE)", "RPE [m]"),
+                  "axis_max_m": ("largest error along the tunnel axis", "along-axis max [m]"),
+                  "end_point_m": ("end-point error", "end-point [m]"),
+                  "ms_per_scan": ("time per scan", "ms/scan"),
+                  "real_time_factor": ("real-time factor", "real-time factor [x]")}
+
+
+def ReadCompareTable(path, metrics):
+  """compare.csv -> (variant names, {metric: [value or NaN per variant]}, failed flags)."""
+  if not os.path.isfile(path):
+    raise PlotError("cannot read %s: no such file" % path)
+  with open(path, newline="") as f:
+    reader = csv.DictReader(f)
+    header = [h.strip() for h in (reader.fieldnames or [])]
+    rows = list(reader)
+  missing = [c for c in ("variant",) + tuple(metrics) if c not in header]
+  if missing:
+    raise PlotError("%s: missing column(s) %s" % (path, ", ".join(missing)))
+  if not rows:
+    raise PlotError("%s: no rows" % path)
+  names = [r["variant"] for r in rows]
+  failed = [r.get("status", "ok") not in ("ok", "") for r in rows]
+  values = {m: [float("nan") if bad else ToFloat(r.get(m)) for r, bad in zip(rows, failed)]
+            for m in metrics}
+  return names, values, failed
+
+
+def CmdCompareBars(args):
+  metrics = args.metric or list(COMPARE_METRICS)
+  names, values, failed = ReadCompareTable(args.table, metrics)
+  colors = ColorCycle()
+  width = max(7.0, 2.0 + 1.1 * len(names) * len(metrics) / 2.0)
+  fig, axes = Pyplot().subplots(1, len(metrics), figsize=(width, 3.8), squeeze=False)
+  x = np.arange(len(names))
+  for ax, metric in zip(axes[0], metrics):
+    v = np.array(values[metric])
+    bars = ax.bar(x, np.nan_to_num(v), 0.7, color=[colors[i % len(colors)] for i in x])
+    for bar, value, bad in zip(bars, v, failed):
+      if math.isfinite(value):
+        ax.annotate("%.3g" % value, (bar.get_x() + bar.get_width() / 2, value), xytext=(0, 2),
+                    textcoords="offset points", ha="center", va="bottom", fontsize=7)
+      else:
+        ax.annotate("failed" if bad else "n/a", (bar.get_x() + bar.get_width() / 2, 0.01),
+                    xycoords=ax.get_xaxis_transform(), ha="center", va="bottom", fontsize=7,
+                    color="tab:red")
+    ax.set_xticks(x)
+    ax.set_xticklabels(names, rotation=30, ha="right", fontsize=8)
+    title, ylabel = COMPARE_TITLES.get(metric, (metric, MetricLabel(metric)))
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9, loc="left")
+    finite = v[np.isfinite(v)]
+    top = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
+    ax.set_ylim(0.0, 1.18 * top)  # room for the value labels
+  fig.suptitle("rvlio compare: %s" % os.path.basename(os.path.dirname(os.path.abspath(
+      args.table))), fontsize=10)
+  fig.tight_layout()
+  for name, metric_values in zip(names, zip(*[values[m] for m in metrics])):
+    print("variant %s: %s" % (name, ", ".join("%s %.6g" % (m, v)
+                                              for m, v in zip(metrics, metric_values))))
+  SaveFigure(fig, args.out, "compare_bars")
+
+
+# --------------------------------------------------------------------------
 # Command line
 # --------------------------------------------------------------------------
 
@@ -693,6 +772,12 @@ def BuildParser():
   p.add_argument("--metric", action="append", help="metric column (repeatable)")
   p.add_argument("--yscale", choices=("auto", "linear", "log"), default="auto")
   p.set_defaults(func=CmdAblation)
+  p = sub.add_parser("compare-bars", help="bar chart of the compare.csv of rvlio compare")
+  p.add_argument("--table", required=True, help="compare.csv: variant,status,metrics...")
+  p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
+  p.add_argument("--metric", action="append",
+                 help="metric column (repeatable; default ATE, RPE, along-axis max)")
+  p.set_defaults(func=CmdCompareBars)
   p = sub.add_parser("check", help="exit 0 when matplotlib is usable")
   p.set_defaults(func=None)
   return parser

@@ -394,6 +394,37 @@ TEST_F(PlotScriptTest, AblationFromMeanAndStdColumns) {
   ExpectFigures("ablation");
 }
 
+// The compare.csv of `rvlio compare`: one bar per variant and metric, a failed
+// variant (empty metrics) drawn as "failed"; the values printed are the table's.
+TEST_F(PlotScriptTest, CompareBarsFromACompareTable) {
+  WriteText(dir_ + "/compare.csv",
+            "variant,label,status,exit_code,init,scans,ate_rmse_m,rpe_rmse_m,axis_max_m\n"
+            "ieskf_rv_off,\"IESKF, RV off\",ok,0,,90,0.0102,0.0022,0.0263\n"
+            "smoother_rv_on,\"smoother, RV on\",failed,2,,0,,,\n"
+            "refine,\"refine (from IESKF, RV off)\",ok,0,ieskf_rv_off,90,0.0027,0.00035,0.0052\n");
+  const Result r = Plot("compare-bars --table " + dir_ + "/compare.csv " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("variant ieskf_rv_off: ate_rmse_m 0.0102, rpe_rmse_m 0.0022, "
+                       "axis_max_m 0.0263"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("variant smoother_rv_on: ate_rmse_m nan"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("variant refine: ate_rmse_m 0.0027"), std::string::npos) << r.out;
+  ExpectFigures("compare_bars");
+}
+
+// An --out ending in '/' is a folder: FOLDER/<kind>.png and .pdf.
+TEST_F(PlotScriptTest, OutputPrefixEndingInSlashIsAFolder) {
+  WriteText(dir_ + "/compare.csv", "variant,status,ate_rmse_m,rpe_rmse_m,axis_max_m\n"
+                                   "a,ok,0.1,0.01,0.2\nb,ok,0.2,0.02,0.3\n");
+  const Result r = Plot("compare-bars --table " + dir_ + "/compare.csv --out " + dir_ +
+                        "/out/plots/");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir_ + "/out/plots"))
+    names.insert(entry.path().filename().string());
+  EXPECT_EQ(names, (std::set<std::string>{"compare_bars.png", "compare_bars.pdf"}));
+  EXPECT_TRUE(ReadPngInfo(ReadAll(dir_ + "/out/plots/compare_bars.png")).signature);
+}
+
 TEST_F(PlotScriptTest, BadInputIsOneErrorLineAndNoOutput) {
   const std::vector<Pose> gt = GroundTruth(0.0, false);
   const std::string gt_path = WriteGt(gt);
@@ -422,6 +453,8 @@ TEST_F(PlotScriptTest, BadInputIsOneErrorLineAndNoOutput) {
   WriteText(dir_ + "/abl.csv", "sequence,variant,ate_rmse\ntunnel,rv_on,0.1\n");
   ExpectBadInput("ablation --table " + dir_ + "/abl.csv --metric rpe " + Out(), "no column 'rpe'");
   ExpectBadInput("ablation --table " + dir_ + "/missing.csv " + Out(), "missing.csv");
+  ExpectBadInput("compare-bars --table " + dir_ + "/abl.csv " + Out(),
+                 "missing column(s) ate_rmse_m, rpe_rmse_m, axis_max_m");
   ExpectBadInput("trajectories --gt " + gt_path + " --align sim3 --run a=" + run + " " + Out(),
                  "--align");
 }

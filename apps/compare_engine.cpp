@@ -1,0 +1,505 @@
+#include "compare_engine.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "commands.h"
+#include "plot_runner.h"
+#include "run_pipeline.h"
+#include "rvlio/eval/evaluate.h"
+#include "rvlio/io/atomic_file.h"
+#include "rvlio/io/config.h"
+#include "rvlio/io/sensor_bag.h"
+#include "rvlio/io/trajectory_io.h"
+
+namespace rvlio::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+constexpr const char* kName = "compare";
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kRefine = "refine";
+
+struct Variant {
+  std::string name, label;
+  std::vector<std::string> overrides;
+};
+
+std::vector<Variant> StandardVariants() {
+  return {{"ieskf_rv_off", "IESKF, RV off", {"backend=ieskf", "rv.enabled=false"}},
+          {"ieskf_rv_on", "IESKF, RV on (RV-LIO)", {"backend=ieskf", "rv.enabled=true"}},
+          {"smoother_rv_off", "smoother, RV off", {"backend=smoother", "rv.enabled=false"}},
+          {"smoother_rv_on", "smoother, RV on", {"backend=smoother", "rv.enabled=true"}}};
+}
+
+// One line of the table. A failed row has exit_code != 0 and no metrics.
+struct Row {
+  std::string name, label;
+  std::string init;  // refine: the variant it started from
+  int exit_code = 0;
+  std::string error;
+  std::optional<EvalResult> eval;
+  int scans = 0;
+  double ms_per_scan = kNaN;       // run: median CPU ms; refine: wall ms per scan (batch)
+  double real_time_factor = kNaN;  // sequence duration / compute time
+  double wall_s = 0.0;             // whole step, including reading the bag
+
+  bool ok() const { return exit_code == 0 && eval.has_value(); }
+};
+
+double SecondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Calls another subcommand in-process with the given arguments.
+int Invoke(int (*command)(int, char**), std::vector<std::string> args) {
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  return command(static_cast<int>(args.size()), argv.data());
+}
+
+// Sends this process's stdout into a file while alive (refine's round lines go
+// to OUT/refine/refine.log instead of between compare's step lines).
+class StdoutToFile {
+ public:
+  explicit StdoutToFile(const std::string& path) {
+    std::cout.flush();
+    std::fflush(stdout);
+    const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) return;
+    saved_ = dup(STDOUT_FILENO);
+    if (saved_ >= 0) dup2(fd, STDOUT_FILENO);
+    close(fd);
+  }
+  ~StdoutToFile() {
+    if (saved_ < 0) return;
+    std::cout.flush();
+    std::fflush(stdout);
+    dup2(saved_, STDOUT_FILENO);
+    close(saved_);
+  }
+  StdoutToFile(const StdoutToFile&) = delete;
+  StdoutToFile& operator=(const StdoutToFile&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
+class Steps {
+ public:
+  Steps(const CompareRequest& r)
+      : quiet_(r.quiet), next_(r.first_step),
+        total_(r.total_steps > 0 ? r.total_steps : CompareSteps(r)) {}
+  void Say(const std::string& text) {
+    if (quiet_) return;
+    std::printf("[%d/%d] %s\n", next_++, total_, text.c_str());
+    std::fflush(stdout);
+  }
+  void Detail(const std::string& text) const {
+    if (quiet_) return;
+    std::printf("      %s\n", text.c_str());
+    std::fflush(stdout);
+  }
+
+ private:
+  bool quiet_;
+  int next_, total_;
+};
+
+std::string Fixed(double v, int decimals) {
+  if (!std::isfinite(v)) return "-";
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+  return buf;
+}
+
+// Enough digits for the CSV to reproduce `rvlio eval --json` (10 significant).
+std::string Exact(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "%.10g", v);
+  return buf;
+}
+
+nlohmann::json Num(double v) {
+  if (!std::isfinite(v)) return nullptr;
+  return std::strtod(Exact(v).c_str(), nullptr);
+}
+
+// ---------------------------------------------------------------------------
+// Input checks: everything that would make every run fail, before any run.
+// ---------------------------------------------------------------------------
+
+int CheckInputs(const CompareRequest& req, Trajectory* truth) {
+  StatusOr<OdometryOptions> options = LoadConfig(req.config_files, req.overrides);
+  if (!options.ok()) return Fail(kName, options.status().message());
+  for (const Variant& v : StandardVariants()) {
+    std::vector<std::string> sets = req.overrides;
+    sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
+    if (StatusOr<OdometryOptions> o = LoadConfig(req.config_files, sets); !o.ok())
+      return Fail(kName, "variant " + v.name + ": " + o.status().message());
+  }
+  StatusOr<Trajectory> gt = ReadTrajectory(req.gt);
+  if (!gt.ok()) return Fail(kName, "--gt: " + gt.status().message());
+  if (gt->size() < 3)
+    return Fail(kName, "--gt: " + req.gt + " has " + std::to_string(gt->size()) +
+                           " poses; at least 3 are needed to align and evaluate");
+  *truth = std::move(*gt);
+  StatusOr<std::unique_ptr<SensorBagReader>> reader =
+      SensorBagReader::Open(req.bag, options->lidar, options->imu);
+  if (!reader.ok()) return Fail(kName, reader.status().message());
+  return PrepareOutputDir(kName, req.out_dir) ? 0 : 2;
+}
+
+// ---------------------------------------------------------------------------
+// Runs
+// ---------------------------------------------------------------------------
+
+void EvaluateRow(const Trajectory& truth, const std::string& dir, Row* row) {
+  StatusOr<Trajectory> est = ReadTum(dir + "/trajectory.tum");
+  StatusOr<EvalResult> e = est.ok() ? Evaluate(truth, *est, EvalOptions())
+                                    : StatusOr<EvalResult>(est.status());
+  if (!e.ok()) {
+    row->exit_code = e.status().exit_code();
+    row->error = "evaluation: " + e.status().message();
+    std::fprintf(stderr, "rvlio %s: warning: %s: %s\n", kName, row->name.c_str(),
+                 row->error.c_str());
+    return;
+  }
+  row->eval = std::move(*e);
+}
+
+std::string ResultLine(const Row& row) {
+  if (!row.ok())
+    return row.name + " failed (exit " + std::to_string(row.exit_code) + ")" +
+           (row.error.empty() ? "" : ": " + row.error);
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "ATE %.4f m, %d scans, %.1f s", row.eval->ape_m.rmse, row.scans,
+                row.wall_s);
+  return buf;
+}
+
+Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& truth, Steps* steps) {
+  steps->Say("rvlio run " + v.name + ": " + v.label);
+  Row row;
+  row.name = v.name;
+  row.label = v.label;
+  std::vector<std::string> sets = req.overrides;
+  sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
+  RunRequest run{req.bag, req.out_dir + "/" + v.name, req.config_files, sets, req.quiet};
+  RunOutcome outcome;
+  const auto t0 = Clock::now();
+  row.exit_code = RunOdometryOnBag(run, &outcome);
+  row.wall_s = SecondsSince(t0);
+  if (row.exit_code == 0) {
+    row.scans = outcome.scans;
+    row.ms_per_scan = outcome.median_ms;
+    row.real_time_factor = outcome.real_time_factor;
+    EvaluateRow(truth, run.out_dir, &row);
+  }
+  steps->Detail(ResultLine(row));
+  return row;
+}
+
+const Row* BestRow(const std::vector<Row>& rows) {
+  const Row* best = nullptr;
+  for (const Row& r : rows)
+    if (r.ok() && (!best || r.eval->ape_m.rmse < best->eval->ape_m.rmse)) best = &r;
+  return best;
+}
+
+// Refine's timing from its summary.json: wall time of the batch solve.
+void ReadRefineTiming(const std::string& dir, Row* row) {
+  std::ifstream in(dir + "/summary.json");
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return;
+  const double refine_s = j.value(nlohmann::json::json_pointer("/time_s/refine"), kNaN);
+  const double duration_s = j.value("sequence_duration_s", kNaN);
+  row->scans = j.value("scan_count", 0);
+  if (row->scans > 0 && refine_s > 0) row->ms_per_scan = 1000.0 * refine_s / row->scans;
+  if (refine_s > 0) row->real_time_factor = duration_s / refine_s;
+}
+
+Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& truth, Steps* steps) {
+  const std::string dir = req.out_dir + "/" + kRefine;
+  steps->Say("rvlio refine from " + start.name + " (log: " + dir + "/refine.log)");
+  Row row;
+  row.name = kRefine;
+  row.label = "refine (from " + start.label + ")";
+  row.init = start.name;
+  std::vector<std::string> args = {"rvlio", "refine", "--bag", req.bag, "--init",
+                                   req.out_dir + "/" + start.name + "/trajectory.tum",
+                                   "--out", dir};
+  for (const auto& c : req.config_files) args.insert(args.end(), {"--config", c});
+  for (const auto& s : req.overrides) args.insert(args.end(), {"--set", s});
+  const auto t0 = Clock::now();
+  {
+    std::error_code ec;
+    fs::create_directories(dir, ec);  // for the log; refine itself reports a bad folder
+    StdoutToFile log(dir + "/refine.log");
+    row.exit_code = Invoke(CmdRefine, args);
+  }
+  row.wall_s = SecondsSince(t0);
+  if (row.exit_code == 0) {
+    ReadRefineTiming(dir, &row);
+    EvaluateRow(truth, dir, &row);
+  }
+  steps->Detail(ResultLine(row));
+  return row;
+}
+
+// ---------------------------------------------------------------------------
+// Tables
+// ---------------------------------------------------------------------------
+
+const char* kCsvHeader =
+    "variant,label,status,exit_code,init,scans,ate_rmse_m,rpe_rmse_m,axis_max_m,end_point_m,"
+    "ms_per_scan,real_time_factor\n";
+
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::string CsvText(const std::vector<Row>& rows) {
+  std::ostringstream os;
+  os << kCsvHeader;
+  for (const Row& r : rows) {
+    os << r.name << "," << CsvField(r.label) << "," << (r.ok() ? "ok" : "failed") << ","
+       << r.exit_code << "," << r.init << "," << r.scans;
+    if (r.ok()) {
+      os << "," << Exact(r.eval->ape_m.rmse) << "," << Exact(r.eval->rpe.trans_m.rmse) << ","
+         << Exact(r.eval->along_axis.max_abs_m) << "," << Exact(r.eval->end_point_error_m) << ","
+         << Exact(r.ms_per_scan) << "," << Exact(r.real_time_factor);
+    } else {
+      os << ",,,,,,";
+    }
+    os << "\n";
+  }
+  return os.str();
+}
+
+std::string AlignName(const std::vector<Row>& rows) {
+  for (const Row& r : rows)
+    if (r.ok()) return AlignModeName(r.eval->align);
+  return "se3";
+}
+
+std::string MarkdownText(const CompareRequest& req, const std::vector<Row>& rows) {
+  std::ostringstream os;
+  os << "| variant | ATE [m] | RPE [m] | along-axis max [m] | end-point [m] | ms/scan | "
+        "real-time factor |\n|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) {
+    os << "| " << r.label << " | ";
+    if (!r.ok()) {
+      os << "failed (exit " << r.exit_code << ") | | | | | |\n";
+      continue;
+    }
+    os << Fixed(r.eval->ape_m.rmse, 4) << " | " << Fixed(r.eval->rpe.trans_m.rmse, 4) << " | "
+       << Fixed(r.eval->along_axis.max_abs_m, 4) << " | " << Fixed(r.eval->end_point_error_m, 4)
+       << " | " << Fixed(r.ms_per_scan, 2) << (r.name == kRefine ? " (wall)" : "") << " | "
+       << Fixed(r.real_time_factor, 1) << "x |\n";
+  }
+  os << "\nBag `" << req.bag << "`, ground truth `" << req.gt << "`. ATE: translation RMSE after "
+     << AlignName(rows)
+     << " alignment; RPE: 1-frame translation RMSE; along-axis max: largest error along the "
+        "principal axis of the ground truth; end-point: error of the last pose. ms/scan: median "
+        "CPU time per scan of the odometry (refine: wall time of the batch solve divided by the "
+        "scans); real-time factor: sequence duration / that time.\n";
+  return os.str();
+}
+
+void PrintTable(const std::vector<Row>& rows) {
+  std::printf("\n  %-30s %9s %9s %12s %9s %9s %8s\n", "variant", "ATE [m]", "RPE [m]",
+              "axis max [m]", "end [m]", "ms/scan", "speed");
+  for (const Row& r : rows) {
+    if (!r.ok()) {
+      std::printf("  %-30s failed (exit %d)\n", r.label.c_str(), r.exit_code);
+      continue;
+    }
+    std::printf("  %-30s %9.4f %9.4f %12.4f %9.4f %9.2f %7.1fx\n", r.label.c_str(),
+                r.eval->ape_m.rmse, r.eval->rpe.trans_m.rmse, r.eval->along_axis.max_abs_m,
+                r.eval->end_point_error_m, r.ms_per_scan, r.real_time_factor);
+  }
+  std::printf("\n  ATE: RMSE after %s alignment; RPE: 1-frame translation RMSE; axis max: largest\n"
+              "  error along the tunnel axis; end: end-point error. ms/scan: median CPU time per\n"
+              "  scan (refine: wall time of the batch solve per scan); speed: real-time factor.\n",
+              AlignName(rows).c_str());
+}
+
+nlohmann::json StatsJson(const ErrorStats& s) {
+  return {{"rmse", Num(s.rmse)}, {"mean", Num(s.mean)}, {"median", Num(s.median)},
+          {"std", Num(s.std)},   {"min", Num(s.min)},   {"max", Num(s.max)}};
+}
+
+nlohmann::json RowJson(const CompareRequest& req, const Row& r,
+                       const std::vector<std::string>& overrides) {
+  nlohmann::json j = {{"variant", r.name},
+                      {"label", r.label},
+                      {"status", r.ok() ? "ok" : "failed"},
+                      {"exit_code", r.exit_code},
+                      {"dir", req.out_dir + "/" + r.name},
+                      {"overrides", overrides},
+                      {"wall_s", Num(r.wall_s)}};
+  if (!r.init.empty()) j["init"] = r.init;
+  if (!r.error.empty()) j["error"] = r.error;
+  if (!r.ok()) return j;
+  const EvalResult& e = *r.eval;
+  j["scans"] = r.scans;
+  j["ate_rmse_m"] = Num(e.ape_m.rmse);
+  j["rpe_rmse_m"] = Num(e.rpe.trans_m.rmse);
+  j["axis_max_m"] = Num(e.along_axis.max_abs_m);
+  j["end_point_m"] = Num(e.end_point_error_m);
+  j["ms_per_scan"] = Num(r.ms_per_scan);
+  j["ms_per_scan_kind"] = r.name == kRefine ? "wall, batch solve / scans" : "CPU, median";
+  j["real_time_factor"] = Num(r.real_time_factor);
+  j["eval"] = {{"matched", e.matched},
+               {"align", AlignModeName(e.align)},
+               {"ape", StatsJson(e.ape_m)},
+               {"ape_rot_deg", StatsJson(e.ape_rot_deg)},
+               {"rpe", StatsJson(e.rpe.trans_m)},
+               {"rpe_rot_deg", StatsJson(e.rpe.rot_deg)},
+               {"end_point_error", Num(e.end_point_error_m)},
+               {"along_axis",
+                {{"rmse", Num(e.along_axis.rmse_m)}, {"max", Num(e.along_axis.max_abs_m)}}},
+               {"warnings", e.warnings}};
+  return j;
+}
+
+// ---------------------------------------------------------------------------
+// Plots
+// ---------------------------------------------------------------------------
+
+struct PlotReport {
+  std::string status = "not requested";  // "ok", "skipped", "partial"
+  std::string message;
+  std::vector<std::string> files;
+};
+
+const Row* FindRow(const std::vector<Row>& rows, const std::string& name) {
+  for (const Row& r : rows)
+    if (r.name == name && r.ok()) return &r;
+  return nullptr;
+}
+
+// Draws OUT/plots/{trajectories,rv_profile,compare_bars}.{png,pdf}.
+PlotReport DrawPlots(const CompareRequest& req, const std::vector<Row>& rows) {
+  PlotReport report;
+  const std::string dir = req.out_dir + "/plots/";
+  std::vector<std::pair<std::string, std::vector<std::string>>> jobs;
+  std::vector<std::string> traj = {"trajectories", "--gt", req.gt, "--align", "se3", "--out", dir};
+  for (const Row& r : rows)
+    if (r.ok()) traj.insert(traj.end(), {"--run", r.name + "=" + req.out_dir + "/" + r.name});
+  jobs.push_back({"trajectories", traj});
+  if (FindRow(rows, "ieskf_rv_on"))
+    jobs.push_back({"rv_profile", {"rv-profile", "--run", req.out_dir + "/ieskf_rv_on", "--gt",
+                                   req.gt, "--out", dir}});
+  jobs.push_back({"compare_bars", {"compare-bars", "--table", req.out_dir + "/compare.csv",
+                                   "--out", dir}});
+  std::vector<std::string> failures;
+  for (const auto& [kind, args] : jobs) {
+    const PlotResult p = RunPlotScript(args);
+    if (!p.ran) {
+      report.status = "skipped";
+      report.message = p.message;
+      return report;
+    }
+    if (!p.ok) {
+      failures.push_back(kind + ": " + p.message);
+      continue;
+    }
+    for (const char* ext : {".png", ".pdf"}) report.files.push_back(dir + kind + ext);
+  }
+  report.status = failures.empty() ? "ok" : "partial";
+  for (const auto& f : failures) report.message += (report.message.empty() ? "" : "; ") + f;
+  return report;
+}
+
+void PrintPlotReport(const CompareRequest& req, const PlotReport& plots) {
+  if (plots.status == "skipped") {
+    std::printf("  plots skipped: %s\n", plots.message.c_str());
+    return;
+  }
+  if (plots.status == "partial")
+    std::fprintf(stderr, "rvlio %s: warning: some plots failed: %s\n", kName,
+                 plots.message.c_str());
+  if (plots.files.empty()) return;
+  std::printf("  plots:  %s/plots/ (", req.out_dir.c_str());
+  for (size_t i = 0; i < plots.files.size(); i += 2)
+    std::printf("%s%s", i ? ", " : "", fs::path(plots.files[i]).stem().c_str());
+  std::printf("; .png and .pdf)\n");
+}
+
+Status WriteJson(const CompareRequest& req, const std::vector<Row>& rows,
+                 const PlotReport& plots) {
+  nlohmann::json j;
+  j["version"] = RVLIO_VERSION;
+  j["command"] = kName;
+  j["bag"] = req.bag;
+  j["gt"] = req.gt;
+  j["config"] = req.config_files;
+  j["set"] = req.overrides;
+  j["align"] = AlignName(rows);
+  j["variants"] = nlohmann::json::array();
+  const std::vector<Variant> variants = StandardVariants();
+  for (const Row& r : rows) {
+    std::vector<std::string> overrides;
+    for (const Variant& v : variants)
+      if (v.name == r.name) overrides = v.overrides;
+    j["variants"].push_back(RowJson(req, r, overrides));
+  }
+  j["plots"] = {{"status", plots.status}, {"message", plots.message}, {"files", plots.files}};
+  return WriteFileAtomically(req.out_dir + "/compare.json", j.dump(2) + "\n");
+}
+
+}  // namespace
+
+int CompareSteps(const CompareRequest& request) {
+  return static_cast<int>(StandardVariants().size()) + (request.refine ? 1 : 0);
+}
+
+int RunCompare(const CompareRequest& req) {
+  Trajectory truth;
+  if (int rc = CheckInputs(req, &truth); rc != 0) return rc;
+  Steps steps(req);
+  std::vector<Row> rows;
+  for (const Variant& v : StandardVariants()) rows.push_back(RunVariant(req, v, truth, &steps));
+  if (const Row* best = BestRow(rows); req.refine && best != nullptr) {
+    const Row start = *best;  // rows grows below
+    rows.push_back(RunRefine(req, start, truth, &steps));
+  }
+  const bool any_ok = BestRow(rows) != nullptr;
+  for (const auto& [file, text] : {std::pair<std::string, std::string>{"compare.csv", CsvText(rows)},
+                                   {"compare.md", MarkdownText(req, rows)}}) {
+    if (Status s = WriteFileAtomically(req.out_dir + "/" + file, text); !s.ok())
+      return Fail(kName, s.message(), 1);
+  }
+  PrintTable(rows);
+  PlotReport plots;
+  if (req.plots && any_ok) plots = DrawPlots(req, rows);
+  if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kName, s.message(), 1);
+  std::printf("\n  tables: %s/compare.{csv,md,json}; runs: %s/<variant>/\n", req.out_dir.c_str(),
+              req.out_dir.c_str());
+  if (req.plots) PrintPlotReport(req, plots);
+  if (!any_ok) return Fail(kName, "every variant failed (see the table)", 1);
+  return 0;
+}
+
+}  // namespace rvlio::cli

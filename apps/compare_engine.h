@@ -1,0 +1,35 @@
+#pragma once
+// `rvlio compare` as a function, so that `rvlio demo` runs it in-process: the
+// standard variants on one sequence (IESKF and smoother, RV off and on), then
+// `refine` from the best of them, each evaluated against the ground truth,
+// tabulated (OUT/compare.csv, .md, .json) and plotted (OUT/plots/).
+#include <string>
+#include <vector>
+
+namespace rvlio::cli {
+
+struct CompareRequest {
+  std::string bag;
+  std::string gt;       // ground-truth trajectory (TUM or KITTI, as `rvlio eval`)
+  std::string out_dir;  // OUT/<variant>/ for each run
+  std::vector<std::string> config_files;
+  std::vector<std::string> overrides;  // --set key=value, before each variant's own
+  bool refine = true;
+  bool plots = true;
+  bool quiet = false;  // no step lines; the table and the summary lines remain
+  // Step numbering of the progress lines, so that `demo` can continue its own
+  // ("[k/n] ..."): the first variant is step first_step of total_steps
+  // (total_steps 0: compare's own count).
+  int first_step = 1;
+  int total_steps = 0;
+};
+
+// Number of steps (runs) compare makes for `request`: 4 variants + refine.
+int CompareSteps(const CompareRequest& request);
+
+// Runs the comparison; returns the exit status (0: at least one variant ran,
+// 1: every variant failed, 2: bad input before any run, with one line on
+// stderr and nothing written).
+int RunCompare(const CompareRequest& request);
+
+}  // namespace rvlio::cli
