@@ -119,10 +119,12 @@ struct Request {
 Status WriteOutputs(const Request& req, const OdometryOptions& options, const RefineResult& res,
                     const SensorReaderStats& reader_stats, int64_t raw_points, double read_s,
                     double wall_s) {
-  namespace fs = std::filesystem;
-  const fs::path dir(req.out_dir);
-  if (Status s = WriteTum((dir / "trajectory.tum").string(), res.trajectory); !s.ok()) return s;
-  if (Status s = WriteMapPcd((dir / "map.pcd").string(), res.map_points); !s.ok()) return s;
+  OutputStage stage(req.out_dir);  // all outputs or none (run_pipeline.h)
+  if (Status s = stage.Open(); !s.ok()) return s;
+  if (Status s = WriteTum(stage.Path("trajectory.tum"), res.trajectory); !s.ok())
+    return stage.Explain(s);
+  if (Status s = WriteMapPcd(stage.Path("map.pcd"), res.map_points); !s.ok())
+    return stage.Explain(s);
   nlohmann::json j;
   j["version"] = RVLIO_VERSION;
   j["command"] = "refine";
@@ -146,7 +148,9 @@ Status WriteOutputs(const Request& req, const OdometryOptions& options, const Re
   j["peak_memory_mb"] = PeakMemoryMb();
   j["stats"] = StatsJson(res.stats, reader_stats, raw_points);
   j["warnings"] = res.warnings;
-  return WriteFileAtomically((dir / "summary.json").string(), j.dump(2) + "\n");
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), j.dump(2) + "\n"); !s.ok())
+    return stage.Explain(s);
+  return stage.Commit();
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // rvlio: LiDAR-inertial odometry for weak-feature environments.
 // This file only dispatches to the subcommands (apps/cmd_*.cpp).
+#include <csignal>
 #include <cstring>
 #include <iostream>
 
@@ -44,6 +45,10 @@ void PrintHelp() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A write past a file-size limit (ulimit -f) then fails with EFBIG and the
+  // writers discard their temporary files, instead of the process dying with
+  // a half-written file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
       !std::strcmp(argv[1], "help")) {
     PrintHelp();

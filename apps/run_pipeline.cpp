@@ -3,8 +3,10 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 
@@ -83,19 +85,23 @@ int RvActiveScans(const std::vector<ScanResult>& results) {
 
 struct RunData {
   std::vector<ScanResult> results;
+  std::vector<double> rss_mb;  // resident memory when each result came out
   TimeNs first_ns = -1, last_ns = -1;
   double wall_s = 0.0;
 };
 
 Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const Odometry& odo,
                     const SensorReaderStats& reader_stats, const RunData& data,
-                    const std::string& layout, RunOutcome* outcome) {
-  namespace fs = std::filesystem;
-  const fs::path dir(req.out_dir);
-  if (Status s = WriteTum((dir / "trajectory.tum").string(), ToTrajectory(data.results)); !s.ok())
-    return s;
-  if (Status s = WriteMapPcd((dir / "map.pcd").string(), odo.MapPoints()); !s.ok()) return s;
-  if (Status s = WriteScansCsv((dir / "scans.csv").string(), data.results); !s.ok()) return s;
+                    const std::string& layout, const std::vector<std::string>& warnings,
+                    RunOutcome* outcome) {
+  OutputStage stage(req.out_dir);
+  if (Status s = stage.Open(); !s.ok()) return s;
+  if (Status s = WriteTum(stage.Path("trajectory.tum"), ToTrajectory(data.results)); !s.ok())
+    return stage.Explain(s);
+  if (Status s = WriteMapPcd(stage.Path("map.pcd"), odo.MapPoints()); !s.ok())
+    return stage.Explain(s);
+  if (Status s = WriteScansCsv(stage.Path("scans.csv"), data.results, data.rss_mb); !s.ok())
+    return stage.Explain(s);
   const TimingStats t = ComputeTimingStats(data.results);
   const double duration_s =
       data.first_ns >= 0 ? NsToSeconds(data.last_ns - data.first_ns) : 0.0;
@@ -116,11 +122,39 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   j["peak_memory_mb"] = PeakMemoryMb();
   j["rv_active_scans"] = RvActiveScans(data.results);
   j["stats"] = StatsJson(odo.stats(), reader_stats);
-  j["warnings"] = odo.warnings();
+  j["warnings"] = warnings;
   outcome->scans = static_cast<int>(data.results.size());
   outcome->median_ms = t.median_ms;
   outcome->real_time_factor = j["real_time_factor"];
-  return WriteFileAtomically((dir / "summary.json").string(), j.dump(2) + "\n");
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), j.dump(2) + "\n"); !s.ok())
+    return stage.Explain(s);
+  return stage.Commit();
+}
+
+// Why a run produced no scan at all, naming the topic and the keys to look at.
+std::string NoScanMessage(const RunRequest& req, const OdometryOptions& o,
+                          const SensorReaderStats& r) {
+  const std::string topic = "lidar.topic '" + o.lidar.topic + "' in " + req.bag;
+  if (r.scans == 0 && r.empty_scans > 0) {
+    char range[96];
+    std::snprintf(range, sizeof(range), "lidar.min_range %g m, lidar.max_range %g m",
+                  o.lidar.min_range, o.lidar.max_range);
+    return "every one of the " + std::to_string(r.empty_scans) + " scans on " + topic +
+           " is empty after dropping " + std::to_string(r.invalid_points) + " invalid and " +
+           std::to_string(r.out_of_range_points) + " out-of-range points (" + range + ")";
+  }
+  if (r.imu_samples == 0)
+    return "no usable IMU sample on imu.topic '" + o.imu.topic + "' in " + req.bag +
+           " (see summary.json stats.reader)";
+  return "no scan could be processed from " + req.bag +
+         " (see summary.json stats: IMU coverage, points per scan)";
+}
+
+// A number in its shortest form ("0.1", "2e-05").
+std::string Short(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
 }
 
 }  // namespace
@@ -130,6 +164,9 @@ nlohmann::json ReaderStatsJson(const SensorReaderStats& r) {
           {"imu_samples", r.imu_samples},
           {"empty_scans", r.empty_scans},
           {"invalid_points", r.invalid_points},
+          {"out_of_range_points", r.out_of_range_points},
+          {"imu_invalid", r.imu_invalid},
+          {"scans_before_first_imu", r.scans_before_first_imu},
           {"imu_duplicates", r.imu_duplicates},
           {"imu_non_monotonic", r.imu_non_monotonic},
           {"imu_gaps", r.imu_gaps},
@@ -140,6 +177,87 @@ double PeakMemoryMb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KB on Linux
+}
+
+double CurrentMemoryMb() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (f == nullptr) return 0.0;
+  long total_pages = 0, resident_pages = 0;
+  const int n = std::fscanf(f, "%ld %ld", &total_pages, &resident_pages);
+  std::fclose(f);
+  if (n != 2) return 0.0;
+  return static_cast<double>(resident_pages) * static_cast<double>(::sysconf(_SC_PAGESIZE)) /
+         (1024.0 * 1024.0);
+}
+
+OutputStage::~OutputStage() {
+  if (stage_dir_.empty()) return;
+  std::error_code ec;
+  std::filesystem::remove_all(stage_dir_, ec);
+}
+
+Status OutputStage::Open() {
+  stage_dir_ = (std::filesystem::path(out_dir_) / (".rvlio_stage." + std::to_string(::getpid())))
+                   .string();
+  std::error_code ec;
+  std::filesystem::remove_all(stage_dir_, ec);  // left by a killed run with our pid
+  if (!std::filesystem::create_directory(stage_dir_, ec)) {
+    const std::string why = ec.message();
+    stage_dir_.clear();
+    return Status::InvalidInput("cannot write to output folder " + out_dir_ + ": " + why);
+  }
+  return Status::Ok();
+}
+
+std::string OutputStage::Path(const std::string& name) {
+  names_.push_back(name);
+  return (std::filesystem::path(stage_dir_) / name).string();
+}
+
+Status OutputStage::Commit() {
+  for (const std::string& name : names_) {
+    const std::string from = (std::filesystem::path(stage_dir_) / name).string();
+    const std::string to = (std::filesystem::path(out_dir_) / name).string();
+    if (std::rename(from.c_str(), to.c_str()) != 0)
+      return Status::InvalidInput("cannot move " + name + " into " + out_dir_ + ": " +
+                                  std::strerror(errno));
+  }
+  return Status::Ok();
+}
+
+Status OutputStage::Explain(const Status& s) const {
+  std::string message = s.message();
+  const std::string staged = stage_dir_ + "/";
+  const std::string final_dir = (std::filesystem::path(out_dir_) / "").string();
+  for (size_t at = message.find(staged); at != std::string::npos; at = message.find(staged, at))
+    message.replace(at, staged.size(), final_dir);
+  return s.code() == StatusCode::kInternal ? Status::Internal(message)
+                                           : Status::InvalidInput(message);
+}
+
+std::vector<std::string> ReaderWarnings(const SensorReaderStats& r, const LidarOptions& lidar,
+                                        const ImuOptions& imu) {
+  std::vector<std::string> w;
+  const std::string scans_on = " on lidar.topic '" + lidar.topic + "'";
+  const std::string imu_on = " on imu.topic '" + imu.topic + "'";
+  auto add = [&w](int64_t n, const std::string& text) {
+    if (n > 0) w.push_back(std::to_string(n) + text);
+  };
+  add(r.empty_scans, " scans" + scans_on + " had no valid point in range and were skipped");
+  add(r.scans_before_first_imu,
+      " scans" + scans_on + " came before the first IMU sample and were skipped");
+  add(r.imu_invalid, " IMU samples" + imu_on + " with NaN/Inf values were dropped");
+  add(r.imu_duplicates, " IMU samples" + imu_on + " repeat the previous stamp and were dropped");
+  add(r.imu_non_monotonic,
+      " IMU samples" + imu_on + " are older than the previous one and were dropped");
+  if (r.imu_gaps > 0) {
+    char text[160];
+    std::snprintf(text, sizeof(text), " (longest %.3f s) were bridged by the estimator",
+                  r.imu_max_gap_s);
+    w.push_back("IMU gaps longer than imu.max_gap " + Short(imu.max_gap) + " s" + imu_on + ": " +
+                std::to_string(r.imu_gaps) + text);
+  }
+  return w;
 }
 
 bool PrepareOutputDir(const std::string& command, const std::string& dir) {
@@ -188,19 +306,24 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     if (*m == SensorMessage::kImu) (*odo)->AddImu(imu);
     else (*odo)->AddScan(std::move(scan));
     (*odo)->Poll(&data.results);
+    if (data.rss_mb.size() < data.results.size())
+      data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
     progress.Update(static_cast<int>(data.results.size()), t);
   }
   (*odo)->Finish(&data.results);
+  data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
   data.wall_s = SecondsSince(t0);
-  const Status written = WriteOutputs(req, *options, **odo, (*reader)->stats(), data,
-                                      (*reader)->lidar_layout(), outcome);
-  for (const auto& w : (*odo)->warnings()) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
+  const SensorReaderStats& reader_stats = (*reader)->stats();
+  std::vector<std::string> warnings = ReaderWarnings(reader_stats, options->lidar, options->imu);
+  for (const auto& w : (*odo)->warnings()) warnings.push_back(w);
+  const Status written = WriteOutputs(req, *options, **odo, reader_stats, data,
+                                      (*reader)->lidar_layout(), warnings, outcome);
+  // A failed run says one line (the warnings are in summary.json when written).
   if (!written.ok()) return Fail("run", written.message(), written.exit_code());
   if (!read_error.ok())
     return Fail("run", read_error.message() + " (outputs hold the scans read before it)");
-  if (data.results.empty())
-    return Fail("run", "no scan could be processed from " + req.bag +
-                           " (see summary.json stats: IMU coverage, points per scan)");
+  if (data.results.empty()) return Fail("run", NoScanMessage(req, *options, reader_stats));
+  for (const auto& w : warnings) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
   return 0;
 }
 

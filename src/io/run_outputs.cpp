@@ -1,9 +1,8 @@
 #include "rvlio/io/run_outputs.h"
 
 #include <algorithm>
-#include <cerrno>
+#include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <sstream>
 
 #include <pcl/io/pcd_io.h>
@@ -22,6 +21,8 @@ std::string EmptyPcd() {
          "DATA binary\n";
 }
 
+constexpr size_t kPcdBlockPoints = 1 << 15;  // points per Append of map.pcd
+
 // Absolute stamps need all nine decimals; the stream's precision is for the rest.
 std::string FormatSeconds(TimeNs t_ns) {
   char buf[32];
@@ -32,36 +33,41 @@ std::string FormatSeconds(TimeNs t_ns) {
 }  // namespace
 
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world) {
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  cloud.reserve(p_world.size());
-  for (const auto& p : p_world)
-    cloud.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                                  static_cast<float>(p.z())));
-  cloud.width = static_cast<uint32_t>(cloud.size());
-  cloud.height = 1;
-  cloud.is_dense = true;
-  const std::string tmp = path + ".tmp";
-  pcl::PCDWriter writer;
-  if (cloud.empty() || writer.writeBinary(tmp, cloud) != 0) {
-    std::remove(tmp.c_str());
-    if (cloud.empty()) return WriteFileAtomically(path, EmptyPcd());
-    return Status::InvalidInput("cannot write " + path);
+  // PCL's own writer maps the file into memory after fallocate and throws on
+  // failure; a full disk must instead be a clean error that leaves no half
+  // file. So PCL only makes the header and the points go through the atomic
+  // writer, byte for byte what PCDWriter::writeBinary produces.
+  const pcl::PointCloud<pcl::PointXYZ> no_points;  // the header needs only the fields
+  const std::string header =
+      p_world.empty() ? EmptyPcd()
+                      : pcl::PCDWriter::generateHeader(no_points, static_cast<int>(p_world.size())) +
+                            "DATA binary\n";
+  AtomicFileWriter writer;
+  if (Status s = writer.Open(path); !s.ok()) return s;
+  if (Status s = writer.Append(header); !s.ok()) return s;
+  std::string block;
+  block.reserve(kPcdBlockPoints * 3 * sizeof(float));
+  for (size_t i = 0; i < p_world.size(); ++i) {
+    const float xyz[3] = {static_cast<float>(p_world[i].x()), static_cast<float>(p_world[i].y()),
+                          static_cast<float>(p_world[i].z())};
+    block.append(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+    if (block.size() >= kPcdBlockPoints * sizeof(xyz) || i + 1 == p_world.size()) {
+      if (Status s = writer.Append(block); !s.ok()) return s;
+      block.clear();
+    }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    return Status::InvalidInput("cannot write " + path + ": " + why);
-  }
-  return Status::Ok();
+  return writer.Commit();
 }
 
-Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results) {
+Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
+                     const std::vector<double>& rss_mb) {
   std::ostringstream os;
   os.precision(9);
   os << "t,status,raw_points,points,constraints,iterations,rv_active,n_alpha_x,n_alpha_y,"
         "n_alpha_z,scv,coplanar,repaired,K,rv_iterations,coplanar_fraction,localizability,"
-        "ms,x,y,z,acc_x,acc_y,acc_z\n";
-  for (const ScanResult& r : results) {
+        "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb\n";
+  for (size_t i = 0; i < results.size(); ++i) {
+    const ScanResult& r = results[i];
     const RvReport& v = r.rv;
     os << FormatSeconds(r.t_ns) << ',' << ScanStatusName(r.status) << ',' << r.raw_points << ','
        << r.downsampled_points << ',' << r.constraints << ',' << r.iterations << ','
@@ -70,7 +76,8 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
        << ',' << v.K << ',' << v.iterations << ',' << v.coplanar_fraction << ','
        << v.localizability << ',' << r.ms << ',' << r.T_world_imu.t.x() << ','
        << r.T_world_imu.t.y() << ',' << r.T_world_imu.t.z() << ',' << r.mean_acc_imu.x() << ','
-       << r.mean_acc_imu.y() << ',' << r.mean_acc_imu.z() << '\n';
+       << r.mean_acc_imu.y() << ',' << r.mean_acc_imu.z() << ','
+       << (i < rss_mb.size() ? rss_mb[i] : std::nan("")) << '\n';
   }
   return WriteFileAtomically(path, os.str());
 }

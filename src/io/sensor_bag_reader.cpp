@@ -145,6 +145,7 @@ class RosbagSensorReader final : public SensorBagReader {
       return false;
     }
     ++stats_.scans;
+    if (!have_imu_) ++stats_.scans_before_first_imu;
     *out = std::move(scan).value();
     return true;
   }

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <exception>
 #include <limits>
+#include <memory>
 
 #include <rosbag/bag.h>
 #include <sensor_msgs/Imu.h>
@@ -121,17 +122,19 @@ class RosbagSensorWriter final : public SensorBagWriter {
   explicit RosbagSensorWriter(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp") {}
   ~RosbagSensorWriter() override {
     if (!open_) return;
-    try {
-      bag_.close();
-    } catch (const std::exception&) {
-    }
+    std::string why;
+    (void)CloseBag(&why);
     std::remove(tmp_.c_str());
   }
 
   Status Init() {
+    bag_ = std::make_unique<rosbag::Bag>();
     try {
-      bag_.open(tmp_, rosbag::bagmode::Write);
+      bag_->open(tmp_, rosbag::bagmode::Write);
     } catch (const std::exception& e) {
+      std::string ignored;
+      (void)CloseBag(&ignored);  // a half-opened Bag may still hold the file
+      std::remove(tmp_.c_str());
       return Status::InvalidInput("cannot write bag '" + tmp_ + "' (" + e.what() + ")");
     }
     open_ = true;
@@ -173,11 +176,9 @@ class RosbagSensorWriter final : public SensorBagWriter {
   Status Close() override {
     if (!open_) return Status::Internal("bag '" + path_ + "' is already closed");
     open_ = false;
-    try {
-      bag_.close();
-    } catch (const std::exception& e) {
+    if (std::string why; !CloseBag(&why)) {
       std::remove(tmp_.c_str());
-      return Status::InvalidInput("cannot finish bag '" + tmp_ + "' (" + e.what() + ")");
+      return Status::InvalidInput("cannot write bag '" + path_ + "' (" + why + ")");
     }
     if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
       const std::string why = std::strerror(errno);
@@ -191,15 +192,31 @@ class RosbagSensorWriter final : public SensorBagWriter {
   template <typename Msg>
   Status Write(const std::string& topic, const ros::Time& time, const Msg& msg) {
     try {
-      bag_.write(topic, time, msg);
+      bag_->write(topic, time, msg);
     } catch (const std::exception& e) {
-      return Status::InvalidInput("cannot write to bag '" + tmp_ + "' (" + e.what() + ")");
+      return Status::InvalidInput("cannot write bag '" + path_ + "' (" + e.what() + ")");
     }
     return Status::Ok();
   }
 
+  // Closes the bag. When that fails (disk full, file-size limit) the
+  // rosbag::Bag is abandoned rather than destroyed: its destructor retries the
+  // failed write and throws from a destructor, which terminates the process.
+  // Its file is closed when the process exits; the caller removes it.
+  bool CloseBag(std::string* why) {
+    try {
+      bag_->close();
+      bag_.reset();
+      return true;
+    } catch (const std::exception& e) {
+      *why = e.what();
+      (void)bag_.release();
+      return false;
+    }
+  }
+
   std::string path_, tmp_;
-  rosbag::Bag bag_;
+  std::unique_ptr<rosbag::Bag> bag_;
   bool open_ = false;
 };
 

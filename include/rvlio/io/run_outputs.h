@@ -11,13 +11,14 @@
 
 namespace rvlio {
 
-// Binary PCD (x y z float32) through PCL, written to a temporary file and
-// renamed into place.
+// Binary PCD (x y z float32; header made by PCL), written atomically.
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
 
-// One row per scan: time, status, point and constraint counts, the RV report
-// and the processing time.
-Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results);
+// One row per scan: time, status, point and constraint counts, the RV report,
+// the processing time and `rss_mb[i]`, the process's resident memory (MB) when
+// scan i was done (nan where rss_mb has no entry).
+Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
+                     const std::vector<double>& rss_mb = {});
 
 // The estimated trajectory (IMU in world at each scan end).
 Trajectory ToTrajectory(const std::vector<ScanResult>& results);

@@ -26,6 +26,7 @@ struct SensorReaderStats {
   int64_t imu_duplicates = 0;         // samples with the stamp of the previous one (dropped)
   int64_t imu_non_monotonic = 0;      // samples older than the previous one (dropped)
   int64_t imu_gaps = 0;               // gaps longer than imu.max_gap
+  int64_t scans_before_first_imu = 0;  // scans delivered before any IMU sample (LiDAR started first)
   double imu_max_gap_s = 0.0;
 };
 

@@ -1,0 +1,138 @@
+// The rest of the bad-input matrix: configuration files with unknown keys,
+// wrong types and out-of-range values, output folders that cannot be written
+// (in ways that stop root too), and a full disk simulated with a file-size
+// limit (RLIMIT_FSIZE, which binds root as well): a failed write exits 2 with
+// one line naming the file, leaves no half or temporary file, and leaves the
+// complete outputs of an earlier run in that folder untouched.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "badinput_util.h"
+
+namespace rvlio::badinput {
+namespace {
+
+namespace fs = std::filesystem;
+
+class BadConfigOutputTest : public SimulatedSuite {
+ protected:
+  static std::string WriteConfig(const std::string& name, const std::string& text) {
+    const std::string path = dir_ + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+  }
+  // A copy of the clean run's outputs in a new folder: "the earlier run".
+  static std::string EarlierRun(const std::string& name) {
+    const std::string dir = dir_ + "/" + name;
+    fs::create_directories(dir);
+    for (const auto& f : OutputNames()) fs::copy_file(Clean(f), dir + "/" + f);
+    return dir;
+  }
+  static void ExpectUntouched(const std::string& dir) {
+    EXPECT_EQ(Entries(dir), OutputNames()) << "no half, temporary or staging file may stay";
+    for (const auto& f : OutputNames())
+      EXPECT_EQ(ReadFile(dir + "/" + f), ReadFile(Clean(f))) << f;
+  }
+};
+
+TEST_F(BadConfigOutputTest, ConfigFileErrorsNameKeyAndFileAndStopBeforeOutput) {
+  struct Case {
+    std::string file, text, line;
+  };
+  const std::vector<Case> cases = {
+      {"unknown.yaml", "rv:\n  epss0: 0.3\n", "rv.epss0: unknown key in FILE:2 (did you mean rv.eps0?)"},
+      {"type.yaml", "lidar:\n  max_range: far\n", "lidar.max_range in FILE:2: expected a number, got 'far'"},
+      {"range.yaml", "lidar:\n  min_range: -1\n", "FILE:2: lidar.min_range = -1 is out of range [0, 1000]"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = WriteConfig(c.file, c.text);
+    std::string line = c.line;
+    line.replace(line.find("FILE"), 4, path);
+    const std::string out = dir_ + "/out_config";
+    const ToolRun r = Run(Bag(), out, "--config " + path);
+    EXPECT_EQ(r.exit_code, 2) << c.file << ": " << r.err;
+    EXPECT_EQ(r.err, "rvlio run: error: " + line + "\n") << c.file;
+    EXPECT_FALSE(fs::exists(out)) << c.file;
+  }
+}
+
+TEST_F(BadConfigOutputTest, OutputFolderThatCannotBeWrittenStopsEvenForRoot) {
+  // A regular file where a folder is needed: mkdir fails with ENOTDIR/EEXIST
+  // whatever the user's privileges (chmod would not stop root).
+  const std::string file = WriteConfig("a_file", "keep me\n");
+  const ToolRun below = Run(Bag(), file + "/out");
+  EXPECT_EQ(below.exit_code, 2) << below.err;
+  EXPECT_EQ(below.err, "rvlio run: error: cannot create output folder " + file +
+                           "/out: Not a directory\n");
+  const ToolRun itself = Run(Bag(), file);
+  EXPECT_EQ(itself.exit_code, 2) << itself.err;
+  EXPECT_EQ(Lines(itself.err), 1) << itself.err;
+  EXPECT_EQ(itself.err.rfind("rvlio run: error: cannot create output folder " + file + ": ", 0), 0u)
+      << itself.err;
+  EXPECT_EQ(ReadFile(file), "keep me\n");
+}
+
+TEST_F(BadConfigOutputTest, DiskFullDuringMapWriteLeavesTheEarlierRunIntact) {
+  ASSERT_GT(fs::file_size(Clean("map.pcd")), 60000u);
+  ASSERT_LT(fs::file_size(Clean("trajectory.tum")), 40000u);
+  const std::string out = EarlierRun("full_map");
+  const ToolRun r = RunToolWith("run --bag " + Bag() + " --config " + Sensors() +
+                                    " --set rv.enabled=false --out " + out,
+                                dir_, "", "", 40000);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err, "rvlio run: error: cannot write '" + out + "/map.pcd': File too large\n");
+  // trajectory.tum of the new run was complete, but it must not be mixed
+  // with the earlier run's map: the folder is exactly as before.
+  ExpectUntouched(out);
+}
+
+TEST_F(BadConfigOutputTest, DiskFullDuringTrajectoryWriteLeavesNoFile) {
+  const std::string out = dir_ + "/full_fresh";
+  const ToolRun r = RunToolWith("run --bag " + Bag() + " --config " + Sensors() + " --out " + out,
+                                dir_, "", "", 1000);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err, "rvlio run: error: cannot write '" + out + "/trajectory.tum': File too large\n");
+  EXPECT_TRUE(Entries(out).empty()) << Entries(out).front();
+  // The same folder takes the next run that has room.
+  const ToolRun ok = Run(Bag(), out);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_EQ(Entries(out), OutputNames());
+  EXPECT_EQ(ReadFile(out + "/trajectory.tum"), ReadFile(Clean("trajectory.tum")));
+}
+
+TEST_F(BadConfigOutputTest, DiskFullWhileSimulatingLeavesNoHalfBag) {
+  const std::string out = dir_ + "/full_sim";
+  for (rlim_t limit : {4000, 2000000}) {  // fails at the first chunk / in the middle
+    const ToolRun r = RunToolWith("simulate --preset tunnel --duration 2 --set lidar.columns=512 "
+                                  "--out " + out, dir_, "", "", limit);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    // Names the bag (its temporary name when creating the file already failed).
+    EXPECT_EQ(r.err.rfind("rvlio simulate: error: cannot write bag '" + out + "/tunnel.bag", 0), 0u)
+        << r.err;
+    EXPECT_NE(r.err.find("Error writing to file"), std::string::npos) << r.err;
+    EXPECT_TRUE(Entries(out).empty()) << Entries(out).front();
+  }
+}
+
+TEST_F(BadConfigOutputTest, DiskFullDuringRefineLeavesTheEarlierRunIntact) {
+  const std::string out = dir_ + "/full_refine";
+  fs::create_directories(out);
+  for (const char* f : {"trajectory.tum", "map.pcd", "summary.json"})
+    fs::copy_file(Clean(f), out + "/" + f);
+  const ToolRun r = RunToolWith("refine --bag " + Bag() + " --config " + Sensors() + " --init " +
+                                    Clean("trajectory.tum") +
+                                    " --set smoother.refine_rounds=1 --out " + out,
+                                dir_, "", "", 20000);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.substr(r.err.find("rvlio refine: error")),
+            "rvlio refine: error: cannot write '" + out + "/map.pcd': File too large\n");
+  EXPECT_EQ(Entries(out), (std::vector<std::string>{"map.pcd", "summary.json", "trajectory.tum"}));
+  for (const char* f : {"trajectory.tum", "map.pcd", "summary.json"})
+    EXPECT_EQ(ReadFile(out + "/" + f), ReadFile(Clean(f))) << f;
+}
+
+}  // namespace
+}  // namespace rvlio::badinput
