@@ -1,15 +1,119 @@
+// rvlio ablate: a grid of sequences x variants x parameters, one `rvlio run`
+// process per cell, resumable, with a summary over seeds. The grid format is
+// described in ablate_grid.h and workflow/README.md; --plan, --data, --cell
+// and --summarize are the machine interface of workflow/Snakefile.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "ablate_grid.h"
+#include "ablate_runner.h"
+#include "ablate_summary.h"
 #include "commands.h"
 #include "common_options.h"
+#include "run_pipeline.h"
+#include "rvlio/io/atomic_file.h"
 
 namespace rvlio::cli {
+namespace {
+
+constexpr const char* kName = "ablate";
+constexpr int kMaxJobs = 256;
+
+CommandSpec AblateSpec() {
+  return {kName,
+          "Runs a grid of sequences x variants x parameters: each cell is one `rvlio run`\n"
+          "process, evaluated against ground truth, recorded in OUT/cells/<id>/cell.json.\n"
+          "Resumable: finished cells (same configuration hash) are skipped. Writes\n"
+          "OUT/summary.csv (one row per cell), OUT/table.csv and OUT/table.md (mean and std\n"
+          "over seeds) and plots. A failing cell is recorded, not fatal (exit status 0).",
+          {{"grid", "FILE", "grid description (YAML, see workflow/README.md)", true},
+           {"out", "DIR", "output folder", true},
+           {"jobs", "N", "cells run in parallel (default 1)"},
+           {"plan", "", "print the expanded cells as JSON and exit (runs nothing)"},
+           {"summarize", "", "only build the summary from the finished cells"},
+           {"cell", "ID", "run only this cell of the plan (Snakemake jobs)"},
+           {"data", "ID", "only simulate this sequence/seed of the plan"},
+           {"no-plots", "", "do not call the plot script"},
+           {"quiet", "", "no progress output"}}};
+}
+
+std::string SelfPath() {
+  std::error_code ec;
+  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("rvlio") : p.string();
+}
+
+// Returns 0 and sets `jobs`, or the exit status after an error.
+int ReadJobs(const Args& args, int* jobs) {
+  *jobs = 1;
+  if (!args.Has("jobs")) return 0;
+  const std::string text = args.Get("jobs");
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || v < 1 || v > kMaxJobs)
+    return Fail(kName, "--jobs '" + text + "' is not a whole number in [1, " +
+                           std::to_string(kMaxJobs) + "]");
+  *jobs = static_cast<int>(v);
+  return 0;
+}
+
+int Summarize(const ablate::Plan& plan, const Args& args) {
+  StatusOr<ablate::SummaryResult> r = ablate::WriteSummary(plan, !args.Has("no-plots"));
+  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  std::cout << r->table_md;
+  std::printf("rvlio ablate: %d cells: %d done, %d failed, %d not run -> %s/table.md\n", r->cells,
+              r->done, r->failed, r->missing, plan.out_dir.c_str());
+  std::printf("rvlio ablate: %s\n", r->plot_note.c_str());
+  return 0;
+}
+
+int RunSingle(const ablate::Plan& plan, const std::string& id, const ablate::RunnerOptions& o) {
+  ablate::RunCounts counts;
+  if (!ablate::RunOne(plan, id, o, &counts))
+    return Fail(kName,
+                "no cell or data '" + id + "' in the plan of " + plan.grid_path + " (see --plan)");
+  const char* what = counts.skipped ? "already done" : counts.failed ? "failed (recorded)" : "done";
+  std::printf("rvlio ablate: %s %s\n", id.c_str(), what);
+  return 0;
+}
+
+}  // namespace
 
 int CmdAblate(int argc, char** argv) {
-  CommandSpec spec{"ablate",
-                   "Runs a grid of sequences x variants x parameters; resumable.",
-                   {{"grid", "FILE", "grid description (YAML)", true},
-                    {"out", "DIR", "output folder", true},
-                    {"jobs", "N", "parallel runs"}}};
-  return EngineComesLater(spec, argc, argv, "ablation workflow (issue 7)");
+  const CommandSpec spec = AblateSpec();
+  Args args;
+  if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  ablate::RunnerOptions options;
+  if (int rc = ReadJobs(args, &options.jobs); rc != 0) return rc;
+  int modes = 0;
+  for (const char* m : {"plan", "summarize", "cell", "data"}) modes += args.Has(m) ? 1 : 0;
+  if (modes > 1) return Fail(kName, "--plan, --summarize, --cell and --data exclude each other");
+  options.rvlio_bin = SelfPath();
+  options.progress = !args.Has("quiet");
+
+  StatusOr<ablate::Plan> plan = ablate::LoadPlan(args.Get("grid"), args.Get("out"));
+  if (!plan.ok()) return Fail(kName, plan.status().message(), plan.status().exit_code());
+  if (args.Has("plan")) {
+    std::cout << ablate::PlanJson(*plan).dump(2) << "\n";
+    return 0;
+  }
+  if (!PrepareOutputDir(kName, plan->out_dir)) return 2;
+  if (args.Has("summarize")) return Summarize(*plan, args);
+  if (args.Has("cell")) return RunSingle(*plan, args.Get("cell"), options);
+  if (args.Has("data")) return RunSingle(*plan, args.Get("data"), options);
+
+  if (Status s =
+          WriteFileAtomically(plan->out_dir + "/plan.json", ablate::PlanJson(*plan).dump(2) + "\n");
+      !s.ok())
+    return Fail(kName, s.message(), s.exit_code());
+  const ablate::RunCounts c = ablate::RunPlan(*plan, options);
+  std::printf("rvlio ablate: %d cells: %d already done, %d run now (%d done, %d failed)\n", c.total,
+              c.skipped, c.done + c.failed, c.done, c.failed);
+  return Summarize(*plan, args);
 }
 
 }  // namespace rvlio::cli

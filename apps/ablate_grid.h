@@ -1,0 +1,85 @@
+#pragma once
+// `rvlio ablate` grid files: parsing, expansion into cells, stable hashes and
+// the machine-readable plan (JSON) that workflow/Snakefile consumes. This is
+// the one grid parser of the project; the Snakefile never reads the YAML.
+//
+// Grid YAML (paths relative to the grid file):
+//   config: [files]                 common to all cells (optional)
+//   set: {key: value}               common overrides (optional)
+//   sequences:                      required, non-empty
+//     - {name, bag, gt, config: [files], set: {..}}                 recorded
+//     - {name, simulate: {preset, duration, set: {..}}, seeds: [..]} simulated
+//   variants: {name: {key: value, config: [files]}}   (optional; default one "default")
+//   parameters: {key: [values] | {from, to, step}}    cartesian product (optional)
+// Cell configuration order: grid config, sequence config, variant config,
+// then grid set, sequence set, variant overrides, parameter values.
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rvlio/common/status.h"
+
+namespace rvlio::cli::ablate {
+
+// One simulated sequence for one seed, generated into D/data/<id>/.
+struct DataItem {
+  std::string id;    // "<sequence>_s<seed>_<hash10>"
+  std::string hash;  // 16 hex digits of the simulate arguments
+  std::string sequence;
+  int64_t seed = 0;
+  std::string dir;                         // D/data/<id>
+  std::vector<std::string> simulate_args;  // "simulate" ... (without the program)
+  std::string bag, gt, sensor_config;      // files inside dir
+  std::string Marker() const { return dir + "/data.json"; }
+};
+
+// One independent `rvlio run` (+ evaluation).
+struct Cell {
+  std::string id;    // "<sequence>_<variant>[_s<seed>]_<hash10>"
+  std::string hash;  // 16 hex digits of the resolved configuration
+  std::string sequence;
+  bool has_seed = false;
+  int64_t seed = 0;
+  std::string variant;
+  std::vector<std::pair<std::string, std::string>> params;  // key, value text
+  std::string label;    // variant, plus " k=v,k=v" when the grid has parameters
+  std::string dir;      // D/cells/<id>
+  int data_index = -1;  // into Plan::data for a simulated sequence
+  std::string bag, gt;  // gt may be empty (no metrics then)
+  std::vector<std::string> config_files;
+  std::vector<std::string> overrides;  // "key=value", applied in order
+  std::string RunDir() const { return dir + "/run"; }
+  std::string CellJson() const { return dir + "/cell.json"; }
+  std::vector<std::string> RunArgs() const;   // "run" ... (without the program)
+  std::vector<std::string> EvalArgs() const;  // "eval" ... --json
+};
+
+struct Plan {
+  std::string grid_path;
+  std::string out_dir;
+  std::vector<std::string> param_keys;  // in grid order
+  std::vector<DataItem> data;
+  std::vector<Cell> cells;
+};
+
+// Reads and expands the grid. Every error is InvalidInput with one line that
+// starts with the grid file (and line) and names the key.
+StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir);
+
+// The plan as JSON: {grid, out, param_keys, data: [...], cells: [...]}.
+nlohmann::json PlanJson(const Plan& plan);
+
+// FNV-1a, 64 bit, as 16 lower-case hex digits.
+std::string HashHex(std::string_view bytes);
+
+// Expands a {from, to, step} range inclusively without float drift: values
+// from + i*step printed with 12 significant digits (integers when all three
+// are integers). Errors: zero step, empty range, more than 10000 values.
+StatusOr<std::vector<std::string>> ExpandRange(const std::string& from, const std::string& to,
+                                               const std::string& step);
+
+}  // namespace rvlio::cli::ablate

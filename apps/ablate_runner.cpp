@@ -1,0 +1,422 @@
+#include "ablate_runner.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "rvlio/eval/evaluate.h"
+#include "rvlio/io/atomic_file.h"
+#include "rvlio/io/trajectory_io.h"
+
+extern char** environ;
+
+namespace rvlio::cli::ablate {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+constexpr size_t kTailLines = 12;
+constexpr size_t kTailChars = 2000;
+
+// One child process: `rvlio ARGS` with stdout+stderr into `log`.
+struct Job {
+  std::string name;
+  std::vector<std::string> args;
+  std::string log;
+  std::function<bool()> prepare;  // false: do not start (already recorded)
+  // Called with the raw wait status (or -1 when the spawn failed) and the
+  // wall seconds; returns true when the item succeeded.
+  std::function<bool(int, double)> finish;
+};
+
+pid_t Spawn(const std::string& program, const Job& job) {
+  std::vector<std::string> argv_s = {program};
+  argv_s.insert(argv_s.end(), job.args.begin(), job.args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, job.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return rc == 0 ? pid : -1;
+}
+
+// "[12/40] done 11, failed 1, running 2": rewritten in place on a terminal,
+// one plain line per finished item otherwise.
+class Progress {
+ public:
+  Progress(bool enabled, const std::string& what, int total, int skipped)
+      : tty_(enabled && isatty(STDERR_FILENO)),
+        enabled_(enabled),
+        what_(what),
+        total_(total),
+        skipped_(skipped) {}
+  void Running(int n) {
+    running_ = n;
+    if (tty_) Draw();
+  }
+  void Finished(const std::string& name, bool ok, double wall_s) {
+    (ok ? done_ : failed_)++;
+    if (tty_)
+      Draw();
+    else if (enabled_)
+      std::fprintf(stderr, "[%d/%d] %s %s %s (%.1f s)\n", skipped_ + done_ + failed_, total_,
+                   what_.c_str(), name.c_str(), ok ? "done" : "FAILED", wall_s);
+  }
+  ~Progress() {
+    if (drawn_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  void Draw() {
+    std::fprintf(stderr, "\r[%d/%d] %s: done %d, failed %d, running %d   ",
+                 skipped_ + done_ + failed_, total_, what_.c_str(), skipped_ + done_, failed_,
+                 running_);
+    drawn_ = true;
+  }
+  bool tty_, enabled_;
+  std::string what_;
+  int total_, skipped_, done_ = 0, failed_ = 0, running_ = 0;
+  bool drawn_ = false;
+};
+
+// Runs the jobs `parallel` at a time; returns how many succeeded.
+int RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress* progress) {
+  struct Running {
+    size_t index;
+    Clock::time_point t0;
+  };
+  std::map<pid_t, Running> running;
+  size_t next = 0;
+  int ok = 0;
+  const size_t parallel = static_cast<size_t>(std::max(1, options.jobs));
+  while (next < jobs.size() || !running.empty()) {
+    while (running.size() < parallel && next < jobs.size()) {
+      Job& job = jobs[next];
+      if (job.prepare && !job.prepare()) {  // recorded as failed by prepare()
+        progress->Finished(job.name, false, 0.0);
+        ++next;
+        continue;
+      }
+      const pid_t pid = Spawn(options.rvlio_bin, job);
+      if (pid < 0) {
+        const bool good = job.finish(-1, 0.0);
+        ok += good;
+        progress->Finished(job.name, good, 0.0);
+      } else {
+        running[pid] = {next, Clock::now()};
+      }
+      ++next;
+    }
+    progress->Running(static_cast<int>(running.size()));
+    if (running.empty()) continue;
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      break;  // ECHILD: nothing left to wait for
+    }
+    auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const double wall = std::chrono::duration<double>(Clock::now() - it->second.t0).count();
+    Job& job = jobs[it->second.index];
+    running.erase(it);
+    const bool good = job.finish(status, wall);
+    ok += good;
+    progress->Finished(job.name, good, wall);
+  }
+  return ok;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+json ReadJsonFile(const std::string& path) {
+  const std::string text = ReadText(path);
+  if (text.empty()) return nullptr;
+  json j = json::parse(text, nullptr, false);
+  return j.is_discarded() ? json(nullptr) : j;
+}
+
+// The last lines of a log, for cell.json.
+std::string Tail(const std::string& text) {
+  size_t pos = text.size();
+  for (size_t lines = 0; pos > 0 && lines <= kTailLines;) {
+    --pos;
+    if (text[pos] == '\n' && pos + 1 < text.size()) ++lines;
+    if (lines > kTailLines) {
+      ++pos;
+      break;
+    }
+  }
+  std::string tail = text.substr(pos);
+  if (tail.size() > kTailChars) tail = tail.substr(tail.size() - kTailChars);
+  return tail;
+}
+
+// "exited with status 2", "killed by signal 11 (Segmentation fault)", ...
+std::string Describe(int status, int* exit_code) {
+  *exit_code = -1;
+  if (status == -1) return "could not be started";
+  if (WIFEXITED(status)) {
+    *exit_code = WEXITSTATUS(status);
+    return "exited with status " + std::to_string(*exit_code);
+  }
+  if (WIFSIGNALED(status))
+    return "killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
+           strsignal(WTERMSIG(status)) + ")";
+  return "ended abnormally";
+}
+
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+// Metrics from run/summary.json and the evaluation against ground truth.
+// Returns "" or why the cell failed after a successful run.
+std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
+  const json summary = ReadJsonFile(cell.RunDir() + "/summary.json");
+  if (!summary.is_object())
+    return "run finished but " + cell.RunDir() + "/summary.json is unreadable";
+  const double scans = summary.value("scan_count", 0.0);
+  (*metrics)["scans"] = scans;
+  (*metrics)["ms_per_scan"] =
+      summary.contains("per_scan_ms") ? summary["per_scan_ms"].value("median", 0.0) : 0.0;
+  (*metrics)["rtf"] = summary.value("real_time_factor", 0.0);
+  (*metrics)["rv_active_fraction"] =
+      scans > 0 ? summary.value("rv_active_scans", 0.0) / scans : 0.0;
+  for (const char* m : {"ate_rmse", "rpe_rmse", "axis_max", "end_point"}) (*metrics)[m] = nullptr;
+  if (cell.gt.empty()) return "";
+  StatusOr<Trajectory> gt = ReadTrajectory(cell.gt);
+  if (!gt.ok()) return "eval: " + gt.status().message();
+  StatusOr<Trajectory> est = ReadTrajectory(cell.RunDir() + "/trajectory.tum");
+  if (!est.ok()) return "eval: " + est.status().message();
+  StatusOr<EvalResult> r = Evaluate(*gt, *est, EvalOptions());
+  if (!r.ok()) return "eval: " + r.status().message();
+  (*metrics)["ate_rmse"] = Number(r->ape_m.rmse);
+  (*metrics)["rpe_rmse"] = Number(r->rpe.trans_m.rmse);
+  (*metrics)["axis_max"] = Number(r->along_axis.max_abs_m);
+  (*metrics)["end_point"] = Number(r->end_point_error_m);
+  *warnings = r->warnings;
+  return "";
+}
+
+json CellHeader(const Cell& cell) {
+  json params = json::object();
+  for (const auto& [k, v] : cell.params) params[k] = v;
+  return {{"format", 1},
+          {"id", cell.id},
+          {"hash", cell.hash},
+          {"sequence", cell.sequence},
+          {"seed", cell.has_seed ? json(cell.seed) : json(nullptr)},
+          {"variant", cell.variant},
+          {"params", params},
+          {"label", cell.label},
+          {"run_argv", cell.RunArgs()}};
+}
+
+bool WriteCellRecord(const Cell& cell, json record) {
+  const Status s = WriteFileAtomically(cell.CellJson(), record.dump(2) + "\n");
+  if (!s.ok()) std::fprintf(stderr, "rvlio ablate: error: %s\n", s.message().c_str());
+  return s.ok() && record["status"] == "done";
+}
+
+// Records a cell that could not run because its data is missing or failed.
+bool RecordDataFailure(const Cell& cell, const DataItem& d) {
+  std::error_code ec;
+  fs::create_directories(cell.dir, ec);
+  json r = CellHeader(cell);
+  r["status"] = "failed";
+  r["exit_code"] = nullptr;
+  r["error"] = "data " + d.id + " could not be simulated (see " + d.dir + "/simulate.log)";
+  r["stderr_tail"] = Tail(ReadText(d.dir + "/simulate.log"));
+  r["metrics"] = json::object();
+  r["wall_s"] = 0.0;
+  return WriteCellRecord(cell, r);
+}
+
+bool FinishCell(const Cell& cell, int status, double wall_s) {
+  json r = CellHeader(cell);
+  int exit_code = -1;
+  const std::string how = Describe(status, &exit_code);
+  r["exit_code"] = exit_code >= 0 ? json(exit_code) : json(nullptr);
+  r["wall_s"] = wall_s;
+  r["stderr_tail"] = Tail(ReadText(cell.dir + "/run.log"));
+  json metrics = json::object(), warnings = json::array();
+  std::string error =
+      exit_code == 0 ? CollectMetrics(cell, &metrics, &warnings) : "rvlio run " + how;
+  r["status"] = error.empty() ? "done" : "failed";
+  r["error"] = error.empty() ? json(nullptr) : json(error);
+  r["metrics"] = metrics;
+  r["eval_warnings"] = warnings;
+  return WriteCellRecord(cell, r);
+}
+
+bool DataReady(const DataItem& d) {
+  const json marker = ReadJsonFile(d.Marker());
+  return marker.is_object() && marker.value("hash", "") == d.hash &&
+         marker.value("status", "") == "done" && fs::is_regular_file(d.bag);
+}
+
+bool FinishData(const DataItem& d, int status, double wall_s) {
+  int exit_code = -1;
+  const std::string how = Describe(status, &exit_code);
+  const bool ok = exit_code == 0 && fs::is_regular_file(d.bag) && fs::is_regular_file(d.gt) &&
+                  fs::is_regular_file(d.sensor_config);
+  const json marker = {{"format", 1},
+                       {"id", d.id},
+                       {"hash", d.hash},
+                       {"status", ok ? "done" : "failed"},
+                       {"error", ok ? "" : "rvlio simulate " + how},
+                       {"wall_s", wall_s},
+                       {"simulate_argv", d.simulate_args}};
+  const Status s = WriteFileAtomically(d.Marker(), marker.dump(2) + "\n");
+  return ok && s.ok();
+}
+
+bool CellDone(const Cell& cell) {
+  const json r = ReadCellRecord(cell);
+  return r.is_object() && r.value("status", "") == "done";
+}
+
+Job DataJob(const DataItem& d) {
+  Job job;
+  job.name = d.id;
+  job.args = d.simulate_args;
+  job.log = d.dir + "/simulate.log";
+  job.prepare = [&d] {
+    std::error_code ec;
+    fs::create_directories(d.dir, ec);
+    fs::remove(d.Marker(), ec);
+    return true;
+  };
+  job.finish = [&d](int status, double wall) { return FinishData(d, status, wall); };
+  return job;
+}
+
+Job CellJob(const Plan& plan, const Cell& cell) {
+  Job job;
+  job.name = cell.id;
+  job.args = cell.RunArgs();
+  job.log = cell.dir + "/run.log";
+  job.prepare = [&plan, &cell] {
+    std::error_code ec;
+    fs::create_directories(cell.dir, ec);
+    fs::remove(cell.CellJson(), ec);
+    fs::remove_all(cell.RunDir(), ec);
+    if (cell.data_index >= 0 && !DataReady(plan.data[cell.data_index])) {
+      RecordDataFailure(cell, plan.data[cell.data_index]);
+      return false;
+    }
+    return true;
+  };
+  job.finish = [&cell](int status, double wall) { return FinishCell(cell, status, wall); };
+  return job;
+}
+
+// Runs the given jobs under one progress display; updates the counts.
+void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& what,
+              const RunnerOptions& options, RunCounts* counts) {
+  if (jobs.empty()) return;
+  Progress progress(options.progress, what, total, skipped);
+  const int ok = RunJobs(jobs, options, &progress);
+  if (counts != nullptr) {
+    counts->done += ok;
+    counts->failed += static_cast<int>(jobs.size()) - ok;
+  }
+}
+
+}  // namespace
+
+const std::vector<std::string>& MetricNames() {
+  static const std::vector<std::string> kNames = {
+      "ate_rmse", "rpe_rmse", "axis_max", "end_point", "ms_per_scan", "rtf", "rv_active_fraction"};
+  return kNames;
+}
+
+json ReadCellRecord(const Cell& cell) {
+  json r = ReadJsonFile(cell.CellJson());
+  if (!r.is_object() || r.value("hash", "") != cell.hash) return nullptr;
+  return r;
+}
+
+RunCounts RunPlan(const Plan& plan, const RunnerOptions& options) {
+  RunCounts counts;
+  counts.total = static_cast<int>(plan.cells.size());
+  // Data needed by a cell that is not finished yet.
+  std::vector<bool> needed(plan.data.size(), false);
+  std::vector<Job> cell_jobs;
+  for (const Cell& c : plan.cells) {
+    if (CellDone(c)) {
+      ++counts.skipped;
+      continue;
+    }
+    if (c.data_index >= 0) needed[c.data_index] = true;
+    cell_jobs.push_back(CellJob(plan, c));
+  }
+  std::vector<Job> data_jobs;
+  int data_total = 0, data_skipped = 0;
+  for (size_t i = 0; i < plan.data.size(); ++i) {
+    if (!needed[i]) continue;
+    ++data_total;
+    if (DataReady(plan.data[i]))
+      ++data_skipped;
+    else
+      data_jobs.push_back(DataJob(plan.data[i]));
+  }
+  RunBatch(std::move(data_jobs), data_total, data_skipped, "data", options, nullptr);
+  RunBatch(std::move(cell_jobs), counts.total, counts.skipped, "cell", options, &counts);
+  return counts;
+}
+
+bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& options,
+            RunCounts* counts) {
+  for (const DataItem& d : plan.data)
+    if (d.id == id) {
+      if (!DataReady(d))
+        RunBatch({DataJob(d)}, 1, 0, "data", options, counts);
+      else if (counts != nullptr)
+        ++counts->skipped;
+      return true;
+    }
+  for (const Cell& c : plan.cells)
+    if (c.id == id) {
+      counts->total = 1;
+      if (CellDone(c)) {
+        ++counts->skipped;
+        return true;
+      }
+      // Simulate missing data (not data that already failed: parallel
+      // Snakemake cell jobs of one sequence must not simulate it twice).
+      if (c.data_index >= 0 && !fs::exists(plan.data[c.data_index].Marker()))
+        RunBatch({DataJob(plan.data[c.data_index])}, 1, 0, "data", options, nullptr);
+      RunBatch({CellJob(plan, c)}, 1, 0, "cell", options, counts);
+      return true;
+    }
+  return false;
+}
+
+}  // namespace rvlio::cli::ablate

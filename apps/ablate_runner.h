@@ -1,0 +1,44 @@
+#pragma once
+// Runs the cells of an ablation plan: each simulated sequence once per seed
+// (`rvlio simulate`) and each cell as its own `rvlio run` process (spawned
+// directly, no shell), then evaluates the trajectory in-process and writes
+// CELL/cell.json atomically. A crashing or failing run is recorded in its
+// cell.json ("status": "failed"), never fatal for the others. Finished cells
+// (status done, same hash) and finished data (data.json, same hash) are skipped.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "ablate_grid.h"
+
+namespace rvlio::cli::ablate {
+
+struct RunCounts {
+  int total = 0;
+  int skipped = 0;  // already done before this call
+  int done = 0;     // finished now
+  int failed = 0;   // failed now (including cells whose data failed)
+};
+
+struct RunnerOptions {
+  std::string rvlio_bin;  // the program spawned for simulate/run
+  int jobs = 1;
+  bool progress = true;  // "\r[12/40] ..." on a terminal stderr, plain lines otherwise
+};
+
+// Everything the plan needs: data first, then cells, `jobs` at a time.
+RunCounts RunPlan(const Plan& plan, const RunnerOptions& options);
+
+// Only one data item or one cell (the Snakemake jobs). A cell prepares its
+// data first if that is missing. Returns false when `id` is not in the plan.
+bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& options,
+            RunCounts* counts);
+
+// cell.json of a finished cell with the plan's hash (status done or
+// failed), or null when there is none.
+nlohmann::json ReadCellRecord(const Cell& cell);
+
+// The metric fields of cell.json "metrics", in table order.
+const std::vector<std::string>& MetricNames();
+
+}  // namespace rvlio::cli::ablate

@@ -1,0 +1,220 @@
+#include "ablate_summary.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "ablate_runner.h"
+#include "plot_runner.h"
+#include "rvlio/io/atomic_file.h"
+
+namespace rvlio::cli::ablate {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Metrics of the grouped table and their Markdown headers.
+const std::vector<std::pair<std::string, std::string>>& TableMetrics() {
+  static const std::vector<std::pair<std::string, std::string>> kMetrics = {
+      {"ate_rmse", "ATE [m]"},
+      {"rpe_rmse", "RPE [m]"},
+      {"axis_max", "axis max [m]"},
+      {"end_point", "end [m]"},
+      {"ms_per_scan", "ms/scan"},
+      {"rtf", "RTF"},
+      {"rv_active_fraction", "RV active"}};
+  return kMetrics;
+}
+
+std::string Csv(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::string Num(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.12g", v);
+  return buf;
+}
+
+// Mean and sample standard deviation (n-1) of the finite values.
+struct Stats {
+  int n = 0;
+  double mean = NAN, std = NAN;
+};
+
+Stats Describe(const std::vector<double>& values) {
+  Stats s;
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  s.n = static_cast<int>(values.size());
+  if (s.n == 0) return s;
+  s.mean = sum / s.n;
+  if (s.n < 2) return s;
+  double sq = 0.0;
+  for (double v : values) sq += (v - s.mean) * (v - s.mean);
+  s.std = std::sqrt(sq / (s.n - 1));
+  return s;
+}
+
+struct Group {
+  const Cell* first = nullptr;  // sequence, label, params
+  int cells = 0, done = 0, failed = 0;
+  std::map<std::string, std::vector<double>> values;  // metric -> finite values of done cells
+};
+
+double MetricOf(const json& record, const std::string& m) {
+  if (!record.contains("metrics") || !record["metrics"].contains(m) ||
+      !record["metrics"][m].is_number())
+    return NAN;
+  return record["metrics"][m].get<double>();
+}
+
+std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
+  std::ostringstream o;
+  o << "id,sequence,variant,seed";
+  for (const auto& k : plan.param_keys) o << "," << Csv(k);
+  o << ",status,exit_code";
+  for (const auto& m : MetricNames()) o << "," << m;
+  o << ",wall_s,error\n";
+  for (size_t i = 0; i < plan.cells.size(); ++i) {
+    const Cell& c = plan.cells[i];
+    const json& r = records[i];
+    o << c.id << "," << Csv(c.sequence) << "," << Csv(c.variant) << ","
+      << (c.has_seed ? std::to_string(c.seed) : "");
+    for (const auto& [k, v] : c.params) o << "," << Csv(v);
+    const std::string status = r.is_object() ? r.value("status", "missing") : "missing";
+    o << "," << status << ","
+      << (r.is_object() && r["exit_code"].is_number() ? std::to_string(r["exit_code"].get<int>())
+                                                      : "");
+    for (const auto& m : MetricNames()) o << "," << Num(r.is_object() ? MetricOf(r, m) : NAN);
+    o << "," << Num(r.is_object() ? r.value("wall_s", NAN) : NAN) << ","
+      << Csv(r.is_object() && r["error"].is_string() ? r["error"].get<std::string>() : "") << "\n";
+  }
+  return o.str();
+}
+
+std::vector<Group> GroupCells(const Plan& plan, const std::vector<json>& records) {
+  std::vector<Group> groups;
+  std::map<std::string, size_t> index;
+  for (size_t i = 0; i < plan.cells.size(); ++i) {
+    const Cell& c = plan.cells[i];
+    const std::string key = c.sequence + "\n" + c.label;
+    auto [it, fresh] = index.emplace(key, groups.size());
+    if (fresh) {
+      groups.emplace_back();
+      groups.back().first = &c;
+    }
+    Group& g = groups[it->second];
+    ++g.cells;
+    const json& r = records[i];
+    const std::string status = r.is_object() ? r.value("status", "") : "";
+    if (status == "failed") ++g.failed;
+    if (status != "done") continue;
+    ++g.done;
+    for (const auto& [m, header] : TableMetrics()) {
+      const double v = MetricOf(r, m);
+      if (std::isfinite(v)) g.values[m].push_back(v);
+    }
+  }
+  return groups;
+}
+
+std::string TableCsv(const Plan& plan, const std::vector<Group>& groups) {
+  std::ostringstream o;
+  o << "sequence,variant";
+  for (const auto& k : plan.param_keys) o << "," << Csv(k);
+  o << ",cells,n,failed";
+  for (const auto& [m, header] : TableMetrics()) o << "," << m << "_mean," << m << "_std";
+  o << "\n";
+  for (const Group& g : groups) {
+    o << Csv(g.first->sequence) << "," << Csv(g.first->label);
+    for (const auto& [k, v] : g.first->params) o << "," << Csv(v);
+    o << "," << g.cells << "," << g.done << "," << g.failed;
+    for (const auto& [m, header] : TableMetrics()) {
+      const Stats s = Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>());
+      o << "," << Num(s.mean) << "," << Num(s.std);
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+
+std::string MeanStd(const Stats& s, int precision) {
+  if (s.n == 0) return "-";
+  char buf[64];
+  if (s.n < 2)
+    std::snprintf(buf, sizeof(buf), "%.*f", precision, s.mean);
+  else
+    std::snprintf(buf, sizeof(buf), "%.*f ± %.*f", precision, s.mean, precision, s.std);
+  return buf;
+}
+
+std::string TableMarkdown(const std::vector<Group>& groups) {
+  std::ostringstream o;
+  o << "| sequence | variant | n | failed |";
+  for (const auto& [m, header] : TableMetrics()) o << " " << header << " |";
+  o << "\n|---|---|---|---|";
+  for (size_t i = 0; i < TableMetrics().size(); ++i) o << "---|";
+  o << "\n";
+  for (const Group& g : groups) {
+    o << "| " << g.first->sequence << " | " << g.first->label << " | " << g.done << " | "
+      << g.failed << " |";
+    for (const auto& [m, header] : TableMetrics()) {
+      const int precision =
+          m == "ms_per_scan" || m == "rtf" ? 2 : (m == "rv_active_fraction" ? 2 : 4);
+      o << " "
+        << MeanStd(Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>()), precision)
+        << " |";
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+
+std::string MakePlots(const Plan& plan, const SummaryResult& result) {
+  if (result.done == 0) return "plots skipped: no finished cell";
+  const std::string prefix = (fs::path(plan.out_dir) / "plots" / "summary").string();
+  const PlotResult p =
+      RunPlotScript({"ablation", "--table", plan.out_dir + "/table.csv", "--out", prefix,
+                     "--metric", "ate_rmse", "--metric", "axis_max", "--metric", "ms_per_scan"});
+  if (!p.ran) return "plots skipped: " + p.message;
+  if (!p.ok) return "plots failed: " + p.message;
+  return "plots: " + prefix + "_ablation.png, " + prefix + "_ablation.pdf";
+}
+
+}  // namespace
+
+StatusOr<SummaryResult> WriteSummary(const Plan& plan, bool plots) {
+  SummaryResult result;
+  std::vector<json> records;
+  for (const Cell& c : plan.cells) {
+    records.push_back(ReadCellRecord(c));
+    const json& r = records.back();
+    ++result.cells;
+    if (!r.is_object())
+      ++result.missing;
+    else if (r.value("status", "") == "done")
+      ++result.done;
+    else
+      ++result.failed;
+  }
+  const std::vector<Group> groups = GroupCells(plan, records);
+  result.table_md = TableMarkdown(groups);
+  const fs::path out(plan.out_dir);
+  for (const auto& [name, text] :
+       {std::pair<const char*, std::string>{"summary.csv", SummaryCsv(plan, records)},
+        {"table.csv", TableCsv(plan, groups)},
+        {"table.md", result.table_md}})
+    if (Status s = WriteFileAtomically((out / name).string(), text); !s.ok()) return s;
+  result.plot_note = plots ? MakePlots(plan, result) : "plots skipped: --no-plots";
+  return result;
+}
+
+}  // namespace rvlio::cli::ablate
