@@ -542,14 +542,19 @@ def MetricLabel(metric):
   return metric
 
 
-def ReadAblationTable(path, metrics):
-  """Rows of the table -> {metric: {(sequence, variant): [values]}}, orders kept."""
+def ReadCsvTable(path):
+  """A CSV file with a header -> (stripped column names, rows as dicts)."""
   if not os.path.isfile(path):
     raise PlotError("cannot read %s: no such file" % path)
   with open(path, newline="") as f:
     reader = csv.DictReader(f)
     header = [h.strip() for h in (reader.fieldnames or [])]
-    rows = list(reader)
+    return header, list(reader)
+
+
+def ReadAblationTable(path, metrics):
+  """Rows of the table -> {metric: {(sequence, variant): [values]}}, orders kept."""
+  header, rows = ReadCsvTable(path)
   missing = [c for c in ("sequence", "variant") if c not in header]
   if missing:
     raise PlotError("%s: missing column(s) %s" % (path, ", ".join(missing)))
@@ -677,12 +682,7 @@ COMPARE_TITLES = {"ate_rmse_m": ("ATE (RMSE)", "ATE [m]"),
 
 def ReadCompareTable(path, metrics):
   """compare.csv -> (variant names, {metric: [value or NaN per variant]}, failed flags)."""
-  if not os.path.isfile(path):
-    raise PlotError("cannot read %s: no such file" % path)
-  with open(path, newline="") as f:
-    reader = csv.DictReader(f)
-    header = [h.strip() for h in (reader.fieldnames or [])]
-    rows = list(reader)
+  header, rows = ReadCsvTable(path)
   missing = [c for c in ("variant",) + tuple(metrics) if c not in header]
   if missing:
     raise PlotError("%s: missing column(s) %s" % (path, ", ".join(missing)))
