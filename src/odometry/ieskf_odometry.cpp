@@ -98,11 +98,17 @@ Eigen::Vector3d IeskfOdometry::Predict(TimeNs t_end_ns) {
 }
 
 // Associate -> RV -> Update, iterated inside the filter (paper Alg. 3).
+// The iterations of one scan share an AssociationCache: a point whose world
+// position moved less than constraints.reuse_distance since its last k-NN
+// search keeps that plane (with a fresh residual), so the later iterations,
+// which move the pose by millimetres, mostly skip the search (the dominant
+// cost, bench/RESULTS.md). A new cache per scan: the map changed since.
 ScanStatus IeskfOdometry::Correct(ScanResult* r) {
-  const AssociateFn associate = [this](const FilterState& x, ConstraintList* constraints) {
+  AssociationCache cache(options_.constraints.reuse_distance);
+  const AssociateFn associate = [this, &cache](const FilterState& x, ConstraintList* constraints) {
     AssociationStats stats;
     Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_.map(), options_.constraints,
-              constraints, &stats);
+              constraints, &stats, &cache);
   };
   const IeskfUpdateResult u = filter_.Update(associate);
   r->constraints = u.num_constraints;

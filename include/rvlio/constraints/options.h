@@ -13,6 +13,7 @@ struct ConstraintOptions {
   double max_residual = 1.0;            // m, |r| above this is an outlier at association time
   double lidar_noise = 0.03;            // m, std of one point-to-plane residual
   double max_normal_std_deg = 0.0;      // deg, reject planes whose normal is this uncertain (0: off)
+  double reuse_distance = 0.05;         // m, IESKF: later iterations of one scan keep a point's plane while it moved less (0: search every iteration)
 
   template <class V>
   void Visit(V& v) {
@@ -27,6 +28,8 @@ struct ConstraintOptions {
     v.Field("lidar_noise", lidar_noise, Spec().Unit("m").Positive().Help("residual std (R = sigma^2)"));
     v.Field("max_normal_std_deg", max_normal_std_deg, Spec().Unit("deg").Range(0.0, 90.0)
         .Help("reject planes whose normal's predicted tilt std (from lidar_noise) exceeds this; 0: off"));
+    v.Field("reuse_distance", reuse_distance, Spec().Unit("m").Range(0.0, 1.0)
+        .Help("IESKF iterations of one scan reuse a point's plane while it moved less than this; 0: search every iteration"));
   }
   Status Validate() { return ValidateFields(*this, "constraints"); }
 };

@@ -3,9 +3,11 @@
 // voxel of edge MapOptions::output_resolution, and each occupied voxel
 // contributes one point, the centroid of what fell into it. Unbounded and
 // insert-only (nothing is ever removed); output order is the order in which
-// voxels were first touched, so it is deterministic.
+// voxels were first touched, so it is deterministic. Voxels are found through
+// an open-addressing table (linear probing, power-of-two capacity, load <=
+// 1/2) of indices into the cell array.
 #include <cstddef>
-#include <unordered_map>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,9 +35,14 @@ class OutputMap {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double count = 0.0;
   };
+  // Index into cells_ of key's voxel, creating the cell when it is new.
+  size_t FindOrAddCell(const VoxelKey& key);
+  void Rehash(size_t capacity);
+
   double resolution_;
   double inv_resolution_;
-  std::unordered_map<VoxelKey, size_t, VoxelKeyHash> index_;  // key -> cells_ index
+  std::vector<int32_t> table_;  // cells_ index per slot, -1: empty
+  std::vector<VoxelKey> keys_;  // key of cells_[i]
   std::vector<Cell> cells_;
 };
 

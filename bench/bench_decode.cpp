@@ -1,0 +1,191 @@
+// Bag decoding per scan: DecodePointCloud2 on one in-memory OS1-32 message
+// (32 x 1024, the Ouster driver layout the simulator writes, organized with
+// zero points for no-returns), and reading a small simulated bag through the
+// SensorBagReader (rosbag chunk reading + message deserialization + decode),
+// reported per scan. Neither is inside `rvlio run`'s per-scan time: the reader
+// decodes the next scan before the estimator sees it.
+//
+//   build-bench/bin/bench_decode
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <benchmark/benchmark.h>
+
+#include "rvlio/io/pointcloud2.h"
+#include "rvlio/io/sensor_bag.h"
+
+namespace rvlio {
+namespace {
+
+constexpr int kRows = 32;
+constexpr int kCols = 1024;
+constexpr uint32_t kPointStep = 48;  // x y z . intensity t reflectivity ring ambient range .
+
+// Range from o along d to the walls of a 200 x 8 x 5 m box tunnel; rays that
+// travel farther than 60 m are no-returns (0).
+double BoxRange(const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+  const Eigen::Vector3d lo(-100.0, -4.0, 0.0), hi(100.0, 4.0, 5.0);
+  double t = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (d(a) > 1e-12) t = std::min(t, (hi(a) - o(a)) / d(a));
+    if (d(a) < -1e-12) t = std::min(t, (lo(a) - o(a)) / d(a));
+  }
+  return t > 60.0 ? 0.0 : t;
+}
+
+// One organized sweep (row-major by ring), times 0..100 ms over the columns.
+Scan Sweep(std::mt19937* rng) {
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const Eigen::Vector3d o(0.0, 0.5, 2.0);
+  Scan scan;
+  scan.t_start_ns = 1700000000000000000LL;
+  scan.t_end_ns = scan.t_start_ns + 99902343;
+  for (int b = 0; b < kRows; ++b) {
+    const double e = (-22.5 + 45.0 * b / (kRows - 1)) * M_PI / 180;
+    for (int c = 0; c < kCols; ++c) {
+      const double a = 2 * M_PI * c / kCols;
+      const Eigen::Vector3d d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+      const double r = BoxRange(o, d);
+      LidarPoint p;
+      if (r > 0.0) p.p_lidar = ((r + noise(*rng)) * d).cast<float>();
+      p.intensity = 100.0f;
+      p.t_ns = scan.t_start_ns + (c * 100000000LL) / kCols;
+      p.ring = static_cast<uint16_t>(b);
+      scan.points.push_back(p);
+    }
+  }
+  return scan;
+}
+
+template <class T>
+void Put(uint8_t* dst, uint32_t offset, T value) {
+  std::memcpy(dst + offset, &value, sizeof(T));
+}
+
+struct Message {
+  std::vector<uint8_t> data;
+  PointCloud2View view;
+};
+
+Message OusterMessage(const Scan& scan) {
+  Message m;
+  m.data.assign(scan.points.size() * kPointStep, 0);
+  for (size_t i = 0; i < scan.points.size(); ++i) {
+    const LidarPoint& p = scan.points[i];
+    uint8_t* dst = m.data.data() + i * kPointStep;
+    Put<float>(dst, 0, p.p_lidar.x());
+    Put<float>(dst, 4, p.p_lidar.y());
+    Put<float>(dst, 8, p.p_lidar.z());
+    Put<float>(dst, 16, p.intensity);
+    Put<uint32_t>(dst, 20, static_cast<uint32_t>(p.t_ns - scan.t_start_ns));
+    Put<uint16_t>(dst, 26, p.ring);
+    Put<uint32_t>(dst, 32, static_cast<uint32_t>(1000.0f * p.p_lidar.norm()));
+  }
+  PointCloud2View& v = m.view;
+  v.header_stamp_ns = scan.t_start_ns;
+  v.height = kRows;
+  v.width = kCols;
+  v.point_step = kPointStep;
+  v.row_step = kPointStep * kCols;
+  v.fields = {{"x", 0, kPointFloat32, 1},         {"y", 4, kPointFloat32, 1},
+              {"z", 8, kPointFloat32, 1},         {"intensity", 16, kPointFloat32, 1},
+              {"t", 20, kPointUint32, 1},         {"reflectivity", 24, kPointUint16, 1},
+              {"ring", 26, kPointUint16, 1},      {"ambient", 28, kPointUint16, 1},
+              {"range", 32, kPointUint32, 1}};
+  v.data = m.data.data();
+  v.data_size = m.data.size();
+  v.topic = "/os_cloud_node/points";
+  return m;
+}
+
+void BM_DecodePointCloud2(benchmark::State& state) {
+  std::mt19937 rng(1);
+  const Message m = OusterMessage(Sweep(&rng));
+  LidarOptions lidar;
+  lidar.type = "ouster";
+  DecodeStats stats;
+  for (auto _ : state) {
+    StatusOr<Scan> scan = DecodePointCloud2(m.view, lidar, &stats);
+    benchmark::DoNotOptimize(scan.ok());
+  }
+  state.counters["raw_points"] = static_cast<double>(stats.raw_points);
+  state.counters["invalid"] = static_cast<double>(stats.invalid_points);
+}
+BENCHMARK(BM_DecodePointCloud2)->Unit(benchmark::kMillisecond);
+
+// A 2 s bag: 20 scans of the sweep above and 200 Hz IMU, written once.
+class BagFile {
+ public:
+  static constexpr int kScans = 20;
+  BagFile() {
+    path_ = (std::filesystem::temp_directory_path() /
+             ("rvlio_bench_decode_" + std::to_string(::getpid()) + ".bag"))
+                .string();
+    std::mt19937 rng(1);
+    Scan scan = Sweep(&rng);
+    auto writer = SensorBagWriter::Create(path_);
+    if (!writer.ok()) return;
+    const LidarOptions lidar;
+    const ImuOptions imu_options;
+    for (int k = 0; k < kScans; ++k) {
+      for (int j = 0; j < 20; ++j) {
+        ImuSample imu;
+        imu.t_ns = scan.t_start_ns + j * 5000000LL;
+        imu.acc_imu = Eigen::Vector3d(0.0, 0.0, 9.81);
+        (void)(*writer)->WriteImu(imu_options.topic, "imu", imu);
+      }
+      (void)(*writer)->WriteOusterScan(lidar.topic, "os_sensor", scan, kRows, kCols);
+      for (LidarPoint& p : scan.points) p.t_ns += 100000000LL;
+      scan.t_start_ns += 100000000LL;
+      scan.t_end_ns += 100000000LL;
+    }
+    ok_ = (*writer)->Close().ok();
+  }
+  ~BagFile() { std::filesystem::remove(path_); }
+  bool ok() const { return ok_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  bool ok_ = false;
+};
+
+void BM_ReadBagPerScan(benchmark::State& state) {
+  static const BagFile bag;
+  if (!bag.ok()) {
+    state.SkipWithError("could not write the temporary bag");
+    return;
+  }
+  int64_t scans = 0;
+  for (auto _ : state) {
+    auto reader = SensorBagReader::Open(bag.path(), LidarOptions(), ImuOptions());
+    if (!reader.ok()) {
+      state.SkipWithError(reader.status().message().c_str());
+      return;
+    }
+    ImuSample imu;
+    Scan scan;
+    for (;;) {
+      StatusOr<SensorMessage> m = (*reader)->Next(&imu, &scan);
+      if (!m.ok() || *m == SensorMessage::kEnd) break;
+      scans += *m == SensorMessage::kScan ? 1 : 0;
+    }
+  }
+  // items = scans: items_per_second is scans per second.
+  state.SetItemsProcessed(scans);
+  state.SetLabel("20 scans + 400 IMU samples per iteration");
+}
+BENCHMARK(BM_ReadBagPerScan)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace rvlio
+
+BENCHMARK_MAIN();
