@@ -13,31 +13,11 @@ ScanPreprocessor::ScanPreprocessor(const LidarOptions& options)
       voxel_size_(options.voxel_size),
       inv_voxel_size_(options.voxel_size > 0.0 ? 1.0 / options.voxel_size : 0.0),
       stride_(options.point_stride) {
+  // Every in-range point is keyable when max_range is far below the int32
+  // limit (|coordinate| <= range): the per-point test is then skipped.
+  range_keyable_ = options.max_range * inv_voxel_size_ < 0.5 * kMaxVoxelIndex;
   RVLIO_CHECK(options.voxel_size >= 0.0);
   RVLIO_CHECK(options.point_stride >= 1);
-}
-
-void ScanPreprocessor::CollectCandidates(const Scan& scan) {
-  stats_ = PreprocessStats();
-  stats_.num_input = static_cast<int>(scan.points.size());
-  candidates_.clear();
-  for (int i = 0; i < stats_.num_input; ++i) {
-    if (stride_ > 1 && i % stride_ != 0) {
-      ++stats_.num_strided_out;
-      continue;
-    }
-    const Eigen::Vector3d p = scan.points[i].p_lidar.cast<double>();
-    if (!p.allFinite()) {
-      ++stats_.num_invalid;
-      continue;
-    }
-    const double r2 = p.squaredNorm();
-    if (r2 < min_range2_ || r2 > max_range2_) {
-      ++stats_.num_out_of_range;
-      continue;
-    }
-    candidates_.push_back(i);
-  }
 }
 
 // Starts a new stamp: entries of earlier scans become free without clearing
@@ -51,7 +31,7 @@ void ScanPreprocessor::BeginScan() {
   used_.clear();
 }
 
-size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) {
+size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) const {
   const size_t mask = table_.size() - 1;
   size_t slot = HashVoxelKey(key) & mask;
   while (table_[slot].stamp == stamp_ && table_[slot].key != key) slot = (slot + 1) & mask;
@@ -59,8 +39,7 @@ size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) {
 }
 
 // Doubles the table when the load reaches 1/2, moving this scan's entries.
-void ScanPreprocessor::GrowIfNeeded() {
-  if (2 * (used_.size() + 1) <= table_.size()) return;
+void ScanPreprocessor::Grow() {
   std::vector<Entry> old(2 * table_.size(), Entry());
   old.swap(table_);
   for (int32_t& slot : used_) {
@@ -71,26 +50,68 @@ void ScanPreprocessor::GrowIfNeeded() {
   }
 }
 
-void ScanPreprocessor::VoxelFilter(const Scan& scan, std::vector<int>* indices) {
-  BeginScan();
+// The table slot of key for the current scan, creating the entry (for point
+// i at squared centre distance d2) when the voxel is new; *created tells.
+size_t ScanPreprocessor::SlotOf(const VoxelKey& key, int i, float d2, bool* created) {
+  size_t slot = FindOrAdd(key);
+  *created = table_[slot].stamp != stamp_;
+  if (!*created) return slot;
+  if (2 * (used_.size() + 1) > table_.size()) {  // keep the load <= 1/2
+    Grow();
+    slot = FindOrAdd(key);
+  }
+  table_[slot] = Entry{key, i, d2, stamp_};
+  used_.push_back(static_cast<int32_t>(slot));
+  return slot;
+}
+
+// One pass: stride, finiteness and range tests, then the voxel grid. Raw
+// sweeps are ordered by ring and column, so consecutive points mostly share
+// a voxel: the last voxel's slot is remembered and the hash lookup skipped.
+void ScanPreprocessor::FilterPoints(const Scan& scan, std::vector<int>* indices) {
+  const bool grid = voxel_size_ > 0.0;
+  if (grid) BeginScan();
   const double s = voxel_size_;
-  for (const int i : candidates_) {
-    const Eigen::Vector3d p = scan.points[i].p_lidar.cast<double>();
-    if (!IsKeyable(p.x(), p.y(), p.z(), inv_voxel_size_)) continue;  // beyond int32 voxels
+  const int n = stats_.num_input;
+  stats_.num_strided_out = n - (n + stride_ - 1) / stride_;
+  VoxelKey last_key;
+  size_t last_slot = 0;
+  bool have_last = false;
+  for (int i = 0; i < n; i += stride_) {
+    const Eigen::Vector3f& p_f = scan.points[i].p_lidar;
+    if (!std::isfinite(p_f.x()) || !std::isfinite(p_f.y()) || !std::isfinite(p_f.z())) {
+      ++stats_.num_invalid;
+      continue;
+    }
+    const Eigen::Vector3d p = p_f.cast<double>();
+    const double r2 = p.squaredNorm();
+    if (r2 < min_range2_ || r2 > max_range2_) {
+      ++stats_.num_out_of_range;
+      continue;
+    }
+    if (!grid) {
+      indices->push_back(i);
+      continue;
+    }
+    if (!range_keyable_ && !IsKeyable(p.x(), p.y(), p.z(), inv_voxel_size_))
+      continue;  // beyond int32 voxels
     const VoxelKey key = KeyOf(p, inv_voxel_size_);
     const Eigen::Vector3d centre((key.x + 0.5) * s, (key.y + 0.5) * s, (key.z + 0.5) * s);
     const float d2 = static_cast<float>((p - centre).squaredNorm());
-    GrowIfNeeded();
-    const size_t slot = FindOrAdd(key);
-    Entry& e = table_[slot];
-    if (e.stamp != stamp_) {
-      e = Entry{key, i, d2, stamp_};
-      used_.push_back(static_cast<int32_t>(slot));
-    } else if (d2 < e.d2) {  // ties keep the earlier point
+    if (!have_last || key != last_key) {
+      bool created = false;
+      last_slot = SlotOf(key, i, d2, &created);
+      last_key = key;
+      have_last = true;
+      if (created) continue;
+    }
+    Entry& e = table_[last_slot];
+    if (d2 < e.d2) {  // ties keep the earlier point
       e.best = i;
       e.d2 = d2;
     }
   }
+  if (!grid) return;
   for (const int32_t slot : used_) indices->push_back(table_[slot].best);
   std::sort(indices->begin(), indices->end());
 }
@@ -98,12 +119,9 @@ void ScanPreprocessor::VoxelFilter(const Scan& scan, std::vector<int>* indices) 
 void ScanPreprocessor::SelectIndices(const Scan& scan, std::vector<int>* indices) {
   RVLIO_CHECK(indices != nullptr);
   indices->clear();
-  CollectCandidates(scan);
-  if (voxel_size_ > 0.0) {
-    VoxelFilter(scan, indices);
-  } else {
-    indices->assign(candidates_.begin(), candidates_.end());
-  }
+  stats_ = PreprocessStats();
+  stats_.num_input = static_cast<int>(scan.points.size());
+  FilterPoints(scan, indices);
   stats_.num_output = static_cast<int>(indices->size());
 }
 

@@ -5,6 +5,10 @@
 #include <cstdlib>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "rvlio/common/check.h"
 
 namespace rvlio {
@@ -12,7 +16,6 @@ namespace rvlio {
 namespace {
 
 constexpr size_t kInitialCapacity = 1024;  // slots (power of two)
-constexpr int kDistanceChunk = 64;         // points per vectorized distance pass
 constexpr int kFirstBlockCapacity = 4;     // points in a new voxel's block
 
 // Voxel keys are packed into 64 bits, 21 per axis with a bias; points whose
@@ -92,6 +95,17 @@ inline double AxisGap(int d, double q_local, double s) {
   return 0.0;
 }
 
+// Squared distance from the query to the nearest voxel of shell r (Chebyshev
+// offset r): the smallest single-axis gap to the faces at offsets +-r, so no
+// voxel of the shell has a smaller squared gap sum (same expressions as
+// VisitOffset and VisitShell, so the bound is exact in floating point too).
+inline double ShellGap(int r, const double q_local[3], double s) {
+  if (r == 0) return 0.0;
+  double g = AxisGap(r, q_local[0], s);
+  for (int a = 0; a < 3; ++a) g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
+  return g * g;
+}
+
 }  // namespace
 
 // The k best candidates of one query, sorted ascending by squared distance.
@@ -139,7 +153,18 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
   min_d2_ = static_cast<float>(options.min_point_distance * options.min_point_distance);
   max_points_ = options.max_points_per_voxel;
   free_blocks_.resize(CapacityClass(max_points_) + 1);
-  for (int r = 0; r <= kPrecomputedShells; ++r) shells_[r] = MakeShell<Offset>(r);
+  for (int r = 0; r <= kPrecomputedShells; ++r) {
+    const std::vector<Offset> shell = MakeShell<Offset>(r);
+    for (int octant = 0; octant < 8; ++octant) {
+      const int sx = (octant & 1) ? -1 : 1, sy = (octant & 2) ? -1 : 1, sz = (octant & 4) ? -1 : 1;
+      for (const Offset& o : shell) {
+        const int dx = sx * o.dx, dy = sy * o.dy, dz = sz * o.dz;
+        shells_[r][octant].push_back(OctantOffset{
+            o.lower_bound2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
+            static_cast<uint8_t>(dz + r), OffsetKey(0, dx, dy, dz)});
+      }
+    }
+  }
   Rebuild(kInitialCapacity, {});
 }
 
@@ -293,34 +318,42 @@ std::vector<Eigen::Vector3d> VoxelMap::Points() const {
 
 // ------------------------------------------------------------------ queries
 
-// Squared distances of a whole block in a branch-free pass (vectorized by the
-// compiler), a branch-free compaction of the points that beat the current
-// limit, then the insertion of those few (the limit may tighten meanwhile).
+// Squared distances four points at a time (SSE2: the same float operations
+// in the same order as the scalar tail), a compare against the current limit
+// and a movemask, so a group whose points are all too far costs a few
+// instructions; the points that beat the limit are offered in index order,
+// each re-checked against the limit as it tightens.
 void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
   const float* x = pool_.data() + s.offset;
   const float* y = x + s.capacity;
   const float* z = y + s.capacity;
   const int n = s.count;
-  float d2[kDistanceChunk];
-  int hits[kDistanceChunk];
-  for (int start = 0; start < n; start += kDistanceChunk) {
-    const int m = std::min(kDistanceChunk, n - start);
-    for (int i = 0; i < m; ++i) {
-      const float dx = x[start + i] - q[0];
-      const float dy = y[start + i] - q[1];
-      const float dz = z[start + i] - q[2];
-      d2[i] = dx * dx + dy * dy + dz * dz;
+  int i = 0;
+#if defined(__SSE2__)
+  const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]);
+  for (; i + 4 <= n; i += 4) {
+    const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x + i), qx);
+    const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y + i), qy);
+    const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z + i), qz);
+    const __m128 d2 =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    int mask = _mm_movemask_ps(_mm_cmplt_ps(d2, _mm_set1_ps(c->limit())));
+    if (mask == 0) continue;
+    alignas(16) float d2_lane[4];
+    _mm_store_ps(d2_lane, d2);
+    while (mask != 0) {
+      const int lane = __builtin_ctz(static_cast<unsigned>(mask));
+      mask &= mask - 1;
+      if (d2_lane[lane] < c->limit()) c->Offer(d2_lane[lane], x + i + lane, s.capacity);
     }
-    const float limit = c->limit();
-    int num_hits = 0;
-    for (int i = 0; i < m; ++i) {
-      hits[num_hits] = i;
-      num_hits += d2[i] < limit ? 1 : 0;
-    }
-    for (int h = 0; h < num_hits; ++h) {
-      const int i = hits[h];
-      if (d2[i] < c->limit()) c->Offer(d2[i], x + start + i, s.capacity);
-    }
+  }
+#endif
+  for (; i < n; ++i) {
+    const float dx = x[i] - q[0];
+    const float dy = y[i] - q[1];
+    const float dz = z[i] - q[2];
+    const float d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 < c->limit()) c->Offer(d2, x + i, s.capacity);
   }
 }
 
@@ -342,8 +375,16 @@ void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const d
 void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
                           Candidates* c) const {
   if (r > kPrecomputedShells) {
+    // Whole planes and rows of the shell are skipped when their gap alone
+    // exceeds the limit (the limit only shrinks, so exactly the voxels a
+    // per-voxel test would skip).
+    const double s = options_.voxel_size;
     for (int dx = -r; dx <= r; ++dx) {
+      const double gx = AxisGap(dx, q_local[0], s);
+      if (gx * gx > c->limit()) continue;
       for (int dy = -r; dy <= r; ++dy) {
+        const double gy = AxisGap(dy, q_local[1], s);
+        if (gx * gx + gy * gy > c->limit()) continue;
         const bool side = std::abs(dx) == r || std::abs(dy) == r;
         const int dz_step = side ? 1 : 2 * r;  // interior columns: only the two caps
         for (int dz = -r; dz <= r; dz += dz_step) VisitOffset(home, dx, dy, dz, q_local, q, c);
@@ -351,13 +392,13 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
     }
     return;
   }
-  // Mirror the precomputed order into the query's octant; squared gaps per
+  // The precomputed order mirrored into the query's octant; squared gaps per
   // axis and offset come from small tables instead of per-voxel branches.
   const double s = options_.voxel_size;
-  int sign[3];
+  int octant = 0;
   double gap2[3][2 * kPrecomputedShells + 1];
   for (int a = 0; a < 3; ++a) {
-    sign[a] = q_local[a] < 0.5 * s ? -1 : 1;
+    if (q_local[a] < 0.5 * s) octant |= 1 << a;
     for (int d = -r; d <= r; ++d) {
       const double g = AxisGap(d, q_local[a], s);
       gap2[a][d + r] = g * g;
@@ -365,11 +406,10 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
   }
   const double s2 = s * s;
   const uint64_t home_key = PackKey(home.x, home.y, home.z);  // |home| < kKeyLimit: no carries
-  for (const Offset& o : shells_[r]) {
+  for (const OctantOffset& o : shells_[r][octant]) {
     if (o.lower_bound2 * s2 > c->limit()) break;  // sorted: the rest are no closer
-    const int dx = sign[0] * o.dx, dy = sign[1] * o.dy, dz = sign[2] * o.dz;
-    if (gap2[0][dx + r] + gap2[1][dy + r] + gap2[2][dz + r] > c->limit()) continue;
-    const int slot = FindSlot(OffsetKey(home_key, dx, dy, dz));
+    if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > c->limit()) continue;
+    const int slot = FindSlot(home_key + o.key_delta);  // == OffsetKey(home_key, dx, dy, dz)
     if (slot >= 0) ScanBlock(slots_[slot], q, c);
   }
 }
@@ -415,8 +455,7 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
     ScanAllVoxels(q_world, q, &c);
   } else {
     for (int r = 0; r <= max_shell; ++r) {
-      const double shell_gap = std::max(0, r - 1) * s;
-      if (shell_gap * shell_gap > c.limit()) break;  // nothing closer remains
+      if (ShellGap(r, q_local, s) > c.limit()) break;  // nothing closer remains
       VisitShell(r, home, q_local, q, &c);
     }
   }

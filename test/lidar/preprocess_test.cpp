@@ -95,6 +95,82 @@ TEST(Preprocess, OnePointPerVoxelNearestTheCentre) {
   }
 }
 
+// A ring-major sweep (rows of columns, like an organized Ouster cloud) with
+// coordinates on a 1 cm grid (exact distance ties), repeated points, gaps
+// (zero points), non-finite and far points.
+Scan SweepWithTies(std::mt19937* rng, int rows, int cols) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Scan scan;
+  scan.t_end_ns = 100000000;
+  for (int r = 0; r < rows; ++r) {
+    const double el = -0.4 + 0.8 * r / std::max(1, rows - 1);
+    for (int c = 0; c < cols; ++c) {
+      const double az = 2.0 * M_PI * c / cols;
+      const double range = 2.0 + 30.0 * u(*rng) * u(*rng);
+      Eigen::Vector3d p(range * std::cos(el) * std::cos(az), range * std::cos(el) * std::sin(az),
+                        range * std::sin(el));
+      p = (p * 100.0).array().round() / 100.0;
+      LidarPoint pt;
+      pt.p_lidar = p.cast<float>();
+      pt.t_ns = c * 1000;
+      const double roll = u(*rng);
+      if (roll < 0.05) pt.p_lidar.setZero();                                   // no return
+      if (roll > 0.98) pt.p_lidar.x() = std::numeric_limits<float>::quiet_NaN();
+      if (roll > 0.97 && roll <= 0.98) pt.p_lidar *= 100.0f;                   // beyond max_range
+      if (roll > 0.9 && roll <= 0.97 && !scan.points.empty())
+        pt.p_lidar = scan.points.back().p_lidar;                               // exact repeat
+      scan.points.push_back(pt);
+    }
+  }
+  return scan;
+}
+
+// Exact reference of the documented rule: per voxel the point with the
+// smallest squared distance to the centre (float, as documented), the
+// earliest on ties; ascending indices.
+std::vector<int> ReferenceIndices(const Scan& scan, const LidarOptions& o) {
+  std::map<Key, std::pair<float, int>> best;
+  const double inv = 1.0 / o.voxel_size;
+  for (int i = 0; i < static_cast<int>(scan.points.size()); i += o.point_stride) {
+    const Eigen::Vector3d p = scan.points[i].p_lidar.cast<double>();
+    if (!p.allFinite()) continue;
+    const double r2 = p.squaredNorm();
+    if (r2 < o.min_range * o.min_range || r2 > o.max_range * o.max_range) continue;
+    const VoxelKey k = KeyOf(p, inv);
+    const Eigen::Vector3d centre((k.x + 0.5) * o.voxel_size, (k.y + 0.5) * o.voxel_size,
+                                 (k.z + 0.5) * o.voxel_size);
+    const float d2 = static_cast<float>((p - centre).squaredNorm());
+    auto [it, added] = best.emplace(Key(k.x, k.y, k.z), std::make_pair(d2, i));
+    if (!added && d2 < it->second.first) it->second = std::make_pair(d2, i);
+  }
+  std::vector<int> out;
+  for (const auto& [k, v] : best) out.push_back(v.second);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(Preprocess, SweepMatchesExactReferenceIncludingTies) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 24; ++trial) {
+    LidarOptions options;
+    options.voxel_size = (trial % 4 == 0) ? 0.05 : 0.1 + 0.2 * (trial % 6);
+    options.min_range = 0.5 + 0.5 * (trial % 3);
+    options.max_range = 20.0 + 10.0 * (trial % 4);
+    options.point_stride = 1 + trial % 3;
+    ScanPreprocessor pre(options);
+    std::vector<int> indices;
+    // Several sweeps through the same preprocessor (table reuse and growth).
+    for (int sweep = 0; sweep < 3; ++sweep) {
+      const Scan scan = SweepWithTies(&rng, 16, 256 + 256 * sweep);
+      pre.SelectIndices(scan, &indices);
+      const std::vector<int> expected = ReferenceIndices(scan, options);
+      ASSERT_GT(expected.size(), 50u);
+      ASSERT_EQ(indices, expected) << "trial " << trial << " sweep " << sweep;
+      EXPECT_EQ(pre.stats().num_output, static_cast<int>(expected.size()));
+    }
+  }
+}
+
 TEST(Preprocess, VoxelSizeZeroKeepsEveryPointInRange) {
   std::mt19937 rng(2);
   LidarOptions options;

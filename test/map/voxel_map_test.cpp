@@ -221,3 +221,41 @@ TEST(VoxelMap, ClearEmptiesTheMap) {
 
 }  // namespace
 }  // namespace rvlio
+
+namespace rvlio {
+namespace {
+
+// Points and queries on a lattice aligned with the voxel faces (queries on
+// faces, edges and corners: zero in-voxel offsets, many equal distances),
+// sparse enough that most queries search deep shells with a loose limit.
+TEST(VoxelMap, LatticeQueriesOnVoxelFacesMatchBruteForce) {
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> cell(-12, 12);
+  MapOptions options;
+  options.voxel_size = 0.5;
+  options.min_point_distance = 0.0;
+  VoxelMap map(options);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < 400; ++i) pts.emplace_back(0.25 * cell(rng), 0.25 * cell(rng), 0.25 * cell(rng));
+  map.Insert(pts);
+  const std::vector<Eigen::Vector3d> stored = map.Points();
+  int checked = 0, deep = 0;
+  for (int query = 0; query < 600; ++query) {
+    const Eigen::Vector3d q(0.5 * cell(rng), 0.5 * cell(rng), 0.25 * cell(rng));
+    const int k = 1 + query % 8;
+    const double max_dist = 0.3 + 0.1 * (query % 25);  // up to 2.7 m: shells up to 6
+    if (NearBoundary(stored, q, max_dist)) continue;
+    NeighborBuffer nb;
+    const std::vector<double> expected = BruteForce(stored, q, k, max_dist);
+    ASSERT_EQ(map.KNearest(q, k, max_dist, &nb), static_cast<int>(expected.size()))
+        << "query " << query;
+    for (int i = 0; i < nb.size; ++i) EXPECT_NEAR(nb.dist2[i], expected[i], 1e-9);
+    ++checked;
+    if (!expected.empty() && expected.back() > 1.5 * 1.5) ++deep;
+  }
+  EXPECT_GT(checked, 300);
+  EXPECT_GT(deep, 20);  // neighbours beyond 1.5 m: shells 4 and deeper searched
+}
+
+}  // namespace
+}  // namespace rvlio

@@ -44,20 +44,20 @@ class ScanPreprocessor {
     uint32_t stamp = 0;  // entry is in use for the current scan iff stamp == stamp_
   };
 
-  void CollectCandidates(const Scan& scan);
-  void VoxelFilter(const Scan& scan, std::vector<int>* indices);
+  void FilterPoints(const Scan& scan, std::vector<int>* indices);
   void BeginScan();
-  size_t FindOrAdd(const VoxelKey& key);  // the key's slot, or the free slot for it
-  void GrowIfNeeded();
+  size_t FindOrAdd(const VoxelKey& key) const;  // the key's slot, or the free slot for it
+  size_t SlotOf(const VoxelKey& key, int i, float d2, bool* created);
+  void Grow();
 
   double min_range2_;
   double max_range2_;
   double voxel_size_;
   double inv_voxel_size_;
   int stride_;
+  bool range_keyable_ = false;  // max_range keeps every in-range point keyable
 
   PreprocessStats stats_;
-  std::vector<int> candidates_;  // strided, finite, in-range point indices
   std::vector<Entry> table_;     // open addressing, power-of-two size
   std::vector<int32_t> used_;    // table slots used by the current scan
   std::vector<int> indices_;     // scratch for Downsample

@@ -87,6 +87,13 @@ class VoxelMap {
     int8_t dx, dy, dz;
     float lower_bound2;  // squared box distance bound, in voxel edges^2 (see MakeShell)
   };
+  // An offset mirrored into one query octant: its per-axis gap-table
+  // indices (offset + r) and the packed-key difference it adds.
+  struct OctantOffset {
+    float lower_bound2;
+    uint8_t ix, iy, iz;
+    uint64_t key_delta;
+  };
   class Candidates;
 
   int FindSlot(uint64_t key) const;  // slot index, or -1
@@ -121,7 +128,9 @@ class VoxelMap {
   // shells_[r]: voxel offsets with Chebyshev norm r in visiting order (see
   // MakeShell), for r <= kPrecomputedShells.
   static constexpr int kPrecomputedShells = 3;
-  std::array<std::vector<Offset>, kPrecomputedShells + 1> shells_;
+  // shells_[r][octant]: the same mirrored into each octant (bit a set when
+  // the query lies in the lower half of its voxel along axis a).
+  std::array<std::array<std::vector<OctantOffset>, 8>, kPrecomputedShells + 1> shells_;
 };
 
 }  // namespace rvlio
