@@ -13,9 +13,11 @@ packages=(
   pluginlib-dev libclass-loader-dev librcpputils-dev libament-index-cpp-dev
   python3-rosbag python3-matplotlib python3-yaml
 )
-# Extra packages the test command needs (Snakemake workflow test).
+# Extra packages the test command needs (Snakemake workflow test; clang with
+# the libFuzzer/ASan runtimes and llvm-symbolizer for scripts/fuzz.sh — gcc's
+# ASan/UBSan runtimes for scripts/sanitize.sh come with build-essential).
 if [[ "${1:-}" == "--with-test-tools" ]]; then
-  packages+=(snakemake)
+  packages+=(snakemake clang-14 libclang-rt-14-dev llvm-14)
 fi
 
 missing=()

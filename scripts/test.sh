@@ -1,8 +1,60 @@
 #!/usr/bin/env bash
-# The README's test command: installs what is missing, builds, runs every test.
+# The README's test command (CI runs it through .ci/run): installs what is
+# missing, then runs the stages in order and stops at the first failure:
+#
+#   release   Release build in build/ + ctest (every test)
+#   sanitize  scripts/sanitize.sh: the test suite built with gcc
+#             ASan + UBSan (-O1 -g) in build-asan/ + ctest there
+#   fuzz      scripts/fuzz.sh: the libFuzzer targets of fuzz/ (clang) in
+#             build-fuzz/, $RVLIO_FUZZ_SECONDS (default 60) s per target
+#
+# A developer may run a subset: RVLIO_CI_STAGES=release (or "release,fuzz",
+# ...) bash scripts/test.sh. RVLIO_FUZZ_SECONDS=10 shortens the fuzz stage.
+# Each stage's wall time is printed at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+stages=${RVLIO_CI_STAGES:-release,sanitize,fuzz}
+jobs=$(nproc 2>/dev/null || echo 2)
+for s in ${stages//,/ }; do
+  case "$s" in
+    release|sanitize|fuzz) ;;
+    *) echo "test.sh: unknown stage '$s' in RVLIO_CI_STAGES (release, sanitize, fuzz)" >&2; exit 2 ;;
+  esac
+done
+want() { [[ ",$stages," == *",$1,"* ]]; }
+
+times=()
+stage_start=$SECONDS
+finish_stage() { times+=("$1 $((SECONDS - stage_start)) s"); stage_start=$SECONDS; }
+# Tests run, summed over the stages, from each runner's closing line.
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+passed=0
+count_tests() {
+  local n
+  n=$(grep -Eo '(tests failed out of [0-9]+|^fuzz: [0-9]+ passed)' "$log" | grep -Eo '[0-9]+' | tail -1 || true)
+  passed=$((passed + ${n:-0}))
+}
+
 bash scripts/install_deps.sh --with-test-tools
-bash scripts/build.sh
-cd build
-ctest --output-on-failure -j "$(nproc 2>/dev/null || echo 2)"
+finish_stage install
+
+if want release; then
+  bash scripts/build.sh
+  (cd build && ctest --output-on-failure -j "$jobs") 2>&1 | tee "$log"
+  count_tests
+  finish_stage release
+fi
+if want sanitize; then
+  bash scripts/sanitize.sh 2>&1 | tee "$log"
+  count_tests
+  finish_stage sanitize
+fi
+if want fuzz; then
+  bash scripts/fuzz.sh 2>&1 | tee "$log"
+  count_tests
+  finish_stage fuzz
+fi
+
+echo "test.sh: stages $stages passed; wall time per stage: $(IFS=,; echo "${times[*]}" | sed 's/,/, /g')"
+echo "test.sh: $passed passed, 0 failed"

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -94,9 +95,33 @@ bool ParseDouble(const std::string& s, double* out) {
 
 int LineOf(const YAML::Node& y) { return y.Mark().line >= 0 ? y.Mark().line + 1 : 0; }
 
+// Bounds of a document. A configuration is a few hundred values nested a few
+// levels deep; the bounds stop a recursive alias ("a: &x [*x]", endless
+// recursion) and nested aliases that expand exponentially ("billion laughs").
+constexpr int kMaxDepth = 64;
+constexpr size_t kMaxValues = 10000;  // config/default.yaml has 84
+
+struct ConvertBudget {
+  size_t values_left = kMaxValues;
+};
+
 // yaml-cpp document -> Node; `path` is the dotted key of `y` for messages.
-Status Convert(const YAML::Node& y, const std::string& path, const std::string& source, Node* out) {
+Status Convert(const YAML::Node& y, const std::string& path, const std::string& source, int depth,
+               ConvertBudget* budget, Node* out) {
   out->line = LineOf(y);
+  // The key of the top-level entry: deep paths ("a[0][0]...") would be unreadable.
+  const auto what = [&path] {
+    return path.empty() ? std::string("top level") : path.substr(0, path.find_first_of(".["));
+  };
+  if (depth > kMaxDepth)
+    return Status::InvalidInput(what() + " in " + Where(source, out->line) +
+                                ": nested deeper than " + std::to_string(kMaxDepth) +
+                                " levels (a recursive alias?)");
+  if (budget->values_left == 0)
+    return Status::InvalidInput(what() + " in " + Where(source, out->line) + ": more than " +
+                                std::to_string(kMaxValues) +
+                                " values (aliases expanding exponentially?)");
+  --budget->values_left;
   if (y.IsNull()) {
     out->kind = Node::Kind::kNull;
   } else if (y.IsScalar()) {
@@ -104,13 +129,16 @@ Status Convert(const YAML::Node& y, const std::string& path, const std::string& 
     out->scalar = y.Scalar();
   } else if (y.IsSequence()) {
     out->kind = Node::Kind::kSequence;
-    for (size_t i = 0; i < y.size(); ++i) {
+    size_t i = 0;  // iterators: y[i] costs a search per element in yaml-cpp
+    for (const YAML::Node& item : y) {
       out->items.emplace_back();
-      Status s = Convert(y[i], path + "[" + std::to_string(i) + "]", source, &out->items.back());
+      Status s = Convert(item, path + "[" + std::to_string(i++) + "]", source, depth + 1, budget,
+                         &out->items.back());
       if (!s.ok()) return s;
     }
   } else if (y.IsMap()) {
     out->kind = Node::Kind::kMap;
+    std::set<std::string> seen;  // duplicate keys, without a quadratic search
     for (const auto& kv : y) {
       const int line = LineOf(kv.first);
       if (!kv.first.IsScalar())
@@ -118,12 +146,12 @@ Status Convert(const YAML::Node& y, const std::string& path, const std::string& 
                                     Where(source, line) + ": keys must be plain names");
       const std::string key = kv.first.Scalar();
       const std::string full = options_detail::Join(path, key.c_str());
-      if (std::find(out->keys.begin(), out->keys.end(), key) != out->keys.end())
+      if (!seen.insert(key).second)
         return Status::InvalidInput(full + ": duplicate key in " + Where(source, line));
       out->keys.push_back(key);
       out->key_lines.push_back(line);
       out->items.emplace_back();
-      Status s = Convert(kv.second, full, source, &out->items.back());
+      Status s = Convert(kv.second, full, source, depth + 1, budget, &out->items.back());
       if (!s.ok()) return s;
     }
   }
@@ -140,7 +168,8 @@ StatusOr<Node> LoadYaml(const std::string& text, const std::string& source, OnEr
     return on_error(e);
   }
   Node root;
-  Status s = Convert(y, "", source, &root);
+  ConvertBudget budget;
+  Status s = Convert(y, "", source, 0, &budget, &root);
   if (!s.ok()) return s;
   return root;
 }

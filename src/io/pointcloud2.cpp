@@ -316,17 +316,19 @@ void DecodePoints(const PointCursor& cursor, const Layout& layout, const PointFi
     LidarPoint p;
     const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z) &&
                         std::abs(x) < 1e9 && std::abs(y) < 1e9 && std::abs(z) < 1e9;
-    if (!finite || (x == 0.0 && y == 0.0 && z == 0.0) ||
+    // The zero and range tests use the stored float coordinates: a float64
+    // coordinate of 1e-50 becomes 0 and must not slip through as a point.
+    if (finite) p.p_lidar = Eigen::Vector3f(float(x), float(y), float(z));
+    if (!finite || p.p_lidar.isZero(0.0f) ||
         !ToAbsoluteNs(RawTime(cursor, i, layout), mapping, &p.t_ns)) {
       ++stats->invalid_points;
       continue;
     }
-    const double r2 = x * x + y * y + z * z;
+    const double r2 = p.p_lidar.cast<double>().squaredNorm();
     if (r2 < min_r2 || r2 > max_r2) {
       ++stats->out_of_range_points;
       continue;
     }
-    p.p_lidar = Eigen::Vector3f(float(x), float(y), float(z));
     if (f.intensity.present) {
       const double v = cursor.Read(i, f.intensity);
       p.intensity = std::isfinite(v) && std::abs(v) < 1e30 ? float(v) : 0.0f;

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <vector>
 
 #include <Eigen/SVD>
@@ -26,12 +27,20 @@ constexpr int kKittiValues = 12;
 // KITTI files print 6-7 significant digits, so R^T R deviates from I by ~1e-6;
 // anything far beyond that is not a rotation.
 constexpr double kKittiOrthonormalTol = 1e-3;
+// Largest stamp in seconds whose ns value fits int64 (as ParseSecondsToNs).
+constexpr double kMaxStampS = 9.2e9;
 
 // One non-blank, non-comment line split into values.
 struct DataLine {
   int number = 0;  // 1-based line number in the file
   std::vector<std::string> tokens;
 };
+
+std::string FormatG(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", x);
+  return buf;
+}
 
 Status LineError(const std::string& path, int line, const std::string& message) {
   return Status::InvalidInput(path + ", line " + std::to_string(line) + ": " + message);
@@ -52,28 +61,48 @@ std::vector<std::string> Split(const std::string& line) {
   return tokens;
 }
 
-// All data lines of a text file; what = "trajectory" or "times" for messages.
-StatusOr<std::vector<DataLine>> ReadDataLines(const std::string& path, const std::string& what) {
+// The whole text of a file; what = "trajectory" or "times" for messages.
+Status ReadFileText(const std::string& path, const std::string& what, std::string* text) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0)
     return Status::InvalidInput("cannot open " + what + " file '" + path +
                                 "': " + std::strerror(errno));
   if (S_ISDIR(st.st_mode))
     return Status::InvalidInput("cannot read " + what + " file '" + path + "': it is a directory");
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in)
     return Status::InvalidInput("cannot open " + what + " file '" + path +
                                 "': " + std::strerror(errno));
-  std::vector<DataLine> lines;
-  std::string text;
-  for (int number = 1; std::getline(in, text); ++number) {
-    const size_t first = text.find_first_not_of(" \t\r");
-    if (first == std::string::npos || text[first] == '#') continue;
-    lines.push_back({number, Split(text)});
-  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
   if (in.bad()) return Status::InvalidInput("error while reading " + what + " file '" + path + "'");
-  if (lines.empty()) return Status::InvalidInput(what + " file '" + path + "' contains no poses");
+  *text = buffer.str();
+  return Status::Ok();
+}
+
+// All data lines of a text (blank lines and '#' comments dropped); `source`
+// names it in messages.
+StatusOr<std::vector<DataLine>> SplitDataLines(const std::string& text, const std::string& source,
+                                               const std::string& what) {
+  std::vector<DataLine> lines;
+  size_t start = 0;
+  for (int number = 1; start < text.size(); ++number) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(start, end - start);
+    start = end + 1;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    lines.push_back({number, Split(line)});
+  }
+  if (lines.empty()) return Status::InvalidInput(what + " file '" + source + "' contains no poses");
   return lines;
+}
+
+StatusOr<std::vector<DataLine>> ReadDataLines(const std::string& path, const std::string& what) {
+  std::string text;
+  if (Status s = ReadFileText(path, what, &text); !s.ok()) return s;
+  return SplitDataLines(text, path, what);
 }
 
 bool ParseFinite(const std::string& text, double* value) {
@@ -125,9 +154,13 @@ StatusOr<StampedPose> ParseTumLine(const std::string& path, const DataLine& line
   if (Status s = ParseValues(path, line, 1, v); !s.ok()) return s;
   pose.p_world_imu = Eigen::Vector3d(v[0], v[1], v[2]);
   Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // Eigen order: w, x, y, z
-  const double norm = q.norm();
-  if (!(norm > 1e-12)) return LineError(path, line.number, "quaternion is zero");
-  pose.q_world_imu = Eigen::Quaterniond(q.coeffs() / norm);
+  // Scaled by the largest component first: the norm of 1e200 components
+  // would overflow to inf (and the quaternion become zero).
+  const double scale = q.coeffs().cwiseAbs().maxCoeff();
+  if (!(scale > 0.0)) return LineError(path, line.number, "quaternion is zero");
+  const Eigen::Vector4d scaled = q.coeffs() / scale;
+  if (!(scale * scaled.norm() > 1e-12)) return LineError(path, line.number, "quaternion is zero");
+  pose.q_world_imu = Eigen::Quaterniond(scaled.normalized());
   return pose;
 }
 
@@ -169,17 +202,44 @@ StatusOr<Trajectory> TumFromLines(const std::string& path, const std::vector<Dat
   return trajectory;
 }
 
-Status AssignKittiTimes(const std::string& path, const std::string& times_path, double rate_hz,
+// The stamps of a KITTI times file, read only once the poses parsed.
+using TimesLoader = StatusOr<std::vector<DataLine>> (*)(const std::string& source,
+                                                        const std::string* text);
+
+StatusOr<std::vector<DataLine>> LoadTimesFile(const std::string& path, const std::string*) {
+  return ReadDataLines(path, "times");
+}
+
+StatusOr<std::vector<DataLine>> LoadTimesText(const std::string& source, const std::string* text) {
+  return SplitDataLines(*text, source, "times");
+}
+
+struct KittiTimes {
+  std::string source;                 // times file path or name; empty: constant rate
+  const std::string* text = nullptr;  // the text, for LoadTimesText
+  TimesLoader load = LoadTimesFile;
+  double rate_hz = 10.0;
+};
+
+Status AssignKittiTimes(const std::string& path, const KittiTimes& times,
                         Trajectory* trajectory) {
+  const std::string& times_path = times.source;
   if (times_path.empty()) {
+    const double rate_hz = times.rate_hz;
     if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
       return Status::InvalidInput("KITTI rate must be positive (got " + std::to_string(rate_hz) +
                                   " Hz)");
+    // The last stamp must fit int64 ns (a rate of 1e-300 Hz would not).
+    const double last_s = static_cast<double>(trajectory->size() - 1) / rate_hz;
+    if (!(last_s < kMaxStampS))
+      return Status::InvalidInput("KITTI rate " + FormatG(rate_hz) + " Hz is too low for " +
+                                  std::to_string(trajectory->size()) +
+                                  " poses: the stamps would overflow");
     for (size_t i = 0; i < trajectory->size(); ++i)
       (*trajectory)[i].t_ns = SecondsToNs(static_cast<double>(i) / rate_hz);
     return Status::Ok();
   }
-  StatusOr<std::vector<DataLine>> lines = ReadDataLines(times_path, "times");
+  StatusOr<std::vector<DataLine>> lines = times.load(times_path, times.text);
   if (!lines.ok()) return lines.status();
   if (lines->size() != trajectory->size())
     return Status::InvalidInput("times file '" + times_path + "' has " +
@@ -194,11 +254,31 @@ Status AssignKittiTimes(const std::string& path, const std::string& times_path, 
 }
 
 StatusOr<Trajectory> KittiFromLines(const std::string& path, const std::vector<DataLine>& lines,
-                                    const std::string& times_path, double rate_hz) {
+                                    const KittiTimes& times) {
   StatusOr<Trajectory> trajectory = ParseAll(path, lines, ParseKittiLine);
   if (!trajectory.ok()) return trajectory;
-  if (Status s = AssignKittiTimes(path, times_path, rate_hz, &*trajectory); !s.ok()) return s;
+  if (Status s = AssignKittiTimes(path, times, &*trajectory); !s.ok()) return s;
   return trajectory;
+}
+
+KittiTimes TimesFile(const std::string& times_path, double rate_hz) {
+  KittiTimes times;
+  times.source = times_path;
+  times.rate_hz = rate_hz;
+  return times;
+}
+
+// Format detected from the value count of the first data line.
+StatusOr<Trajectory> TrajectoryFromLines(const std::string& path,
+                                         const std::vector<DataLine>& lines,
+                                         const KittiTimes& times) {
+  const DataLine& first = lines.front();
+  if (first.tokens.size() == kTumValues) return TumFromLines(path, lines);
+  if (first.tokens.size() == kKittiValues) return KittiFromLines(path, lines, times);
+  return LineError(path, first.number,
+                   "unknown trajectory format: expected 8 values (TUM: t x y z qx qy qz qw) or 12 "
+                   "(KITTI: 3x4 matrix), found " +
+                       std::to_string(first.tokens.size()));
 }
 
 // Digits of [begin, end) as an unsigned integer; false on overflow of `limit`.
@@ -231,7 +311,7 @@ bool ParseSecondsToNs(const std::string& text, TimeNs* t_ns) {
   const bool plain = i == n && (int_end > int_begin || frac_end > frac_begin);
   if (!plain) {  // exponent notation or garbage: through double
     double seconds = 0.0;
-    if (!ParseFinite(text, &seconds) || std::fabs(seconds) > 9.2e9) return false;
+    if (!ParseFinite(text, &seconds) || std::fabs(seconds) > kMaxStampS) return false;
     *t_ns = SecondsToNs(seconds);
     return true;
   }
@@ -258,21 +338,46 @@ StatusOr<Trajectory> ReadKitti(const std::string& path, const std::string& times
                                double rate_hz) {
   StatusOr<std::vector<DataLine>> lines = ReadDataLines(path, "trajectory");
   if (!lines.ok()) return lines.status();
-  return KittiFromLines(path, *lines, times_path, rate_hz);
+  return KittiFromLines(path, *lines, TimesFile(times_path, rate_hz));
 }
 
 StatusOr<Trajectory> ReadTrajectory(const std::string& path, const std::string& kitti_times_path,
                                     double kitti_rate_hz) {
   StatusOr<std::vector<DataLine>> lines = ReadDataLines(path, "trajectory");
   if (!lines.ok()) return lines.status();
-  const DataLine& first = lines->front();
-  if (first.tokens.size() == kTumValues) return TumFromLines(path, *lines);
-  if (first.tokens.size() == kKittiValues)
-    return KittiFromLines(path, *lines, kitti_times_path, kitti_rate_hz);
-  return LineError(path, first.number,
-                   "unknown trajectory format: expected 8 values (TUM: t x y z qx qy qz qw) or 12 "
-                   "(KITTI: 3x4 matrix), found " +
-                       std::to_string(first.tokens.size()));
+  return TrajectoryFromLines(path, *lines, TimesFile(kitti_times_path, kitti_rate_hz));
+}
+
+StatusOr<Trajectory> ParseTumText(const std::string& text, const std::string& source) {
+  StatusOr<std::vector<DataLine>> lines = SplitDataLines(text, source, "trajectory");
+  if (!lines.ok()) return lines.status();
+  return TumFromLines(source, *lines);
+}
+
+StatusOr<Trajectory> ParseKittiText(const std::string& text, const std::string& source,
+                                    double rate_hz) {
+  StatusOr<std::vector<DataLine>> lines = SplitDataLines(text, source, "trajectory");
+  if (!lines.ok()) return lines.status();
+  return KittiFromLines(source, *lines, TimesFile("", rate_hz));
+}
+
+StatusOr<Trajectory> ParseKittiText(const std::string& text, const std::string& source,
+                                    const std::string& times_text,
+                                    const std::string& times_source) {
+  StatusOr<std::vector<DataLine>> lines = SplitDataLines(text, source, "trajectory");
+  if (!lines.ok()) return lines.status();
+  KittiTimes times;
+  times.source = times_source.empty() ? std::string("times") : times_source;
+  times.text = &times_text;
+  times.load = LoadTimesText;
+  return KittiFromLines(source, *lines, times);
+}
+
+StatusOr<Trajectory> ParseTrajectoryText(const std::string& text, const std::string& source,
+                                         double kitti_rate_hz) {
+  StatusOr<std::vector<DataLine>> lines = SplitDataLines(text, source, "trajectory");
+  if (!lines.ok()) return lines.status();
+  return TrajectoryFromLines(source, *lines, TimesFile("", kitti_rate_hz));
 }
 
 std::string FormatTumLine(const StampedPose& pose) {

@@ -32,6 +32,20 @@ StatusOr<Trajectory> ReadTrajectory(const std::string& path,
                                     const std::string& kitti_times_path = "",
                                     double kitti_rate_hz = 10.0);
 
+// The same parsers on text in memory (the file readers above read the file
+// and parse it with these); `source` stands for the path in error messages.
+StatusOr<Trajectory> ParseTumText(const std::string& text, const std::string& source);
+// KITTI poses at a constant rate: t_i = i / rate_hz (s).
+StatusOr<Trajectory> ParseKittiText(const std::string& text, const std::string& source,
+                                    double rate_hz = 10.0);
+// KITTI poses with the text of a times file (one stamp per pose).
+StatusOr<Trajectory> ParseKittiText(const std::string& text, const std::string& source,
+                                    const std::string& times_text,
+                                    const std::string& times_source);
+// Format detected like ReadTrajectory; KITTI at a constant rate.
+StatusOr<Trajectory> ParseTrajectoryText(const std::string& text, const std::string& source,
+                                         double kitti_rate_hz = 10.0);
+
 // Formats one TUM line (with '\n'): time with 9 decimals (exact ns), position
 // with 9 decimals (nm), quaternion with 12 decimals.
 std::string FormatTumLine(const StampedPose& pose);

@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets of fuzz/ with clang (ASan + UBSan) in
+# ./build-fuzz and runs each for a bounded time from its committed seeds.
+#
+#   bash scripts/fuzz.sh [--seconds N] [TARGET ...]
+#
+#   --seconds N   fuzzing time per target (default: $RVLIO_FUZZ_SECONDS or 60)
+#   TARGET        pointcloud2, config, trajectory (default: all three)
+#
+# Seeds: fuzz/corpus/<target>/ (read only; refresh with fuzz/make_seeds.py).
+# New interesting inputs go to build-fuzz/corpus/<target>/, which later runs
+# reuse. A crash, a timeout (> 10 s on one input) or an out-of-memory (> 2 GB)
+# stops the target; the script then prints the reproducer
+# (build-fuzz/artifacts/<target>-crash-...) and the command that replays it,
+# and exits 1 once every target has run. Logs: build-fuzz/logs/<target>.log.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+seconds=${RVLIO_FUZZ_SECONDS:-60}
+targets=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --seconds) seconds=$2; shift 2 ;;
+    --seconds=*) seconds=${1#*=}; shift ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -*) echo "fuzz.sh: unknown option '$1'" >&2; exit 2 ;;
+    *) targets+=("$1"); shift ;;
+  esac
+done
+[[ ${#targets[@]} -eq 0 ]] && targets=(pointcloud2 config trajectory)
+if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [[ "$seconds" -lt 1 ]]; then
+  echo "fuzz.sh: --seconds must be a positive integer (got '$seconds')" >&2
+  exit 2
+fi
+
+# Longest input per target: a few times the largest seed.
+declare -A max_len=([pointcloud2]=8192 [config]=8192 [trajectory]=4096)
+for t in "${targets[@]}"; do
+  [[ -n "${max_len[$t]:-}" ]] || { echo "fuzz.sh: unknown target '$t'" >&2; exit 2; }
+done
+
+build=$root/build-fuzz
+cxx=$(command -v clang++ || command -v clang++-14 || true)
+[[ -n "$cxx" ]] || { echo "fuzz.sh: clang++ not found (bash scripts/install_deps.sh --with-test-tools)" >&2; exit 1; }
+cmake -S fuzz -B "$build" -DCMAKE_CXX_COMPILER="$cxx" >/dev/null
+cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target "${targets[@]/#/fuzz_}"
+
+symbolizer=$(command -v llvm-symbolizer || command -v llvm-symbolizer-14 || true)
+[[ -n "$symbolizer" ]] && export ASAN_SYMBOLIZER_PATH=$symbolizer
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+
+mkdir -p "$build/artifacts" "$build/logs"
+failed=()
+for t in "${targets[@]}"; do
+  corpus=$build/corpus/$t
+  mkdir -p "$corpus"
+  log=$build/logs/$t.log
+  before=$(ls "$build/artifacts" | grep -c "^$t-" || true)
+  echo "fuzz: $t for ${seconds} s (max_len ${max_len[$t]}, seeds fuzz/corpus/$t)"
+  rc=0
+  "$build/fuzz_$t" -max_total_time="$seconds" -max_len="${max_len[$t]}" -timeout=10 \
+    -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" \
+    "$corpus" "fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
+  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo "?")
+  after=$(ls "$build/artifacts" | grep -c "^$t-" || true)
+  if [[ $rc -ne 0 || $after -gt $before ]]; then
+    failed+=("$t")
+    echo "fuzz: $t FAILED (exit $rc) after $runs runs; last lines of $log:"
+    tail -n 40 "$log" | sed 's/^/  | /'
+    artifact=$(ls -t "$build/artifacts" | grep "^$t-" | head -1 || true)
+    if [[ -n "$artifact" ]]; then
+      echo "fuzz: reproducer: $build/artifacts/$artifact"
+      echo "fuzz: replay with: $build/fuzz_$t $build/artifacts/$artifact"
+    fi
+  else
+    echo "fuzz: $t ok: $runs runs, coverage $cov, corpus $(ls "$corpus" | wc -l) inputs"
+  fi
+done
+
+if [[ ${#failed[@]} -gt 0 ]]; then
+  echo "fuzz: failing targets: ${failed[*]}"
+  echo "fuzz: $(( ${#targets[@]} - ${#failed[@]} )) passed, ${#failed[@]} failed"
+  exit 1
+fi
+echo "fuzz: ${#targets[@]} passed, 0 failed"
