@@ -51,32 +51,48 @@ export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 
 mkdir -p "$build/artifacts" "$build/logs"
-failed=()
-for t in "${targets[@]}"; do
-  corpus=$build/corpus/$t
+
+# Fuzzes one target for $seconds; prints its verdict; returns nonzero on a finding.
+fuzz_one() {
+  local t=$1 corpus=$build/corpus/$1 log=$build/logs/$1.log rc=0
   mkdir -p "$corpus"
-  log=$build/logs/$t.log
+  local before
   before=$(ls "$build/artifacts" | grep -c "^$t-" || true)
-  echo "fuzz: $t for ${seconds} s (max_len ${max_len[$t]}, seeds fuzz/corpus/$t)"
-  rc=0
   "$build/fuzz_$t" -max_total_time="$seconds" -max_len="${max_len[$t]}" -timeout=10 \
     -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" \
     "$corpus" "fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
+  local runs cov after
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo "?")
   after=$(ls "$build/artifacts" | grep -c "^$t-" || true)
   if [[ $rc -ne 0 || $after -gt $before ]]; then
-    failed+=("$t")
-    echo "fuzz: $t FAILED (exit $rc) after $runs runs; last lines of $log:"
-    tail -n 40 "$log" | sed 's/^/  | /'
-    artifact=$(ls -t "$build/artifacts" | grep "^$t-" | head -1 || true)
-    if [[ -n "$artifact" ]]; then
-      echo "fuzz: reproducer: $build/artifacts/$artifact"
-      echo "fuzz: replay with: $build/fuzz_$t $build/artifacts/$artifact"
-    fi
-  else
-    echo "fuzz: $t ok: $runs runs, coverage $cov, corpus $(ls "$corpus" | wc -l) inputs"
+    {
+      echo "fuzz: $t FAILED (exit $rc) after $runs runs; last lines of $log:"
+      tail -n 40 "$log" | sed 's/^/  | /'
+      local artifact
+      artifact=$(ls -t "$build/artifacts" | grep "^$t-" | head -1 || true)
+      if [[ -n "$artifact" ]]; then
+        echo "fuzz: reproducer: $build/artifacts/$artifact"
+        echo "fuzz: replay with: $build/fuzz_$t $build/artifacts/$artifact"
+      fi
+    } >"$log.verdict"
+    return 1
   fi
+  echo "fuzz: $t ok: $runs runs, coverage $cov, corpus $(ls "$corpus" | wc -l) inputs" >"$log.verdict"
+}
+
+# The targets run side by side (each for $seconds of wall time), so the stage
+# takes about $seconds however many targets there are.
+declare -A pids=()
+for t in "${targets[@]}"; do
+  echo "fuzz: $t for ${seconds} s (max_len ${max_len[$t]}, seeds fuzz/corpus/$t)"
+  fuzz_one "$t" &
+  pids[$t]=$!
+done
+failed=()
+for t in "${targets[@]}"; do
+  wait "${pids[$t]}" || failed+=("$t")
+  cat "$build/logs/$t.log.verdict"
 done
 
 if [[ ${#failed[@]} -gt 0 ]]; then
