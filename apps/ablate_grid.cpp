@@ -1,4 +1,5 @@
 #include "ablate_grid.h"
+#include "json_text.h"
 
 #include <sys/stat.h>
 
@@ -399,7 +400,7 @@ DataItem MakeDataItem(const Sequence& seq, int64_t seed, const std::string& out_
   if (!seq.duration.empty()) args.insert(args.end(), {"--duration", seq.duration});
   for (const auto& o : seq.sim_overrides) args.insert(args.end(), {"--set", o});
   args.insert(args.end(), {"--name", stem});
-  d.hash = HashHex(nlohmann::json({{"format", 1}, {"simulate", args}}).dump());
+  d.hash = HashHex(JsonText(nlohmann::json({{"format", 1}, {"simulate", args}}), -1));
   d.id = stem + "_s" + std::to_string(seed) + "_" + d.hash.substr(0, 10);
   d.dir = (fs::path(out_dir) / "data" / d.id).string();
   args.insert(args.end(), {"--out", d.dir});
@@ -440,7 +441,7 @@ std::string CellHash(const Cell& c, const Plan& plan) {
       {"config", files},
       {"set", c.overrides},
       {"eval", "se3,rpe1"}};
-  return HashHex(identity.dump());
+  return HashHex(JsonText(identity, -1));
 }
 
 // Checks the keys and values of a cell's configuration now (the sensor file

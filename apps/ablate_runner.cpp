@@ -1,4 +1,5 @@
 #include "ablate_runner.h"
+#include "json_text.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -239,7 +240,7 @@ json CellHeader(const Cell& cell) {
 }
 
 bool WriteCellRecord(const Cell& cell, json record) {
-  const Status s = WriteFileAtomically(cell.CellJson(), record.dump(2) + "\n");
+  const Status s = WriteFileAtomically(cell.CellJson(), JsonText(record) + "\n");
   if (!s.ok()) std::fprintf(stderr, "rvlio ablate: error: %s\n", s.message().c_str());
   return s.ok() && record["status"] == "done";
 }
@@ -293,7 +294,7 @@ bool FinishData(const DataItem& d, int status, double wall_s) {
                        {"error", ok ? "" : "rvlio simulate " + how},
                        {"wall_s", wall_s},
                        {"simulate_argv", d.simulate_args}};
-  const Status s = WriteFileAtomically(d.Marker(), marker.dump(2) + "\n");
+  const Status s = WriteFileAtomically(d.Marker(), JsonText(marker) + "\n");
   return ok && s.ok();
 }
 

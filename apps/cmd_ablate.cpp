@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "ablate_grid.h"
+#include "json_text.h"
 #include "ablate_runner.h"
 #include "ablate_summary.h"
 #include "commands.h"
@@ -98,7 +99,7 @@ int CmdAblate(int argc, char** argv) {
   StatusOr<ablate::Plan> plan = ablate::LoadPlan(args.Get("grid"), args.Get("out"));
   if (!plan.ok()) return Fail(kName, plan.status().message(), plan.status().exit_code());
   if (args.Has("plan")) {
-    std::cout << ablate::PlanJson(*plan).dump(2) << "\n";
+    std::cout << JsonText(ablate::PlanJson(*plan)) << "\n";
     return 0;
   }
   if (!PrepareOutputDir(kName, plan->out_dir)) return 2;
@@ -107,7 +108,7 @@ int CmdAblate(int argc, char** argv) {
   if (args.Has("data")) return RunSingle(*plan, args.Get("data"), options);
 
   if (Status s =
-          WriteFileAtomically(plan->out_dir + "/plan.json", ablate::PlanJson(*plan).dump(2) + "\n");
+          WriteFileAtomically(plan->out_dir + "/plan.json", JsonText(ablate::PlanJson(*plan)) + "\n");
       !s.ok())
     return Fail(kName, s.message(), s.exit_code());
   const ablate::RunCounts c = ablate::RunPlan(*plan, options);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_text.h"
 #include "common_options.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/io/trajectory_io.h"
@@ -84,7 +85,7 @@ void PrintJson(const EvalResult& r) {
       {"end_point_error", Num(r.end_point_error_m)},
       {"along_axis", {{"rmse", Num(r.along_axis.rmse_m)}, {"max", Num(r.along_axis.max_abs_m)}}},
       {"warnings", r.warnings}};
-  std::cout << out.dump() << "\n";
+  std::cout << JsonText(out, -1) << "\n";
 }
 
 void PrintRow(const char* label, const ErrorStats& s, const std::string& note = "") {

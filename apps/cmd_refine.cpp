@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "json_text.h"
 #include "commands.h"
 #include "common_options.h"
 #include "run_pipeline.h"
@@ -148,7 +149,7 @@ Status WriteOutputs(const Request& req, const OdometryOptions& options, const Re
   j["peak_memory_mb"] = PeakMemoryMb();
   j["stats"] = StatsJson(res.stats, reader_stats, raw_points);
   j["warnings"] = res.warnings;
-  if (Status s = WriteFileAtomically(stage.Path("summary.json"), j.dump(2) + "\n"); !s.ok())
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
     return stage.Explain(s);
   return stage.Commit();
 }

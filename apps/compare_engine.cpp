@@ -1,4 +1,5 @@
 #include "compare_engine.h"
+#include "json_text.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -466,7 +467,7 @@ Status WriteJson(const CompareRequest& req, const std::vector<Row>& rows,
     j["variants"].push_back(RowJson(req, r, overrides));
   }
   j["plots"] = {{"status", plots.status}, {"message", plots.message}, {"files", plots.files}};
-  return WriteFileAtomically(req.out_dir + "/compare.json", j.dump(2) + "\n");
+  return WriteFileAtomically(req.out_dir + "/compare.json", JsonText(j) + "\n");
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 #include "run_pipeline.h"
+#include "json_text.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -126,7 +127,7 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   outcome->scans = static_cast<int>(data.results.size());
   outcome->median_ms = t.median_ms;
   outcome->real_time_factor = j["real_time_factor"];
-  if (Status s = WriteFileAtomically(stage.Path("summary.json"), j.dump(2) + "\n"); !s.ok())
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
     return stage.Explain(s);
   return stage.Commit();
 }

@@ -134,5 +134,20 @@ TEST_F(BadConfigOutputTest, DiskFullDuringRefineLeavesTheEarlierRunIntact) {
     EXPECT_EQ(ReadFile(out + "/" + f), ReadFile(Clean(f))) << f;
 }
 
+// Found by the config fuzzer's notes: file names and --set strings need not be
+// UTF-8 (Latin-1 folder names are common). summary.json must still be written
+// and parse, with the bytes replaced (U+FFFD), instead of an uncaught throw.
+TEST_F(BadConfigOutputTest, NonUtf8PathsStillGiveAParsableSummary) {
+  const std::string latin1_dir = dir_ + "/caf\xe9";
+  fs::create_directories(latin1_dir);
+  fs::copy_file(Bag(), latin1_dir + "/t.bag");
+  const std::string out = latin1_dir + "/out";
+  const ToolRun r = Run(latin1_dir + "/t.bag", out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out + "/summary.json"), nullptr, false);
+  ASSERT_FALSE(summary.is_discarded());
+  EXPECT_NE(summary.dump().find("caf\xef\xbf\xbd"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rvlio::badinput
