@@ -11,6 +11,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_util.h"
+
 #include "rvlio/constraints/associate.h"
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/map/voxel_map.h"
@@ -22,23 +24,6 @@ namespace {
 constexpr TimeNs kScanNs = 100000000;  // 10 Hz
 constexpr TimeNs kImuNs = 5000000;     // 200 Hz
 constexpr double kSpeed = 1.0;         // m/s along x
-
-// Walls, floor and ceiling of a 10 x 8 m tunnel, x in [-40, 40], 2 cm roughness.
-std::vector<Eigen::Vector3d> TunnelPoints(std::mt19937_64* rng, double step) {
-  std::normal_distribution<double> n(0.0, 0.02);
-  std::vector<Eigen::Vector3d> pts;
-  for (double x = -40.0; x <= 40.0; x += step) {
-    for (double s = -5.0; s <= 5.0; s += step) {
-      pts.emplace_back(x, s, 0.0 + n(*rng));
-      pts.emplace_back(x, s, 8.0 + n(*rng));
-    }
-    for (double z = 0.0; z <= 8.0; z += step) {
-      pts.emplace_back(x, -5.0 + n(*rng), z);
-      pts.emplace_back(x, 5.0 + n(*rng), z);
-    }
-  }
-  return pts;
-}
 
 Eigen::Vector3d TruePosition(TimeNs t_ns) {
   return Eigen::Vector3d(-20.0 + kSpeed * NsToSeconds(t_ns), 0.5, 3.0);
@@ -59,8 +44,8 @@ struct World {
   std::vector<ImuSample> imu;                 // level, constant velocity: specific force = -g
   World() {
     std::mt19937_64 rng(1);
-    map.Insert(TunnelPoints(&rng, 0.1));
-    scan_points = TunnelPoints(&rng, 0.3);
+    map.Insert(bench::TunnelPoints(&rng, 0.1, 40.0));
+    scan_points = bench::TunnelPoints(&rng, 0.3, 40.0);
     for (TimeNs t = 0; t <= 60 * kScanNs * 10; t += kImuNs) {
       ImuSample s;
       s.t_ns = t;
