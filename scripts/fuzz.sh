@@ -2,9 +2,15 @@
 # Builds the libFuzzer targets of fuzz/ with clang (ASan + UBSan) in
 # ./build-fuzz and runs each for a bounded time from its committed seeds.
 #
-#   bash scripts/fuzz.sh [--seconds N] [TARGET ...]
+#   bash scripts/fuzz.sh [--seconds N] [--ci] [TARGET ...]
 #
 #   --seconds N   fuzzing time per target (default: $RVLIO_FUZZ_SECONDS or 60)
+#   --ci          reproducible run (what scripts/test.sh uses): libFuzzer seed 1
+#                 and a fixed number of inputs per target (about a minute here),
+#                 starting from the committed seeds only, so CI's verdict is the
+#                 same on every machine (a slower machine stops at --seconds
+#                 after a prefix of the same inputs). Without --ci the seed is
+#                 random and new inputs accumulate: use that to hunt for bugs.
 #   TARGET        pointcloud2, config, trajectory (default: all three)
 #
 # Seeds: fuzz/corpus/<target>/ (read only; refresh with fuzz/make_seeds.py).
@@ -18,10 +24,12 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 seconds=${RVLIO_FUZZ_SECONDS:-60}
 targets=()
+ci=false
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seconds) seconds=$2; shift 2 ;;
     --seconds=*) seconds=${1#*=}; shift ;;
+    --ci) ci=true; shift ;;
     -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option '$1'" >&2; exit 2 ;;
     *) targets+=("$1"); shift ;;
@@ -35,6 +43,8 @@ fi
 
 # Longest input per target: a few times the largest seed.
 declare -A max_len=([pointcloud2]=8192 [config]=8192 [trajectory]=4096)
+# --ci: inputs per target, about 60 s each on the 2-core machine of bench/RESULTS.md.
+declare -A ci_runs=([pointcloud2]=600000 [config]=10000 [trajectory]=500000)
 for t in "${targets[@]}"; do
   [[ -n "${max_len[$t]:-}" ]] || { echo "fuzz.sh: unknown target '$t'" >&2; exit 2; }
 done
@@ -55,12 +65,18 @@ mkdir -p "$build/artifacts" "$build/logs"
 # Fuzzes one target for $seconds; prints its verdict; returns nonzero on a finding.
 fuzz_one() {
   local t=$1 corpus=$build/corpus/$1 log=$build/logs/$1.log rc=0
+  local mode=()
+  if $ci; then
+    corpus=$build/corpus-ci/$t
+    rm -rf "$corpus"
+    mode=(-seed=1 -runs="${ci_runs[$t]}")
+  fi
   mkdir -p "$corpus"
   local before
   before=$(ls "$build/artifacts" | grep -c "^$t-" || true)
   "$build/fuzz_$t" -max_total_time="$seconds" -max_len="${max_len[$t]}" -timeout=10 \
     -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" \
-    "$corpus" "fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
+    "${mode[@]}" "$corpus" "fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
   local runs cov after
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo "?")
@@ -85,7 +101,7 @@ fuzz_one() {
 # takes about $seconds however many targets there are.
 declare -A pids=()
 for t in "${targets[@]}"; do
-  echo "fuzz: $t for ${seconds} s (max_len ${max_len[$t]}, seeds fuzz/corpus/$t)"
+  echo "fuzz: $t for ${seconds} s$($ci && echo ", seed 1, at most ${ci_runs[$t]} inputs") (max_len ${max_len[$t]}, seeds fuzz/corpus/$t)"
   fuzz_one "$t" &
   pids[$t]=$!
 done

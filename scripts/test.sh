@@ -5,8 +5,9 @@
 #   release   Release build in build/ + ctest (every test)
 #   sanitize  scripts/sanitize.sh: the test suite built with gcc
 #             ASan + UBSan (-O1 -g) in build-asan/ + ctest there
-#   fuzz      scripts/fuzz.sh: the libFuzzer targets of fuzz/ (clang) in
-#             build-fuzz/, $RVLIO_FUZZ_SECONDS (default 60) s per target
+#   fuzz      scripts/fuzz.sh --ci: the libFuzzer targets of fuzz/ (clang) in
+#             build-fuzz/, seed 1, a fixed number of inputs (about 60 s) per
+#             target, at most $RVLIO_FUZZ_SECONDS (default 60) s each
 #
 # A developer may run a subset: RVLIO_CI_STAGES=release (or "release,fuzz",
 # ...) bash scripts/test.sh. RVLIO_FUZZ_SECONDS=10 shortens the fuzz stage.
@@ -51,7 +52,7 @@ if want sanitize; then
   finish_stage sanitize
 fi
 if want fuzz; then
-  bash scripts/fuzz.sh 2>&1 | tee "$log"
+  bash scripts/fuzz.sh --ci 2>&1 | tee "$log"
   count_tests
   finish_stage fuzz
 fi

@@ -105,11 +105,14 @@ StatusOr<std::vector<DataLine>> ReadDataLines(const std::string& path, const std
   return SplitDataLines(text, path, what);
 }
 
+// strtod reports ERANGE both for overflow (+-HUGE_VAL, rejected by isfinite)
+// and for underflow; an underflowing value (a subnormal, or 0 for 1e-400) is
+// a finite number as written, e.g. by our own writer for a rotation-matrix
+// entry of 1e-320, and is accepted.
 bool ParseFinite(const std::string& text, double* value) {
   char* end = nullptr;
-  errno = 0;
   *value = std::strtod(text.c_str(), &end);
-  return end != text.c_str() && *end == '\0' && errno != ERANGE && std::isfinite(*value);
+  return end != text.c_str() && *end == '\0' && std::isfinite(*value);
 }
 
 Status ParseValues(const std::string& path, const DataLine& line, size_t first, double* out) {

@@ -181,6 +181,23 @@ TEST(TrajectoryFuzzRegress, KittiRateTooLowForThePosesIsAnError) {
   EXPECT_LT(std::llabs((*slow)[2].t_ns - 2000000000000000000), 1000);
 }
 
+// Found by CI's fuzz stage: the quaternion of "0e200 1e260 1e000 1e200"
+// (after scaling) has a rotation matrix with entries of ~1e-320; our KITTI
+// writer prints them and strtod flags such subnormals with ERANGE, which the
+// parser took for "not a finite number". Underflow is a finite value.
+TEST(TrajectoryFuzzRegress, SubnormalAndUnderflowingValuesParse) {
+  const std::string kitti =
+      "-1 -1.999977734365366e-320 1e-60 0 1.999977734365366e-320 1 1e-260 0 -1e-60 1e-260 -1 0\n";
+  const StatusOr<Trajectory> t = ParseKittiText(kitti, "sub.txt", 10.0);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  EXPECT_NEAR(std::abs((*t)[0].q_world_imu.coeffs().dot(Eigen::Vector4d(0, 1, 0, 0))), 1.0, 1e-12);
+  const StatusOr<Trajectory> tum = ParseTumText("0 1e-400 0 0 0 0 0 1\n", "under.tum");
+  ASSERT_TRUE(tum.ok()) << tum.status().message();
+  EXPECT_EQ((*tum)[0].p_world_imu.x(), 0.0);
+  const StatusOr<Trajectory> over = ParseTumText("0 1e400 0 0 0 0 0 1\n", "over.tum");
+  ASSERT_FALSE(over.ok());
+}
+
 // The text parsers and the file readers give the same results and messages.
 TEST(TrajectoryFuzzRegress, TextParsersMatchFileReaders) {
   const std::string dir = MakeTempDir("rvlio_fuzzregress");
