@@ -68,7 +68,8 @@ double ReinforcementCoefficient(const RvOptions& options, int num_scv, int num_c
   return num_scv > 0 ? std::max(K, options.min_K) : K;
 }
 
-int ReinforceScv(double K, const RvWorkspace& ws, ConstraintList* constraints) {
+int ReinforceScv(double K, const RvWorkspace& ws, ConstraintList* constraints,
+                 double max_abs_residual_m) {
   RVLIO_CHECK(constraints != nullptr && ws.size() == static_cast<int>(constraints->size()));
   RVLIO_CHECK(K > 0.0 && std::isfinite(K));
   // R_i = sigma^2 / weight  ->  K R_i  <=>  weight / K.
@@ -77,8 +78,9 @@ int ReinforceScv(double K, const RvWorkspace& ws, ConstraintList* constraints) {
   for (int i = 0; i < ws.size(); ++i) {
     if (ws.cls[i] != VectorClass::kScv) continue;
     Constraint& c = (*constraints)[i];
-    c.weight *= scale;
     c.role = RvRole::kScv;
+    if (max_abs_residual_m > 0.0 && std::abs(c.residual) > max_abs_residual_m) continue;
+    c.weight *= scale;
     ++edited;
   }
   return edited;

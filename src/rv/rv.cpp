@@ -56,7 +56,7 @@ RvReport ApplyRv(const RvOptions& options, const Pose3& T_world_lidar, Constrain
       report.num_coplanar = refit.num_coplanar;
       report.K = ReinforcementCoefficient(options, refit.num_scv, refit.num_coplanar);  // Eq. (19)
       if (options.reinforce && refit.num_scv > 0) {
-        report.num_reinforced = ReinforceScv(report.K, *ws, constraints);
+        report.num_reinforced = ReinforceScv(report.K, *ws, constraints, options.reinforce_max_residual);
       }
       if (options.repair) {  // Alg. 3
         report.num_repaired =

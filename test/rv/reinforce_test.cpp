@@ -193,6 +193,44 @@ TEST(ReinforceTest, ApplyRvScalesExactlyTheScvWeightsByOneOverK) {
   }
 }
 
+// Ours (rv.reinforce_max_residual): an SCV that does not fit its plane at the
+// current iterate is left at its plain weight, every other SCV is reinforced.
+TEST(ReinforceTest, ScvsWithLargeResidualsAreNotReinforced) {
+  std::mt19937 rng(35);
+  std::uniform_real_distribution<double> small(-0.04, 0.04), large(0.06, 0.5);
+  for (int trial = 0; trial < 100; ++trial) {
+    test::TunnelSpec spec;
+    spec.num_coplanar = 1000;
+    spec.num_scv = 10 + trial % 50;
+    test::TunnelSet set = test::MakeTunnelSet(rng, spec);
+    int consistent_scvs = 0;
+    for (size_t i = 0; i < set.list.size(); ++i) {
+      const bool outlier = set.is_scv[i] && i % 3 == 0;
+      set.list[i].residual = outlier ? (i % 2 ? 1.0 : -1.0) * large(rng) : small(rng);
+      consistent_scvs += set.is_scv[i] && !outlier;
+    }
+    RvOptions options = PaperSimOptions();
+    options.repair = false;
+    options.k0 = 0.053;  // K < 1: reinforcement really changes weights
+    options.reinforce_max_residual = 0.05;
+    ConstraintList list = set.list;
+    const RvReport report = ApplyRv(options, set.T_world_lidar, &list);
+    ASSERT_TRUE(report.active);
+    ASSERT_LT(report.K, 1.0);
+    ASSERT_EQ(report.num_scv, spec.num_scv);
+    EXPECT_EQ(report.num_reinforced, consistent_scvs);
+    for (size_t i = 0; i < list.size(); ++i) {
+      const bool reinforced = set.is_scv[i] && std::abs(set.list[i].residual) <= 0.05;
+      if (reinforced) {
+        EXPECT_NEAR(list[i].weight, set.list[i].weight / report.K, 1e-12 * list[i].weight);
+      } else {
+        EXPECT_EQ(list[i].weight, set.list[i].weight);
+      }
+      EXPECT_EQ(list[i].role, set.is_scv[i] ? RvRole::kScv : RvRole::kPlain);
+    }
+  }
+}
+
 TEST(ReinforceTest, ClampedReinforcementNeverLowersLocalizability) {
   std::mt19937 rng(35);
   for (int trial = 0; trial < 100; ++trial) {

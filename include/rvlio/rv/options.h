@@ -15,6 +15,7 @@ struct RvOptions {
   int max_iterations = 10;        // cap of the Alg. 2 refit loop
   bool clamp = true;              // never let K weaken an SCV: K = min(K, 1)
   double min_K = 0.5;             // floor on K: an SCV's information grows at most 1/min_K times
+  double reinforce_max_residual = 0.0;  // m, ours: SCVs with |r| above this are not reinforced (0: off)
   int min_constraints = 20;       // fewer constraints: criterion not evaluated
 
   template <class V>
@@ -31,6 +32,8 @@ struct RvOptions {
     v.Field("clamp", clamp, Spec().Help("K = min(K, 1): reinforcement never weakens an SCV"));
     v.Field("min_K", min_K, Spec().Range(1e-6, 1.0)
                                 .Help("floor on K (ours): SCV information grows at most 1/min_K times"));
+    v.Field("reinforce_max_residual", reinforce_max_residual, Spec().Unit("m").Range(0.0, 10.0)
+        .Help("ours: an SCV whose residual exceeds this is not reinforced (0: off, the paper)"));
     v.Field("min_constraints", min_constraints, Spec().Range(3, 100000));
   }
   Status Validate() {

@@ -34,7 +34,11 @@ double ReinforcementCoefficient(const RvOptions& options, int num_scv, int num_c
 
 // Alg. 2 step 11: the SCV rows' noise becomes K R, i.e. their information
 // multiplier `weight` is divided by K; their role becomes kScv. Returns the
-// number of constraints edited. Requires K > 0 and finite.
-int ReinforceScv(double K, const RvWorkspace& ws, ConstraintList* constraints);
+// number of constraints reinforced. Requires K > 0 and finite. With
+// max_abs_residual_m > 0 (ours, rv.reinforce_max_residual), an SCV whose
+// point-to-plane residual at the current iterate exceeds it keeps its plain
+// weight (its role is still kScv): a mis-associated feature is not amplified.
+int ReinforceScv(double K, const RvWorkspace& ws, ConstraintList* constraints,
+                 double max_abs_residual_m = 0.0);
 
 }  // namespace rvlio
