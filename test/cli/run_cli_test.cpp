@@ -42,14 +42,6 @@ TEST_F(RunCliTest, IeskfWritesTheOutputContractAndMeetsTheRegressionBound) {
             std::count(tum.begin(), tum.end(), '\n') - std::count(tum.begin(), tum.end(), '#'));
 }
 
-TEST_F(RunCliTest, SameInputGivesAByteIdenticalTrajectory) {
-  const ToolRun a = Run(dir_ + "/det_a", "--set rv.enabled=true");
-  const ToolRun b = Run(dir_ + "/det_b", "--set rv.enabled=true");
-  ASSERT_EQ(a.exit_code, 0) << a.err;
-  ASSERT_EQ(b.exit_code, 0) << b.err;
-  EXPECT_EQ(ReadFile(dir_ + "/det_a/trajectory.tum"), ReadFile(dir_ + "/det_b/trajectory.tum"));
-}
-
 TEST_F(RunCliTest, BadInputIsOneLineAndExitTwo) {
   struct Case {
     std::string args, part;
