@@ -209,7 +209,8 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   (*metrics)["rtf"] = summary.value("real_time_factor", 0.0);
   (*metrics)["rv_active_fraction"] =
       scans > 0 ? summary.value("rv_active_scans", 0.0) / scans : 0.0;
-  for (const char* m : {"ate_rmse", "rpe_rmse", "axis_max", "end_point"}) (*metrics)[m] = nullptr;
+  for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point"})
+    (*metrics)[m] = nullptr;
   if (cell.gt.empty()) return "";
   StatusOr<Trajectory> gt = ReadTrajectory(cell.gt);
   if (!gt.ok()) return "eval: " + gt.status().message();
@@ -219,6 +220,7 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   if (!r.ok()) return "eval: " + r.status().message();
   (*metrics)["ate_rmse"] = Number(r->ape_m.rmse);
   (*metrics)["rpe_rmse"] = Number(r->rpe.trans_m.rmse);
+  (*metrics)["axis_rmse"] = Number(r->along_axis.rmse_m);
   (*metrics)["axis_max"] = Number(r->along_axis.max_abs_m);
   (*metrics)["end_point"] = Number(r->end_point_error_m);
   *warnings = r->warnings;
@@ -354,7 +356,8 @@ void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& 
 
 const std::vector<std::string>& MetricNames() {
   static const std::vector<std::string> kNames = {
-      "ate_rmse", "rpe_rmse", "axis_max", "end_point", "ms_per_scan", "rtf", "rv_active_fraction"};
+      "ate_rmse",    "rpe_rmse", "axis_rmse",         "axis_max",
+      "end_point", "ms_per_scan", "rtf", "rv_active_fraction"};
   return kNames;
 }
 

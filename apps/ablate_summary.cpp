@@ -21,6 +21,7 @@ const std::vector<std::pair<std::string, std::string>>& TableMetrics() {
   static const std::vector<std::pair<std::string, std::string>> kMetrics = {
       {"ate_rmse", "ATE [m]"},
       {"rpe_rmse", "RPE [m]"},
+      {"axis_rmse", "axis RMSE [m]"},
       {"axis_max", "axis max [m]"},
       {"end_point", "end [m]"},
       {"ms_per_scan", "ms/scan"},

@@ -244,7 +244,7 @@ void CheckCells(const ToolRun& first, const json& plan) {
       ++done;
       EXPECT_EQ(r["status"], "done") << r.dump();
       EXPECT_EQ(r["exit_code"], 0);
-      for (const char* m : {"ate_rmse", "rpe_rmse", "axis_max", "end_point", "ms_per_scan"}) {
+      for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point", "ms_per_scan"}) {
         ASSERT_TRUE(r["metrics"][m].is_number()) << m;
         EXPECT_GT(r["metrics"][m].get<double>(), 0.0) << m;
       }
@@ -260,7 +260,7 @@ void CheckTable(const json& plan, const std::string& out) {
   for (const json& c : plan["cells"]) {
     if (c["sequence"] != "tunnel") continue;
     const json r = json::parse(ReadFile(c["cell_json"]));
-    for (const char* m : {"ate_rmse", "rpe_rmse", "axis_max", "end_point", "ms_per_scan"})
+    for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point", "ms_per_scan"})
       values[c["variant"].get<std::string>() + "/" + m].push_back(r["metrics"][m].get<double>());
   }
   const auto rows = ReadCsv(out + "/table.csv");
@@ -270,7 +270,7 @@ void CheckTable(const json& plan, const std::string& out) {
     ASSERT_NE(row, nullptr) << variant;
     EXPECT_EQ(row->at("n"), "2");
     EXPECT_EQ(row->at("failed"), "0");
-    for (const char* m : {"ate_rmse", "rpe_rmse", "axis_max", "end_point", "ms_per_scan"}) {
+    for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point", "ms_per_scan"}) {
       const auto& v = values[std::string(variant) + "/" + m];
       ASSERT_EQ(v.size(), 2u);
       const double mean = 0.5 * (v[0] + v[1]);
@@ -388,7 +388,7 @@ TEST_F(AblateRunTest, SnakemakeWorkflowGivesTheSameTable) {
     const auto* s = FindRow(sm, "tunnel", variant);
     ASSERT_TRUE(a && s) << variant;
     EXPECT_EQ(s->at("n"), "2");
-    for (const char* m : {"ate_rmse", "rpe_rmse", "axis_max", "end_point"})
+    for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point"})
       for (const char* stat : {"_mean", "_std"}) {
         const std::string col = std::string(m) + stat;
         EXPECT_NEAR(std::stod(s->at(col)), std::stod(a->at(col)), 1e-9) << variant << " " << col;
