@@ -439,9 +439,28 @@ def RunTitle(run_dir, summary):
   return "RV profile of %s" % name + (" (%s)" % ", ".join(parts) if parts else "")
 
 
-def ProfilePanels(scans, t, run_errors):
+def AxisAcceleration(t, p, axis, window_s=0.1):
+  """World-frame acceleration along `axis` [m/s^2]: the second derivative of
+  the positions projected on the axis, averaged over `window_s` (centred; the
+  ends, where the average would be one-sided, are dropped). (times, values) or
+  None when the trajectory is too short."""
+  if len(t) < 5:
+    return None
+  s = p @ axis
+  a = np.gradient(np.gradient(s, t), t)
+  n = max(1, int(round(window_s / float(np.median(np.diff(t))))))
+  if n > 1:
+    if len(a) <= n:
+      return None
+    a = np.convolve(a, np.ones(n) / n, mode="valid")
+    t = t[(n - 1) // 2:(n - 1) // 2 + len(a)]
+  return t, a
+
+
+def ProfilePanels(scans, t, run_errors, axis_acc=None):
   """[(title, ylabel, x, y, color, log)] for each panel drawn; optional columns
-  (older scans.csv files lack some) and the GT error only when available."""
+  (older scans.csv files lack some), the GT error and the GT axis acceleration
+  only when available."""
   panels = [
       ("Number of SCVs (special constraint vectors, d_i > eps0)", "count", t, scans["scv"],
        "tab:blue", False),
@@ -456,6 +475,12 @@ def ProfilePanels(scans, t, run_errors):
   if "acc_x" in scans:
     panels.append(("IMU acceleration along x (mean specific force per scan, IMU frame)",
                    "acc_x [m/s$^2$]", t, scans["acc_x"], "tab:red", False))
+  if axis_acc is not None:
+    # A multirotor accelerates by tilting, so the body-frame specific force
+    # above hardly shows the speed changes ("shocks", paper Fig. 6); this is
+    # the world-frame acceleration along the axis, from the ground truth.
+    panels.append(("Acceleration along the tunnel axis (ground truth, world frame)",
+                   "a_axis [m/s$^2$]", axis_acc[0], axis_acc[1], "tab:orange", False))
   if run_errors is not None:
     panels.append(("Error along the tunnel axis vs ground truth (origin-aligned)",
                    "error [m]", run_errors[0], run_errors[1], "black", False))
@@ -498,19 +523,25 @@ def CmdRvProfile(args):
   RepairScanTimes(scans, args.run)
   summary = ReadSummary(args.run)
   t0 = scans["t"][0]
-  run_errors = None
+  run_errors = axis_acc = None
   if args.gt:
     gt = ReadTum(args.gt)
     est = ReadTum(RunTrajectoryPath(args.run))
+    axis = TunnelAxis(gt[1])
     run = RunErrors(os.path.basename(os.path.normpath(args.run)), est, gt, "origin",
-                    args.max_dt, TunnelAxis(gt[1]))
+                    args.max_dt, axis)
     print(run.Describe())
     t0 = gt[0][0]
     run_errors = (run.t_match - t0, run.axis_error)
+    axis_acc = AxisAcceleration(gt[0], gt[1], axis)
+    if axis_acc is not None:
+      print("ground truth: acceleration along the axis median %.6f m/s^2, largest |a| %.6f m/s^2"
+            % (float(np.median(axis_acc[1])), float(np.max(np.abs(axis_acc[1])))))
+      axis_acc = (axis_acc[0] - t0, axis_acc[1])
   t = scans["t"] - t0
   active = np.nan_to_num(scans["rv_active"])
   spans = ActiveSpans(t, active)
-  panels = ProfilePanels(scans, t, run_errors)
+  panels = ProfilePanels(scans, t, run_errors, axis_acc)
   for column in ("coplanar_fraction", "localizability", "acc_x"):
     if column not in scans:
       print("note: scans.csv has no column %s; its panel is left out" % column)

@@ -1,4 +1,5 @@
-// End to end: the RV modules in the IESKF on seeded simulated bags. In a
+// End to end: the RV modules in the IESKF on seeded simulated bags. In the
+// tunnel RV (defaults) beats RV off on ATE and along the axis; in a
 // feature-rich hall the criterion stays inactive and RV changes nothing that
 // matters; in a featureless tunnel it activates on nearly every scan and the
 // run completes without NaN (paper Remark 3: the axis itself is unobservable).
@@ -28,8 +29,9 @@ class RvCliTest : public ::testing::Test {
   void SetUp() override { dir_ = testing_cli::MakeTempDir("rvlio_rv_cli"); }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  void Simulate(const std::string& preset, int seconds) {
-    const ToolRun r = RunTool("simulate --preset " + preset + " --seed 2 --duration " +
+  void Simulate(const std::string& preset, int seconds, int seed = 2) {
+    const ToolRun r = RunTool("simulate --preset " + preset + " --seed " + std::to_string(seed) +
+                                  " --duration " +
                                   std::to_string(seconds) + " --set lidar.columns=512 --out " +
                                   dir_ + "/data",
                               dir_);
@@ -48,6 +50,34 @@ class RvCliTest : public ::testing::Test {
   }
   std::string dir_;
 };
+
+double Metric(const RvRun& run, const char* group, const char* stat) {
+  return run.eval[group][stat].get<double>();
+}
+
+// The defaults (gated reinforcement, repair up to eps1 0.03) were chosen on
+// full-length tunnels, noisy tunnels, corridors and loopbacks (README "RV
+// defaults"); on 20 s, 512-column tunnels they beat RV off on ATE and
+// along-axis RMSE for each of seeds 1-6 (config/grids/rv_defaults.yaml), by
+// 4-11 %. Seeds 1 and 2 are checked here, with no extra margin: the claim is
+// "better", and the runs are deterministic.
+TEST_F(RvCliTest, TunnelRvOnBeatsRvOffOnAteAndAlongAxisError) {
+  for (int seed : {1, 2}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    Simulate("tunnel", 20, seed);
+    const RvRun off = Run("tunnel", "off" + std::to_string(seed), "--set rv.enabled=false");
+    const RvRun on = Run("tunnel", "on" + std::to_string(seed), "");
+    ASSERT_FALSE(off.eval.is_null());
+    ASSERT_FALSE(on.eval.is_null());
+    const double scans = on.summary["scan_count"].get<double>();
+    EXPECT_GE(on.summary["rv_active_scans"].get<double>(), 0.5 * scans);  // the tunnel is degenerate
+    EXPECT_EQ(off.summary["rv_active_scans"].get<double>(), 0.0);
+    EXPECT_LT(Metric(on, "ape", "rmse"), Metric(off, "ape", "rmse"));
+    EXPECT_LT(Metric(on, "along_axis", "rmse"), Metric(off, "along_axis", "rmse"));
+    EXPECT_LT(Metric(on, "ape", "rmse"), 0.05);  // and both stay localized
+    EXPECT_LT(Metric(off, "ape", "rmse"), 0.05);
+  }
+}
 
 TEST_F(RvCliTest, HallStaysInactiveAndKeepsItsAccuracy) {
   Simulate("hall", 20);

@@ -299,8 +299,8 @@ TEST(ConfigErrors, CrossFieldRulesNameEverySource) {
   Status s = LoadConfig({f}, {}).status();
   EXPECT_TRUE(IsConfigError(s, {f + ":3: rv.eps1 must not exceed rv.eps0",
                                 "rv.eps1 from " + f + ":3", "rv.eps0 from " + f + ":2"}));
-  // Only one side set: the other is named as the built-in default.
-  EXPECT_TRUE(IsConfigError(LoadConfig({}, {"rv.eps0=0.05"}).status(),
+  // Only one side set: the other is named as the built-in default (eps1 0.03).
+  EXPECT_TRUE(IsConfigError(LoadConfig({}, {"rv.eps0=0.02"}).status(),
                             {"--set: rv.eps1 must not exceed rv.eps0",
                              "rv.eps1 from built-in default", "rv.eps0 from --set"}));
   // Equal values are allowed (the paper's real preset is nearly equal).

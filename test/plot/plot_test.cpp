@@ -348,6 +348,11 @@ TEST_F(PlotScriptTest, RvProfileWithGroundTruth) {
   EXPECT_NEAR(ParseRun(r.out, "rv_on").final_error, ExpectedFinalError(gt, 0.002), 2e-6)
       << r.out;
   EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
+  // The GT moves 0.5 s + 0.02 s^2 along its axis: 0.04 m/s^2 throughout.
+  const std::string key = "acceleration along the axis median ";
+  const size_t at = r.out.find(key);
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_NEAR(std::stod(r.out.substr(at + key.size())), 0.04, 1e-4) << r.out;
   ExpectFigures("rv_profile");
 }
 

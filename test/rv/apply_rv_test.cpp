@@ -127,12 +127,14 @@ TEST(ApplyRvTest, ReportIsConsistent) {
     EXPECT_LE(r.s_eigenvalues(1), r.s_eigenvalues(2));
     EXPECT_NEAR(r.s_eigenvalues.sum(), 1050.0, 1e-8);  // trace of sum u u^T, unit u
     EXPECT_DOUBLE_EQ(r.K, std::max(options.min_K, std::min(1.0, options.k0 * 50.0 / 1000.0)));
-    int scv = 0, repaired = 0;
+    int scv = 0, repaired = 0, fitting_scv = 0;
     for (const Constraint& c : list) {
       scv += c.role == RvRole::kScv;
       repaired += c.role == RvRole::kRepaired;
+      fitting_scv += c.role == RvRole::kScv && std::abs(c.residual) <= options.reinforce_max_residual;
     }
-    EXPECT_EQ(scv, r.num_reinforced);
+    EXPECT_EQ(scv, r.num_scv);
+    EXPECT_EQ(fitting_scv, r.num_reinforced);  // the default gate leaves the others alone
     EXPECT_EQ(repaired, r.num_repaired);
     EXPECT_NEAR(r.localizability, SmallestEigenvalue(PositionInformation(list)), 1e-9);
   }

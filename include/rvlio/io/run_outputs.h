@@ -16,7 +16,9 @@ Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& 
 
 // One row per scan: time, status, point and constraint counts, the RV report,
 // the processing time and `rss_mb[i]`, the process's resident memory (MB) when
-// scan i was done (nan where rss_mb has no entry).
+// scan i was done (nan where rss_mb has no entry), and last `reinforced`, the
+// SCVs whose weight the reinforcement scaled (fewer than `scv` when
+// rv.reinforce_max_residual leaves badly fitting ones at their plain weight).
 Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
                      const std::vector<double>& rss_mb = {});
 
