@@ -29,10 +29,10 @@ class RvCliTest : public ::testing::Test {
   void SetUp() override { dir_ = testing_cli::MakeTempDir("rvlio_rv_cli"); }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  void Simulate(const std::string& preset, int seconds, int seed = 2) {
+  void Simulate(const std::string& preset, int seconds, int seed = 2, int columns = 512) {
     const ToolRun r = RunTool("simulate --preset " + preset + " --seed " + std::to_string(seed) +
-                                  " --duration " +
-                                  std::to_string(seconds) + " --set lidar.columns=512 --out " +
+                                  " --duration " + std::to_string(seconds) +
+                                  " --set lidar.columns=" + std::to_string(columns) + " --out " +
                                   dir_ + "/data",
                               dir_);
     ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -55,28 +55,26 @@ double Metric(const RvRun& run, const char* group, const char* stat) {
   return run.eval[group][stat].get<double>();
 }
 
-// The defaults (gated reinforcement, repair up to eps1 0.03) were chosen on
-// full-length tunnels, noisy tunnels, corridors and loopbacks (README "RV
-// defaults"); on 20 s, 512-column tunnels they beat RV off on ATE and
-// along-axis RMSE for each of seeds 1-6 (config/grids/rv_defaults.yaml), by
-// 4-11 %. Seeds 1 and 2 are checked here, with no extra margin: the claim is
-// "better", and the runs are deterministic.
+// The tunnel preset as shipped (52 s, OS1-32 1024 columns). The defaults
+// (gated reinforcement, repair up to eps1 0.03) beat RV off on ATE and
+// along-axis RMSE and max on each of seeds 1-6 (README "RV defaults",
+// config/grids/rv_defaults.yaml: -5 to -23 % ATE); seed 3 is checked here
+// because the paper's ungated modules lose to RV off on it (ATE 0.0228 vs
+// 0.0199 m), so this test also guards the gate. No extra margin: the claim
+// is "better", and the runs are deterministic.
 TEST_F(RvCliTest, TunnelRvOnBeatsRvOffOnAteAndAlongAxisError) {
-  for (int seed : {1, 2}) {
-    SCOPED_TRACE("seed " + std::to_string(seed));
-    Simulate("tunnel", 20, seed);
-    const RvRun off = Run("tunnel", "off" + std::to_string(seed), "--set rv.enabled=false");
-    const RvRun on = Run("tunnel", "on" + std::to_string(seed), "");
-    ASSERT_FALSE(off.eval.is_null());
-    ASSERT_FALSE(on.eval.is_null());
-    const double scans = on.summary["scan_count"].get<double>();
-    EXPECT_GE(on.summary["rv_active_scans"].get<double>(), 0.5 * scans);  // the tunnel is degenerate
-    EXPECT_EQ(off.summary["rv_active_scans"].get<double>(), 0.0);
-    EXPECT_LT(Metric(on, "ape", "rmse"), Metric(off, "ape", "rmse"));
-    EXPECT_LT(Metric(on, "along_axis", "rmse"), Metric(off, "along_axis", "rmse"));
-    EXPECT_LT(Metric(on, "ape", "rmse"), 0.05);  // and both stay localized
-    EXPECT_LT(Metric(off, "ape", "rmse"), 0.05);
-  }
+  Simulate("tunnel", 52, /*seed=*/3, /*columns=*/1024);
+  const RvRun off = Run("tunnel", "off", "--set rv.enabled=false");
+  const RvRun on = Run("tunnel", "on", "");
+  ASSERT_FALSE(off.eval.is_null());
+  ASSERT_FALSE(on.eval.is_null());
+  const double scans = on.summary["scan_count"].get<double>();
+  EXPECT_GE(on.summary["rv_active_scans"].get<double>(), 0.8 * scans);  // the tunnel is degenerate
+  EXPECT_EQ(off.summary["rv_active_scans"].get<double>(), 0.0);
+  EXPECT_LT(Metric(on, "ape", "rmse"), Metric(off, "ape", "rmse"));
+  EXPECT_LT(Metric(on, "along_axis", "rmse"), Metric(off, "along_axis", "rmse"));
+  EXPECT_LT(Metric(on, "along_axis", "max"), Metric(off, "along_axis", "max"));
+  EXPECT_LT(Metric(on, "ape", "rmse"), 0.10);  // the issue's target for RV-IESKF on the tunnel
 }
 
 TEST_F(RvCliTest, HallStaysInactiveAndKeepsItsAccuracy) {

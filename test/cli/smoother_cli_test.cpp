@@ -58,7 +58,7 @@ TEST_F(SmootherCliTest, WritesTheOutputContractWithinTheAccuracyBound) {
   const std::string tum = ReadFile(out + "/trajectory.tum");
   const std::string csv = ReadFile(out + "/scans.csv");
   EXPECT_FALSE(HasNonFinite(tum));
-  EXPECT_FALSE(HasNonFinite(csv));
+  EXPECT_FALSE(HasNonFinite(csv.substr(csv.find('\n') + 1)));  // values, not the header's "reinforced"
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n') - 1,
             std::count(tum.begin(), tum.end(), '\n') - std::count(tum.begin(), tum.end(), '#'));
   EXPECT_NE(csv.find(",updated,"), std::string::npos);
