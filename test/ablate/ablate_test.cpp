@@ -159,6 +159,18 @@ TEST_F(AblatePlanTest, ExpandsListsRangesAndTheProduct) {
   EXPECT_EQ(plan["cells"].back()["run_argv"][2], dir_ + "/rec.bag");
 }
 
+// The grids shipped in config/grids plan without error and have the number
+// of cells their comments and the README quote.
+TEST_F(AblatePlanTest, ShippedGridsPlanWithTheDocumentedCellCounts) {
+  const std::string grids = std::string(RVLIO_SOURCE_DIR) + "/config/grids/";
+  for (const auto& [name, cells] : std::vector<std::pair<std::string, size_t>>{
+           {"rv_ablation.yaml", 36}, {"rv_defaults.yaml", 217}, {"rv_gain.yaml", 115}}) {
+    const json plan = PlanJson(grids + name);
+    ASSERT_TRUE(plan.is_object()) << name;
+    EXPECT_EQ(plan["cells"].size(), cells) << name;
+  }
+}
+
 TEST_F(AblatePlanTest, PlanIsStableAndTheHashFollowsTheConfiguration) {
   const std::string grid = Grid(kGrid);
   const ToolRun a = Plan(grid), b = Plan(grid);
