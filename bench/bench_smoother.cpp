@@ -13,6 +13,8 @@
 #include <benchmark/benchmark.h>
 #include <ceres/problem.h>
 
+#include "bench_util.h"
+
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/smoother/imu_factor.h"
 #include "rvlio/smoother/manifolds.h"
@@ -26,14 +28,7 @@ using rvlio::ImuPreintegration;
 using rvlio::ImuSample;
 using rvlio::TimeNs;
 
-ImuNoise Noise() {
-  ImuNoise n;
-  n.gyro_noise_density = 1e-3;
-  n.accel_noise_density = 1e-2;
-  n.gyro_bias_random_walk = 1e-4;
-  n.accel_bias_random_walk = 1e-3;
-  return n;
-}
+ImuNoise Noise() { return rvlio::bench::MakeImuNoise(1e-3, 1e-2, 1e-4, 1e-3); }
 
 // A wobbling IMU at rate_hz over [0, duration].
 std::vector<ImuSample> Samples(double rate_hz, double duration_s) {

@@ -5,7 +5,20 @@
 
 #include <Eigen/Core>
 
+#include "rvlio/imu/noise.h"
+
 namespace rvlio::bench {
+
+// IMU noise densities: gyro [rad/s/sqrt(Hz)], accel [m/s^2/sqrt(Hz)] and
+// their bias random walks [rad/s^2/sqrt(Hz)], [m/s^3/sqrt(Hz)].
+inline ImuNoise MakeImuNoise(double gyro, double accel, double gyro_walk, double accel_walk) {
+  ImuNoise n;
+  n.gyro_noise_density = gyro;
+  n.accel_noise_density = accel;
+  n.gyro_bias_random_walk = gyro_walk;
+  n.accel_bias_random_walk = accel_walk;
+  return n;
+}
 
 // Walls, floor and ceiling of a 10 x 8 m rectangular tunnel section,
 // x in [-half_length, half_length] m, sampled every `step` m with 2 cm

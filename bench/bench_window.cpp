@@ -29,14 +29,8 @@ Eigen::Vector3d TruePosition(TimeNs t_ns) {
   return Eigen::Vector3d(-20.0 + kSpeed * NsToSeconds(t_ns), 0.5, 3.0);
 }
 
-ImuNoise Noise() {
-  ImuNoise n;
-  n.gyro_noise_density = 2e-4;
-  n.accel_noise_density = 2e-3;
-  n.gyro_bias_random_walk = 2e-5;
-  n.accel_bias_random_walk = 2e-4;
-  return n;
-}
+// The simulator's IMU noise (SimImuOptions defaults).
+ImuNoise Noise() { return bench::MakeImuNoise(2e-4, 2e-3, 2e-5, 2e-4); }
 
 struct World {
   VoxelMap map{MapOptions()};
