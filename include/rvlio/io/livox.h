@@ -1,0 +1,53 @@
+#pragma once
+// Livox CustomMsg (livox_ros_driver/CustomMsg in ROS1,
+// livox_ros_driver2/msg/CustomMsg in ROS 2: the same fields), free of ROS
+// types. The ROS1 reader (io/sensor_bag_reader) and the CDR decoder (io/cdr)
+// fill this struct; one conversion turns it into a Scan for both.
+//
+// Per-point time: timebase (ns, absolute) + offset_time (ns, relative).
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/time.h"
+#include "rvlio/common/types.h"
+#include "rvlio/io/pointcloud2.h"
+#include "rvlio/lidar/options.h"
+
+namespace rvlio {
+
+struct LivoxCustomPoint {
+  uint32_t offset_time = 0;  // ns since timebase
+  float x = 0.0f, y = 0.0f, z = 0.0f;
+  uint8_t reflectivity = 0;
+  uint8_t tag = 0;
+  uint8_t line = 0;
+};
+
+struct LivoxCustomMsg {
+  TimeNs header_stamp_ns = 0;
+  std::string frame_id;
+  uint64_t timebase = 0;   // ns, time of the first point
+  uint32_t point_num = 0;  // as written; the decoder checks it against points.size()
+  uint8_t lidar_id = 0;
+  std::array<uint8_t, 3> rsvd{};
+  std::vector<LivoxCustomPoint> points;
+};
+
+// The message definitions, as the drivers declare them (for bag connection
+// headers and MCAP schemas).
+extern const char kLivoxRos1Type[];     // "livox_ros_driver/CustomMsg"
+extern const char kLivoxRos2Type[];     // "livox_ros_driver2/msg/CustomMsg"
+
+// A CustomMsg -> Scan with absolute per-point times, dropping invalid and
+// out-of-range points exactly as DecodePointCloud2 does (stats->layout is
+// "livox_custom"). InvalidInput when point_num disagrees with the points.
+StatusOr<Scan> DecodeLivoxCustomMsg(const LivoxCustomMsg& msg, const LidarOptions& lidar,
+                                    DecodeStats* stats = nullptr);
+
+// A Scan -> CustomMsg (timebase = scan.t_start_ns), for the simulator.
+LivoxCustomMsg ScanToLivoxCustomMsg(const Scan& scan, const std::string& frame_id);
+
+}  // namespace rvlio
