@@ -102,6 +102,24 @@ std::string Hex32(uint32_t v) {
   return buf;
 }
 
+// A name read from the file, safe for a one-line message: control and
+// non-ASCII bytes as \xNN, at most 64 bytes shown.
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (size_t i = 0; i < text.size() && i < 64; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7F && c != '\\') {
+      out.push_back(static_cast<char>(c));
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\x%02x", c);
+      out += buf;
+    }
+  }
+  if (text.size() > 64) out += "...";
+  return out;
+}
+
 // ---------------------------------------------------------------------------
 // Chunk decompression. The output grows with what the decoder produces (never
 // more than uncompressed_size + 1 bytes), so a corrupt size field cannot make
@@ -559,7 +577,7 @@ Status McapReader::Decompress(uint64_t offset, const ChunkHeader& chunk, std::st
     problem = DecompressLz4(chunk.records, chunk.uncompressed_size, records);
   } else {
     return Error("chunk at offset " + std::to_string(offset) + " uses unknown compression '" +
-                 chunk.compression + "'");
+                 Printable(chunk.compression) + "'");
   }
   if (problem.empty() && records->size() != chunk.uncompressed_size)
     problem = "decompressed size differs from the uncompressed_size " +
