@@ -632,6 +632,8 @@ Status McapReader::ScanChunk(uint64_t offset, std::string_view content, Segment*
   return Status::Ok();
 }
 
+constexpr uint64_t kCrcBlock = 1 << 20;
+
 // Reads the data section record by record from data_start_ up to data_end
 // (exclusive), stopping early at DataEnd or at a record that does not fit.
 Status McapReader::Scan(uint64_t data_end, bool fill_summary) {
@@ -685,6 +687,17 @@ Status McapReader::Scan(uint64_t data_end, bool fill_summary) {
       break;
     }
     if (opcode == detail::kFooter) break;
+    const bool needed = opcode == detail::kMessage || opcode == detail::kChunk ||
+                        opcode == detail::kSchema || opcode == detail::kChannel;
+    if (!needed) {  // attachments, indexes, ...: only their CRC, in blocks
+      for (uint64_t at = pos; at < end; at += kCrcBlock) {
+        if (Status s = ReadBytes(at, std::min<uint64_t>(kCrcBlock, end - at), &record); !s.ok())
+          return s;
+        crc = detail::Crc32Update(crc, record.data(), record.size());
+      }
+      pos = end;
+      continue;
+    }
     std::string bytes;
     if (Status s = ReadBytes(pos, end - pos, &bytes); !s.ok()) return s;
     crc = detail::Crc32Update(crc, bytes.data(), bytes.size());
