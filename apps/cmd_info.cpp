@@ -80,7 +80,7 @@ int CmdInfo(int argc, char** argv) {
   if (!info.ok()) return Fail(spec.name, info.status().message(), info.status().exit_code());
   Print(*info);
   for (const std::string& w : info->warnings)
-    std::cerr << "rvlio info: warning: " << info->path << ": " << w << "\n";
+    std::cerr << "rvlio info: warning: " << w << "\n";
   return 0;
 }
 

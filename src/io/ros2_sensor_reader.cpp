@@ -73,6 +73,7 @@ class Ros2SensorReader final : public SensorBagReader {
 
   const SensorReaderStats& stats() const override { return gate_.stats(); }
   std::string lidar_layout() const override { return layout_; }
+  std::vector<std::string> warnings() const override { return source_->warnings(); }
 
  private:
   // Decodes the first LiDAR message so that a cloud without a usable time

@@ -52,6 +52,9 @@ class SensorBagReader {
   virtual StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) = 0;
   virtual const SensorReaderStats& stats() const = 0;
   virtual std::string lidar_layout() const = 0;  // "ouster", "velodyne", "hesai" or "livox"
+  // Problems of the recording that did not stop reading (e.g. an MCAP file
+  // cut short: its complete part is read); each names the file.
+  virtual std::vector<std::string> warnings() const { return {}; }
 };
 
 // How SensorBagWriter::Create writes.
