@@ -113,6 +113,7 @@ struct TopRecord {
   uint8_t opcode = 0;
   uint64_t offset = 0, end = 0;
   uint64_t messages = 0;  // Message: 1; uncompressed Chunk: messages inside
+  std::vector<uint16_t> channels;  // of those messages
 };
 
 // Top-level records from after the magic up to `size` bytes, stopping at the
@@ -130,7 +131,10 @@ inline std::vector<TopRecord> WalkRecords(const std::string& b, size_t size) {
     if (r.opcode == 0x05) r.messages = 1;
     if (r.opcode == 0x06 && Le(b, pos + 9 + 28, 4) == 0) {  // compression ""
       for (size_t p = pos + 9 + 40; p < r.end; p += 9 + Le(b, p + 1, 8))
-        r.messages += b[p] == 0x05 ? 1 : 0;
+        if (b[p] == 0x05) {
+          ++r.messages;
+          r.channels.push_back(static_cast<uint16_t>(Le(b, p + 9, 2)));
+        }
     }
     records.push_back(r);
     pos = r.end;
