@@ -34,8 +34,8 @@ StatusOr<RecordingKind> DetectDirectory(const std::string& path) {
   if (fs::is_regular_file(fs::path(path) / kMetadataFile, ec)) return RecordingKind::kRos2Folder;
   if (fs::is_empty(path, ec))
     return Status::InvalidInput("'" + path + "' is an empty directory, not a ROS 2 bag folder");
-  return Status::InvalidInput("directory '" + path + "' has no " + kMetadataFile +
-                              ", so it is not a ROS 2 bag folder");
+  return Status::InvalidInput("'" + path + "' is a directory, not a regular file, and not a "
+                              "ROS 2 bag folder (no " + kMetadataFile + ")");
 }
 
 // ---------------------------------------------------------------------------
@@ -454,7 +454,7 @@ const char* RecordingKindName(RecordingKind kind) {
 
 StatusOr<RecordingKind> DetectRecording(const std::string& path) {
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return Status::InvalidInput("'" + path + "' does not exist");
+  if (::stat(path.c_str(), &st) != 0) return Status::InvalidInput("bag '" + path + "' does not exist");
   if (S_ISDIR(st.st_mode)) return DetectDirectory(path);
   if (!S_ISREG(st.st_mode)) return Status::InvalidInput("'" + path + "' is not a regular file");
   std::ifstream in(path, std::ios::binary);
@@ -465,6 +465,9 @@ StatusOr<RecordingKind> DetectRecording(const std::string& path) {
   if (StartsWith(head, kRos1Magic, sizeof(kRos1Magic) - 1)) return RecordingKind::kRos1Bag;
   if (StartsWith(head, kMcapMagic, sizeof(kMcapMagic) - 1)) return RecordingKind::kMcap;
   if (StartsWith(head, kSqliteMagic, sizeof(kSqliteMagic))) return RecordingKind::kSqlite3;
+  // A .bag of no known kind goes to the ROS1 reader, which says why it is not
+  // a bag (empty, truncated header, text).
+  if (fs::path(path).extension() == ".bag") return RecordingKind::kRos1Bag;
   return Status::InvalidInput("'" + path + "' is not a recording rvlio reads (neither a ROS1 bag, "
                               "an MCAP file, a sqlite3 .db3 nor a ROS 2 bag folder)");
 }

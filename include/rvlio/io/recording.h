@@ -26,7 +26,9 @@ enum class RecordingKind {
 const char* RecordingKindName(RecordingKind kind);
 
 // InvalidInput naming the path when it is missing, unreadable, an empty
-// directory, a directory without metadata.yaml, or a file of none of the kinds.
+// directory, a directory without metadata.yaml, or a file of none of the kinds
+// (a `.bag` file of no known kind is reported as kRos1Bag: the ROS1 reader
+// then says why it cannot read it).
 StatusOr<RecordingKind> DetectRecording(const std::string& path);
 
 struct RecordingTopic {
