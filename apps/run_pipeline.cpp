@@ -317,6 +317,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   const SensorReaderStats& reader_stats = (*reader)->stats();
   std::vector<std::string> warnings = ReaderWarnings(reader_stats, options->lidar, options->imu);
   for (const auto& w : (*odo)->warnings()) warnings.push_back(w);
+  for (const auto& w : (*reader)->warnings()) warnings.push_back(w);
   const Status written = WriteOutputs(req, *options, **odo, reader_stats, data,
                                       (*reader)->lidar_layout(), warnings, outcome);
   // A failed run says one line (the warnings are in summary.json when written).
