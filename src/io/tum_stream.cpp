@@ -20,7 +20,7 @@ Status TumStream::Open(const std::string& path, double sync_period_s) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) return Fail("cannot create", errno);
   last_sync_ = Clock::now();
-  return Status::Ok();
+  return WriteLine(kTumColumnsComment);  // as WriteTum: the file is a prefix of its output
 }
 
 Status TumStream::Fail(const std::string& what, int err) {
@@ -32,7 +32,11 @@ Status TumStream::Fail(const std::string& what, int err) {
 
 Status TumStream::Append(const StampedPose& pose) {
   if (fd_ < 0) return error_;
-  const std::string line = FormatTumLine(pose);
+  if (Status s = WriteLine(FormatTumLine(pose)); !s.ok()) return s;
+  return SyncIfDue();
+}
+
+Status TumStream::WriteLine(const std::string& line) {
   ssize_t n;
   do {
     n = ::write(fd_, line.data(), line.size());  // one call: whole lines only
@@ -40,7 +44,7 @@ Status TumStream::Append(const StampedPose& pose) {
   if (n < 0) return Fail("cannot write", errno);
   if (static_cast<size_t>(n) != line.size()) return Fail("cannot write", ENOSPC);
   dirty_ = true;
-  return SyncIfDue();
+  return Status::Ok();
 }
 
 Status TumStream::SyncIfDue() {

@@ -4,9 +4,9 @@
 // most the last second of poses. Each line (FormatTumLine) goes to the file
 // with one write(2), so the file always holds whole lines: what a killed run
 // leaves is a valid TUM file, the prefix of the trajectory the complete run
-// writes. The data is synced to disk (fdatasync) when at least
-// `sync_period_s` passed since the last sync, checked in Append() and in
-// SyncIfDue(); no sync per pose.
+// writes (WriteTum, which starts with the same column comment line). The data
+// is synced to disk (fdatasync) when at least `sync_period_s` passed since
+// the last sync, checked in Append() and in SyncIfDue(); no sync per pose.
 #include <chrono>
 #include <string>
 
@@ -37,6 +37,7 @@ class TumStream {
 
  private:
   Status Fail(const std::string& what, int err);
+  Status WriteLine(const std::string& line);  // one write(2)
 
   using Clock = std::chrono::steady_clock;
   int fd_ = -1;
