@@ -406,6 +406,7 @@ void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
   std::vector<char> active(n, 0);
   std::vector<AssociationWorkspace> workspaces(threads_);
   ParallelFor(begin, end, threads_, [&](int k, int t) {
+    if (StopRequested()) return;  // the round is dropped
     bool a = false;
     factors[k - begin] = AssociateOne(k, begin, end, &workspaces[t], &stats[k - begin], &a);
     active[k - begin] = a;
@@ -416,6 +417,7 @@ void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
     report->rv_active_scans += active[i];
   }
   report->associate_s += SecondsSince(t0);
+  if (StopRequested()) return;
 
   // One problem: PlaneFactor per scan, ImuFactor between consecutive scans.
   t0 = Clock::now();
@@ -461,23 +463,29 @@ bool BatchRefiner::RunRound(int round, RefineRound* out) {
   report.round = round;
   const std::vector<RefineState> start = states_;
   const size_t warnings_before = result_.warnings.size();
+  const RefineStats stats_before = result_.stats;
+  auto stopped = [&] {
+    if (!StopRequested()) return false;
+    states_ = start;
+    result_.warnings.resize(warnings_before);
+    result_.stats = stats_before;
+    return true;
+  };
   auto t0 = Clock::now();
   DeskewAll();
   report.deskew_s = SecondsSince(t0);
+  if (stopped()) return false;
   t0 = Clock::now();
   BuildMap();
   report.map_s = SecondsSince(t0);
+  if (stopped()) return false;
   const auto chunks = MakeChunks(static_cast<int>(states_.size()),
                                  config_.smoother.refine_chunk_scans);
   report.chunks = static_cast<int>(chunks.size());
   result_.stats.chunks = report.chunks;
   for (const auto& [begin, end] : chunks) {
-    if (!StopRequested()) SolveChunk(begin, end, &report);
-    if (StopRequested()) {
-      states_ = start;
-      result_.warnings.resize(warnings_before);
-      return false;
-    }
+    SolveChunk(begin, end, &report);
+    if (stopped()) return false;
   }
   for (size_t k = 0; k < states_.size(); ++k) {
     const Pose3 a = start[k].T_world_imu(), b = states_[k].T_world_imu();
