@@ -5,6 +5,9 @@
 // CELL/cell.json atomically. A crashing or failing run is recorded in its
 // cell.json ("status": "failed"), never fatal for the others. Finished cells
 // (status done, same hash) and finished data (data.json, same hash) are skipped.
+// SIGINT/SIGTERM (under an InterruptScope, interrupt.h) reach the running
+// children, which run in their own process group; no further child starts,
+// the children the signal stopped leave no cell.json and no run folder.
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -18,6 +21,8 @@ struct RunCounts {
   int skipped = 0;  // already done before this call
   int done = 0;     // finished now
   int failed = 0;   // failed now (including cells whose data failed)
+  int interrupted = 0;  // stopped by a signal: nothing kept, run again next time
+  int not_started = 0;  // not started because of a signal
 };
 
 struct RunnerOptions {

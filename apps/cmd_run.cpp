@@ -2,6 +2,7 @@
 
 #include "commands.h"
 #include "common_options.h"
+#include "interrupt.h"
 #include "run_pipeline.h"
 
 namespace rvlio::cli {
@@ -20,6 +21,7 @@ int CmdRun(int argc, char** argv) {
   RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), args.GetAll("set"),
                  args.Has("quiet")};
   RunOutcome outcome;
+  InterruptScope interrupt_scope;  // SIGINT/SIGTERM: write what is done, exit 130/143
   const int rc = RunOdometryOnBag(req, &outcome);
   if (rc == 0)
     std::printf("rvlio run: %d scans, per-scan median %.2f ms, %.1fx real time -> %s\n",

@@ -18,6 +18,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "interrupt.h"
 #include "plot_runner.h"
 #include "run_pipeline.h"
 #include "rvlio/eval/evaluate.h"
@@ -58,8 +59,10 @@ struct Row {
   double ms_per_scan = kNaN;       // run: median CPU ms; refine: wall ms per scan (batch)
   double real_time_factor = kNaN;  // sequence duration / compute time
   double wall_s = 0.0;             // whole step, including reading the bag
+  bool interrupted = false;        // a signal stopped it or came before it started
 
   bool ok() const { return exit_code == 0 && eval.has_value(); }
+  const char* status() const { return interrupted ? "interrupted" : ok() ? "ok" : "failed"; }
 };
 
 double SecondsSince(Clock::time_point t0) {
@@ -186,6 +189,7 @@ void EvaluateRow(const Trajectory& truth, const std::string& dir, Row* row) {
 }
 
 std::string ResultLine(const Row& row) {
+  if (row.interrupted) return row.name + " interrupted (its folder holds the scans it finished)";
   if (!row.ok())
     return row.name + " failed (exit " + std::to_string(row.exit_code) + ")" +
            (row.error.empty() ? "" : ": " + row.error);
@@ -207,6 +211,7 @@ Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& tr
   const auto t0 = Clock::now();
   row.exit_code = RunOdometryOnBag(run, &outcome);
   row.wall_s = SecondsSince(t0);
+  row.interrupted = Interrupted() && IsInterruptExit(row.exit_code);
   if (row.exit_code == 0) {
     row.scans = outcome.scans;
     row.ms_per_scan = outcome.median_ms;
@@ -256,6 +261,7 @@ Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& tru
     row.exit_code = Invoke(CmdRefine, args);
   }
   row.wall_s = SecondsSince(t0);
+  row.interrupted = Interrupted() && IsInterruptExit(row.exit_code);
   if (row.exit_code == 0) {
     ReadRefineTiming(dir, &row);
     EvaluateRow(truth, dir, &row);
@@ -283,7 +289,7 @@ std::string CsvText(const std::vector<Row>& rows) {
   std::ostringstream os;
   os << kCsvHeader;
   for (const Row& r : rows) {
-    os << r.name << "," << CsvField(r.label) << "," << (r.ok() ? "ok" : "failed") << ","
+    os << r.name << "," << CsvField(r.label) << "," << r.status() << ","
        << r.exit_code << "," << r.init << "," << r.scans;
     if (r.ok()) {
       os << "," << Exact(r.eval->ape_m.rmse) << "," << Exact(r.eval->rpe.trans_m.rmse) << ","
@@ -309,6 +315,10 @@ std::string MarkdownText(const CompareRequest& req, const std::vector<Row>& rows
         "real-time factor |\n|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     os << "| " << r.label << " | ";
+    if (r.interrupted) {
+      os << "interrupted | | | | | |\n";
+      continue;
+    }
     if (!r.ok()) {
       os << "failed (exit " << r.exit_code << ") | | | | | |\n";
       continue;
@@ -331,6 +341,10 @@ void PrintTable(const std::vector<Row>& rows) {
   std::printf("\n  %-30s %9s %9s %12s %9s %9s %8s\n", "variant", "ATE [m]", "RPE [m]",
               "axis max [m]", "end [m]", "ms/scan", "speed");
   for (const Row& r : rows) {
+    if (r.interrupted) {
+      std::printf("  %-30s interrupted\n", r.label.c_str());
+      continue;
+    }
     if (!r.ok()) {
       std::printf("  %-30s failed (exit %d)\n", r.label.c_str(), r.exit_code);
       continue;
@@ -354,7 +368,7 @@ nlohmann::json RowJson(const CompareRequest& req, const Row& r,
                        const std::vector<std::string>& overrides) {
   nlohmann::json j = {{"variant", r.name},
                       {"label", r.label},
-                      {"status", r.ok() ? "ok" : "failed"},
+                      {"status", r.status()},
                       {"exit_code", r.exit_code},
                       {"dir", req.out_dir + "/" + r.name},
                       {"overrides", overrides},
@@ -470,6 +484,30 @@ Status WriteJson(const CompareRequest& req, const std::vector<Row>& rows,
   return WriteFileAtomically(req.out_dir + "/compare.json", JsonText(j) + "\n");
 }
 
+// A row for a step a signal came before.
+Row NotRun(const std::string& name, const std::string& label) {
+  Row row;
+  row.name = name;
+  row.label = label;
+  row.exit_code = InterruptExitCode();
+  row.interrupted = true;
+  return row;
+}
+
+// compare.json without plots, and the one line; returns 130 / 143.
+int ReportInterrupt(const CompareRequest& req, const std::vector<Row>& rows) {
+  PlotReport plots;
+  plots.status = "skipped";
+  plots.message = "interrupted";
+  if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kName, s.message(), 1);
+  int finished = 0;
+  for (const Row& r : rows) finished += r.interrupted ? 0 : 1;
+  std::fprintf(stderr, "rvlio compare: interrupted by %s: %d of %zu steps finished; wrote "
+               "compare.{csv,md,json} (the rest marked interrupted) to %s\n",
+               InterruptSignalName().c_str(), finished, rows.size(), req.out_dir.c_str());
+  return InterruptExitCode();
+}
+
 }  // namespace
 
 int CompareSteps(const CompareRequest& request) {
@@ -477,12 +515,16 @@ int CompareSteps(const CompareRequest& request) {
 }
 
 int RunCompare(const CompareRequest& req) {
+  InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop the running variant, tabulate, 130/143
   Trajectory truth;
   if (int rc = CheckInputs(req, &truth); rc != 0) return rc;
   Steps steps(req);
   std::vector<Row> rows;
-  for (const Variant& v : StandardVariants()) rows.push_back(RunVariant(req, v, truth, &steps));
-  if (const Row* best = BestRow(rows); req.refine && best != nullptr) {
+  for (const Variant& v : StandardVariants())
+    rows.push_back(Interrupted() ? NotRun(v.name, v.label) : RunVariant(req, v, truth, &steps));
+  if (const Row* best = BestRow(rows); req.refine && Interrupted()) {
+    rows.push_back(NotRun(kRefine, "refine"));
+  } else if (req.refine && best != nullptr) {
     const Row start = *best;  // rows grows below
     rows.push_back(RunRefine(req, start, truth, &steps));
   }
@@ -494,6 +536,7 @@ int RunCompare(const CompareRequest& req) {
   }
   PrintTable(rows);
   PlotReport plots;
+  if (Interrupted()) return ReportInterrupt(req, rows);
   if (req.plots && any_ok) plots = DrawPlots(req, rows);
   if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kName, s.message(), 1);
   std::printf("\n  tables: %s/compare.{csv,md,json}; runs: %s/<variant>/\n", req.out_dir.c_str(),
