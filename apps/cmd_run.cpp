@@ -2,6 +2,7 @@
 
 #include "commands.h"
 #include "common_options.h"
+#include "divergence_cli.h"
 #include "run_pipeline.h"
 
 namespace rvlio::cli {
@@ -14,11 +15,12 @@ int CmdRun(int argc, char** argv) {
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
-                    {"quiet", "", "no progress line"}}};
+                    {"quiet", "", "no progress line"},
+                    AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), args.GetAll("set"),
-                 args.Has("quiet")};
+                 args.Has("quiet"), args.Has("allow-divergence")};
   RunOutcome outcome;
   const int rc = RunOdometryOnBag(req, &outcome);
   if (rc == 0)

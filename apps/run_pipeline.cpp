@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "divergence_cli.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/run_outputs.h"
@@ -123,8 +124,10 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   j["peak_memory_mb"] = PeakMemoryMb();
   j["rv_active_scans"] = RvActiveScans(data.results);
   j["stats"] = StatsJson(odo.stats(), reader_stats);
+  j["divergence"] = DivergenceJson(odo.divergence());
   j["warnings"] = warnings;
   outcome->scans = static_cast<int>(data.results.size());
+  outcome->diverged = odo.divergence().detected;
   outcome->median_ms = t.median_ms;
   outcome->real_time_factor = j["real_time_factor"];
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
@@ -294,6 +297,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   ImuSample imu;
   Scan scan;
   Status read_error;
+  size_t divergence_warned = 0;
   for (;;) {
     StatusOr<SensorMessage> m = (*reader)->Next(&imu, &scan);
     if (!m.ok()) {
@@ -310,8 +314,10 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     if (data.rss_mb.size() < data.results.size())
       data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
     progress.Update(static_cast<int>(data.results.size()), t);
+    WarnDivergence("run", (*odo)->divergence(), &divergence_warned);
   }
   (*odo)->Finish(&data.results);
+  WarnDivergence("run", (*odo)->divergence(), &divergence_warned);
   data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
   data.wall_s = SecondsSince(t0);
   const SensorReaderStats& reader_stats = (*reader)->stats();
@@ -325,6 +331,8 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     return Fail("run", read_error.message() + " (outputs hold the scans read before it)");
   if (data.results.empty()) return Fail("run", NoScanMessage(req, *options, reader_stats));
   for (const auto& w : warnings) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
+  if ((*odo)->divergence().detected)
+    return FinishDiverged("run", (*odo)->divergence(), req.out_dir, req.allow_divergence);
   return 0;
 }
 

@@ -15,6 +15,18 @@ const char* ScanStatusName(ScanStatus s) {
   return "unknown";
 }
 
+HealthSample HealthSampleOf(const ScanResult& r) {
+  HealthSample s;
+  s.t_ns = r.t_ns;
+  s.p_world_imu = r.T_world_imu.t;
+  s.v_world_imu = r.v_world_imu;
+  s.associated = r.status != ScanStatus::kMapInit;
+  s.points = r.downsampled_points;
+  s.constraints = r.constraints;
+  s.health = r.health;
+  return s;
+}
+
 StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& options) {
   OdometryOptions checked = options;
   if (Status s = checked.Validate(); !s.ok()) return s;
