@@ -12,6 +12,7 @@
 #include "json_text.h"
 #include "commands.h"
 #include "common_options.h"
+#include "divergence_cli.h"
 #include "run_pipeline.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
@@ -118,8 +119,8 @@ struct Request {
 };
 
 Status WriteOutputs(const Request& req, const OdometryOptions& options, const RefineResult& res,
-                    const SensorReaderStats& reader_stats, int64_t raw_points, double read_s,
-                    double wall_s) {
+                    const DivergenceReport& divergence, const SensorReaderStats& reader_stats,
+                    int64_t raw_points, double read_s, double wall_s) {
   OutputStage stage(req.out_dir);  // all outputs or none (run_pipeline.h)
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), res.trajectory); !s.ok())
@@ -149,6 +150,7 @@ Status WriteOutputs(const Request& req, const OdometryOptions& options, const Re
   j["peak_memory_mb"] = PeakMemoryMb();
   j["stats"] = StatsJson(res.stats, reader_stats, raw_points);
   j["warnings"] = res.warnings;
+  j["divergence"] = DivergenceJson(divergence);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
     return stage.Explain(s);
   return stage.Commit();
@@ -165,7 +167,8 @@ int CmdRefine(int argc, char** argv) {
                     {"init", "TUM", "initial trajectory (TUM format), e.g. rvlio run's", true},
                     ConfigOption(),
                     SetOption(),
-                    {"out", "DIR", "output folder", true}}};
+                    {"out", "DIR", "output folder", true},
+                    AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   const auto t0 = Clock::now();
@@ -191,14 +194,20 @@ int CmdRefine(int argc, char** argv) {
   if (!result.ok())
     return Fail("refine", result.status().message() + " (bag " + req.bag + ", init " + req.init + ")",
                 result.status().exit_code());
-  const Status written = WriteOutputs(req, *options, *result, (*reader)->stats(), raw_points,
-                                      read_s, SecondsSince(t0));
+  const DivergenceReport divergence = CheckRefineResult(
+      *result, options->divergence, options->constraints.lidar_noise, options->imu.gravity);
+  const Status written = WriteOutputs(req, *options, *result, divergence, (*reader)->stats(),
+                                      raw_points, read_s, SecondsSince(t0));
   for (const auto& w : result->warnings) std::fprintf(stderr, "rvlio refine: warning: %s\n", w.c_str());
+  size_t warned = 0;
+  WarnDivergence("refine", divergence, &warned);
   if (!written.ok()) return Fail("refine", written.message(), written.exit_code());
   std::printf("rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
               result->trajectory.size(), result->rounds.size(),
               result->converged ? " (converged)" : "", result->linear_solver.c_str(),
               SecondsSince(t0), PeakMemoryMb(), req.out_dir.c_str());
+  if (divergence.detected)
+    return FinishDiverged("refine", divergence, req.out_dir, args.Has("allow-divergence"));
   return 0;
 }
 

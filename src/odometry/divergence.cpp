@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "rvlio/smoother/refine.h"
+
 namespace rvlio {
 
 const char* DivergenceKindName(DivergenceKind k) {
@@ -14,6 +16,7 @@ const char* DivergenceKindName(DivergenceKind k) {
     case DivergenceKind::kNis: return "nis";
     case DivergenceKind::kResidual: return "residual";
     case DivergenceKind::kInliers: return "inliers";
+    case DivergenceKind::kGravity: return "gravity";
   }
   return "unknown";
 }
@@ -54,6 +57,12 @@ std::string DivergenceEvent::Describe() const {
                     "constraints per point %.2f (window mean) < divergence.min_inlier_fraction %g",
                     value, threshold);
       break;
+    case DivergenceKind::kGravity:
+      std::snprintf(text, sizeof(text),
+                    "mean measured specific force %.2f m/s^2 (window) where imu.gravity is %g m/s^2: "
+                    "check imu.accel_unit",
+                    value, threshold);
+      break;
   }
   return text;
 }
@@ -72,8 +81,9 @@ double DivergenceMonitor::Window::Median() const {
   return *mid;
 }
 
-DivergenceMonitor::DivergenceMonitor(const DivergenceOptions& options, double lidar_noise_m)
-    : options_(options), lidar_noise_m_(lidar_noise_m) {}
+DivergenceMonitor::DivergenceMonitor(const DivergenceOptions& options, double lidar_noise_m,
+                                     double gravity_mps2)
+    : options_(options), lidar_noise_m_(lidar_noise_m), gravity_mps2_(gravity_mps2) {}
 
 void DivergenceMonitor::Push(Window* w, double value) const {
   w->values.push_back(value);
@@ -138,11 +148,39 @@ uint8_t DivergenceMonitor::Check(const HealthSample& s) {
     if (Full(inliers_) && mean < options_.min_inlier_fraction)
       Trip(DivergenceKind::kInliers, s.t_ns, mean, options_.min_inlier_fraction, &mask);
   }
+  if (std::isfinite(s.specific_force_mps2) && s.specific_force_mps2 > 0.0) {
+    Push(&specific_force_, s.specific_force_mps2);
+    const double mean = specific_force_.Mean();
+    if (Full(specific_force_) &&
+        std::abs(mean / gravity_mps2_ - 1.0) > options_.max_gravity_error)
+      Trip(DivergenceKind::kGravity, s.t_ns, mean, gravity_mps2_, &mask);
+  }
   EndEpisodes(mask);
   if (mask != 0) ++report_.scans_flagged;
   previous_ = s;
   have_previous_ = true;
   return mask;
+}
+
+DivergenceReport CheckRefineResult(const RefineResult& result, const DivergenceOptions& options,
+                                   double lidar_noise_m, double gravity_mps2) {
+  DivergenceMonitor monitor(options, lidar_noise_m, gravity_mps2);
+  const RefineRound* last = result.rounds.empty() ? nullptr : &result.rounds.back();
+  for (size_t i = 0; i < result.trajectory.size(); ++i) {
+    HealthSample s;
+    s.t_ns = result.trajectory[i].t_ns;
+    s.p_world_imu = result.trajectory[i].p_world_imu;
+    if (i < result.v_world_imu.size()) s.v_world_imu = result.v_world_imu[i];
+    if (last != nullptr && last->points > 0) {
+      constexpr int kPerMillion = 1000000;  // the round's ratio in parts per million
+      s.associated = true;
+      s.points = kPerMillion;
+      s.constraints = static_cast<int>(std::lround(
+          kPerMillion * static_cast<double>(last->constraints) / static_cast<double>(last->points)));
+    }
+    monitor.Check(s);
+  }
+  return monitor.report();
 }
 
 }  // namespace rvlio

@@ -16,7 +16,7 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
-      monitor_(options.divergence, options.constraints.lidar_noise),
+      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity),
       initializer_(options.imu.init_duration) {}
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {

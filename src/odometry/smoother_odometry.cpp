@@ -54,7 +54,7 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
       preprocessor_(options.lidar),
       initializer_(options.imu.init_duration),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
-      monitor_(options.divergence, options.constraints.lidar_noise) {}
+      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity) {}
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
   if (!AcceptImu(imu, imu_buffer_, &stats_)) return;

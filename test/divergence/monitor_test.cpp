@@ -11,6 +11,7 @@ namespace rvlio {
 namespace {
 
 constexpr double kNoise = 0.03;     // constraints.lidar_noise, m
+constexpr double kGravity = 9.81;  // imu.gravity, m/s^2
 constexpr TimeNs kPeriod = 100000000;  // 10 Hz scans
 
 // A healthy scan k of a vehicle moving at 2 m/s along x.
@@ -22,6 +23,7 @@ HealthSample Healthy(int k) {
   s.associated = k > 0;
   s.points = 1000;
   s.constraints = 700;
+  s.specific_force_mps2 = 9.81 + 0.3 * std::cos(k);
   s.health.nis_per_dof = 1.5 + 0.5 * std::sin(k);
   s.health.residual_median_m = 0.02;
   s.health.residual_rms_m = 0.03;
@@ -33,7 +35,7 @@ int Episodes(const DivergenceReport& r, DivergenceKind k) {
 }
 
 TEST(DivergenceMonitor, HealthyStreamNeverFires) {
-  DivergenceMonitor m(DivergenceOptions{}, kNoise);
+  DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
   for (int k = 0; k < 500; ++k) EXPECT_EQ(m.Check(Healthy(k)), 0) << "scan " << k;
   EXPECT_FALSE(m.report().detected);
   EXPECT_EQ(m.report().scans_flagged, 0);
@@ -41,7 +43,7 @@ TEST(DivergenceMonitor, HealthyStreamNeverFires) {
 }
 
 TEST(DivergenceMonitor, SpeedFiresOncePerEpisode) {
-  DivergenceMonitor m(DivergenceOptions{}, kNoise);
+  DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
   Eigen::Vector3d p(0, 0, 0);
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
@@ -65,7 +67,7 @@ TEST(DivergenceMonitor, SpeedFiresOncePerEpisode) {
 
 TEST(DivergenceMonitor, SecondEpisodeAfterAClearWindow) {
   DivergenceOptions o;
-  DivergenceMonitor m(o, kNoise);
+  DivergenceMonitor m(o, kNoise, kGravity);
   for (int k = 0; k < 200; ++k) {
     HealthSample s = Healthy(k);
     if (k == 50 || k == 55 || k == 150) s.v_world_imu.x() = 60.0;  // 55: same episode as 50
@@ -77,7 +79,7 @@ TEST(DivergenceMonitor, SecondEpisodeAfterAClearWindow) {
 }
 
 TEST(DivergenceMonitor, JumpBeyondVelocityAndPeriod) {
-  DivergenceMonitor m(DivergenceOptions{}, kNoise);
+  DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
   for (int k = 0; k < 60; ++k) {
     HealthSample s = Healthy(k);
     if (k >= 40) s.p_world_imu.y() += 5.0;  // one 5 m sideways step at scan 40
@@ -92,7 +94,7 @@ TEST(DivergenceMonitor, JumpBeyondVelocityAndPeriod) {
 
 TEST(DivergenceMonitor, NisIsAWindowTestNotASingleScan) {
   DivergenceOptions o;
-  DivergenceMonitor single(o, kNoise);
+  DivergenceMonitor single(o, kNoise, kGravity);
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
     if (k == 50) s.health.nis_per_dof = 200.0;  // one bad scan: mean 200/20 + ~1.5 < 25
@@ -100,7 +102,7 @@ TEST(DivergenceMonitor, NisIsAWindowTestNotASingleScan) {
   }
   EXPECT_FALSE(single.report().detected);
 
-  DivergenceMonitor persistent(o, kNoise);
+  DivergenceMonitor persistent(o, kNoise, kGravity);
   int first = -1;
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
@@ -114,7 +116,7 @@ TEST(DivergenceMonitor, NisIsAWindowTestNotASingleScan) {
 }
 
 TEST(DivergenceMonitor, ResidualsAndInliersPersistent) {
-  DivergenceMonitor m(DivergenceOptions{}, kNoise);
+  DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
     if (k >= 40) {
@@ -128,11 +130,25 @@ TEST(DivergenceMonitor, ResidualsAndInliersPersistent) {
   EXPECT_EQ(Episodes(m.report(), DivergenceKind::kNis), 0);
 }
 
+TEST(DivergenceMonitor, AccelerometerUnitOffByG) {
+  for (const double unit : {1.0 / 9.80665, 9.80665}) {
+    DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
+    for (int k = 0; k < 60; ++k) {
+      HealthSample s = Healthy(k);
+      s.specific_force_mps2 *= unit;
+      m.Check(s);
+    }
+    EXPECT_EQ(Episodes(m.report(), DivergenceKind::kGravity), 1) << unit;
+    EXPECT_EQ(m.report().first_t_ns, Healthy(DivergenceOptions{}.window_scans - 1).t_ns);
+  }
+}
+
 TEST(DivergenceMonitor, UnknownStatisticsAreSkippedAndNonFiniteStateFires) {
-  DivergenceMonitor m(DivergenceOptions{}, kNoise);
+  DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
   for (int k = 0; k < 50; ++k) {
     HealthSample s = Healthy(k);
     s.health = ScanHealth{};  // smoother/refine without NIS, scans without update
+    s.specific_force_mps2 = ScanHealth::kUnknown;
     EXPECT_EQ(m.Check(s), 0);
   }
   HealthSample bad = Healthy(50);
@@ -144,7 +160,7 @@ TEST(DivergenceMonitor, UnknownStatisticsAreSkippedAndNonFiniteStateFires) {
 TEST(DivergenceMonitor, DisabledNeverFires) {
   DivergenceOptions o;
   o.enabled = false;
-  DivergenceMonitor m(o, kNoise);
+  DivergenceMonitor m(o, kNoise, kGravity);
   HealthSample s = Healthy(1);
   s.v_world_imu.x() = 1000.0;
   EXPECT_EQ(m.Check(s), 0);
@@ -160,6 +176,7 @@ TEST(DivergenceMonitor, KindNamesOfAMask) {
   EXPECT_EQ(DivergenceKindNames(0), "");
   EXPECT_EQ(DivergenceKindNames(1u | 4u), "speed+nis");
   EXPECT_EQ(DivergenceKindNames(16u), "inliers");
+  EXPECT_EQ(DivergenceKindNames(32u), "gravity");
 }
 
 }  // namespace

@@ -15,6 +15,11 @@
 //             above max_residual_ratio * constraints.lidar_noise.
 //   inliers   window mean of constraints / downsampled points below
 //             min_inlier_fraction (the scans stop matching the map).
+//   gravity   window mean of the per-scan mean specific force |f| off
+//             imu.gravity by more than max_gravity_error (relative): over
+//             seconds any vehicle's mean |f| is close to g, so a wrong
+//             accelerometer unit (g read as m/s^2, or the reverse) shows
+//             even when the LiDAR keeps the pose on track.
 // A windowed check only trips once its window of `window_scans` scans is
 // full. A kind's episode starts when it trips and ends after `window_scans`
 // consecutive scans where it does not: the caller warns once per episode.
@@ -40,6 +45,7 @@ struct DivergenceOptions {
   double max_nis = 25.0;               // mean NIS per degree of freedom over the window
   double max_residual_ratio = 4.0;     // window median of median |r|, in units of lidar_noise
   double min_inlier_fraction = 0.15;   // window mean of constraints / points
+  double max_gravity_error = 0.3;      // relative error of the window mean |f| vs imu.gravity
 
   template <class V>
   void Visit(V& v) {
@@ -56,12 +62,14 @@ struct DivergenceOptions {
         .Help("window median of the median |point-to-plane residual| after the update, in units of constraints.lidar_noise, above this is divergence"));
     v.Field("min_inlier_fraction", min_inlier_fraction, Spec().Range(0.0, 1.0)
         .Help("window mean of constraints per downsampled point below this is divergence (0: off)"));
+    v.Field("max_gravity_error", max_gravity_error, Spec().Positive()
+        .Help("window mean of the measured specific force off imu.gravity by more than this fraction is divergence (wrong imu.accel_unit)"));
   }
   Status Validate() { return ValidateFields(*this, "divergence"); }
 };
 
-enum class DivergenceKind : int { kSpeed = 0, kJump, kNis, kResidual, kInliers };
-constexpr int kNumDivergenceKinds = 5;
+enum class DivergenceKind : int { kSpeed = 0, kJump, kNis, kResidual, kInliers, kGravity };
+constexpr int kNumDivergenceKinds = 6;
 const char* DivergenceKindName(DivergenceKind k);
 // The kinds set in a ScanHealth::divergence_mask, "speed+nis"; "" for none.
 std::string DivergenceKindNames(uint8_t mask);
@@ -100,12 +108,13 @@ struct HealthSample {
   bool associated = false;  // the scan was matched against the map (not the first scan)
   int points = 0;         // downsampled points
   int constraints = 0;
+  double specific_force_mps2 = ScanHealth::kUnknown;  // |mean IMU acceleration| over the scan
   ScanHealth health;
 };
 
 class DivergenceMonitor {
  public:
-  DivergenceMonitor(const DivergenceOptions& options, double lidar_noise_m);
+  DivergenceMonitor(const DivergenceOptions& options, double lidar_noise_m, double gravity_mps2);
 
   // Checks one scan; returns the mask of kinds tripped on it (ScanHealth).
   // Scans must come in time order.
@@ -125,12 +134,23 @@ class DivergenceMonitor {
 
   DivergenceOptions options_;
   double lidar_noise_m_;
+  double gravity_mps2_;
   DivergenceReport report_;
   bool have_previous_ = false;
   HealthSample previous_;
-  Window nis_, residual_, inliers_;
+  Window nis_, residual_, inliers_, specific_force_;
   std::array<bool, kNumDivergenceKinds> active_{};
   std::array<int, kNumDivergenceKinds> clear_scans_{};
 };
+
+struct RefineResult;
+
+// `refine`'s result through the same checks, scan by scan in time order:
+// speed and jump from the refined poses and velocities, and the inlier
+// fraction of the last round (constraints / points over all scans; refine
+// keeps no per-scan figure). NIS and residuals are the IESKF's and the
+// smoother's online figures and are not checked here.
+DivergenceReport CheckRefineResult(const RefineResult& result, const DivergenceOptions& options,
+                                   double lidar_noise_m, double gravity_mps2);
 
 }  // namespace rvlio
