@@ -1,4 +1,5 @@
 #include "ablate_runner.h"
+#include "divergence_cli.h"
 #include "json_text.h"
 
 #include <fcntl.h>
@@ -317,7 +318,7 @@ json CellHeader(const Cell& cell) {
 bool WriteCellRecord(const Cell& cell, json record) {
   const Status s = WriteFileAtomically(cell.CellJson(), JsonText(record) + "\n");
   if (!s.ok()) std::fprintf(stderr, "rvlio ablate: error: %s\n", s.message().c_str());
-  return s.ok() && record["status"] == "done";
+  return s.ok() && (record["status"] == "done" || record["status"] == "diverged");
 }
 
 // Records a cell that could not run because its data is missing or failed.
@@ -342,9 +343,12 @@ bool FinishCell(const Cell& cell, int status, double wall_s) {
   r["wall_s"] = wall_s;
   r["stderr_tail"] = Tail(ReadText(cell.dir + "/run.log"));
   json metrics = json::object(), warnings = json::array();
-  std::string error =
-      exit_code == 0 ? CollectMetrics(cell, &metrics, &warnings) : "rvlio run " + how;
-  r["status"] = error.empty() ? "done" : "failed";
+  // Exit 3: the run went to the end but its divergence monitor fired. The
+  // cell is finished, its metrics are kept, and its status says so.
+  const bool diverged = exit_code == kExitDiverged;
+  std::string error = exit_code == 0 || diverged ? CollectMetrics(cell, &metrics, &warnings)
+                                                 : "rvlio run " + how;
+  r["status"] = !error.empty() ? "failed" : diverged ? "diverged" : "done";
   r["error"] = error.empty() ? json(nullptr) : json(error);
   r["metrics"] = metrics;
   r["eval_warnings"] = warnings;
@@ -375,7 +379,7 @@ bool FinishData(const DataItem& d, int status, double wall_s) {
 
 bool CellDone(const Cell& cell) {
   const json r = ReadCellRecord(cell);
-  return r.is_object() && r.value("status", "") == "done";
+  return r.is_object() && (r.value("status", "") == "done" || r.value("status", "") == "diverged");
 }
 
 Job DataJob(const DataItem& d) {

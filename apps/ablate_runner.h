@@ -19,7 +19,7 @@ namespace rvlio::cli::ablate {
 struct RunCounts {
   int total = 0;
   int skipped = 0;  // already done before this call
-  int done = 0;     // finished now
+  int done = 0;     // finished now (including cells whose run diverged: cell.json says so)
   int failed = 0;   // failed now (including cells whose data failed)
   int interrupted = 0;  // stopped by a signal: nothing kept, run again next time
   int not_started = 0;  // not started because of a signal
@@ -39,8 +39,9 @@ RunCounts RunPlan(const Plan& plan, const RunnerOptions& options);
 bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& options,
             RunCounts* counts);
 
-// cell.json of a finished cell with the plan's hash (status done or
-// failed), or null when there is none.
+// cell.json of a finished cell with the plan's hash (status done, diverged
+// (the run's divergence monitor fired: exit 3, metrics kept) or failed), or
+// null when there is none.
 nlohmann::json ReadCellRecord(const Cell& cell);
 
 // The metric fields of cell.json "metrics", in table order.

@@ -69,6 +69,9 @@ int Summarize(const ablate::Plan& plan, const Args& args) {
   std::cout << r->table_md;
   std::printf("rvlio ablate: %d cells: %d done, %d failed, %d not run -> %s/table.md\n", r->cells,
               r->done, r->failed, r->missing, plan.out_dir.c_str());
+  if (r->diverged > 0)
+    std::printf("rvlio ablate: %d cells diverged (status diverged in summary.csv; left out of the "
+                "means)\n", r->diverged);
   std::printf("rvlio ablate: %s\n", r->plot_note.c_str());
   return 0;
 }

@@ -14,6 +14,7 @@
 #include "common_options.h"
 #include "interrupt.h"
 #include "refine_checkpoint.h"
+#include "divergence_cli.h"
 #include "run_pipeline.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
@@ -104,8 +105,8 @@ struct Request {
 };
 
 Status WriteOutputs(const Request& req, const OdometryOptions& options, const RefineResult& res,
-                    const SensorReaderStats& reader_stats, int64_t raw_points, double read_s,
-                    double wall_s) {
+                    const DivergenceReport& divergence, const SensorReaderStats& reader_stats,
+                    int64_t raw_points, double read_s, double wall_s) {
   OutputStage stage(req.out_dir);  // all outputs or none (run_pipeline.h)
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), res.trajectory); !s.ok())
@@ -137,6 +138,7 @@ Status WriteOutputs(const Request& req, const OdometryOptions& options, const Re
   j["peak_memory_mb"] = PeakMemoryMb();
   j["stats"] = StatsJson(res.stats, reader_stats, raw_points);
   j["warnings"] = res.warnings;
+  j["divergence"] = DivergenceJson(divergence);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
     return stage.Explain(s);
   return stage.Commit();
@@ -202,7 +204,8 @@ int CmdRefine(int argc, char** argv) {
                      "after each round, write the state to continue from to DIR/refine.checkpoint"},
                     {"resume", "DIR",
                      "continue from DIR/refine.checkpoint (same --bag, --init, --config and --set; "
-                     "smoother.refine_rounds may differ) and go on checkpointing there"}}};
+                     "smoother.refine_rounds may differ) and go on checkpointing there"},
+                    AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   InterruptScope interrupt_scope;
@@ -236,9 +239,13 @@ int CmdRefine(int argc, char** argv) {
   if (!result.ok())
     return Fail("refine", result.status().message() + " (bag " + req.bag + ", init " + req.init + ")",
                 result.status().exit_code());
-  const Status written = WriteOutputs(req, *options, *result, (*reader)->stats(), raw_points,
-                                      read_s, SecondsSince(t0));
+  const DivergenceReport divergence = CheckRefineResult(
+      *result, options->divergence, options->constraints.lidar_noise, options->imu.gravity);
+  const Status written = WriteOutputs(req, *options, *result, divergence, (*reader)->stats(),
+                                      raw_points, read_s, SecondsSince(t0));
   for (const auto& w : result->warnings) std::fprintf(stderr, "rvlio refine: warning: %s\n", w.c_str());
+  size_t warned = 0;
+  WarnDivergence("refine", divergence, &warned);
   if (!written.ok()) return Fail("refine", written.message(), written.exit_code());
   if (result->stopped) {
     std::fprintf(stderr, "rvlio refine: interrupted by %s: wrote the result after round %zu "
@@ -251,6 +258,8 @@ int CmdRefine(int argc, char** argv) {
               result->trajectory.size(), result->rounds.size(),
               result->converged ? " (converged)" : "", result->linear_solver.c_str(),
               SecondsSince(t0), PeakMemoryMb(), req.out_dir.c_str());
+  if (divergence.detected)
+    return FinishDiverged("refine", divergence, req.out_dir, args.Has("allow-divergence"));
   return 0;
 }
 

@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "common_options.h"
 #include "interrupt.h"
+#include "divergence_cli.h"
 #include "run_pipeline.h"
 
 namespace rvlio::cli {
@@ -15,11 +16,12 @@ int CmdRun(int argc, char** argv) {
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
-                    {"quiet", "", "no progress line"}}};
+                    {"quiet", "", "no progress line"},
+                    AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), args.GetAll("set"),
-                 args.Has("quiet")};
+                 args.Has("quiet"), args.Has("allow-divergence")};
   RunOutcome outcome;
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: write what is done, exit 130/143
   const int rc = RunOdometryOnBag(req, &outcome);

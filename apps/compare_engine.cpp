@@ -19,6 +19,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "interrupt.h"
+#include "divergence_cli.h"
 #include "plot_runner.h"
 #include "run_pipeline.h"
 #include "rvlio/eval/evaluate.h"
@@ -60,9 +61,13 @@ struct Row {
   double real_time_factor = kNaN;  // sequence duration / compute time
   double wall_s = 0.0;             // whole step, including reading the bag
   bool interrupted = false;        // a signal stopped it or came before it started
+  bool diverged = false;           // the divergence monitor fired: metrics shown, marked
 
-  bool ok() const { return exit_code == 0 && eval.has_value(); }
-  const char* status() const { return interrupted ? "interrupted" : ok() ? "ok" : "failed"; }
+  bool measured() const { return exit_code == 0 && eval.has_value(); }
+  bool ok() const { return measured() && !diverged; }
+  const char* StatusName() const {
+    return interrupted ? "interrupted" : ok() ? "ok" : (measured() ? "diverged" : "failed");
+  }
 };
 
 double SecondsSince(Clock::time_point t0) {
@@ -190,12 +195,12 @@ void EvaluateRow(const Trajectory& truth, const std::string& dir, Row* row) {
 
 std::string ResultLine(const Row& row) {
   if (row.interrupted) return row.name + " interrupted (its folder holds the scans it finished)";
-  if (!row.ok())
+  if (!row.measured())
     return row.name + " failed (exit " + std::to_string(row.exit_code) + ")" +
            (row.error.empty() ? "" : ": " + row.error);
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "ATE %.4f m, %d scans, %.1f s", row.eval->ape_m.rmse, row.scans,
-                row.wall_s);
+  std::snprintf(buf, sizeof(buf), "ATE %.4f m, %d scans, %.1f s%s", row.eval->ape_m.rmse,
+                row.scans, row.wall_s, row.diverged ? ", DIVERGED (summary.json divergence)" : "");
   return buf;
 }
 
@@ -207,6 +212,7 @@ Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& tr
   std::vector<std::string> sets = req.overrides;
   sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
   RunRequest run{req.bag, req.out_dir + "/" + v.name, req.config_files, sets, req.quiet};
+  run.allow_divergence = true;  // the row is marked instead
   RunOutcome outcome;
   const auto t0 = Clock::now();
   row.exit_code = RunOdometryOnBag(run, &outcome);
@@ -216,6 +222,7 @@ Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& tr
     row.scans = outcome.scans;
     row.ms_per_scan = outcome.median_ms;
     row.real_time_factor = outcome.real_time_factor;
+    row.diverged = outcome.diverged;
     EvaluateRow(truth, run.out_dir, &row);
   }
   steps->Detail(ResultLine(row));
@@ -239,6 +246,7 @@ void ReadRefineTiming(const std::string& dir, Row* row) {
   row->scans = j.value("scan_count", 0);
   if (row->scans > 0 && refine_s > 0) row->ms_per_scan = 1000.0 * refine_s / row->scans;
   if (refine_s > 0) row->real_time_factor = duration_s / refine_s;
+  row->diverged = j.value(nlohmann::json::json_pointer("/divergence/detected"), false);
 }
 
 Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& truth, Steps* steps) {
@@ -250,7 +258,7 @@ Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& tru
   row.init = start.name;
   std::vector<std::string> args = {"rvlio", "refine", "--bag", req.bag, "--init",
                                    req.out_dir + "/" + start.name + "/trajectory.tum",
-                                   "--out", dir};
+                                   "--out", dir, "--allow-divergence"};
   for (const auto& c : req.config_files) args.insert(args.end(), {"--config", c});
   for (const auto& s : req.overrides) args.insert(args.end(), {"--set", s});
   const auto t0 = Clock::now();
@@ -289,9 +297,9 @@ std::string CsvText(const std::vector<Row>& rows) {
   std::ostringstream os;
   os << kCsvHeader;
   for (const Row& r : rows) {
-    os << r.name << "," << CsvField(r.label) << "," << r.status() << ","
+    os << r.name << "," << CsvField(r.label) << "," << r.StatusName() << ","
        << r.exit_code << "," << r.init << "," << r.scans;
-    if (r.ok()) {
+    if (r.measured()) {
       os << "," << Exact(r.eval->ape_m.rmse) << "," << Exact(r.eval->rpe.trans_m.rmse) << ","
          << Exact(r.eval->along_axis.max_abs_m) << "," << Exact(r.eval->end_point_error_m) << ","
          << Exact(r.ms_per_scan) << "," << Exact(r.real_time_factor);
@@ -305,7 +313,7 @@ std::string CsvText(const std::vector<Row>& rows) {
 
 std::string AlignName(const std::vector<Row>& rows) {
   for (const Row& r : rows)
-    if (r.ok()) return AlignModeName(r.eval->align);
+    if (r.measured()) return AlignModeName(r.eval->align);
   return "se3";
 }
 
@@ -314,12 +322,12 @@ std::string MarkdownText(const CompareRequest& req, const std::vector<Row>& rows
   os << "| variant | ATE [m] | RPE [m] | along-axis max [m] | end-point [m] | ms/scan | "
         "real-time factor |\n|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
-    os << "| " << r.label << " | ";
+    os << "| " << r.label << (r.diverged ? " (**diverged**)" : "") << " | ";
     if (r.interrupted) {
       os << "interrupted | | | | | |\n";
       continue;
     }
-    if (!r.ok()) {
+    if (!r.measured()) {
       os << "failed (exit " << r.exit_code << ") | | | | | |\n";
       continue;
     }
@@ -345,13 +353,14 @@ void PrintTable(const std::vector<Row>& rows) {
       std::printf("  %-30s interrupted\n", r.label.c_str());
       continue;
     }
-    if (!r.ok()) {
+    if (!r.measured()) {
       std::printf("  %-30s failed (exit %d)\n", r.label.c_str(), r.exit_code);
       continue;
     }
-    std::printf("  %-30s %9.4f %9.4f %12.4f %9.4f %9.2f %7.1fx\n", r.label.c_str(),
+    std::printf("  %-30s %9.4f %9.4f %12.4f %9.4f %9.2f %7.1fx%s\n", r.label.c_str(),
                 r.eval->ape_m.rmse, r.eval->rpe.trans_m.rmse, r.eval->along_axis.max_abs_m,
-                r.eval->end_point_error_m, r.ms_per_scan, r.real_time_factor);
+                r.eval->end_point_error_m, r.ms_per_scan, r.real_time_factor,
+                r.diverged ? "  DIVERGED" : "");
   }
   std::printf("\n  ATE: RMSE after %s alignment; RPE: 1-frame translation RMSE; axis max: largest\n"
               "  error along the tunnel axis; end: end-point error. ms/scan: median CPU time per\n"
@@ -368,14 +377,15 @@ nlohmann::json RowJson(const CompareRequest& req, const Row& r,
                        const std::vector<std::string>& overrides) {
   nlohmann::json j = {{"variant", r.name},
                       {"label", r.label},
-                      {"status", r.status()},
+                      {"status", r.StatusName()},
+                      {"diverged", r.diverged},
                       {"exit_code", r.exit_code},
                       {"dir", req.out_dir + "/" + r.name},
                       {"overrides", overrides},
                       {"wall_s", Num(r.wall_s)}};
   if (!r.init.empty()) j["init"] = r.init;
   if (!r.error.empty()) j["error"] = r.error;
-  if (!r.ok()) return j;
+  if (!r.measured()) return j;
   const EvalResult& e = *r.eval;
   j["scans"] = r.scans;
   j["ate_rmse_m"] = Num(e.ape_m.rmse);
@@ -542,7 +552,15 @@ int RunCompare(const CompareRequest& req) {
   std::printf("\n  tables: %s/compare.{csv,md,json}; runs: %s/<variant>/\n", req.out_dir.c_str(),
               req.out_dir.c_str());
   if (req.plots) PrintPlotReport(req, plots);
+  int diverged = 0;
+  for (const Row& r : rows) diverged += r.diverged ? 1 : 0;
+  if (!any_ok && diverged > 0)
+    return Fail(kName, "every variant failed or diverged (see the table and each run's summary.json "
+                "divergence)", kExitDiverged);
   if (!any_ok) return Fail(kName, "every variant failed (see the table)", 1);
+  if (diverged > 0)
+    std::fprintf(stderr, "rvlio %s: warning: %d run(s) diverged, marked in the table\n", kName,
+                 diverged);
   return 0;
 }
 

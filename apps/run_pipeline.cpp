@@ -17,6 +17,7 @@
 
 #include "cli.h"
 #include "interrupt.h"
+#include "divergence_cli.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/run_outputs.h"
@@ -129,6 +130,7 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   j["peak_memory_mb"] = PeakMemoryMb();
   j["rv_active_scans"] = RvActiveScans(data.results);
   j["stats"] = StatsJson(odo.stats(), reader_stats);
+  j["divergence"] = DivergenceJson(odo.divergence());
   j["warnings"] = warnings;
   j["interrupted"] = !data.interrupted_by.empty();
   if (!data.interrupted_by.empty()) {
@@ -136,6 +138,7 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
     j["last_stamp_s"] = data.results.empty() ? 0.0 : NsToSeconds(data.results.back().t_ns);
   }
   outcome->scans = static_cast<int>(data.results.size());
+  outcome->diverged = odo.divergence().detected;
   outcome->median_ms = t.median_ms;
   outcome->real_time_factor = j["real_time_factor"];
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
@@ -365,6 +368,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   ImuSample imu;
   Scan scan;
   Status read_error;
+  size_t divergence_warned = 0;
   for (;;) {
     if (Interrupted()) {  // the scans done so far are the outputs; pending ones are dropped
       data.interrupted_by = InterruptSignalName();
@@ -387,8 +391,12 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     if (data.rss_mb.size() < data.results.size())
       data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
     progress.Update(static_cast<int>(data.results.size()), t);
+    WarnDivergence("run", (*odo)->divergence(), &divergence_warned);
   }
-  if (data.interrupted_by.empty()) (*odo)->Finish(&data.results);
+  if (data.interrupted_by.empty()) {
+    (*odo)->Finish(&data.results);
+    WarnDivergence("run", (*odo)->divergence(), &divergence_warned);
+  }
   data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
   data.wall_s = SecondsSince(t0);
   const SensorReaderStats& reader_stats = (*reader)->stats();
@@ -412,6 +420,8 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     return Fail("run", read_error.message() + " (outputs hold the scans read before it)");
   for (const auto& w : warnings) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
   if (!data.interrupted_by.empty()) return ReportInterrupt(req, data);
+  if ((*odo)->divergence().detected)
+    return FinishDiverged("run", (*odo)->divergence(), req.out_dir, req.allow_divergence);
   return 0;
 }
 

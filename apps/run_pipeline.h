@@ -16,12 +16,14 @@ struct RunRequest {
   std::vector<std::string> config_files;
   std::vector<std::string> overrides;  // --set key=value
   bool quiet = false;                  // no progress line even on a terminal
+  bool allow_divergence = false;       // exit 0 even if the divergence monitor fired
 };
 
 struct RunOutcome {
   int scans = 0;
   double median_ms = 0.0;
   double real_time_factor = 0.0;
+  bool diverged = false;  // the divergence monitor fired (summary.json divergence)
 };
 
 // Reads the bag, runs the odometry and writes the outputs of DESIGN.md
@@ -30,7 +32,9 @@ struct RunOutcome {
 // pose as it is estimated (removed at an orderly end). Under an InterruptScope
 // (interrupt.h) a signal stops the reading: the outputs of the scans done so
 // far are written (summary.json "interrupted": true) and the status is 130 /
-// 143. Nothing is written when no scan was done.
+// 143. Nothing is written when no scan was done. A run the divergence
+// monitor flagged writes every output and returns kExitDiverged
+// (divergence_cli.h) unless request.allow_divergence.
 int RunOdometryOnBag(const RunRequest& request, RunOutcome* outcome);
 
 // Creates `dir` if needed and proves it writable; false with a message if not.
