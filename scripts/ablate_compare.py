@@ -8,7 +8,7 @@ OUT/table.csv (one row per sequence x variant x parameters) of the two
 folders, as written by `rvlio ablate` or by workflow/Snakefile: the same rows,
 the same text in every column and the same numbers (relative tolerance
 --rel-tol), except the timing columns (ms_per_scan, rtf and their
-_mean/_std), which differ from run to run. Prints what was compared, or
+_mean/_std, wall_s), which differ from run to run. Prints what was compared, or
 every difference; exit 0 when equal, 1 when not, 2 on unreadable input.
 Standard library only.
 """
@@ -18,7 +18,7 @@ import math
 import os
 import sys
 
-TIMING = ("ms_per_scan", "rtf")
+TIMING = ("ms_per_scan", "rtf", "wall_s")
 
 
 def is_timing(column):

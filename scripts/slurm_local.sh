@@ -15,7 +15,7 @@
 # slurmctld) and the port after it (slurmd). The node gets this machine's
 # CPUs and memory (`slurmd -C`), in one partition `rvlio` (the default).
 # Jobs run as the submitting user; when run as root, SlurmUser is root.
-# No systemd or cgroups needed: proctrack/linuxproc, task/none.
+# No systemd or cgroups needed: proctrack/pgid, task/none.
 #
 # `up` when already up and `down` when not up do nothing and exit 0. `up`
 # that fails says why, shows the daemons' log tails and stops what it started.
@@ -81,8 +81,9 @@ SlurmctldLogFile=$dir/log/slurmctld.log
 SlurmdLogFile=$dir/log/slurmd.log
 SlurmctldDebug=info
 SlurmdDebug=info
-# No systemd or cgroups: processes tracked through /proc, no task binding.
-ProctrackType=proctrack/linuxproc
+# No systemd or cgroups: a job's processes are its process group (they stay
+# in it when their parent dies, unlike with proctrack/linuxproc), no task binding.
+ProctrackType=proctrack/pgid
 TaskPlugin=task/none
 JobAcctGatherType=jobacct_gather/linux
 JobAcctGatherFrequency=task=5

@@ -17,6 +17,8 @@
 #      cell alone fails and its log is named; a job cancelled while it runs is
 #      submitted again (the profile's restart-times) and the grid finishes
 #
+#   5. no process of any job is left
+#
 # Prints "ok - ..." / "FAIL - ..." per check and ends with
 # "slurm: N passed, M failed"; exit 1 when a check failed or the cluster did
 # not start. RVLIO_BIN: the rvlio binary (default build/bin/rvlio, built when
@@ -71,6 +73,7 @@ fi
 echo "$up_out"
 eval "$(bash scripts/slurm_local.sh env)"
 export SLURM_CONF
+export USER=${USER:-$(id -un)}  # Snakemake's Slurm executor reads it (to guess an account)
 
 # Snakemake with the shipped profile, on the local cluster's partition; status
 # checked every second instead of every 30 s.
@@ -81,11 +84,11 @@ snake() {  # snake GRID OUT LOG [extra snakemake options]
     --config grid="$g" out="$out" rvlio="$rvlio" plots=false "$@") >"$log" 2>&1
 }
 
-# Every second: the jobs in the queue (id|name|state|cpus|memory|time limit).
+# Every half second: the jobs in the queue (id|name|state|cpus|memory|time limit).
 poll_queue() {
   while true; do
     squeue -h -o '%i|%j|%T|%C|%m|%l' >>"$work/squeue.txt" 2>/dev/null || true
-    sleep 1
+    sleep 0.5
   done
 }
 
@@ -99,18 +102,26 @@ jobs_of_rule() {  # jobs_of_rule cell|data
   done
 }
 
+job_state() { sacct -c -j "$1" -n -o state 2>/dev/null | tr -d ' '; }
+
 # Waits until a job of a cell matching PATTERN runs `rvlio run` (its run.log
-# exists), cancels it and prints "SLURMID CELL_ID". Gives up after 120 s.
+# exists, its cell.json does not), cancels it and prints "SLURMID CELL_ID"
+# once Slurm has recorded it as CANCELLED (a job that finished just before
+# the scancel does not count; the next one is tried). Gives up after 120 s.
 cancel_running_cell() {  # cancel_running_cell OUT PATTERN
-  local i id cell
+  local i id cell tried=" " j
   for ((i = 0; i < 240; i++)); do
     while read -r id cell; do
-      [[ -n $cell && $cell == $2 ]] || continue
+      [[ -n $cell && $cell == $2 && $tried != *" $id "* ]] || continue
       if [[ $(squeue -h -j "$id" -o %T 2>/dev/null) == RUNNING && -f $1/cells/$cell/run.log &&
             ! -f $1/cells/$cell/cell.json ]]; then
+        tried+="$id "
         scancel "$id"
-        echo "$id $cell"
-        return 0
+        for ((j = 0; j < 60; j++)); do
+          [[ -n $(job_state "$id") ]] && break
+          sleep 0.5
+        done
+        [[ $(job_state "$id") == CANCELLED ]] && { echo "$id $cell"; return 0; }
       fi
     done < <(jobs_of_rule cell)
     sleep 0.5
@@ -143,7 +154,6 @@ snake_pid=""
 read -r cancelled_job cancelled_cell <<<"${cancelled:-- -}"
 check "scancel stopped a running cell job ($cancelled_job, cell $cancelled_cell)" test -n "$cancelled"
 check "the invocation with the cancelled job fails (exit $rc1)" test "$rc1" -ne 0
-job_state() { sacct -c -j "$1" -n -o state 2>/dev/null | tr -d ' '; }
 check "Slurm records the cancelled job as CANCELLED" test "$(job_state "$cancelled_job")" = CANCELLED
 no_result() { ! ls "$work/slurm/cells/$cancelled_cell/" 2>/dev/null | grep -q '^cell\.json'; }
 check "the cancelled cell left no result (no cell.json, no temporary file)" no_result
@@ -230,11 +240,34 @@ bad_log_named() {
     grep -qi 'topic' "$work/bad/cells/$bad_cell/run.log"
 }
 check "the workflow names the failing cell's log, which says why" bad_log_named
+tables_differ() {
+  python3 scripts/ablate_compare.py "$work/local" "$work/bad" >"$work/compare_bad.txt"
+  [[ $? -eq 1 ]] && grep -q "row tunnel/bad only in" "$work/compare_bad.txt"
+}
+check "scripts/ablate_compare.py tells different tables apart" tables_differ
 retried_ok() {
   [[ -n $retried ]] && [[ $(jobs_of_rule cell | awk -v c="$retried_cell" '$2 == c' | wc -l) -ge 2 ]] &&
     grep -q '"status": *"done"' "$work/bad/cells/$retried_cell/cell.json"
 }
 check "a job cancelled while running ($retried_job, cell $retried_cell) was submitted again and finished" retried_ok
+
+# Nothing of any job is still running (a cancelled job's processes included;
+# Slurm kills them KillWait = 5 s after the SIGTERM).
+leftovers() {
+  local i f pids
+  for ((i = 0; i < 30; i++)); do
+    pids=""
+    for f in /proc/[0-9]*/cmdline; do
+      tr '\0' ' ' 2>/dev/null <"$f" | grep -qF -- "$work/" && pids+=" $(basename "$(dirname "$f")")"
+    done
+    [[ -z $pids ]] && return 0
+    sleep 0.5
+  done
+  echo "  still running:$pids" >&2
+  ps -o pid,ppid,pgid,etime,args -p "${pids// /,}" >&2 || true
+  return 1
+}
+check "no process of any job (cancelled ones included) is left running" leftovers
 
 if [[ $failed -gt 0 ]]; then
   for f in "$work"/run*.log; do echo "---- $f (last 30 lines)"; tail -n 30 "$f"; done
