@@ -12,7 +12,7 @@
 #             here (scripts/slurm_local.sh), config/grids/tiny.yaml through
 #             the Snakemake workflow on it, the table compared with the one
 #             of `rvlio ablate`, a failing cell and cancelled jobs (about
-#             3 minutes); the cluster is stopped afterwards, also on failure
+#             2 minutes); the cluster is stopped afterwards, also on failure
 #
 # A developer may run a subset: RVLIO_CI_STAGES=release (or "release,fuzz",
 # ...) bash scripts/test.sh. RVLIO_FUZZ_SECONDS=10 shortens the fuzz stage.
