@@ -35,9 +35,12 @@ poller=""
 snake_pid=""
 
 cleanup() {
-  local rc=$?
+  local rc=$? i
   [[ -n $poller ]] && kill "$poller" 2>/dev/null || true
-  [[ -n $snake_pid ]] && kill "$snake_pid" 2>/dev/null || true
+  if [[ -n $snake_pid ]]; then  # interrupted: Snakemake cancels its jobs on SIGTERM
+    kill "$snake_pid" 2>/dev/null || true
+    for ((i = 0; i < 40; i++)); do kill -0 "$snake_pid" 2>/dev/null || break; sleep 0.5; done
+  fi
   bash scripts/slurm_local.sh down || rc=1
   rm -rf "$work"
   exit "$rc"
@@ -77,11 +80,14 @@ export USER=${USER:-$(id -un)}  # Snakemake's Slurm executor reads it (to guess 
 
 # Snakemake with the shipped profile, on the local cluster's partition; status
 # checked every second instead of every 30 s.
+# Replaces the calling (sub)shell: run it as `(snake ...)` or `snake ... &`
+# (then $! is Snakemake's pid).
 snake() {  # snake GRID OUT LOG [extra snakemake options]
   local g=$1 out=$2 log=$3; shift 3
-  (cd "$sm" && snakemake -s "$repo/workflow/Snakefile" --profile "$repo/workflow/profiles/slurm" \
+  cd "$sm"
+  exec snakemake -s "$repo/workflow/Snakefile" --profile "$repo/workflow/profiles/slurm" \
     --default-resources slurm_partition=rvlio --max-status-checks-per-second 1 --latency-wait 5 \
-    --config grid="$g" out="$out" rvlio="$rvlio" plots=false "$@") >"$log" 2>&1
+    --config grid="$g" out="$out" rvlio="$rvlio" plots=false "$@" >"$log" 2>&1
 }
 
 # Every half second: the jobs in the queue (id|name|state|cpus|memory|time limit).
@@ -169,7 +175,7 @@ check "the other cells finished in that invocation" others_done
 # 3. Again: the cancelled cell runs, nothing else does.
 jobs_before=$(jobs_of_rule cell | wc -l)
 rc2=0
-snake "$grid" "$work/slurm" "$work/run2.log" || rc2=$?
+(snake "$grid" "$work/slurm" "$work/run2.log") || rc2=$?
 check "the next invocation completes (exit $rc2)" test "$rc2" -eq 0
 only_cancelled_again() {
   [[ $(($(jobs_of_rule cell | wc -l) - jobs_before)) -eq 1 ]] &&
