@@ -91,11 +91,11 @@ snake() {  # snake GRID OUT LOG [extra snakemake options]
     --config grid="$g" out="$out" rvlio="$rvlio" plots=false "$@" >"$log" 2>&1
 }
 
-# Every half second: the jobs in the queue (id|name|state|cpus|memory|time limit).
+# Every quarter second: the jobs in the queue (id|name|state|cpus|memory|time limit).
 poll_queue() {
   while true; do
     squeue -h -o '%i|%j|%T|%C|%m|%l' >>"$work/squeue.txt" 2>/dev/null || true
-    sleep 0.5
+    sleep 0.25
   done
 }
 
@@ -117,7 +117,7 @@ job_state() { sacct -c -j "$1" -n -o state 2>/dev/null | tr -d ' '; }
 # the scancel does not count; the next one is tried). Gives up after 120 s.
 cancel_running_cell() {  # cancel_running_cell OUT PATTERN
   local i id cell tried=" " j
-  for ((i = 0; i < 240; i++)); do
+  for ((i = 0; i < 1200; i++)); do  # every 0.1 s: a tiny cell runs for well under a second
     while read -r id cell; do
       # shellcheck disable=SC2053  # $2 is a glob pattern
       [[ -n $cell && $cell == $2 && $tried != *" $id "* ]] || continue
@@ -132,7 +132,7 @@ cancel_running_cell() {  # cancel_running_cell OUT PATTERN
         [[ $(job_state "$id") == CANCELLED ]] && { echo "$id $cell"; return 0; }
       fi
     done < <(jobs_of_rule cell)
-    sleep 0.5
+    sleep 0.1
   done
   return 1
 }
