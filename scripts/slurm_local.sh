@@ -170,7 +170,7 @@ do_up() {
   done
   SLURM_CONF=$conf scontrol ping 2>/dev/null | grep -q "is UP" || fail_up "slurmctld does not answer after 30 s"
 
-  start_daemon slurmd slurmd -D -f "$conf"
+  start_daemon slurmd slurmd -D -N "$(hostname -s)" -f "$conf"
   local state=""
   for ((i = 0; i < 5 * wait_s; i++)); do
     state=$(node_state)

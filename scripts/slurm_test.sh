@@ -36,7 +36,7 @@ snake_pid=""
 
 cleanup() {
   local rc=$? i
-  [[ -n $poller ]] && kill "$poller" 2>/dev/null || true
+  if [[ -n $poller ]]; then kill "$poller" 2>/dev/null || true; fi
   if [[ -n $snake_pid ]]; then  # interrupted: Snakemake cancels its jobs on SIGTERM
     kill "$snake_pid" 2>/dev/null || true
     for ((i = 0; i < 40; i++)); do kill -0 "$snake_pid" 2>/dev/null || break; sleep 0.5; done
@@ -81,20 +81,21 @@ export USER=${USER:-$(id -un)}  # Snakemake's Slurm executor reads it (to guess 
 # Snakemake with the shipped profile, on the local cluster's partition; status
 # checked every second instead of every 30 s.
 # Replaces the calling (sub)shell: run it as `(snake ...)` or `snake ... &`
-# (then $! is Snakemake's pid).
+# (then $! is the pid of `timeout`, which passes SIGTERM on to Snakemake).
+# An invocation normally takes 20-40 s; 180 s bounds a hung cluster.
 snake() {  # snake GRID OUT LOG [extra snakemake options]
   local g=$1 out=$2 log=$3; shift 3
   cd "$sm"
-  exec snakemake -s "$repo/workflow/Snakefile" --profile "$repo/workflow/profiles/slurm" \
+  exec timeout 180 snakemake -s "$repo/workflow/Snakefile" --profile "$repo/workflow/profiles/slurm" \
     --default-resources slurm_partition=rvlio --max-status-checks-per-second 1 --latency-wait 5 \
     --config grid="$g" out="$out" rvlio="$rvlio" plots=false "$@" >"$log" 2>&1
 }
 
-# Every half second: the jobs in the queue (id|name|state|cpus|memory|time limit).
+# Every quarter second: the jobs in the queue (id|name|state|cpus|memory|time limit).
 poll_queue() {
   while true; do
     squeue -h -o '%i|%j|%T|%C|%m|%l' >>"$work/squeue.txt" 2>/dev/null || true
-    sleep 0.5
+    sleep 0.25
   done
 }
 
@@ -116,8 +117,9 @@ job_state() { sacct -c -j "$1" -n -o state 2>/dev/null | tr -d ' '; }
 # the scancel does not count; the next one is tried). Gives up after 120 s.
 cancel_running_cell() {  # cancel_running_cell OUT PATTERN
   local i id cell tried=" " j
-  for ((i = 0; i < 240; i++)); do
+  for ((i = 0; i < 1200; i++)); do  # every 0.1 s: a tiny cell runs for well under a second
     while read -r id cell; do
+      # shellcheck disable=SC2053  # $2 is a glob pattern
       [[ -n $cell && $cell == $2 && $tried != *" $id "* ]] || continue
       if [[ $(squeue -h -j "$id" -o %T 2>/dev/null) == RUNNING && -f $1/cells/$cell/run.log &&
             ! -f $1/cells/$cell/cell.json ]]; then
@@ -130,7 +132,7 @@ cancel_running_cell() {  # cancel_running_cell OUT PATTERN
         [[ $(job_state "$id") == CANCELLED ]] && { echo "$id $cell"; return 0; }
       fi
     done < <(jobs_of_rule cell)
-    sleep 0.5
+    sleep 0.1
   done
   return 1
 }
@@ -161,7 +163,8 @@ read -r cancelled_job cancelled_cell <<<"${cancelled:-- -}"
 check "scancel stopped a running cell job ($cancelled_job, cell $cancelled_cell)" test -n "$cancelled"
 check "the invocation with the cancelled job fails (exit $rc1)" test "$rc1" -ne 0
 check "Slurm records the cancelled job as CANCELLED" test "$(job_state "$cancelled_job")" = CANCELLED
-no_result() { ! ls "$work/slurm/cells/$cancelled_cell/" 2>/dev/null | grep -q '^cell\.json'; }
+# cell.json is written as cell.json.tmp.<pid>, then renamed.
+no_result() { ! compgen -G "$work/slurm/cells/$cancelled_cell/cell.json*" >/dev/null; }
 check "the cancelled cell left no result (no cell.json, no temporary file)" no_result
 others_done() {
   local c
