@@ -167,5 +167,35 @@ TEST_F(RunSignalsTest, SigkillLeavesAParseablePartialTrajectory) {
   for (const std::string& name : kOutputs) EXPECT_FALSE(Exists(out + "/" + name)) << name;
 }
 
+// compare runs its variants in-process: the signal stops the running one,
+// which keeps what it did; it and the steps not run are marked interrupted.
+TEST_F(RunSignalsTest, InterruptedCompareTabulatesWhatItFinished) {
+  const std::string out = dir_ + "/cmp";
+  const pid_t pid = Spawn({"compare", "--bag", dir_ + "/data/tunnel.bag", "--gt",
+                           dir_ + "/data/tunnel_gt.tum", "--config", dir_ + "/data/tunnel.yaml",
+                           "--out", out, "--no-plots", "--quiet"},
+                          dir_ + "/cmp_stdout.txt", dir_ + "/cmp_stderr.txt");
+  const std::string second = out + "/ieskf_rv_on";
+  int status = -1;
+  const bool ready = WaitUntil(
+      pid, [&] { return CountLines(second + "/trajectory.partial.tum") >= 4; }, &status);
+  ASSERT_TRUE(ready) << "compare ended (status " << status << ") before its second variant";
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  ASSERT_EQ(Wait(pid), 130) << ReadFile(dir_ + "/cmp_stderr.txt");
+  EXPECT_NE(ReadFile(dir_ + "/cmp_stderr.txt")
+                .find("rvlio compare: interrupted by SIGINT: 1 of 5 steps finished"),
+            std::string::npos) << ReadFile(dir_ + "/cmp_stderr.txt");
+  const json j = json::parse(ReadFile(out + "/compare.json"), nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  std::vector<std::string> statuses;
+  for (const json& v : j["variants"]) statuses.push_back(v["status"]);
+  EXPECT_EQ(statuses, (std::vector<std::string>{"ok", "interrupted", "interrupted",
+                                                "interrupted", "interrupted"}));
+  EXPECT_EQ(json::parse(ReadFile(second + "/summary.json"))["interrupted"], true);
+  EXPECT_NE(ReadFile(out + "/compare.csv").find("ieskf_rv_on,\"IESKF, RV on (RV-LIO)\",interrupted,130"),
+            std::string::npos);
+  EXPECT_FALSE(Exists(out + "/smoother_rv_off"));
+}
+
 }  // namespace
 }  // namespace rvlio::signals_test
