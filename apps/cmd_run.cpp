@@ -11,7 +11,8 @@ namespace rvlio::cli {
 int CmdRun(int argc, char** argv) {
   CommandSpec spec{"run",
                    "Runs the odometry on a ROS1 bag and writes trajectory.tum, map.pcd, scans.csv "
-                   "and summary.json to the output folder.",
+                   "and summary.json to the output folder (and trajectory.partial.tum while it runs). "
+                   "SIGINT/SIGTERM write the outputs of the scans done and exit 130/143.",
                    {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
                     ConfigOption(),
                     SetOption(),
