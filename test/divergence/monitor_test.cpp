@@ -97,7 +97,7 @@ TEST(DivergenceMonitor, NisIsAWindowTestNotASingleScan) {
   DivergenceMonitor single(o, kNoise, kGravity);
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
-    if (k == 50) s.health.nis_per_dof = 200.0;  // one bad scan: mean 200/20 + ~1.5 < 25
+    if (k == 50) s.health.nis_per_dof = 150.0;  // one bad scan: mean 150/20 + ~1.5 < 10
     single.Check(s);
   }
   EXPECT_FALSE(single.report().detected);
@@ -106,11 +106,11 @@ TEST(DivergenceMonitor, NisIsAWindowTestNotASingleScan) {
   int first = -1;
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
-    if (k >= 50) s.health.nis_per_dof = 60.0;
+    if (k >= 50) s.health.nis_per_dof = 30.0;
     if (persistent.Check(s) != 0 && first < 0) first = k;
   }
   EXPECT_EQ(Episodes(persistent.report(), DivergenceKind::kNis), 1);
-  // The window mean passes 25 once more than ~8 of its 20 scans are at 60.
+  // The window mean passes 10 once more than ~5 of its 20 scans are at 30.
   EXPECT_GT(first, 50);
   EXPECT_LT(first, 50 + o.window_scans);
 }
@@ -120,7 +120,7 @@ TEST(DivergenceMonitor, ResidualsAndInliersPersistent) {
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
     if (k >= 40) {
-      s.health.residual_median_m = 0.5;  // > 4 * 0.03
+      s.health.residual_median_m = 0.2;  // > 2 * 0.03
       s.constraints = 50;                // 5% of the points
     }
     m.Check(s);

@@ -42,10 +42,10 @@ struct DivergenceOptions {
   double max_speed = 50.0;             // m/s
   double jump_slack = 1.0;             // m, added to max(|v|) * dt
   int window_scans = 20;               // scans of the windowed checks
-  double max_nis = 25.0;               // mean NIS per degree of freedom over the window
-  double max_residual_ratio = 4.0;     // window median of median |r|, in units of lidar_noise
+  double max_nis = 10.0;               // mean NIS per degree of freedom over the window
+  double max_residual_ratio = 2.0;     // window median of median |r|, in units of lidar_noise
   double min_inlier_fraction = 0.15;   // window mean of constraints / points
-  double max_gravity_error = 0.3;      // relative error of the window mean |f| vs imu.gravity
+  double max_gravity_error = 0.5;      // relative error of the window mean |f| vs imu.gravity
 
   template <class V>
   void Visit(V& v) {
