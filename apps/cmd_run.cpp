@@ -2,7 +2,6 @@
 
 #include "commands.h"
 #include "common_options.h"
-#include "divergence_cli.h"
 #include "run_pipeline.h"
 
 namespace rvlio::cli {

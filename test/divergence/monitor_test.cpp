@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/odometry/divergence.h"
+#include "rvlio/smoother/refine.h"
 
 namespace rvlio {
 namespace {
@@ -170,6 +171,46 @@ TEST(DivergenceMonitor, DisabledNeverFires) {
 TEST(DivergenceMonitor, DescribeNamesTheOption) {
   DivergenceEvent e{DivergenceKind::kSpeed, 0, 73.24, 50.0};
   EXPECT_EQ(e.Describe(), "speed 73.2 m/s > divergence.max_speed 50 m/s");
+}
+
+// refine's result: speed and jump from its poses and velocities, inliers
+// from its last round.
+RefineResult Refined(int scans) {
+  RefineResult r;
+  for (int k = 0; k < scans; ++k) {
+    const HealthSample s = Healthy(k);
+    StampedPose p;
+    p.t_ns = s.t_ns;
+    p.p_world_imu = s.p_world_imu;
+    r.trajectory.push_back(p);
+    r.v_world_imu.push_back(s.v_world_imu);
+  }
+  RefineRound round;
+  round.points = 100000;
+  round.constraints = 60000;
+  r.rounds.push_back(round);
+  return r;
+}
+
+TEST(DivergenceMonitor, RefineResultChecked) {
+  const DivergenceOptions o;
+  EXPECT_FALSE(CheckRefineResult(Refined(100), o, kNoise, kGravity).detected);
+
+  RefineResult jumped = Refined(100);
+  for (int k = 60; k < 100; ++k) jumped.trajectory[k].p_world_imu.z() += 3.0;
+  const DivergenceReport j = CheckRefineResult(jumped, o, kNoise, kGravity);
+  EXPECT_EQ(Episodes(j, DivergenceKind::kJump), 1);
+  EXPECT_EQ(j.first_t_ns, jumped.trajectory[60].t_ns);
+
+  RefineResult fast = Refined(100);
+  fast.v_world_imu[30].x() = 70.0;
+  EXPECT_EQ(Episodes(CheckRefineResult(fast, o, kNoise, kGravity), DivergenceKind::kSpeed), 1);
+
+  RefineResult unmatched = Refined(100);
+  unmatched.rounds.back().constraints = 5000;  // 5% of the points
+  const DivergenceReport u = CheckRefineResult(unmatched, o, kNoise, kGravity);
+  EXPECT_EQ(Episodes(u, DivergenceKind::kInliers), 1);
+  EXPECT_EQ(u.scans_flagged, 100 - o.window_scans + 1);
 }
 
 TEST(DivergenceMonitor, KindNamesOfAMask) {
