@@ -98,7 +98,7 @@ class DivergenceCli : public ::testing::Test {
     EXPECT_EQ(Count(r.err, "warning: divergence at"), static_cast<int>(d["episodes"].size()))
         << r.err;
     const std::string csv = ReadFile(dir_ + "/" + out + "/scans.csv");
-    EXPECT_NE(csv.find(",nis,residual_median_m,diverged\n"), std::string::npos);  // header
+    EXPECT_NE(csv.find(",nis,residual_median_m,residual_rms_m,diverged\n"), std::string::npos);  // header
     EXPECT_EQ(Count(csv, ",diverged\n") + FlaggedRows(csv), 1 + d["scans_flagged"].get<int>());
   }
 
