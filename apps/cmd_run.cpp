@@ -3,7 +3,6 @@
 #include "commands.h"
 #include "common_options.h"
 #include "interrupt.h"
-#include "divergence_cli.h"
 #include "run_pipeline.h"
 
 namespace rvlio::cli {
