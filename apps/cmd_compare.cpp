@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "common_options.h"
 #include "compare_engine.h"
+#include "window_options.h"
 
 namespace rvlio::cli {
 
@@ -20,6 +21,8 @@ int CmdCompare(int argc, char** argv) {
        ConfigOption(),
        SetOption(),
        {"out", "DIR", "output folder", true},
+       StartOption(),
+       DurationOption(),
        {"no-refine", "", "skip the refine step"},
        {"no-plots", "", "do not draw plots"},
        {"quiet", "", "no step lines or progress; the table is still printed"}}};
@@ -34,6 +37,7 @@ int CmdCompare(int argc, char** argv) {
   req.refine = !args.Has("no-refine");
   req.plots = !args.Has("no-plots");
   req.quiet = args.Has("quiet");
+  if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("compare", err);
   return RunCompare(req);
 }
 

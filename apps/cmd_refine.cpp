@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "common_options.h"
 #include "run_pipeline.h"
+#include "window_options.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/run_outputs.h"
@@ -165,9 +166,13 @@ int CmdRefine(int argc, char** argv) {
                     {"init", "TUM", "initial trajectory (TUM format), e.g. rvlio run's", true},
                     ConfigOption(),
                     SetOption(),
-                    {"out", "DIR", "output folder", true}}};
+                    {"out", "DIR", "output folder", true},
+                    StartOption(),
+                    DurationOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  ReadWindow window;
+  if (std::string err = ParseWindow(args, &window); !err.empty()) return Fail("refine", err);
   const auto t0 = Clock::now();
   const Request req{args.Get("bag"), args.Get("init"), args.Get("out")};
   StatusOr<OdometryOptions> options = LoadConfig(args.GetAll("config"), args.GetAll("set"));
@@ -175,7 +180,7 @@ int CmdRefine(int argc, char** argv) {
   StatusOr<Trajectory> init = ReadTum(req.init);
   if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
-      SensorBagReader::Open(req.bag, options->lidar, options->imu);
+      OpenSensorStream(req.bag, options->lidar, options->imu, window, options->io);
   if (!reader.ok()) return Fail("refine", reader.status().message());
   if (!PrepareOutputDir("refine", req.out_dir)) return 2;
 

@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "common_options.h"
 #include "run_pipeline.h"
+#include "window_options.h"
 
 namespace rvlio::cli {
 
@@ -14,11 +15,14 @@ int CmdRun(int argc, char** argv) {
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
+                    StartOption(),
+                    DurationOption(),
                     {"quiet", "", "no progress line"}}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), args.GetAll("set"),
-                 args.Has("quiet")};
+                 args.Has("quiet"), ReadWindow()};
+  if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("run", err);
   RunOutcome outcome;
   const int rc = RunOdometryOnBag(req, &outcome);
   if (rc == 0)

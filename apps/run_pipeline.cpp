@@ -283,7 +283,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(*options);
   if (!odo.ok()) return Fail("run", odo.status().message());
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
-      SensorBagReader::Open(req.bag, options->lidar, options->imu);
+      OpenSensorStream(req.bag, options->lidar, options->imu, req.window, options->io);
   if (!reader.ok()) return Fail("run", reader.status().message());
   if (!PrepareOutputDir("run", req.out_dir)) return 2;
   StatusOr<BagInfo> info = ReadBagInfo(req.bag);

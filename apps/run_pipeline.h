@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rvlio/io/sensor_bag.h"
+#include "rvlio/io/sensor_stream.h"
 
 namespace rvlio::cli {
 
@@ -16,6 +17,7 @@ struct RunRequest {
   std::vector<std::string> config_files;
   std::vector<std::string> overrides;  // --set key=value
   bool quiet = false;                  // no progress line even on a terminal
+  ReadWindow window;                   // --start / --duration
 };
 
 struct RunOutcome {

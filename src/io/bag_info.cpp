@@ -9,8 +9,10 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include "livox_ros1.h"
 #include "rosbag_common.h"
 #include "rvlio/io/cdr.h"
+#include "rvlio/io/livox.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
 
@@ -35,12 +37,16 @@ class CloudSampler {
       for (const auto& f : cloud->fields) info_->fields.push_back(f.name);
     }
     DecodeStats stats;
-    StatusOr<Scan> scan = DecodePointCloud2(*cloud, lidar_, &stats);
-    if (!scan.ok()) return Fail(scan.status().message());
-    info_->lidar_layout = stats.layout;
-    info_->header_stamp = stats.stamp_is_end ? "end" : "start";
-    points_ += static_cast<int64_t>(scan->points.size());
-    ++info_->scans_sampled;
+    Record(DecodePointCloud2(*cloud, lidar_, &stats), stats);
+  }
+
+  // A Livox CustomMsg (ROS1 or ROS 2) or why it could not be deserialized.
+  void Add(const StatusOr<LivoxCustomMsg>& msg) {
+    if (!msg.ok()) return Fail(msg.status().message());
+    if (info_->fields.empty())
+      info_->fields = {"offset_time", "x", "y", "z", "reflectivity", "tag", "line"};
+    DecodeStats stats;
+    Record(DecodeLivoxCustomMsg(*msg, lidar_, &stats), stats);
   }
 
   void Finish() {
@@ -49,6 +55,14 @@ class CloudSampler {
   }
 
  private:
+  void Record(const StatusOr<Scan>& scan, const DecodeStats& stats) {
+    if (!scan.ok()) return Fail(scan.status().message());
+    info_->lidar_layout = stats.layout;
+    info_->header_stamp = stats.stamp_is_end ? "end" : "start";
+    points_ += static_cast<int64_t>(scan->points.size());
+    ++info_->scans_sampled;
+  }
+
   void Fail(const std::string& why) {
     info_->lidar_layout = "unknown";
     info_->decode_error = why;
@@ -75,11 +89,27 @@ void DescribeCloudTopic(const rosbag::Bag& bag, BagTopicInfo* info) {
   rosbag::View view(bag, rosbag::TopicQuery(info->topic));
   for (const rosbag::MessageInstance& m : view) {
     if (sampler.Full()) break;
+    if (m.getDataType() == kLivoxRos1Type) {
+      const std::vector<uint8_t> bytes = bag_detail::RawMessageBytes(m);
+      sampler.Add(ParseLivoxRos1(bytes.data(), bytes.size(), info->topic));
+      continue;
+    }
     auto msg = m.instantiate<sensor_msgs::PointCloud2>();
     if (!msg) break;
     sampler.Add(bag_detail::ToView(*msg, info->topic));
   }
   sampler.Finish();
+}
+
+bool IsRos1ScanType(const std::string& type) {
+  return type == bag_detail::kPointCloud2Type || type == kLivoxRos1Type;
+}
+
+// The type --lidar-topic must have: the topic's own when it is a LiDAR type.
+std::string LidarTypeOf(const std::map<std::string, std::string>& topics, const std::string& topic,
+                        const char* livox_type, const char* cloud_type) {
+  auto it = topics.find(topic);
+  return it != topics.end() && it->second == livox_type ? livox_type : cloud_type;
 }
 
 BagTopicInfo DescribeTopic(const rosbag::Bag& bag, const std::string& topic,
@@ -91,7 +121,7 @@ BagTopicInfo DescribeTopic(const rosbag::Bag& bag, const std::string& topic,
   info.count = view.size();
   if (info.count > 0)
     SetRate(&info, bag_detail::ToNs(view.getBeginTime()), bag_detail::ToNs(view.getEndTime()));
-  if (decode_clouds && type == bag_detail::kPointCloud2Type) DescribeCloudTopic(bag, &info);
+  if (decode_clouds && IsRos1ScanType(type)) DescribeCloudTopic(bag, &info);
   return info;
 }
 
@@ -99,8 +129,10 @@ StatusOr<BagInfo> Describe(const std::string& path, const rosbag::Bag& bag,
                            const std::string& lidar_topic) {
   const auto topics = bag_detail::TopicTypes(bag);
   if (!lidar_topic.empty()) {
-    Status s = bag_detail::RequireTopic(path, topics, lidar_topic, bag_detail::kPointCloud2Type,
-                                        "--lidar-topic");
+    Status s = bag_detail::RequireTopic(
+        path, topics, lidar_topic,
+        LidarTypeOf(topics, lidar_topic, kLivoxRos1Type, bag_detail::kPointCloud2Type),
+        "--lidar-topic");
     if (!s.ok()) return s;
   }
   BagInfo info;
@@ -135,7 +167,9 @@ StatusOr<BagInfo> ReadRos1Info(const std::string& path, const std::string& lidar
 // ---------------------------------------------------------------------------
 // ROS 2
 
-bool IsCloudType(const std::string& type) { return type == cdr::kPointCloud2Type; }
+bool IsRos2ScanType(const std::string& type) {
+  return type == cdr::kPointCloud2Type || type == kLivoxRos2Type;
+}
 
 // Samples the first clouds of one topic from a fresh source.
 Status DescribeRos2Cloud(const std::string& path, int topic, BagTopicInfo* info) {
@@ -148,7 +182,10 @@ Status DescribeRos2Cloud(const std::string& path, int topic, BagTopicInfo* info)
     StatusOr<bool> got = (*source)->Next(&m);
     if (!got.ok()) return got.status();
     if (!*got) break;
-    sampler.Add(cdr::DecodePointCloud2(m.data.data(), m.data.size(), info->topic));
+    if (info->type == kLivoxRos2Type)
+      sampler.Add(cdr::DecodeLivoxCustomMsg(m.data.data(), m.data.size(), info->topic));
+    else
+      sampler.Add(cdr::DecodePointCloud2(m.data.data(), m.data.size(), info->topic));
   }
   sampler.Finish();
   return Status::Ok();
@@ -161,8 +198,9 @@ StatusOr<BagInfo> ReadRos2Info(const std::string& path, const std::string& lidar
   std::map<std::string, std::string> types;
   for (const RecordingTopic& t : topics) types[t.name] = t.type;
   if (!lidar_topic.empty()) {
-    Status s = bag_detail::RequireTopic(path, types, lidar_topic, cdr::kPointCloud2Type,
-                                        "--lidar-topic");
+    Status s = bag_detail::RequireTopic(
+        path, types, lidar_topic,
+        LidarTypeOf(types, lidar_topic, kLivoxRos2Type, cdr::kPointCloud2Type), "--lidar-topic");
     if (!s.ok()) return s;
   }
   StatusOr<std::vector<RecordingTopicStats>> stats = (*source)->TopicStats();
@@ -180,7 +218,7 @@ StatusOr<BagInfo> ReadRos2Info(const std::string& path, const std::string& lidar
     t.count = st.count;
     SetRate(&t, st.first_ns, st.last_ns);
     const bool decode = lidar_topic.empty() || lidar_topic == t.topic;
-    if (decode && IsCloudType(t.type) && t.count > 0) {
+    if (decode && IsRos2ScanType(t.type) && t.count > 0) {
       if (Status s = DescribeRos2Cloud(path, static_cast<int>(i), &t); !s.ok()) return s;
     }
     info.topics.push_back(std::move(t));

@@ -51,7 +51,8 @@ class SensorBagReader {
   // later call returns the same error.
   virtual StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) = 0;
   virtual const SensorReaderStats& stats() const = 0;
-  virtual std::string lidar_layout() const = 0;  // "ouster", "velodyne", "hesai" or "livox"
+  // "ouster", "velodyne", "hesai" or "livox" (PointCloud2), "livox_custom" (CustomMsg)
+  virtual std::string lidar_layout() const = 0;
   // Problems of the recording that did not stop reading (e.g. an MCAP file
   // cut short: its complete part is read); each names the file.
   virtual std::vector<std::string> warnings() const { return {}; }
@@ -84,6 +85,11 @@ class SensorBagWriter {
   // The header stamp is scan.t_start_ns.
   virtual Status WriteOusterScan(const std::string& topic, const std::string& frame_id,
                                  const Scan& scan, int rows, int cols) = 0;
+  // Livox driver layout (livox_ros_driver/CustomMsg in ROS1,
+  // livox_ros_driver2/msg/CustomMsg in ROS 2; io/livox.h): every point of the
+  // scan, timebase and header stamp = scan.t_start_ns.
+  virtual Status WriteLivoxScan(const std::string& topic, const std::string& frame_id,
+                                const Scan& scan) = 0;
   virtual Status WriteImu(const std::string& topic, const std::string& frame_id,
                           const ImuSample& sample) = 0;
   virtual Status Close() = 0;

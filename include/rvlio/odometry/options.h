@@ -7,6 +7,7 @@
 #include "rvlio/constraints/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
+#include "rvlio/io/reader_options.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/options.h"
 #include "rvlio/rv/options.h"
@@ -24,6 +25,7 @@ struct OdometryOptions {
   RvOptions rv;
   IeskfOptions ieskf;
   SmootherOptions smoother;
+  ReaderOptions io;
 
   template <class V>
   void Visit(V& v) {
@@ -36,6 +38,7 @@ struct OdometryOptions {
     v.Section("rv", rv);
     v.Section("ieskf", ieskf);
     v.Section("smoother", smoother);
+    v.Section("io", io);
   }
 
   // Ranges and choices of every key, then the cross-field rules of each module.
@@ -43,7 +46,8 @@ struct OdometryOptions {
     Status s = ValidateFields(*this);
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
-                     constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate()})
+                     constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate(),
+                     io.Validate()})
       if (!m.ok()) return m;
     return Status::Ok();
   }
