@@ -1,6 +1,8 @@
 // End to end through the built tool: one simulated sequence written as a
 // ROS1 bag, MCAP (zstd, lz4, uncompressed chunks, unchunked) and db3 gives
-// byte-identical odometry outputs; `rvlio info` reads every kind.
+// byte-identical odometry outputs, and so does its Livox CustomMsg version as
+// ROS1, MCAP and db3; `rvlio info` reads every kind.
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -34,13 +36,26 @@ const std::vector<Format>& Formats() {
   return formats;
 }
 
+// The same sequence with Livox CustomMsg scans (livox_ros_driver/CustomMsg in
+// ROS1, livox_ros_driver2/msg/CustomMsg in ROS 2).
+const std::vector<Format>& LivoxFormats() {
+  static const std::vector<Format> formats = {
+      {"livox_ros1", "--lidar-msg livox", "livox_ros1.bag"},
+      {"livox_mcap", "--lidar-msg livox --format mcap", "livox_mcap.mcap"},
+      {"livox_db3", "--lidar-msg livox --format db3", "livox_db3.db3"},
+  };
+  return formats;
+}
+
 // A 4 s, 512-column tunnel, simulated once per format with the same seed.
 class FormatsTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = testing_cli::MakeTempDir("rvlio_ros2");
     ASSERT_FALSE(dir_.empty());
-    for (const Format& f : Formats()) {
+    std::vector<Format> all = Formats();
+    all.insert(all.end(), LivoxFormats().begin(), LivoxFormats().end());
+    for (const Format& f : all) {
       const ToolRun sim =
           RunTool(std::string("simulate --preset tunnel --seed 3 --duration 4 --out ") + dir_ +
                       " --set lidar.columns=512 --name " + f.name + " " + f.options,
@@ -69,13 +84,14 @@ TEST_F(FormatsTest, EachFileIsDetectedAsItsKind) {
   EXPECT_EQ(*kind, RecordingKind::kMcap);
 }
 
-TEST_F(FormatsTest, RunGivesByteIdenticalOutputsOnEveryFormat) {
+// `rvlio run` on each file; every output equals the first one's.
+void ExpectIdenticalRuns(const std::vector<Format>& formats, const std::string& dir) {
   std::string reference_tum, reference_map;
-  for (const Format& f : Formats()) {
-    const std::string out = Path(std::string("out_") + f.name);
-    const ToolRun r = RunTool("run --quiet --bag " + Path(f.file) + " --config " +
-                                  Path(std::string(f.name) + ".yaml") + " --out " + out,
-                              dir_);
+  for (const Format& f : formats) {
+    const std::string out = dir + "/out_" + f.name;
+    const ToolRun r = RunTool("run --quiet --bag " + dir + "/" + f.file + " --config " + dir +
+                                  "/" + f.name + ".yaml --out " + out,
+                              dir);
     ASSERT_EQ(r.exit_code, 0) << f.name << ": " << r.err;
     const std::string tum = ReadFile(out + "/trajectory.tum");
     const std::string map = ReadFile(out + "/map.pcd");
@@ -88,6 +104,19 @@ TEST_F(FormatsTest, RunGivesByteIdenticalOutputsOnEveryFormat) {
     }
     EXPECT_TRUE(tum == reference_tum) << f.name << " trajectory.tum differs from the ROS1 run";
     EXPECT_TRUE(map == reference_map) << f.name << " map.pcd differs from the ROS1 run";
+  }
+}
+
+TEST_F(FormatsTest, RunGivesByteIdenticalOutputsOnEveryFormat) { ExpectIdenticalRuns(Formats(), dir_); }
+
+TEST_F(FormatsTest, LivoxCustomMsgRunsAreByteIdenticalAcrossRos1McapAndDb3) {
+  ExpectIdenticalRuns(LivoxFormats(), dir_);
+  for (const char* file : {"livox_mcap.mcap", "livox_db3.db3"}) {
+    const ToolRun r = RunTool("info --bag " + Path(file), dir_);
+    ASSERT_EQ(r.exit_code, 0) << file << ": " << r.err;
+    EXPECT_NE(r.out.find("livox_ros_driver2/msg/CustomMsg"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("layout: livox_custom"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("points per scan:"), std::string::npos) << r.out;
   }
 }
 
