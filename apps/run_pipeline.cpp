@@ -286,7 +286,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
       OpenSensorStream(req.bag, options->lidar, options->imu, req.window, options->io);
   if (!reader.ok()) return Fail("run", reader.status().message());
   if (!PrepareOutputDir("run", req.out_dir)) return 2;
-  StatusOr<BagInfo> info = ReadBagInfo(req.bag);
+  StatusOr<BagInfo> info = ReadBagSpan(req.bag);
   Progress progress(!req.quiet, info.ok() ? info->start_s : 0.0, info.ok() ? info->end_s : 1.0);
 
   RunData data;

@@ -236,7 +236,53 @@ StatusOr<BagInfo> ReadRos2Info(const std::string& path, const std::string& lidar
   return info;
 }
 
+void SetSpan(BagInfo* info, int64_t messages, TimeNs start_ns, TimeNs end_ns) {
+  info->messages = messages;
+  if (messages == 0) return;
+  info->start_ns = start_ns;
+  info->end_ns = end_ns;
+  info->start_s = NsToSeconds(start_ns);
+  info->end_s = NsToSeconds(end_ns);
+}
+
+StatusOr<BagInfo> ReadRos1Span(const std::string& path) {
+  rosbag::Bag bag;
+  if (Status s = bag_detail::OpenForRead(path, &bag); !s.ok()) return s;
+  try {
+    BagInfo info;
+    info.path = path;
+    info.storage = "ros1";
+    rosbag::View all(bag);
+    SetSpan(&info, all.size(), bag_detail::ToNs(all.getBeginTime()),
+            bag_detail::ToNs(all.getEndTime()));
+    return info;
+  } catch (const std::exception& e) {
+    return Status::InvalidInput("reading bag '" + path + "' failed (" + e.what() +
+                                "); truncated or corrupt?");
+  }
+}
+
+StatusOr<BagInfo> ReadRos2Span(const std::string& path) {
+  StatusOr<std::unique_ptr<RecordingSource>> source = RecordingSource::Open(path);
+  if (!source.ok()) return source.status();
+  StatusOr<RecordingTopicStats> span = (*source)->Span();
+  if (!span.ok()) return span.status();
+  BagInfo info;
+  info.path = path;
+  info.storage = (*source)->storage();
+  SetSpan(&info, span->count, span->first_ns, span->last_ns);
+  info.warnings = (*source)->warnings();
+  return info;
+}
+
 }  // namespace
+
+StatusOr<BagInfo> ReadBagSpan(const std::string& path) {
+  StatusOr<RecordingKind> kind = DetectRecording(path);
+  if (!kind.ok()) return kind.status();
+  if (*kind == RecordingKind::kRos1Bag) return ReadRos1Span(path);
+  return ReadRos2Span(path);
+}
 
 StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic) {
   StatusOr<RecordingKind> kind = DetectRecording(path);

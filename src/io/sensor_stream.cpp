@@ -184,7 +184,7 @@ Status CheckWindow(const std::string& path, const ReadWindow& window) {
   if (!(window.duration_s >= 0.0) || !std::isfinite(window.duration_s))
     return Status::InvalidInput("--duration " + Seconds(window.duration_s) + " must be > 0 s");
   if (window.start_s == 0.0) return Status::Ok();
-  StatusOr<BagInfo> info = ReadBagInfo(path);
+  StatusOr<BagInfo> info = ReadBagSpan(path);
   if (!info.ok()) return info.status();
   const double length_s = NsToSeconds(info->end_ns - info->start_ns);
   if (window.start_s >= length_s)

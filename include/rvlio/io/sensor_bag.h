@@ -123,5 +123,8 @@ struct BagInfo {
 // PointCloud2 topic (only of `lidar_topic` when it is given; it must then be a
 // PointCloud2 topic).
 StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic = "");
+// Only path, storage, messages and the start/end times of ReadBagInfo, from
+// the recording's index or summary (no pass over an MCAP file's chunks).
+StatusOr<BagInfo> ReadBagSpan(const std::string& path);
 
 }  // namespace rvlio
