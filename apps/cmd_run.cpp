@@ -9,9 +9,9 @@ namespace rvlio::cli {
 
 int CmdRun(int argc, char** argv) {
   CommandSpec spec{"run",
-                   "Runs the odometry on a ROS1 bag and writes trajectory.tum, map.pcd, scans.csv "
+                   "Runs the odometry on a recording (ROS1 or ROS 2 bag) and writes trajectory.tum, map.pcd, scans.csv "
                    "and summary.json to the output folder.",
-                   {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
+                   {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
