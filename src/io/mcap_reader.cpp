@@ -102,6 +102,24 @@ std::string Hex32(uint32_t v) {
   return buf;
 }
 
+// A name read from the file, safe for a one-line message: control and
+// non-ASCII bytes as \xNN, at most 64 bytes shown.
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (size_t i = 0; i < text.size() && i < 64; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7F && c != '\\') {
+      out.push_back(static_cast<char>(c));
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\x%02x", c);
+      out += buf;
+    }
+  }
+  if (text.size() > 64) out += "...";
+  return out;
+}
+
 // ---------------------------------------------------------------------------
 // Chunk decompression. The output grows with what the decoder produces (never
 // more than uncompressed_size + 1 bytes), so a corrupt size field cannot make
@@ -343,7 +361,20 @@ class McapReader : public Reader {
   Status ReadSummary(bool* use_index);
   Status ReadSummarySection(uint64_t start, uint64_t end, std::vector<ChunkIndex>* indexes);
   Status UseChunkIndexes(const std::vector<ChunkIndex>& indexes, uint64_t data_end);
+  // State of the linear scan: counts, the running data-section CRC (from the
+  // first byte of the file) and the open run of loose messages.
+  struct ScanState {
+    FileSummary counts;
+    uint32_t crc = 0;
+    Segment run;
+    bool run_open = false;
+    std::set<uint16_t> run_channels;
+  };
   Status Scan(uint64_t data_end, bool fill_summary);
+  Status ScanRecord(uint8_t opcode, uint64_t pos, uint64_t end, ScanState* state);
+  void CloseRun(ScanState* state);
+  void StopScan(const std::string& where);
+  Status CheckDataEnd(uint64_t pos, uint64_t length, uint32_t computed);
   Status ScanChunk(uint64_t offset, std::string_view content, Segment* segment,
                    FileSummary* counts);
   void CountMessage(const MessageView& m, FileSummary* counts);
@@ -559,7 +590,7 @@ Status McapReader::Decompress(uint64_t offset, const ChunkHeader& chunk, std::st
     problem = DecompressLz4(chunk.records, chunk.uncompressed_size, records);
   } else {
     return Error("chunk at offset " + std::to_string(offset) + " uses unknown compression '" +
-                 chunk.compression + "'");
+                 Printable(chunk.compression) + "'");
   }
   if (problem.empty() && records->size() != chunk.uncompressed_size)
     problem = "decompressed size differs from the uncompressed_size " +
@@ -614,33 +645,19 @@ Status McapReader::ScanChunk(uint64_t offset, std::string_view content, Segment*
   return Status::Ok();
 }
 
+constexpr uint64_t kCrcBlock = 1 << 20;
+
 // Reads the data section record by record from data_start_ up to data_end
 // (exclusive), stopping early at DataEnd or at a record that does not fit.
 Status McapReader::Scan(uint64_t data_end, bool fill_summary) {
-  FileSummary counts;
-  uint32_t crc = 0;  // of every byte from the start of the file
-  {
-    std::string head;
-    if (Status s = ReadBytes(0, data_start_, &head); !s.ok()) return s;
-    crc = detail::Crc32(head);
-  }
-  Segment run;  // the open run of loose messages
-  bool run_open = false;
-  std::set<uint16_t> run_channels;
-  auto close_run = [&]() {
-    if (!run_open) return;
-    run.channels.assign(run_channels.begin(), run_channels.end());
-    segments_.push_back(run);
-    run_open = false;
-    run_channels.clear();
-  };
-  uint64_t pos = data_start_;
+  ScanState state;
   std::string record;
+  if (Status s = ReadBytes(0, data_start_, &record); !s.ok()) return s;
+  state.crc = detail::Crc32(record);
+  uint64_t pos = data_start_;
   while (pos < data_end) {
     if (data_end - pos < kRecordHeaderSize) {
-      summary_.truncated = true;
-      warnings_.push_back("'" + path_ + "': incomplete record header at offset " +
-                          std::to_string(pos) + ": the rest of the file is ignored");
+      StopScan("incomplete record header at offset " + std::to_string(pos));
       break;
     }
     if (Status s = ReadBytes(pos, kRecordHeaderSize, &record); !s.ok()) return s;
@@ -648,69 +665,102 @@ Status McapReader::Scan(uint64_t data_end, bool fill_summary) {
     const uint8_t opcode = h.U8();
     const uint64_t length = h.U64();
     if (length > data_end - pos - kRecordHeaderSize) {
-      summary_.truncated = true;
-      warnings_.push_back("'" + path_ + "': record at offset " + std::to_string(pos) +
-                          " (opcode " + std::to_string(opcode) +
-                          ") extends past the end of the data: the rest of the file is ignored");
+      StopScan("record at offset " + std::to_string(pos) + " (opcode " + std::to_string(opcode) +
+               ") extends past the end of the data");
       break;
     }
-    const uint64_t end = pos + kRecordHeaderSize + length;
     if (opcode == detail::kDataEnd) {
-      std::string content;
-      if (Status s = ReadBytes(pos + kRecordHeaderSize, length, &content); !s.ok()) return s;
-      FieldReader r(content);
-      const uint32_t stored = r.U32();
-      if (r.ok() && stored != 0 && stored != crc)
-        return AtOffset("DataEnd", pos,
-                        "data section CRC mismatch (stored " + Hex32(stored) + ", computed " +
-                            Hex32(crc) + ")");
+      if (Status s = CheckDataEnd(pos, length, state.crc); !s.ok()) return s;
       break;
     }
     if (opcode == detail::kFooter) break;
-    std::string bytes;
-    if (Status s = ReadBytes(pos, end - pos, &bytes); !s.ok()) return s;
-    crc = detail::Crc32Update(crc, bytes.data(), bytes.size());
-    const std::string_view content = std::string_view(bytes).substr(kRecordHeaderSize);
-    if (opcode == detail::kMessage) {
-      MessageView m;
-      if (!ParseMessage(content, &m)) return AtOffset("message", pos, "malformed record");
-      CountMessage(m, &counts);
-      if (run_open && m.log_time < run.end_time) close_run();
-      if (!run_open) {
-        run = Segment();
-        run.offset = pos;
-        run.start_time = m.log_time;
-        run_open = true;
-      }
-      run.end = end;
-      run.end_time = m.log_time;
-      run_channels.insert(m.channel_id);
-    } else if (opcode == detail::kChunk) {
-      close_run();
-      Segment segment;
-      segment.is_chunk = true;
-      segment.offset = pos;
-      segment.end = end;
-      if (Status s = ScanChunk(pos, content, &segment, &counts); !s.ok()) return s;
-      if (!segment.channels.empty()) segments_.push_back(std::move(segment));  // has messages
-    } else if (opcode == detail::kSchema) {
-      Schema schema;
-      if (!ParseSchema(content, &schema)) return AtOffset("schema", pos, "malformed record");
-      schemas_.emplace(schema.id, std::move(schema));
-    } else if (opcode == detail::kChannel) {
-      Channel channel;
-      if (!ParseChannel(content, &channel)) return AtOffset("channel", pos, "malformed record");
-      channels_.emplace(channel.id, std::move(channel));
-    }
-    pos = end;
+    if (Status s = ScanRecord(opcode, pos, pos + kRecordHeaderSize + length, &state); !s.ok())
+      return s;
+    pos += kRecordHeaderSize + length;
   }
-  close_run();
+  CloseRun(&state);
   if (fill_summary || summary_.message_count == 0) {
+    const FileSummary& counts = state.counts;
     summary_.message_count = counts.message_count;
     summary_.message_start_time_ns = counts.message_start_time_ns;
     summary_.message_end_time_ns = counts.message_end_time_ns;
     summary_.channel_message_counts = counts.channel_message_counts;
     summary_.chunk_count = counts.chunk_count;
+  }
+  return Status::Ok();
+}
+
+void McapReader::StopScan(const std::string& where) {
+  summary_.truncated = true;
+  warnings_.push_back("'" + path_ + "': " + where + ": the rest of the file is ignored");
+}
+
+Status McapReader::CheckDataEnd(uint64_t pos, uint64_t length, uint32_t computed) {
+  std::string content;
+  if (Status s = ReadBytes(pos + kRecordHeaderSize, length, &content); !s.ok()) return s;
+  FieldReader r(content);
+  const uint32_t stored = r.U32();
+  if (r.ok() && stored != 0 && stored != computed)
+    return AtOffset("DataEnd", pos,
+                    "data section CRC mismatch (stored " + Hex32(stored) + ", computed " +
+                        Hex32(computed) + ")");
+  return Status::Ok();
+}
+
+void McapReader::CloseRun(ScanState* state) {
+  if (!state->run_open) return;
+  state->run.channels.assign(state->run_channels.begin(), state->run_channels.end());
+  segments_.push_back(state->run);
+  state->run_open = false;
+  state->run_channels.clear();
+}
+
+// One complete record [pos, end) of the data section met by the scan.
+Status McapReader::ScanRecord(uint8_t opcode, uint64_t pos, uint64_t end, ScanState* state) {
+  std::string bytes;
+  const bool needed = opcode == detail::kMessage || opcode == detail::kChunk ||
+                      opcode == detail::kSchema || opcode == detail::kChannel;
+  if (!needed) {  // attachments, indexes, ...: only their CRC, in blocks
+    for (uint64_t at = pos; at < end; at += kCrcBlock) {
+      if (Status s = ReadBytes(at, std::min<uint64_t>(kCrcBlock, end - at), &bytes); !s.ok())
+        return s;
+      state->crc = detail::Crc32Update(state->crc, bytes.data(), bytes.size());
+    }
+    return Status::Ok();
+  }
+  if (Status s = ReadBytes(pos, end - pos, &bytes); !s.ok()) return s;
+  state->crc = detail::Crc32Update(state->crc, bytes.data(), bytes.size());
+  const std::string_view content = std::string_view(bytes).substr(kRecordHeaderSize);
+  if (opcode == detail::kMessage) {
+    MessageView m;
+    if (!ParseMessage(content, &m)) return AtOffset("message", pos, "malformed record");
+    CountMessage(m, &state->counts);
+    if (state->run_open && m.log_time < state->run.end_time) CloseRun(state);
+    if (!state->run_open) {
+      state->run = Segment();
+      state->run.offset = pos;
+      state->run.start_time = m.log_time;
+      state->run_open = true;
+    }
+    state->run.end = end;
+    state->run.end_time = m.log_time;
+    state->run_channels.insert(m.channel_id);
+  } else if (opcode == detail::kChunk) {
+    CloseRun(state);
+    Segment segment;
+    segment.is_chunk = true;
+    segment.offset = pos;
+    segment.end = end;
+    if (Status s = ScanChunk(pos, content, &segment, &state->counts); !s.ok()) return s;
+    if (!segment.channels.empty()) segments_.push_back(std::move(segment));  // has messages
+  } else if (opcode == detail::kSchema) {
+    Schema schema;
+    if (!ParseSchema(content, &schema)) return AtOffset("schema", pos, "malformed record");
+    schemas_.emplace(schema.id, std::move(schema));
+  } else {
+    Channel channel;
+    if (!ParseChannel(content, &channel)) return AtOffset("channel", pos, "malformed record");
+    channels_.emplace(channel.id, std::move(channel));
   }
   return Status::Ok();
 }

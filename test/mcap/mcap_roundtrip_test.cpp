@@ -1,5 +1,8 @@
 // MCAP writer -> reader round trips, cut and corrupted files, the channel
 // filter and bad input.
+#include <signal.h>
+#include <sys/resource.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -289,6 +292,30 @@ TEST_F(McapTest, WriterWithoutCloseLeavesNoFile) {
   auto unwritable = mcap::Writer::Create(dir_ + "/no/such/dir/x.mcap", Options("zstd"));
   ASSERT_FALSE(unwritable.ok());
   EXPECT_NE(unwritable.status().message().find("x.mcap"), std::string::npos);
+}
+
+// A write that fails half way (here: the file size limit, as a full disk
+// would) is a Status naming the file, and no file, half or temporary, remains.
+TEST_F(McapTest, FailedWriteLeavesNoFile) {
+  std::vector<mcap::Message> big(20);
+  for (size_t i = 0; i < big.size(); ++i) {
+    big[i].channel_id = static_cast<uint16_t>(i % 3);
+    big[i].log_time_ns = i;
+    big[i].data.assign(200000, static_cast<uint8_t>(i));
+  }
+  const std::string path = dir_ + "/full.mcap";
+  struct rlimit saved {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+  void (*saved_handler)(int) = ::signal(SIGXFSZ, SIG_IGN);  // write() fails with EFBIG instead
+  struct rlimit limited = saved;
+  limited.rlim_cur = 256 << 10;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limited), 0);
+  const Status s = WriteMessages(path, Options(""), big);
+  ::setrlimit(RLIMIT_FSIZE, &saved);
+  ::signal(SIGXFSZ, saved_handler);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("full.mcap"), std::string::npos) << s.message();
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_), {}), 0);
 }
 
 }  // namespace

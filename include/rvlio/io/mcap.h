@@ -99,8 +99,9 @@ struct WriterOptions {
 class Writer {
  public:
   virtual ~Writer() = default;
-  // Writes to path + ".tmp" and renames on Close(): a failed write leaves no
-  // half file behind.
+  // Writes to a temporary file next to `path` (AtomicFileWriter) and renames
+  // it on Close(): a failed write (a full disk) returns its Status and leaves
+  // no half file behind.
   static StatusOr<std::unique_ptr<Writer>> Create(const std::string& path,
                                                   const WriterOptions& options);
   virtual StatusOr<uint16_t> AddSchema(const std::string& name, const std::string& encoding,
