@@ -2,8 +2,11 @@
 // ROS1 bag, MCAP (zstd, lz4, uncompressed chunks, unchunked) and db3 gives
 // byte-identical odometry outputs, and so does its Livox CustomMsg version as
 // ROS1, MCAP and db3; `rvlio info` reads every kind.
+#include <sqlite3.h>
+
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -118,6 +121,43 @@ TEST_F(FormatsTest, LivoxCustomMsgRunsAreByteIdenticalAcrossRos1McapAndDb3) {
     EXPECT_NE(r.out.find("layout: livox_custom"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("points per scan:"), std::string::npos) << r.out;
   }
+}
+
+// The db3 split at its middle into two files of a bag folder (as `ros2 bag
+// record --max-bag-duration` would write it), listed out of order in
+// metadata.yaml's relative_file_paths: the folder reads as the whole db3.
+TEST_F(FormatsTest, SplitBagFolderReadsAsTheWholeRecording) {
+  const std::string folder = Path("split");
+  std::filesystem::create_directories(folder);
+  const char* keep[2] = {"timestamp < 1700000002000000000", "timestamp >= 1700000002000000000"};
+  for (int i = 0; i < 2; ++i) {
+    const std::string part = folder + "/split_" + std::to_string(i) + ".db3";
+    std::filesystem::copy_file(Path("db3.db3"), part);
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(part.c_str(), &db), SQLITE_OK);
+    const std::string sql = std::string("DELETE FROM messages WHERE NOT (") + keep[i] + ")";
+    ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    EXPECT_GT(sqlite3_changes(db), 100);
+    sqlite3_close(db);
+  }
+  std::ofstream(folder + "/metadata.yaml") << "rosbag2_bagfile_information:\n"
+                                              "  version: 5\n"
+                                              "  storage_identifier: sqlite3\n"
+                                              "  relative_file_paths:\n"
+                                              "    - split_1.db3\n"
+                                              "    - split_0.db3\n";
+  const std::string out = Path("out_split");
+  const ToolRun r = RunTool("run --quiet --bag " + folder + " --config " + Path("db3.yaml") +
+                                " --out " + out, dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const ToolRun whole = RunTool("run --quiet --bag " + Path("db3.db3") + " --config " +
+                                    Path("db3.yaml") + " --out " + Path("out_whole"), dir_);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_TRUE(ReadFile(out + "/trajectory.tum") == ReadFile(Path("out_whole/trajectory.tum")));
+  EXPECT_TRUE(ReadFile(out + "/map.pcd") == ReadFile(Path("out_whole/map.pcd")));
+  const ToolRun info = RunTool("info --bag " + folder, dir_);
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("messages: 841"), std::string::npos) << info.out;
 }
 
 TEST_F(FormatsTest, InfoNamesStorageCompressionAndLayout) {
