@@ -1,7 +1,9 @@
 // ReadBagInfo: what `rvlio info` prints about a recording (ROS1 bag through
 // rosbag_storage; ROS 2 .db3 / .mcap / bag folder through io/recording).
 #include <algorithm>
+#include <cstring>
 #include <exception>
+#include <fstream>
 #include <functional>
 #include <limits>
 
@@ -153,11 +155,54 @@ StatusOr<BagInfo> Describe(const std::string& path, const rosbag::Bag& bag,
   return info;
 }
 
+// ROS1 bag format 2.0: after the "#ROSBAG V2.0\n" line, records of
+// header_len (u32 LE), header fields (u32 length + "name=value"), data_len
+// (u32), data. Chunk records (op 0x05) name their "compression" (none, bz2,
+// lz4). Walks the record headers only (one seek per record) up to the index.
+std::vector<std::string> Ros1ChunkCompressions(const std::string& path) {
+  std::vector<std::string> found;
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(13);
+  auto u32 = [&in](uint32_t* v) {
+    unsigned char b[4];
+    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+    *v = b[0] | (b[1] << 8) | (b[2] << 16) | (uint32_t{b[3]} << 24);
+    return true;
+  };
+  constexpr uint32_t kMaxHeader = 1 << 20;
+  uint32_t header_len = 0, data_len = 0;
+  while (u32(&header_len) && header_len <= kMaxHeader) {
+    std::string header(header_len, '\0');
+    if (!in.read(header.data(), header_len) || !u32(&data_len)) break;
+    std::map<std::string, std::string> fields;
+    for (size_t at = 0; at + 4 <= header.size();) {
+      uint32_t n = 0;
+      std::memcpy(&n, header.data() + at, 4);  // little endian on every supported host
+      if (n > header.size() - at - 4) break;
+      const std::string field = header.substr(at + 4, n);
+      const size_t eq = field.find('=');
+      if (eq != std::string::npos) fields[field.substr(0, eq)] = field.substr(eq + 1);
+      at += 4 + n;
+    }
+    const std::string op = fields["op"];
+    if (op == std::string(1, '\x05')) {
+      const std::string& c = fields["compression"];
+      if (std::find(found.begin(), found.end(), c) == found.end()) found.push_back(c);
+    } else if (op == std::string(1, '\x07') || op == std::string(1, '\x06')) {
+      break;  // connection or chunk-info records: the index section, no chunks after
+    }
+    in.seekg(data_len, std::ios::cur);
+  }
+  return found;
+}
+
 StatusOr<BagInfo> ReadRos1Info(const std::string& path, const std::string& lidar_topic) {
   rosbag::Bag bag;
   if (Status s = bag_detail::OpenForRead(path, &bag); !s.ok()) return s;
   try {
-    return Describe(path, bag, lidar_topic);
+    StatusOr<BagInfo> info = Describe(path, bag, lidar_topic);
+    if (info.ok()) info->compressions = Ros1ChunkCompressions(path);
+    return info;
   } catch (const std::exception& e) {
     return Status::InvalidInput("reading bag '" + path + "' failed (" + e.what() +
                                 "); truncated or corrupt?");

@@ -111,7 +111,8 @@ struct BagTopicInfo {
 struct BagInfo {
   std::string path;
   std::string storage;                    // "ros1", "sqlite3" or "mcap"
-  std::vector<std::string> compressions;  // MCAP chunk compressions ("zstd", "lz4", "none")
+  // Chunk compressions: MCAP ("zstd", "lz4", "none"), ROS1 ("none", "bz2", "lz4").
+  std::vector<std::string> compressions;
   std::vector<std::string> warnings;      // problems that did not stop reading
   double start_s = 0.0, end_s = 0.0;
   TimeNs start_ns = 0, end_ns = 0;  // the same, exact
