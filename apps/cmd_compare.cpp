@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "common_options.h"
 #include "compare_engine.h"
+#include "window_options.h"
 
 namespace rvlio::cli {
 
@@ -15,11 +16,13 @@ int CmdCompare(int argc, char** argv) {
       "compare.md, compare.json and OUT/plots/ (trajectories, RV profile, bar chart; needs\n"
       "python3 with matplotlib). Exit 0 when at least one variant ran, 1 when all failed,\n"
       "2 on bad input (before any run).",
-      {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
+      {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
        {"gt", "TUM", "ground-truth trajectory (TUM or KITTI, as rvlio eval)", true},
        ConfigOption(),
        SetOption(),
        {"out", "DIR", "output folder", true},
+       StartOption(),
+       DurationOption(),
        {"no-refine", "", "skip the refine step"},
        {"no-plots", "", "do not draw plots"},
        {"quiet", "", "no step lines or progress; the table is still printed"}}};
@@ -34,6 +37,7 @@ int CmdCompare(int argc, char** argv) {
   req.refine = !args.Has("no-refine");
   req.plots = !args.Has("no-plots");
   req.quiet = args.Has("quiet");
+  if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("compare", err);
   return RunCompare(req);
 }
 

@@ -16,6 +16,7 @@
 #include "refine_checkpoint.h"
 #include "divergence_cli.h"
 #include "run_pipeline.h"
+#include "window_options.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/run_outputs.h"
@@ -216,10 +217,14 @@ int CmdRefine(int argc, char** argv) {
                     {"resume", "DIR",
                      "continue from DIR/refine.checkpoint (same --bag, --init, --config and --set; "
                      "smoother.refine_rounds may differ) and go on checkpointing there"},
-                    AllowDivergenceOption()}};
+                    AllowDivergenceOption(),
+                    StartOption(),
+                    DurationOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   InterruptScope interrupt_scope;
+  ReadWindow window;
+  if (std::string err = ParseWindow(args, &window); !err.empty()) return Fail("refine", err);
   const auto t0 = Clock::now();
   Request req;
   req.bag = args.Get("bag");
@@ -231,7 +236,7 @@ int CmdRefine(int argc, char** argv) {
   if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
   if (int rc = ReadCheckpointArgs(args, &req); rc != 0) return rc;
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
-      SensorBagReader::Open(req.bag, options->lidar, options->imu);
+      OpenSensorStream(req.bag, options->lidar, options->imu, window, options->io);
   if (!reader.ok()) return Fail("refine", reader.status().message());
   if (!PrepareOutputDir("refine", req.out_dir)) return 2;
 

@@ -51,6 +51,9 @@ CommandSpec SimulateSpec() {
           {{"preset", "NAME", "world, sensors and flight (default tunnel)", false, false},
            {"seed", "N", "random seed (default 1)", false, false},
            {"duration", "S", "seconds of data (default: the preset's)", false, false},
+           {"lidar-msg", "TYPE",
+            "pointcloud2 (Ouster layout, default) or livox (livox_ros_driver/CustomMsg on "
+            "/livox/lidar unless sim lidar.topic is --set)", false, false},
            SetOption(),
            {"out", "DIR", "output directory (created if missing)", true, false},
            {"name", "NAME", "output file stem (default: the preset name)", false, false},
@@ -79,6 +82,13 @@ std::string ResolveOptions(const Args& args, SimOptions* options) {
   StatusOr<SimOptions> preset = sim::PresetOptions(args.Get("preset", "tunnel"));
   if (!preset.ok()) return preset.status().message();
   *options = *preset;
+  const std::string lidar_msg = args.Get("lidar-msg", "pointcloud2");
+  if (lidar_msg != "pointcloud2" && lidar_msg != "livox")
+    return "--lidar-msg '" + lidar_msg + "' is not pointcloud2 or livox";
+  if (lidar_msg == "livox") {
+    options->lidar.topic = "/livox/lidar";
+    options->lidar.frame_id = "livox_frame";
+  }
   if (args.Has("seed") && (!ParseInt64(args.Get("seed"), &options->seed) || options->seed < 0))
     return "--seed '" + args.Get("seed") + "' is not a non-negative integer";
   if (args.Has("duration") &&
@@ -117,7 +127,8 @@ std::string Num(double v) {
 
 // The estimator's sensor keys (odometry/options.h) as simulated. The noise
 // densities must be positive there; a noise-free simulation gets a tiny value.
-std::string SensorYaml(const SimOptions& o, const std::string& name, const std::string& bag_file) {
+std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
+                       const std::string& bag_file) {
   auto density = [](double v) { return Num(std::max(v, 1e-9)); };
   const auto& t = o.extrinsics.imu_T_lidar.translation;
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
@@ -127,8 +138,7 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, const std::
     << ".yaml --out DIR\n"
     << "lidar:\n"
     << "  topic: " << o.lidar.topic << "\n"
-    << "  type: ouster\n"
-    << "  header_stamp: start\n"
+    << (livox ? "  type: livox\n" : "  type: ouster\n  header_stamp: start\n")
     << "  min_range: " << Num(o.lidar.min_range) << "\n"
     << "  max_range: " << Num(o.lidar.max_range) << "\n"
     << "imu:\n"
@@ -156,7 +166,7 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, const std::
 // An interrupt stops it too and leaves no bag: the writer's temporary file
 // (path + ".tmp") is removed when the writer goes, or by the abort of a
 // second signal (interrupt.h).
-Status WriteBag(const sim::Simulator& simulator, const std::string& path,
+Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
                 const BagWriterOptions& format) {
   StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
   if (!writer.ok()) return writer.status();
@@ -169,7 +179,8 @@ Status WriteBag(const sim::Simulator& simulator, const std::string& path,
         return error.ok() && !Interrupted();
       },
       [&](const Scan& scan, int rows, int cols) {
-        error = (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
+        error = livox ? (*writer)->WriteLivoxScan(o.lidar.topic, o.lidar.frame_id, scan)
+                      : (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
         return error.ok() && !Interrupted();
       });
   if (error.ok() && !Interrupted()) error = (*writer)->Close();
@@ -207,7 +218,8 @@ int CmdSimulate(int argc, char** argv) {
   if (std::string err = ResolveFormat(args, &format, &extension); !err.empty())
     return Fail(kName, err);
   // The sensor configuration must be one that `rvlio run` accepts.
-  const std::string yaml = SensorYaml(options, name, name + extension);
+  const bool livox = args.Get("lidar-msg") == "livox";
+  const std::string yaml = SensorYaml(options, name, livox, name + extension);
   OdometryOptions check;
   if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
       !s.ok() || !(s = check.Validate()).ok())
@@ -218,7 +230,7 @@ int CmdSimulate(int argc, char** argv) {
   StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
   if (!simulator.ok()) return Fail(kName, simulator.status().message());
   const std::string bag_path = (dir / (name + extension)).string();
-  if (Status s = WriteBag(**simulator, bag_path, format); !s.ok())
+  if (Status s = WriteBag(**simulator, bag_path, livox, format); !s.ok())
     return Fail(kName, s.message(), s.exit_code());
   if (Interrupted()) {
     std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",

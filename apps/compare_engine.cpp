@@ -22,6 +22,7 @@
 #include "divergence_cli.h"
 #include "plot_runner.h"
 #include "run_pipeline.h"
+#include "window_options.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
@@ -169,8 +170,10 @@ int CheckInputs(const CompareRequest& req, Trajectory* truth) {
     return Fail(kName, "--gt: " + req.gt + " has " + std::to_string(gt->size()) +
                            " poses; at least 3 are needed to align and evaluate");
   *truth = std::move(*gt);
+  ReaderOptions inline_io = options->io;
+  inline_io.reader_thread = false;  // only the checks at open: read nothing ahead
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
-      SensorBagReader::Open(req.bag, options->lidar, options->imu);
+      OpenSensorStream(req.bag, options->lidar, options->imu, req.window, inline_io);
   if (!reader.ok()) return Fail(kName, reader.status().message());
   return PrepareOutputDir(kName, req.out_dir) ? 0 : 2;
 }
@@ -213,6 +216,7 @@ Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& tr
   sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
   RunRequest run{req.bag, req.out_dir + "/" + v.name, req.config_files, sets, req.quiet};
   run.allow_divergence = true;  // the row is marked instead
+  run.window = req.window;
   RunOutcome outcome;
   const auto t0 = Clock::now();
   row.exit_code = RunOdometryOnBag(run, &outcome);
@@ -261,6 +265,7 @@ Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& tru
                                    "--out", dir, "--allow-divergence"};
   for (const auto& c : req.config_files) args.insert(args.end(), {"--config", c});
   for (const auto& s : req.overrides) args.insert(args.end(), {"--set", s});
+  for (const auto& w : WindowArgs(req.window)) args.push_back(w);
   const auto t0 = Clock::now();
   {
     std::error_code ec;

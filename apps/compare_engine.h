@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "rvlio/io/sensor_stream.h"
+
 namespace rvlio::cli {
 
 struct CompareRequest {
@@ -17,6 +19,7 @@ struct CompareRequest {
   bool refine = true;
   bool plots = true;
   bool quiet = false;  // no step lines; the table and the summary lines remain
+  ReadWindow window;   // --start / --duration, for every variant and refine
   // Step numbering of the progress lines, so that `demo` can continue its own
   // ("[k/n] ..."): the first variant is step first_step of total_steps
   // (total_steps 0: compare's own count).

@@ -349,12 +349,12 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(*options);
   if (!odo.ok()) return Fail("run", odo.status().message());
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
-      SensorBagReader::Open(req.bag, options->lidar, options->imu);
+      OpenSensorStream(req.bag, options->lidar, options->imu, req.window, options->io);
   if (!reader.ok()) return Fail("run", reader.status().message());
   std::error_code ec;
   const bool out_dir_existed = std::filesystem::exists(req.out_dir, ec);
   if (!PrepareOutputDir("run", req.out_dir)) return 2;
-  StatusOr<BagInfo> info = ReadBagInfo(req.bag);
+  StatusOr<BagInfo> info = ReadBagSpan(req.bag);
   Progress progress(!req.quiet, info.ok() ? info->start_s : 0.0, info.ok() ? info->end_s : 1.0);
 
   RunData data;

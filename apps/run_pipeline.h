@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rvlio/io/sensor_bag.h"
+#include "rvlio/io/sensor_stream.h"
 
 namespace rvlio::cli {
 
@@ -17,6 +18,7 @@ struct RunRequest {
   std::vector<std::string> overrides;  // --set key=value
   bool quiet = false;                  // no progress line even on a terminal
   bool allow_divergence = false;       // exit 0 even if the divergence monitor fired
+  ReadWindow window;                   // --start / --duration
 };
 
 struct RunOutcome {

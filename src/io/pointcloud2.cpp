@@ -308,27 +308,13 @@ uint16_t ToRing(double v) {
 void DecodePoints(const PointCursor& cursor, const Layout& layout, const PointFields& f,
                   const TimeMapping& mapping, const LidarOptions& lidar, Scan* scan,
                   DecodeStats* stats) {
-  const double min_r2 = lidar.min_range * lidar.min_range;
-  const double max_r2 = lidar.max_range * lidar.max_range;
   scan->points.reserve(cursor.size());
   for (uint64_t i = 0; i < cursor.size(); ++i) {
-    const double x = cursor.Read(i, f.x), y = cursor.Read(i, f.y), z = cursor.Read(i, f.z);
     LidarPoint p;
-    const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z) &&
-                        std::abs(x) < 1e9 && std::abs(y) < 1e9 && std::abs(z) < 1e9;
-    // The zero and range tests use the stored float coordinates: a float64
-    // coordinate of 1e-50 becomes 0 and must not slip through as a point.
-    if (finite) p.p_lidar = Eigen::Vector3f(float(x), float(y), float(z));
-    if (!finite || p.p_lidar.isZero(0.0f) ||
-        !ToAbsoluteNs(RawTime(cursor, i, layout), mapping, &p.t_ns)) {
-      ++stats->invalid_points;
+    const bool time_ok = ToAbsoluteNs(RawTime(cursor, i, layout), mapping, &p.t_ns);
+    if (!FilterPoint(cursor.Read(i, f.x), cursor.Read(i, f.y), cursor.Read(i, f.z), time_ok,
+                     lidar, stats, &p.p_lidar))
       continue;
-    }
-    const double r2 = p.p_lidar.cast<double>().squaredNorm();
-    if (r2 < min_r2 || r2 > max_r2) {
-      ++stats->out_of_range_points;
-      continue;
-    }
     if (f.intensity.present) {
       const double v = cursor.Read(i, f.intensity);
       p.intensity = std::isfinite(v) && std::abs(v) < 1e30 ? float(v) : 0.0f;
@@ -339,6 +325,35 @@ void DecodePoints(const PointCursor& cursor, const Layout& layout, const PointFi
 }
 
 }  // namespace
+
+bool FilterPoint(double x, double y, double z, bool time_ok, const LidarOptions& lidar,
+                 DecodeStats* stats, Eigen::Vector3f* p_lidar) {
+  const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z) &&
+                      std::abs(x) < 1e9 && std::abs(y) < 1e9 && std::abs(z) < 1e9;
+  // The zero and range tests use the stored float coordinates: a float64
+  // coordinate of 1e-50 becomes 0 and must not slip through as a point.
+  if (finite) *p_lidar = Eigen::Vector3f(float(x), float(y), float(z));
+  if (!finite || p_lidar->isZero(0.0f) || !time_ok) {
+    ++stats->invalid_points;
+    return false;
+  }
+  const double r2 = p_lidar->cast<double>().squaredNorm();
+  if (r2 < lidar.min_range * lidar.min_range || r2 > lidar.max_range * lidar.max_range) {
+    ++stats->out_of_range_points;
+    return false;
+  }
+  return true;
+}
+
+void SetScanTimeBounds(TimeNs fallback_ns, Scan* scan) {
+  scan->t_start_ns = scan->t_end_ns = fallback_ns;
+  if (scan->points.empty()) return;
+  const auto [lo, hi] = std::minmax_element(
+      scan->points.begin(), scan->points.end(),
+      [](const LidarPoint& a, const LidarPoint& b) { return a.t_ns < b.t_ns; });
+  scan->t_start_ns = lo->t_ns;
+  scan->t_end_ns = hi->t_ns;
+}
 
 size_t PointFieldSize(uint8_t datatype) {
   switch (datatype) {
@@ -388,14 +403,7 @@ StatusOr<Scan> DecodePointCloud2(const PointCloud2View& cloud, const LidarOption
                                   : AbsoluteMapping(cloud, *layout, range, stats);
   Scan scan;
   DecodePoints(cursor, *layout, fields, mapping, lidar, &scan, stats);
-  scan.t_start_ns = scan.t_end_ns = cloud.header_stamp_ns;
-  if (!scan.points.empty()) {
-    const auto [lo, hi] = std::minmax_element(
-        scan.points.begin(), scan.points.end(),
-        [](const LidarPoint& a, const LidarPoint& b) { return a.t_ns < b.t_ns; });
-    scan.t_start_ns = lo->t_ns;
-    scan.t_end_ns = hi->t_ns;
-  }
+  SetScanTimeBounds(cloud.header_stamp_ns, &scan);
   return scan;
 }
 

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "rvlio/io/cdr.h"
+#include "rvlio/io/livox.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
 #include "sensor_reader_common.h"
@@ -44,7 +45,10 @@ class Ros2SensorReader final : public SensorBagReader {
     if (!source.ok()) return source.status();
     source_ = std::move(source).value();
     const auto types = TopicTypes(*source_);
-    if (Status s = RequireTopic(path_, types, lidar_.topic, cdr::kPointCloud2Type, "lidar.topic");
+    const auto lidar_type = types.find(lidar_.topic);
+    livox_ = lidar_type != types.end() && lidar_type->second == kLivoxRos2Type;
+    if (Status s = RequireTopic(path_, types, lidar_.topic,
+                                livox_ ? kLivoxRos2Type : cdr::kPointCloud2Type, "lidar.topic");
         !s.ok())
       return s;
     if (Status s = RequireTopic(path_, types, imu_.topic, cdr::kImuType, "imu.topic"); !s.ok())
@@ -53,7 +57,8 @@ class Ros2SensorReader final : public SensorBagReader {
     imu_index_ = TopicIndex(*source_, imu_.topic);
     if (Status s = RequireCdr(*source_, lidar_index_, "lidar.topic"); !s.ok()) return s;
     if (Status s = RequireCdr(*source_, imu_index_, "imu.topic"); !s.ok()) return s;
-    if (Status s = PeekLayout(); !s.ok()) return s;
+    if (livox_) layout_ = "livox_custom";
+    else if (Status s = PeekLayout(); !s.ok()) return s;
     return source_->SetTopicFilter({lidar_index_, imu_index_});
   }
 
@@ -109,17 +114,33 @@ class Ros2SensorReader final : public SensorBagReader {
   }
 
   StatusOr<bool> ReadScan(Scan* out) {
-    StatusOr<PointCloud2View> cloud =
-        cdr::DecodePointCloud2(message_.data.data(), message_.data.size(), lidar_.topic);
-    if (!cloud.ok()) return InFile(cloud.status());
     DecodeStats decode;
-    StatusOr<Scan> scan = DecodePointCloud2(*cloud, lidar_, &decode);
+    StatusOr<Scan> scan = livox_ ? DecodeLivox(&decode) : DecodeCloud(&decode);
     if (!scan.ok()) return scan.status();
     layout_ = decode.layout;
     return gate_.AcceptScan(decode, std::move(scan).value(), out);
   }
 
+  StatusOr<Scan> DecodeCloud(DecodeStats* decode) const {
+    StatusOr<PointCloud2View> cloud =
+        cdr::DecodePointCloud2(message_.data.data(), message_.data.size(), lidar_.topic);
+    if (!cloud.ok()) return InFile(cloud.status());
+    return DecodePointCloud2(*cloud, lidar_, decode);
+  }
+
+  StatusOr<Scan> DecodeLivox(DecodeStats* decode) const {
+    StatusOr<LivoxCustomMsg> msg =
+        cdr::DecodeLivoxCustomMsg(message_.data.data(), message_.data.size(), lidar_.topic);
+    if (!msg.ok()) return InFile(msg.status());
+    StatusOr<Scan> scan = DecodeLivoxCustomMsg(*msg, lidar_, decode);
+    if (!scan.ok())
+      return Status::InvalidInput("lidar.topic '" + lidar_.topic + "' in '" + path_ +
+                                  "': " + scan.status().message());
+    return scan;
+  }
+
   std::string path_;
+  bool livox_ = false;  // the LiDAR topic holds livox_ros_driver2/msg/CustomMsg
   LidarOptions lidar_;
   ImuOptions imu_;
   SensorGate gate_;

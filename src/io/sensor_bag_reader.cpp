@@ -9,6 +9,7 @@
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include "livox_ros1.h"
 #include "rosbag_common.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
@@ -40,15 +41,19 @@ class RosbagSensorReader final : public SensorBagReader {
     if (Status s = bag_detail::OpenForRead(path_, &bag_); !s.ok()) return s;
     try {
       const auto topics = bag_detail::TopicTypes(bag_);
+      const auto lidar_topic = topics.find(lidar_.topic);
+      livox_ = lidar_topic != topics.end() && lidar_topic->second == kLivoxRos1Type;
       if (Status s = bag_detail::RequireTopic(path_, topics, lidar_.topic,
-                                              bag_detail::kPointCloud2Type, "lidar.topic");
+                                              livox_ ? kLivoxRos1Type : bag_detail::kPointCloud2Type,
+                                              "lidar.topic");
           !s.ok())
         return s;
       if (Status s = bag_detail::RequireTopic(path_, topics, imu_.topic, bag_detail::kImuType,
                                               "imu.topic");
           !s.ok())
         return s;
-      StatusOr<std::string> layout = PeekLayout(bag_, lidar_);
+      StatusOr<std::string> layout =
+          livox_ ? StatusOr<std::string>(std::string("livox_custom")) : PeekLayout(bag_, lidar_);
       if (!layout.ok()) return layout.status();
       layout_ = *layout;
       view_ = std::make_unique<rosbag::View>(
@@ -100,17 +105,37 @@ class RosbagSensorReader final : public SensorBagReader {
 
   // True when *out holds a scan with points; false for an empty scan.
   StatusOr<bool> ReadScan(const rosbag::MessageInstance& m, Scan* out) {
-    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
-    if (!msg) return Status::InvalidInput("lidar.topic '" + lidar_.topic + "' in '" + path_ +
-                                          "' does not hold sensor_msgs/PointCloud2");
     DecodeStats decode;
-    StatusOr<Scan> scan = DecodePointCloud2(ToView(*msg, lidar_.topic), lidar_, &decode);
+    StatusOr<Scan> scan = livox_ ? DecodeLivox(m, &decode) : DecodeCloud(m, &decode);
     if (!scan.ok()) return scan.status();
     layout_ = decode.layout;
     return gate_.AcceptScan(decode, std::move(scan).value(), out);
   }
 
+  StatusOr<Scan> DecodeCloud(const rosbag::MessageInstance& m, DecodeStats* decode) const {
+    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+    if (!msg) return Status::InvalidInput("lidar.topic '" + lidar_.topic + "' in '" + path_ +
+                                          "' does not hold sensor_msgs/PointCloud2");
+    return DecodePointCloud2(ToView(*msg, lidar_.topic), lidar_, decode);
+  }
+
+  // Raw message bytes through the ROS-free parser (io/livox.h).
+  StatusOr<Scan> DecodeLivox(const rosbag::MessageInstance& m, DecodeStats* decode) const {
+    const std::string where = "lidar.topic '" + lidar_.topic + "' in '" + path_ + "'";
+    if (m.getMD5Sum() != kLivoxRos1Md5)
+      return Status::InvalidInput(where + " holds " + kLivoxRos1Type + " with md5 " +
+                                  m.getMD5Sum() + ", not the driver's " + kLivoxRos1Md5 +
+                                  " (a different message layout)");
+    const std::vector<uint8_t> bytes = bag_detail::RawMessageBytes(m);
+    StatusOr<LivoxCustomMsg> msg = ParseLivoxRos1(bytes.data(), bytes.size(), where);
+    if (!msg.ok()) return msg.status();
+    StatusOr<Scan> scan = DecodeLivoxCustomMsg(*msg, lidar_, decode);
+    if (!scan.ok()) return Status::InvalidInput(where + ": " + scan.status().message());
+    return scan;
+  }
+
   std::string path_;
+  bool livox_ = false;  // the LiDAR topic holds livox_ros_driver/CustomMsg
   LidarOptions lidar_;
   ImuOptions imu_;
   rosbag::Bag bag_;

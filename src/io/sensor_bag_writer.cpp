@@ -13,6 +13,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/PointField.h>
 
+#include "livox_ros1.h"
 #include "rosbag_common.h"
 #include "rvlio/io/sensor_bag.h"
 #include "sensor_writer_common.h"
@@ -82,6 +83,19 @@ class RosbagSensorWriter final : public SensorBagWriter {
     msg.header.stamp.fromNSec(static_cast<uint64_t>(scan.t_start_ns));
     msg.header.frame_id = frame_id;
     ToRosCloud(cloud, &msg);
+    // Recorded when the driver publishes it: at the end of the sweep.
+    return Write(topic, bag_detail::RecordTime(scan.t_end_ns), msg);
+  }
+
+  Status WriteLivoxScan(const std::string& topic, const std::string& frame_id,
+                        const Scan& scan) override {
+    if (!open_) return Status::Internal("bag '" + path_ + "' is already closed");
+    if (Status s = CheckRosStamp(scan.t_start_ns, "scan start"); !s.ok()) return s;
+    if (Status s = CheckRosStamp(scan.t_end_ns, "scan end"); !s.ok()) return s;
+    if (scan.t_end_ns < scan.t_start_ns) return Status::InvalidInput("scan ends before it starts");
+    // offset_time must fit uint32 ns after the timebase.
+    if (Status s = bag_detail::CheckRelativePointTimes(scan); !s.ok()) return s;
+    bag_detail::LivoxRos1Bytes msg{SerializeLivoxRos1(ScanToLivoxCustomMsg(scan, frame_id))};
     // Recorded when the driver publishes it: at the end of the sweep.
     return Write(topic, bag_detail::RecordTime(scan.t_end_ns), msg);
   }

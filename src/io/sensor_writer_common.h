@@ -25,6 +25,15 @@ struct OwnedCloud {
 // not fit the uint32 ns field.
 Status BuildOusterCloud(const Scan& scan, int rows, int cols, OwnedCloud* out);
 
+// Time of point `index` in ns from the scan start, as the uint32 relative
+// time fields (Ouster `t`, Livox `offset_time`) hold it. A no-return (zero)
+// point keeps whatever time it has when it fits, else 0; InvalidInput for any
+// other point more than 4.29 s from the start.
+Status RelativePointTime(const Scan& scan, const LidarPoint& p, size_t index, uint32_t* t);
+
+// Checks every point of a scan with RelativePointTime.
+Status CheckRelativePointTimes(const Scan& scan);
+
 // InvalidInput unless 0 <= t_ns <= max_ns ("... outside the <range_text>").
 Status CheckStamp(TimeNs t_ns, TimeNs max_ns, const std::string& range_text,
                   const std::string& what);

@@ -56,7 +56,9 @@ bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan) cons
   };
   for (int64_t k = 0; k < scan_count_; ++k) {
     if (!emit_imu_until(ScanStartTime(k) + lidar_.period_ns())) return false;
-    if (!on_scan(SimulateScan(k), lidar_.rows(), lidar_.cols())) return false;
+    Scan scan = SimulateScan(k);
+    ShiftScanTime(-SecondsToNs(options_.lidar.time_offset), &scan);
+    if (!on_scan(scan, lidar_.rows(), lidar_.cols())) return false;
   }
   return emit_imu_until(t_end_ns_);
 }

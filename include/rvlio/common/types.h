@@ -33,6 +33,14 @@ struct Scan {
   std::vector<LidarPoint> points;
 };
 
+// Adds dt_ns to every time of the scan (t_start_ns, t_end_ns, each point):
+// moves a scan from one clock to another.
+inline void ShiftScanTime(TimeNs dt_ns, Scan* scan) {
+  scan->t_start_ns += dt_ns;
+  scan->t_end_ns += dt_ns;
+  for (LidarPoint& p : scan->points) p.t_ns += dt_ns;
+}
+
 // A timestamped pose (IMU in world), used by trajectories and evaluation.
 struct StampedPose {
   TimeNs t_ns = 0;

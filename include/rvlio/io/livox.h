@@ -40,6 +40,18 @@ struct LivoxCustomMsg {
 // headers and MCAP schemas).
 extern const char kLivoxRos1Type[];     // "livox_ros_driver/CustomMsg"
 extern const char kLivoxRos2Type[];     // "livox_ros_driver2/msg/CustomMsg"
+extern const char kLivoxRos1Md5[];      // ROS1 md5sum of livox_ros_driver/CustomMsg
+extern const char kLivoxRos1Definition[];  // its full ROS1 definition (with Header, CustomPoint)
+
+// ROS1 wire format of livox_ros_driver/CustomMsg (little endian, packed):
+// Header{seq u32, stamp sec u32 nsec u32, frame_id u32 length + bytes},
+// timebase u64, point_num u32, lidar_id u8, rsvd u8[3], points as u32 count +
+// 19-byte CustomPoint{offset_time u32, x y z float32, reflectivity tag line u8}.
+// Parse: InvalidInput (naming `what`) for a short, over-long or trailing-byte
+// payload; point_num is not checked here (DecodeLivoxCustomMsg does).
+StatusOr<LivoxCustomMsg> ParseLivoxRos1(const uint8_t* data, size_t size,
+                                        const std::string& what = "CustomMsg");
+std::vector<uint8_t> SerializeLivoxRos1(const LivoxCustomMsg& msg);
 
 // A CustomMsg -> Scan with absolute per-point times, dropping invalid and
 // out-of-range points exactly as DecodePointCloud2 does (stats->layout is

@@ -85,6 +85,18 @@ StatusOr<std::string> DetectPointCloud2Layout(const PointCloud2View& cloud,
 StatusOr<Scan> DecodePointCloud2(const PointCloud2View& cloud, const LidarOptions& lidar,
                                  DecodeStats* stats = nullptr);
 
+// The point filter of DecodePointCloud2, shared with the other decoders
+// (io/livox): false, counted in stats->invalid_points, for a non-finite, huge
+// (>= 1e9 m) or all-zero (no-return) point or one without a usable time
+// (time_ok false); false, counted in stats->out_of_range_points, outside
+// [lidar.min_range, lidar.max_range]. *p_lidar receives the float point.
+bool FilterPoint(double x, double y, double z, bool time_ok, const LidarOptions& lidar,
+                 DecodeStats* stats, Eigen::Vector3f* p_lidar);
+
+// t_start_ns / t_end_ns = the earliest / latest point time, or fallback_ns
+// for a scan without points.
+void SetScanTimeBounds(TimeNs fallback_ns, Scan* scan);
+
 // "x,y,z,intensity" for messages.
 std::string PointFieldNames(const std::vector<PointField>& fields);
 

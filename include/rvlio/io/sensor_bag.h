@@ -51,7 +51,8 @@ class SensorBagReader {
   // later call returns the same error.
   virtual StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) = 0;
   virtual const SensorReaderStats& stats() const = 0;
-  virtual std::string lidar_layout() const = 0;  // "ouster", "velodyne", "hesai" or "livox"
+  // "ouster", "velodyne", "hesai" or "livox" (PointCloud2), "livox_custom" (CustomMsg)
+  virtual std::string lidar_layout() const = 0;
   // Problems of the recording that did not stop reading (e.g. an MCAP file
   // cut short: its complete part is read); each names the file.
   virtual std::vector<std::string> warnings() const { return {}; }
@@ -84,6 +85,11 @@ class SensorBagWriter {
   // The header stamp is scan.t_start_ns.
   virtual Status WriteOusterScan(const std::string& topic, const std::string& frame_id,
                                  const Scan& scan, int rows, int cols) = 0;
+  // Livox driver layout (livox_ros_driver/CustomMsg in ROS1,
+  // livox_ros_driver2/msg/CustomMsg in ROS 2; io/livox.h): every point of the
+  // scan, timebase and header stamp = scan.t_start_ns.
+  virtual Status WriteLivoxScan(const std::string& topic, const std::string& frame_id,
+                                const Scan& scan) = 0;
   virtual Status WriteImu(const std::string& topic, const std::string& frame_id,
                           const ImuSample& sample) = 0;
   virtual Status Close() = 0;
@@ -105,7 +111,8 @@ struct BagTopicInfo {
 struct BagInfo {
   std::string path;
   std::string storage;                    // "ros1", "sqlite3" or "mcap"
-  std::vector<std::string> compressions;  // MCAP chunk compressions ("zstd", "lz4", "none")
+  // Chunk compressions: MCAP ("zstd", "lz4", "none"), ROS1 ("none", "bz2", "lz4").
+  std::vector<std::string> compressions;
   std::vector<std::string> warnings;      // problems that did not stop reading
   double start_s = 0.0, end_s = 0.0;
   TimeNs start_ns = 0, end_ns = 0;  // the same, exact
@@ -117,5 +124,8 @@ struct BagInfo {
 // PointCloud2 topic (only of `lidar_topic` when it is given; it must then be a
 // PointCloud2 topic).
 StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic = "");
+// Only path, storage, messages and the start/end times of ReadBagInfo, from
+// the recording's index or summary (no pass over an MCAP file's chunks).
+StatusOr<BagInfo> ReadBagSpan(const std::string& path);
 
 }  // namespace rvlio

@@ -14,10 +14,11 @@ struct LidarOptions {
   double max_range = 100.0;           // m
   double voxel_size = 0.5;            // m, scan downsampling before association
   int point_stride = 1;               // keep every n-th raw point before the voxel filter
+  double time_offset = 0.0;           // s, t_imu_clock = t_lidar_stamp + time_offset
 
   template <class V>
   void Visit(V& v) {
-    v.Field("topic", topic, Spec().Help("PointCloud2 topic in the bag"));
+    v.Field("topic", topic, Spec().Help("PointCloud2 or Livox CustomMsg topic in the bag"));
     v.Field("type", type, Spec().Choices({"auto", "ouster", "velodyne", "hesai", "livox"})
                               .Help("per-point time layout; auto detects it from the field names"));
     v.Field("header_stamp", header_stamp, Spec().Choices({"auto", "start", "end"})
@@ -26,6 +27,10 @@ struct LidarOptions {
     v.Field("max_range", max_range, Spec().Unit("m").Positive().Help("maximum point range"));
     v.Field("voxel_size", voxel_size, Spec().Unit("m").Range(0.0, 10.0).Help("scan voxel downsampling (0: off)"));
     v.Field("point_stride", point_stride, Spec().Range(1, 1000).Help("keep every n-th raw point"));
+    v.Field("time_offset", time_offset,
+            Spec().Unit("s").Range(-10.0, 10.0).Help(
+                "added to every LiDAR time to put it on the IMU clock: t_imu = t_lidar_stamp + "
+                "time_offset (LiDAR stamps 30 ms behind the IMU clock: 0.03)"));
   }
   Status Validate() {
     Status s = ValidateFields(*this, "lidar");

@@ -7,6 +7,7 @@
 #include "rvlio/constraints/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
+#include "rvlio/io/reader_options.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/options.h"
 #include "rvlio/odometry/divergence.h"
@@ -26,6 +27,7 @@ struct OdometryOptions {
   IeskfOptions ieskf;
   SmootherOptions smoother;
   DivergenceOptions divergence;
+  ReaderOptions io;
 
   template <class V>
   void Visit(V& v) {
@@ -39,6 +41,7 @@ struct OdometryOptions {
     v.Section("ieskf", ieskf);
     v.Section("smoother", smoother);
     v.Section("divergence", divergence);
+    v.Section("io", io);
   }
 
   // Ranges and choices of every key, then the cross-field rules of each module.
@@ -47,7 +50,7 @@ struct OdometryOptions {
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate(),
-                     divergence.Validate()})
+                     divergence.Validate(), io.Validate()})
       if (!m.ok()) return m;
     return Status::Ok();
   }

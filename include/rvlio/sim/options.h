@@ -88,6 +88,7 @@ struct SimLidarOptions {
   double min_range = 0.5;     // m, closer returns are dropped
   double max_range = 100.0;   // m, farther returns are dropped
   double dropout = 0.0;       // probability of a random missing return
+  double time_offset = 0.0;   // s, written LiDAR stamps = true time - time_offset
 
   template <class V>
   void Visit(V& v) {
@@ -102,6 +103,10 @@ struct SimLidarOptions {
     v.Field("min_range", min_range, Spec().Unit("m").Range(0.0, 1000.0));
     v.Field("max_range", max_range, Spec().Unit("m").Positive());
     v.Field("dropout", dropout, Spec().Range(0.0, 1.0).Help("probability of a missing return"));
+    v.Field("time_offset", time_offset,
+            Spec().Unit("s").Range(-1.0, 1.0).Help(
+                "LiDAR clock error: scan stamps are written as true time - time_offset "
+                "(`rvlio run --set lidar.time_offset=` the same value undoes it)"));
   }
 };
 
