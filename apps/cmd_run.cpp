@@ -2,6 +2,7 @@
 
 #include "commands.h"
 #include "common_options.h"
+#include "interrupt.h"
 #include "run_pipeline.h"
 #include "window_options.h"
 
@@ -9,21 +10,25 @@ namespace rvlio::cli {
 
 int CmdRun(int argc, char** argv) {
   CommandSpec spec{"run",
-                   "Runs the odometry on a recording (ROS1 or ROS 2 bag) and writes trajectory.tum, map.pcd, scans.csv "
-                   "and summary.json to the output folder.",
+                   "Runs the odometry on a recording (ROS1 or ROS 2 bag) and writes trajectory.tum, "
+                   "map.pcd, scans.csv and summary.json to the output folder (and "
+                   "trajectory.partial.tum while it runs). SIGINT/SIGTERM write the outputs of the "
+                   "scans done and exit 130/143.",
                    {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
                     StartOption(),
                     DurationOption(),
-                    {"quiet", "", "no progress line"}}};
+                    {"quiet", "", "no progress line"},
+                    AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), args.GetAll("set"),
-                 args.Has("quiet"), ReadWindow()};
+                 args.Has("quiet"), args.Has("allow-divergence"), ReadWindow()};
   if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("run", err);
   RunOutcome outcome;
+  InterruptScope interrupt_scope;  // SIGINT/SIGTERM: write what is done, exit 130/143
   const int rc = RunOdometryOnBag(req, &outcome);
   if (rc == 0)
     std::printf("rvlio run: %d scans, per-scan median %.2f ms, %.1fx real time -> %s\n",

@@ -18,6 +18,7 @@
 
 #include "commands.h"
 #include "common_options.h"
+#include "interrupt.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/sensor_bag.h"
@@ -162,24 +163,30 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
 }
 
 // Streams the simulation into the bag; the first write error stops the run.
+// An interrupt stops it too and leaves no bag: the writer's temporary file
+// (path + ".tmp") is removed when the writer goes, or by the abort of a
+// second signal (interrupt.h).
 Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
                 const BagWriterOptions& format) {
   StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
   if (!writer.ok()) return writer.status();
+  SetAbortRemovePath(path + ".tmp");
   const SimOptions& o = simulator.options();
   Status error;
   simulator.Run(
       [&](const ImuSample& m) {
         error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
-        return error.ok();
+        return error.ok() && !Interrupted();
       },
       [&](const Scan& scan, int rows, int cols) {
         error = livox ? (*writer)->WriteLivoxScan(o.lidar.topic, o.lidar.frame_id, scan)
                       : (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
-        return error.ok();
+        return error.ok() && !Interrupted();
       });
-  if (!error.ok()) return error;
-  return (*writer)->Close();
+  if (error.ok() && !Interrupted()) error = (*writer)->Close();
+  writer->reset();  // removes the temporary file unless Close() renamed it
+  SetAbortRemovePath("");
+  return error;
 }
 
 std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
@@ -193,6 +200,7 @@ int CmdSimulate(int argc, char** argv) {
   const CommandSpec spec = SimulateSpec();
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop, leave no half bag, exit 130/143
   SimOptions options;
   if (std::string err = ResolveOptions(args, &options); !err.empty()) return Fail(kName, err);
   const std::string name = args.Get("name", args.Get("preset", "tunnel"));
@@ -224,6 +232,11 @@ int CmdSimulate(int argc, char** argv) {
   const std::string bag_path = (dir / (name + extension)).string();
   if (Status s = WriteBag(**simulator, bag_path, livox, format); !s.ok())
     return Fail(kName, s.message(), s.exit_code());
+  if (Interrupted()) {
+    std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",
+                 InterruptSignalName().c_str());
+    return InterruptExitCode();
+  }
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;

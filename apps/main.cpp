@@ -39,7 +39,8 @@ void PrintHelp() {
     for (size_t i = std::strlen(c.name); i < 10; ++i) std::cout << ' ';
     std::cout << c.summary << "\n";
   }
-  std::cout << "\nexit status: 0 success, 2 bad input or configuration, 1 internal failure\n";
+  std::cout << "\nexit status: 0 success, 2 bad input or configuration, 1 internal failure,\n"
+               "130 / 143 stopped by SIGINT / SIGTERM (run, refine, compare, ablate, simulate)\n";
 }
 
 }  // namespace
