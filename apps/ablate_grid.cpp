@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <vector>
 #include <sstream>
 
 #include "rvlio/io/config.h"
@@ -191,12 +192,26 @@ std::string ReadFileText(const std::string& path) {
 }
 
 // Recorded bags are identified by path, size and modification time (hashing
-// gigabytes of bag on every plan would be slow).
-std::string BagIdentity(const std::string& path) {
+// gigabytes of bag on every plan would be slow); a ROS 2 bag folder by those
+// of each of its files.
+std::string FileIdentity(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return path;
   return fs::absolute(path).lexically_normal().string() + "|" + std::to_string(st.st_size) + "|" +
          std::to_string(static_cast<long long>(st.st_mtime));
+}
+
+std::string BagIdentity(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_directory(path, ec)) return FileIdentity(path);
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(path, ec)) {
+    if (e.is_regular_file(ec)) files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  std::string id = FileIdentity(path);
+  for (const std::string& f : files) id += ";" + FileIdentity(f);
+  return id;
 }
 
 std::string Sanitize(const std::string& s) {
@@ -285,7 +300,8 @@ Status ReadRecorded(const GridContext& g, const Node& n, const std::string& wher
   if (bag == nullptr || bag->kind != Node::Kind::kScalar)
     return g.Error(n, where, "needs `bag: FILE` or `simulate: {...}`");
   seq->bag = g.Resolve(bag->scalar);
-  if (!fs::is_regular_file(seq->bag))
+  // A file (ROS1 .bag, .db3, .mcap) or a ROS 2 bag folder.
+  if (!fs::is_regular_file(seq->bag) && !fs::is_directory(seq->bag))
     return g.Error(*bag, where + ".bag", "file not found: " + seq->bag);
   if (const Node* gt = Find(n, "gt")) {
     if (gt->kind != Node::Kind::kScalar) return g.Error(*gt, where + ".gt", "expected a file");
