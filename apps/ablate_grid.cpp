@@ -228,6 +228,7 @@ struct Grid {
   std::vector<Sequence> sequences;
   std::vector<Variant> variants;
   std::vector<std::pair<std::string, std::vector<std::string>>> parameters;
+  JobResources resources;
 };
 
 Status ReadSeeds(const GridContext& g, const Node* n, const std::string& where,
@@ -358,10 +359,40 @@ Status ReadParameters(const GridContext& g, const Node* n, Grid* grid) {
   return Status::Ok();
 }
 
+// `resources: {cpus, mem_mb, runtime}`: whole numbers, each optional.
+Status ReadResources(const GridContext& g, const Node* n, JobResources* r) {
+  if (n == nullptr || n->kind == Node::Kind::kNull) return Status::Ok();
+  if (Status s = ExpectMap(g, *n, "resources"); !s.ok()) return s;
+  if (Status s = CheckKeys(g, *n, "resources", {"cpus", "mem_mb", "runtime"}); !s.ok()) return s;
+  const struct {
+    const char* key;
+    const char* unit;
+    long long max;
+    int* value;
+  } fields[] = {{"cpus", "CPUs", 1024, &r->cpus},
+                {"mem_mb", "MB", 100000000, &r->mem_mb},
+                {"runtime", "minutes", 525600, &r->runtime_min}};
+  for (const auto& f : fields) {
+    const Node* v = Find(*n, f.key);
+    if (v == nullptr) continue;
+    const std::string where = std::string("resources.") + f.key;
+    const long long x = v->kind == Node::Kind::kScalar && IsIntegerText(v->scalar)
+                            ? std::strtoll(v->scalar.c_str(), nullptr, 10)
+                            : 0;
+    if (x < 1 || x > f.max)
+      return g.Error(*v, where,
+                     "'" + v->scalar + "' is not a whole number of " + f.unit + " in [1, " +
+                         std::to_string(f.max) + "]");
+    *f.value = static_cast<int>(x);
+  }
+  return Status::Ok();
+}
+
 StatusOr<Grid> ReadGrid(const GridContext& g, const Node& root) {
   Grid grid;
   if (root.kind != Node::Kind::kMap) return g.Error(root, "sequences", "the grid file is empty");
-  if (Status s = CheckKeys(g, root, "", {"sequences", "variants", "parameters", "config", "set"});
+  if (Status s = CheckKeys(g, root, "",
+                           {"sequences", "variants", "parameters", "config", "set", "resources"});
       !s.ok())
     return s;
   const Node* seqs = Find(root, "sequences");
@@ -383,6 +414,7 @@ StatusOr<Grid> ReadGrid(const GridContext& g, const Node& root) {
   if (Status s = ReadConfigFiles(g, Find(root, "config"), "config", &grid.config_files); !s.ok())
     return s;
   if (Status s = ReadOverrides(g, Find(root, "set"), "set", &grid.overrides); !s.ok()) return s;
+  if (Status s = ReadResources(g, Find(root, "resources"), &grid.resources); !s.ok()) return s;
   return grid;
 }
 
@@ -558,6 +590,7 @@ StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir
   Plan plan;
   plan.grid_path = grid_path;
   plan.out_dir = out_dir;
+  plan.resources = grid->resources;
   for (const auto& p : grid->parameters) plan.param_keys.push_back(p.first);
   for (const Sequence& seq : grid->sequences) {
     if (!seq.simulated) {
@@ -613,6 +646,10 @@ nlohmann::json PlanJson(const Plan& plan) {
   return {{"grid", plan.grid_path},
           {"out", plan.out_dir},
           {"param_keys", plan.param_keys},
+          {"resources",
+           {{"cpus", plan.resources.cpus},
+            {"mem_mb", plan.resources.mem_mb},
+            {"runtime", plan.resources.runtime_min}}},
           {"data", data},
           {"cells", cells}};
 }

@@ -11,6 +11,8 @@
 //     - {name, simulate: {preset, duration, set: {..}}, seeds: [..]} simulated
 //   variants: {name: {key: value, config: [files]}}   (optional; default one "default")
 //   parameters: {key: [values] | {from, to, step}}    cartesian product (optional)
+//   resources: {cpus, mem_mb, runtime}  per Slurm job of the Snakefile (optional;
+//                                   not part of the hash, unused by `rvlio ablate`)
 // Cell configuration order: grid config, sequence config, variant config,
 // then grid set, sequence set, variant overrides, parameter values.
 #include <cstdint>
@@ -58,19 +60,29 @@ struct Cell {
   std::vector<std::string> EvalArgs() const;  // "eval" ... --json
 };
 
+// What one job (a simulation or a cell) asks the scheduler for, from the
+// grid's `resources:` block: the Snakefile's threads, mem_mb and runtime.
+struct JobResources {
+  int cpus = 1;
+  int mem_mb = 4000;
+  int runtime_min = 120;
+};
+
 struct Plan {
   std::string grid_path;
   std::string out_dir;
   std::vector<std::string> param_keys;  // in grid order
   std::vector<DataItem> data;
   std::vector<Cell> cells;
+  JobResources resources;
 };
 
 // Reads and expands the grid. Every error is InvalidInput with one line that
 // starts with the grid file (and line) and names the key.
 StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir);
 
-// The plan as JSON: {grid, out, param_keys, data: [...], cells: [...]}.
+// The plan as JSON: {grid, out, param_keys, resources: {cpus, mem_mb, runtime},
+// data: [...], cells: [...]}.
 nlohmann::json PlanJson(const Plan& plan);
 
 // FNV-1a, 64 bit, as 16 lower-case hex digits.

@@ -1,4 +1,5 @@
 #include "ablate_runner.h"
+#include "divergence_cli.h"
 #include "json_text.h"
 
 #include <fcntl.h>
@@ -18,6 +19,7 @@
 #include <map>
 #include <sstream>
 
+#include "interrupt.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/trajectory_io.h"
@@ -43,6 +45,35 @@ struct Job {
   // Called with the raw wait status (or -1 when the spawn failed) and the
   // wall seconds; returns true when the item succeeded.
   std::function<bool(int, double)> finish;
+  // Instead of finish() for a child that a signal stopped: removes what it
+  // left, so the item is run again next time.
+  std::function<void()> discard;
+};
+
+// A child stopped by the signal forwarded to it (exit 130/143 or killed by it).
+bool StoppedBySignal(int status) {
+  if (WIFEXITED(status)) return IsInterruptExit(WEXITSTATUS(status));
+  return WIFSIGNALED(status) && (WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM);
+}
+
+// Blocks SIGINT and SIGTERM while alive: a signal arriving between the
+// Interrupted() check and the registration of a new child is delivered after
+// it, and so forwarded to that child too.
+class BlockInterrupts {
+ public:
+  BlockInterrupts() {
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set, &saved_);
+  }
+  ~BlockInterrupts() { pthread_sigmask(SIG_SETMASK, &saved_, nullptr); }
+  BlockInterrupts(const BlockInterrupts&) = delete;
+  BlockInterrupts& operator=(const BlockInterrupts&) = delete;
+
+ private:
+  sigset_t saved_;
 };
 
 pid_t Spawn(const std::string& program, const Job& job) {
@@ -57,9 +88,19 @@ pid_t Spawn(const std::string& program, const Job& job) {
   posix_spawn_file_actions_addopen(&actions, 1, job.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
                                    0644);
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  // Its own process group, so that a terminal's Ctrl-C reaches it once,
+  // forwarded by this process (interrupt.h); no signal blocked.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK);
+  posix_spawnattr_setpgroup(&attr, 0);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attr, &none);
   pid_t pid = -1;
-  const int rc = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+  const int rc = posix_spawn(&pid, program.c_str(), &actions, &attr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attr);
   return rc == 0 ? pid : -1;
 }
 
@@ -76,6 +117,10 @@ class Progress {
   void Running(int n) {
     running_ = n;
     if (tty_) Draw();
+  }
+  void Stopped(const std::string& name) {
+    ++stopped_;
+    if (!tty_ && enabled_) std::fprintf(stderr, "%s %s interrupted\n", what_.c_str(), name.c_str());
   }
   void Finished(const std::string& name, bool ok, double wall_s) {
     (ok ? done_ : failed_)++;
@@ -98,37 +143,59 @@ class Progress {
   }
   bool tty_, enabled_;
   std::string what_;
-  int total_, skipped_, done_ = 0, failed_ = 0, running_ = 0;
+  int total_, skipped_, done_ = 0, failed_ = 0, running_ = 0, stopped_ = 0;
   bool drawn_ = false;
 };
 
-// Runs the jobs `parallel` at a time; returns how many succeeded.
-int RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress* progress) {
+struct JobCounts {
+  int ok = 0, failed = 0, stopped = 0;  // stopped: by a signal, discarded
+  void Add(bool good) { (good ? ok : failed)++; }
+};
+
+// Starts a job; false when it did not start (recorded by prepare() or
+// finish(-1)). Called with signals blocked (BlockInterrupts).
+bool Start(Job& job, const RunnerOptions& options, Progress* progress, JobCounts* counts,
+           pid_t* pid_out) {
+  if (job.prepare && !job.prepare()) {  // recorded as failed by prepare()
+    counts->Add(false);
+    progress->Finished(job.name, false, 0.0);
+    return false;
+  }
+  const pid_t pid = Spawn(options.rvlio_bin, job);
+  if (pid < 0 || !AddForwardPid(pid)) {
+    if (pid > 0) {  // more children than the forwarding table holds: not started
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, 0);
+    }
+    const bool good = job.finish(-1, 0.0);
+    counts->Add(good);
+    progress->Finished(job.name, good, 0.0);
+    return false;
+  }
+  *pid_out = pid;
+  return true;
+}
+
+// Runs the jobs `parallel` at a time. After a signal (forwarded to the
+// running children by the handler) no job starts; the running ones end, and
+// those the signal stopped are discarded.
+JobCounts RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress* progress) {
   struct Running {
     size_t index;
     Clock::time_point t0;
   };
   std::map<pid_t, Running> running;
   size_t next = 0;
-  int ok = 0;
+  JobCounts counts;
   const size_t parallel = static_cast<size_t>(std::max(1, options.jobs));
-  while (next < jobs.size() || !running.empty()) {
-    while (running.size() < parallel && next < jobs.size()) {
-      Job& job = jobs[next];
-      if (job.prepare && !job.prepare()) {  // recorded as failed by prepare()
-        progress->Finished(job.name, false, 0.0);
-        ++next;
-        continue;
+  while ((next < jobs.size() && !Interrupted()) || !running.empty()) {
+    {
+      BlockInterrupts block;
+      for (; running.size() < parallel && next < jobs.size() && !Interrupted(); ++next) {
+        pid_t pid = -1;
+        if (Start(jobs[next], options, progress, &counts, &pid))
+          running[pid] = {next, Clock::now()};
       }
-      const pid_t pid = Spawn(options.rvlio_bin, job);
-      if (pid < 0) {
-        const bool good = job.finish(-1, 0.0);
-        ok += good;
-        progress->Finished(job.name, good, 0.0);
-      } else {
-        running[pid] = {next, Clock::now()};
-      }
-      ++next;
     }
     progress->Running(static_cast<int>(running.size()));
     if (running.empty()) continue;
@@ -138,16 +205,23 @@ int RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress* prog
       if (errno == EINTR) continue;
       break;  // ECHILD: nothing left to wait for
     }
+    RemoveForwardPid(pid);
     auto it = running.find(pid);
     if (it == running.end()) continue;
     const double wall = std::chrono::duration<double>(Clock::now() - it->second.t0).count();
     Job& job = jobs[it->second.index];
     running.erase(it);
+    if (Interrupted() && StoppedBySignal(status)) {
+      if (job.discard) job.discard();
+      ++counts.stopped;
+      progress->Stopped(job.name);
+      continue;
+    }
     const bool good = job.finish(status, wall);
-    ok += good;
+    counts.Add(good);
     progress->Finished(job.name, good, wall);
   }
-  return ok;
+  return counts;
 }
 
 std::string ReadText(const std::string& path) {
@@ -244,7 +318,7 @@ json CellHeader(const Cell& cell) {
 bool WriteCellRecord(const Cell& cell, json record) {
   const Status s = WriteFileAtomically(cell.CellJson(), JsonText(record) + "\n");
   if (!s.ok()) std::fprintf(stderr, "rvlio ablate: error: %s\n", s.message().c_str());
-  return s.ok() && record["status"] == "done";
+  return s.ok() && (record["status"] == "done" || record["status"] == "diverged");
 }
 
 // Records a cell that could not run because its data is missing or failed.
@@ -269,9 +343,12 @@ bool FinishCell(const Cell& cell, int status, double wall_s) {
   r["wall_s"] = wall_s;
   r["stderr_tail"] = Tail(ReadText(cell.dir + "/run.log"));
   json metrics = json::object(), warnings = json::array();
-  std::string error =
-      exit_code == 0 ? CollectMetrics(cell, &metrics, &warnings) : "rvlio run " + how;
-  r["status"] = error.empty() ? "done" : "failed";
+  // Exit 3: the run went to the end but its divergence monitor fired. The
+  // cell is finished, its metrics are kept, and its status says so.
+  const bool diverged = exit_code == kExitDiverged;
+  std::string error = exit_code == 0 || diverged ? CollectMetrics(cell, &metrics, &warnings)
+                                                 : "rvlio run " + how;
+  r["status"] = !error.empty() ? "failed" : diverged ? "diverged" : "done";
   r["error"] = error.empty() ? json(nullptr) : json(error);
   r["metrics"] = metrics;
   r["eval_warnings"] = warnings;
@@ -302,7 +379,7 @@ bool FinishData(const DataItem& d, int status, double wall_s) {
 
 bool CellDone(const Cell& cell) {
   const json r = ReadCellRecord(cell);
-  return r.is_object() && r.value("status", "") == "done";
+  return r.is_object() && (r.value("status", "") == "done" || r.value("status", "") == "diverged");
 }
 
 Job DataJob(const DataItem& d) {
@@ -317,6 +394,10 @@ Job DataJob(const DataItem& d) {
     return true;
   };
   job.finish = [&d](int status, double wall) { return FinishData(d, status, wall); };
+  job.discard = [&d] {  // simulate removes its half bag itself
+    std::error_code ec;
+    fs::remove(d.Marker(), ec);
+  };
   return job;
 }
 
@@ -337,6 +418,11 @@ Job CellJob(const Plan& plan, const Cell& cell) {
     return true;
   };
   job.finish = [&cell](int status, double wall) { return FinishCell(cell, status, wall); };
+  job.discard = [&cell] {  // no half result: the cell runs again next time
+    std::error_code ec;
+    fs::remove(cell.CellJson(), ec);
+    fs::remove_all(cell.RunDir(), ec);
+  };
   return job;
 }
 
@@ -345,10 +431,12 @@ void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& 
               const RunnerOptions& options, RunCounts* counts) {
   if (jobs.empty()) return;
   Progress progress(options.progress, what, total, skipped);
-  const int ok = RunJobs(jobs, options, &progress);
+  const JobCounts c = RunJobs(jobs, options, &progress);
   if (counts != nullptr) {
-    counts->done += ok;
-    counts->failed += static_cast<int>(jobs.size()) - ok;
+    counts->done += c.ok;
+    counts->failed += c.failed;
+    counts->interrupted += c.stopped;
+    counts->not_started += static_cast<int>(jobs.size()) - c.ok - c.failed - c.stopped;
   }
 }
 

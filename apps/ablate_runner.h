@@ -5,6 +5,9 @@
 // CELL/cell.json atomically. A crashing or failing run is recorded in its
 // cell.json ("status": "failed"), never fatal for the others. Finished cells
 // (status done, same hash) and finished data (data.json, same hash) are skipped.
+// SIGINT/SIGTERM (under an InterruptScope, interrupt.h) reach the running
+// children, which run in their own process group; no further child starts,
+// the children the signal stopped leave no cell.json and no run folder.
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -16,8 +19,10 @@ namespace rvlio::cli::ablate {
 struct RunCounts {
   int total = 0;
   int skipped = 0;  // already done before this call
-  int done = 0;     // finished now
+  int done = 0;     // finished now (including cells whose run diverged: cell.json says so)
   int failed = 0;   // failed now (including cells whose data failed)
+  int interrupted = 0;  // stopped by a signal: nothing kept, run again next time
+  int not_started = 0;  // not started because of a signal
 };
 
 struct RunnerOptions {
@@ -34,8 +39,9 @@ RunCounts RunPlan(const Plan& plan, const RunnerOptions& options);
 bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& options,
             RunCounts* counts);
 
-// cell.json of a finished cell with the plan's hash (status done or
-// failed), or null when there is none.
+// cell.json of a finished cell with the plan's hash (status done, diverged
+// (the run's divergence monitor fired: exit 3, metrics kept) or failed), or
+// null when there is none.
 nlohmann::json ReadCellRecord(const Cell& cell);
 
 // The metric fields of cell.json "metrics", in table order.

@@ -66,7 +66,7 @@ Stats Describe(const std::vector<double>& values) {
 
 struct Group {
   const Cell* first = nullptr;  // sequence, label, params
-  int cells = 0, done = 0, failed = 0;
+  int cells = 0, done = 0, failed = 0, diverged = 0;
   std::map<std::string, std::vector<double>> values;  // metric -> finite values of done cells
 };
 
@@ -117,6 +117,7 @@ std::vector<Group> GroupCells(const Plan& plan, const std::vector<json>& records
     const json& r = records[i];
     const std::string status = r.is_object() ? r.value("status", "") : "";
     if (status == "failed") ++g.failed;
+    if (status == "diverged") ++g.diverged;
     if (status != "done") continue;
     ++g.done;
     for (const auto& [m, header] : TableMetrics()) {
@@ -131,13 +132,13 @@ std::string TableCsv(const Plan& plan, const std::vector<Group>& groups) {
   std::ostringstream o;
   o << "sequence,variant";
   for (const auto& k : plan.param_keys) o << "," << Csv(k);
-  o << ",cells,n,failed";
+  o << ",cells,n,failed,diverged";
   for (const auto& [m, header] : TableMetrics()) o << "," << m << "_mean," << m << "_std";
   o << "\n";
   for (const Group& g : groups) {
     o << Csv(g.first->sequence) << "," << Csv(g.first->label);
     for (const auto& [k, v] : g.first->params) o << "," << Csv(v);
-    o << "," << g.cells << "," << g.done << "," << g.failed;
+    o << "," << g.cells << "," << g.done << "," << g.failed << "," << g.diverged;
     for (const auto& [m, header] : TableMetrics()) {
       const Stats s = Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>());
       o << "," << Num(s.mean) << "," << Num(s.std);
@@ -159,14 +160,14 @@ std::string MeanStd(const Stats& s, int precision) {
 
 std::string TableMarkdown(const std::vector<Group>& groups) {
   std::ostringstream o;
-  o << "| sequence | variant | n | failed |";
+  o << "| sequence | variant | n | failed | diverged |";
   for (const auto& [m, header] : TableMetrics()) o << " " << header << " |";
-  o << "\n|---|---|---|---|";
+  o << "\n|---|---|---|---|---|";
   for (size_t i = 0; i < TableMetrics().size(); ++i) o << "---|";
   o << "\n";
   for (const Group& g : groups) {
     o << "| " << g.first->sequence << " | " << g.first->label << " | " << g.done << " | "
-      << g.failed << " |";
+      << g.failed << " | " << g.diverged << " |";
     for (const auto& [m, header] : TableMetrics()) {
       const int precision =
           m == "ms_per_scan" || m == "rtf" ? 2 : (m == "rv_active_fraction" ? 2 : 4);
@@ -203,6 +204,8 @@ StatusOr<SummaryResult> WriteSummary(const Plan& plan, bool plots) {
       ++result.missing;
     else if (r.value("status", "") == "done")
       ++result.done;
+    else if (r.value("status", "") == "diverged")
+      ++result.diverged;
     else
       ++result.failed;
   }

@@ -3,7 +3,8 @@
 // `rvlio ablate` and the Snakemake workflow produce the same tables):
 //   D/summary.csv         one row per cell (status, exit code, metrics, error)
 //   D/table.csv, table.md grouped by sequence x variant (x parameters):
-//                         n, failed, and mean and sample std over seeds
+//                         n, failed, diverged, and mean and sample std over
+//                         the seeds that finished without diverging
 //   D/plots/summary_ablation.png/.pdf  via scripts/rvlio_plot.py when usable
 #include <string>
 
@@ -14,6 +15,7 @@ namespace rvlio::cli::ablate {
 
 struct SummaryResult {
   int cells = 0, done = 0, failed = 0, missing = 0;  // missing: no cell.json with this hash
+  int diverged = 0;  // ran to the end but the divergence monitor fired (not in the means)
   std::string table_md;                              // the Markdown table (also in table.md)
   std::string plot_note;                             // "plots: ..." or "plots skipped: why"
 };

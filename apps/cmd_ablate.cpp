@@ -15,6 +15,7 @@
 #include "ablate_summary.h"
 #include "commands.h"
 #include "common_options.h"
+#include "interrupt.h"
 #include "run_pipeline.h"
 #include "rvlio/io/atomic_file.h"
 
@@ -68,8 +69,21 @@ int Summarize(const ablate::Plan& plan, const Args& args) {
   std::cout << r->table_md;
   std::printf("rvlio ablate: %d cells: %d done, %d failed, %d not run -> %s/table.md\n", r->cells,
               r->done, r->failed, r->missing, plan.out_dir.c_str());
+  if (r->diverged > 0)
+    std::printf("rvlio ablate: %d cells diverged (status diverged in summary.csv; left out of the "
+                "means)\n", r->diverged);
   std::printf("rvlio ablate: %s\n", r->plot_note.c_str());
   return 0;
+}
+
+// The one line after a signal; returns 130 / 143.
+int ReportInterrupt(const ablate::RunCounts& c) {
+  std::fprintf(stderr,
+               "rvlio ablate: interrupted by %s: %d cells finished now and kept (%d were done "
+               "before), %d stopped and %d not started (run next time)\n",
+               InterruptSignalName().c_str(), c.done + c.failed, c.skipped, c.interrupted,
+               c.not_started);
+  return InterruptExitCode();
 }
 
 int RunSingle(const ablate::Plan& plan, const std::string& id, const ablate::RunnerOptions& o) {
@@ -77,6 +91,7 @@ int RunSingle(const ablate::Plan& plan, const std::string& id, const ablate::Run
   if (!ablate::RunOne(plan, id, o, &counts))
     return Fail(kName,
                 "no cell or data '" + id + "' in the plan of " + plan.grid_path + " (see --plan)");
+  if (Interrupted()) return ReportInterrupt(counts);
   const char* what = counts.skipped ? "already done" : counts.failed ? "failed (recorded)" : "done";
   std::printf("rvlio ablate: %s %s\n", id.c_str(), what);
   return 0;
@@ -104,6 +119,7 @@ int CmdAblate(int argc, char** argv) {
   }
   if (!PrepareOutputDir(kName, plan->out_dir)) return 2;
   if (args.Has("summarize")) return Summarize(*plan, args);
+  InterruptScope interrupt_scope;  // SIGINT/SIGTERM: finished cells stay, the rest run next time
   if (args.Has("cell")) return RunSingle(*plan, args.Get("cell"), options);
   if (args.Has("data")) return RunSingle(*plan, args.Get("data"), options);
 
@@ -112,6 +128,7 @@ int CmdAblate(int argc, char** argv) {
       !s.ok())
     return Fail(kName, s.message(), s.exit_code());
   const ablate::RunCounts c = ablate::RunPlan(*plan, options);
+  if (Interrupted()) return ReportInterrupt(c);
   std::printf("rvlio ablate: %d cells: %d already done, %d run now (%d done, %d failed)\n", c.total,
               c.skipped, c.done + c.failed, c.done, c.failed);
   return Summarize(*plan, args);

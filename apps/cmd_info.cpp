@@ -1,4 +1,4 @@
-// rvlio info --bag FILE [--lidar-topic T]: what is in a bag and whether its
+// rvlio info --bag PATH [--lidar-topic T]: what is in a recording and whether its
 // LiDAR messages carry per-point times the reader understands.
 #include <cstdio>
 #include <iostream>
@@ -49,7 +49,10 @@ std::string Stamp(TimeNs t_ns) {
 
 void Print(const BagInfo& info) {
   std::cout << "bag:      " << info.path << "\n"
-            << "duration: " << Fixed(NsToSeconds(info.end_ns - info.start_ns), 3) << " s\n"
+            << "storage:  " << info.storage << "\n";
+  if (!info.compressions.empty())
+    std::cout << "compression: " << Join(info.compressions) << "\n";
+  std::cout << "duration: " << Fixed(NsToSeconds(info.end_ns - info.start_ns), 3) << " s\n"
             << "start:    " << Stamp(info.start_ns) << " s\n"
             << "end:      " << Stamp(info.end_ns) << " s\n"
             << "messages: " << info.messages << "\n"
@@ -65,16 +68,19 @@ void Print(const BagInfo& info) {
 
 int CmdInfo(int argc, char** argv) {
   CommandSpec spec{"info",
-                   "Lists the topics of a ROS1 bag (type, count, rate) and, for PointCloud2\n"
+                   "Lists the topics of a recording (ROS1 bag, ROS 2 .db3 / .mcap / bag folder:\n"
+                   "type, count, rate; storage and chunk compression) and, for PointCloud2\n"
                    "topics, the detected per-point time layout, the fields and the mean\n"
                    "number of valid points per scan (from the first few messages).",
-                   {{"bag", "FILE", "ROS1 bag", true, false},
+                   {{"bag", "PATH", "ROS1 bag, .db3, .mcap or ROS 2 bag folder", true, false},
                     {"lidar-topic", "TOPIC", "analyse only this PointCloud2 topic", false, false}}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   StatusOr<BagInfo> info = ReadBagInfo(args.Get("bag"), args.Get("lidar-topic"));
   if (!info.ok()) return Fail(spec.name, info.status().message(), info.status().exit_code());
   Print(*info);
+  for (const std::string& w : info->warnings)
+    std::cerr << "rvlio info: warning: " << w << "\n";
   return 0;
 }
 

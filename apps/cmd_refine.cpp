@@ -12,6 +12,9 @@
 #include "json_text.h"
 #include "commands.h"
 #include "common_options.h"
+#include "interrupt.h"
+#include "refine_checkpoint.h"
+#include "divergence_cli.h"
 #include "run_pipeline.h"
 #include "window_options.h"
 #include "rvlio/io/atomic_file.h"
@@ -47,12 +50,13 @@ RefineConfig ToRefineConfig(const OdometryOptions& o) {
 
 // Every IMU sample and every scan, downsampled as the odometry does
 // (lidar/preprocess.h), so that a 100 s sequence stays small in memory.
+// Stops early (Ok) when interrupted.
 Status ReadBag(SensorBagReader* reader, const LidarOptions& lidar, RefineInput* input,
                int64_t* raw_points) {
   ScanPreprocessor preprocessor(lidar);
   ImuSample imu;
   Scan scan;
-  for (;;) {
+  while (!Interrupted()) {
     StatusOr<SensorMessage> m = reader->Next(&imu, &scan);
     if (!m.ok()) return m.status();
     if (*m == SensorMessage::kEnd) return Status::Ok();
@@ -65,6 +69,7 @@ Status ReadBag(SensorBagReader* reader, const LidarOptions& lidar, RefineInput* 
     preprocessor.Downsample(scan, &small);
     input->scans.push_back(std::move(small));
   }
+  return Status::Ok();
 }
 
 void PrintRound(const RefineRound& r, int rounds) {
@@ -76,26 +81,6 @@ void PrintRound(const RefineRound& r, int rounds) {
       r.max_rotation_change_deg, static_cast<long long>(r.constraints), r.rv_active_scans,
       r.total_s, r.deskew_s, r.map_s, r.associate_s, r.solve_s);
   std::fflush(stdout);
-}
-
-nlohmann::json RoundJson(const RefineRound& r) {
-  return {{"round", r.round},
-          {"chunks", r.chunks},
-          {"cost_before", r.cost_before},
-          {"cost_after", r.cost_after},
-          {"iterations", r.iterations},
-          {"max_translation_change_m", r.max_translation_change_m},
-          {"max_rotation_change_deg", r.max_rotation_change_deg},
-          {"points", r.points},
-          {"constraints", r.constraints},
-          {"rv_active_scans", r.rv_active_scans},
-          {"solve_failures", r.solve_failures},
-          {"time_s",
-           {{"deskew", r.deskew_s},
-            {"map", r.map_s},
-            {"associate", r.associate_s},
-            {"solve", r.solve_s},
-            {"total", r.total_s}}}};
 }
 
 nlohmann::json StatsJson(const RefineStats& s, const SensorReaderStats& r, int64_t raw_points) {
@@ -116,11 +101,13 @@ nlohmann::json StatsJson(const RefineStats& s, const SensorReaderStats& r, int64
 
 struct Request {
   std::string bag, init, out_dir;
+  std::string checkpoint_dir;  // --checkpoint, or --resume's folder
+  bool resume = false;
 };
 
 Status WriteOutputs(const Request& req, const OdometryOptions& options, const RefineResult& res,
-                    const SensorReaderStats& reader_stats, int64_t raw_points, double read_s,
-                    double wall_s) {
+                    const DivergenceReport& divergence, const SensorReaderStats& reader_stats,
+                    int64_t raw_points, double read_s, double wall_s) {
   OutputStage stage(req.out_dir);  // all outputs or none (run_pipeline.h)
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), res.trajectory); !s.ok())
@@ -142,6 +129,8 @@ Status WriteOutputs(const Request& req, const OdometryOptions& options, const Re
   j["rounds"] = nlohmann::json::array();
   for (const RefineRound& r : res.rounds) j["rounds"].push_back(RoundJson(r));
   j["converged"] = res.converged;
+  j["interrupted"] = res.stopped;
+  if (res.stopped) j["signal"] = InterruptSignalName();
   j["map_points"] = res.map_points.size();
   j["time_s"] = {{"read_bag", read_s},
                  {"init_solve", res.init_solve_s},
@@ -150,9 +139,53 @@ Status WriteOutputs(const Request& req, const OdometryOptions& options, const Re
   j["peak_memory_mb"] = PeakMemoryMb();
   j["stats"] = StatsJson(res.stats, reader_stats, raw_points);
   j["warnings"] = res.warnings;
+  j["divergence"] = DivergenceJson(divergence);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
     return stage.Explain(s);
   return stage.Commit();
+}
+
+}  // namespace
+
+namespace {
+
+// The refinement with its hooks: round lines, checkpoints, the interrupt flag.
+StatusOr<RefineResult> RefineWithHooks(const Request& req, const OdometryOptions& options,
+                                       RefineInput input) {
+  const int rounds = options.smoother.refine_rounds;
+  RefineHooks hooks;
+  hooks.on_round = [rounds](const RefineRound& r) { PrintRound(r, rounds); };
+  hooks.stop = [] { return Interrupted(); };
+  const uint64_t fingerprint =
+      req.checkpoint_dir.empty() ? 0 : RefineFingerprint(options, input);
+  if (!req.checkpoint_dir.empty())
+    hooks.on_state = [&req, fingerprint](const RefineRoundState& state) {
+      return WriteRefineCheckpoint(req.checkpoint_dir, fingerprint, state);
+    };
+  if (!req.resume) return Refine(ToRefineConfig(options), std::move(input), hooks);
+  StatusOr<RefineRoundState> resume = ReadRefineCheckpoint(req.checkpoint_dir, fingerprint);
+  if (!resume.ok()) return resume.status();
+  hooks.resume = &*resume;
+  std::printf("rvlio refine: resuming after round %d from %s\n", resume->rounds_done,
+              req.checkpoint_dir.c_str());
+  return Refine(ToRefineConfig(options), std::move(input), hooks);
+}
+
+// --checkpoint DIR / --resume DIR (the same folder goes on receiving checkpoints).
+int ReadCheckpointArgs(const Args& args, Request* req) {
+  if (args.Has("checkpoint") && args.Has("resume") &&
+      args.Get("checkpoint") != args.Get("resume"))
+    return Fail("refine", "--resume " + args.Get("resume") + " goes on checkpointing there; "
+                "--checkpoint " + args.Get("checkpoint") + " names another folder");
+  req->resume = args.Has("resume");
+  req->checkpoint_dir = req->resume ? args.Get("resume") : args.Get("checkpoint");
+  if (req->resume) {
+    if (Status s = CheckpointExists(req->checkpoint_dir); !s.ok())
+      return Fail("refine", s.message());
+  } else if (!req->checkpoint_dir.empty() && !PrepareOutputDir("refine", req->checkpoint_dir)) {
+    return 2;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -161,24 +194,34 @@ int CmdRefine(int argc, char** argv) {
   CommandSpec spec{"refine",
                    "Batch-refines a whole sequence starting from a previous run's trajectory "
                    "(all scans, IMU factors, re-association rounds; sparse Cholesky) and writes "
-                   "trajectory.tum, map.pcd and summary.json to the output folder.",
+                   "trajectory.tum, map.pcd and summary.json to the output folder. SIGINT/SIGTERM "
+                   "write the last completed round's result and exit 130/143.",
                    {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
                     {"init", "TUM", "initial trajectory (TUM format), e.g. rvlio run's", true},
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
-                    StartOption(),
-                    DurationOption()}};
+                    {"checkpoint", "DIR",
+                     "after each round, write the state to continue from to DIR/refine.checkpoint"},
+                    {"resume", "DIR",
+                     "continue from DIR/refine.checkpoint (same --bag, --init, --config and --set; "
+                     "smoother.refine_rounds may differ) and go on checkpointing there"},
+                    AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   ReadWindow window;
   if (std::string err = ParseWindow(args, &window); !err.empty()) return Fail("refine", err);
+  InterruptScope interrupt_scope;
   const auto t0 = Clock::now();
-  const Request req{args.Get("bag"), args.Get("init"), args.Get("out")};
+  Request req;
+  req.bag = args.Get("bag");
+  req.init = args.Get("init");
+  req.out_dir = args.Get("out");
   StatusOr<OdometryOptions> options = LoadConfig(args.GetAll("config"), args.GetAll("set"));
   if (!options.ok()) return Fail("refine", options.status().message());
   StatusOr<Trajectory> init = ReadTum(req.init);
   if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
+  if (int rc = ReadCheckpointArgs(args, &req); rc != 0) return rc;
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(req.bag, options->lidar, options->imu, window, options->io);
   if (!reader.ok()) return Fail("refine", reader.status().message());
@@ -189,21 +232,37 @@ int CmdRefine(int argc, char** argv) {
   int64_t raw_points = 0;
   if (Status s = ReadBag(reader->get(), options->lidar, &input, &raw_points); !s.ok())
     return Fail("refine", s.message());
+  if (Interrupted()) {
+    std::fprintf(stderr, "rvlio refine: interrupted by %s while reading the bag; nothing written\n",
+                 InterruptSignalName().c_str());
+    return InterruptExitCode();
+  }
   const double read_s = SecondsSince(t0);
-  const int rounds = options->smoother.refine_rounds;
-  StatusOr<RefineResult> result = Refine(ToRefineConfig(*options), std::move(input),
-                                         [rounds](const RefineRound& r) { PrintRound(r, rounds); });
+  StatusOr<RefineResult> result = RefineWithHooks(req, *options, std::move(input));
   if (!result.ok())
     return Fail("refine", result.status().message() + " (bag " + req.bag + ", init " + req.init + ")",
                 result.status().exit_code());
-  const Status written = WriteOutputs(req, *options, *result, (*reader)->stats(), raw_points,
-                                      read_s, SecondsSince(t0));
+  const DivergenceReport divergence = CheckRefineResult(
+      *result, options->divergence, options->constraints.lidar_noise, options->imu.gravity);
+  const Status written = WriteOutputs(req, *options, *result, divergence, (*reader)->stats(),
+                                      raw_points, read_s, SecondsSince(t0));
   for (const auto& w : result->warnings) std::fprintf(stderr, "rvlio refine: warning: %s\n", w.c_str());
+  size_t warned = 0;
+  WarnDivergence("refine", divergence, &warned);
   if (!written.ok()) return Fail("refine", written.message(), written.exit_code());
+  if (result->stopped) {
+    std::fprintf(stderr, "rvlio refine: interrupted by %s: wrote the result after round %zu "
+                 "(trajectory.tum, map.pcd, summary.json) to %s\n", InterruptSignalName().c_str(),
+                 result->rounds.empty() ? size_t{0} : static_cast<size_t>(result->rounds.back().round),
+                 req.out_dir.c_str());
+    return InterruptExitCode();
+  }
   std::printf("rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
               result->trajectory.size(), result->rounds.size(),
               result->converged ? " (converged)" : "", result->linear_solver.c_str(),
               SecondsSince(t0), PeakMemoryMb(), req.out_dir.c_str());
+  if (divergence.detected)
+    return FinishDiverged("refine", divergence, req.out_dir, args.Has("allow-divergence"));
   return 0;
 }
 

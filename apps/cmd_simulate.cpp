@@ -1,5 +1,7 @@
 // rvlio simulate: runs the deterministic tunnel simulator (sim/) and writes
 //   DIR/NAME.bag     ROS1 bag: Ouster-layout PointCloud2 + sensor_msgs/Imu
+//                    (--format mcap: DIR/NAME.mcap, --format db3: DIR/NAME.db3,
+//                    ROS 2 CDR messages)
 //   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
 // Argument parsing, file output and the summary line only.
@@ -16,6 +18,7 @@
 
 #include "commands.h"
 #include "common_options.h"
+#include "interrupt.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/sensor_bag.h"
@@ -39,7 +42,8 @@ std::string PresetList() {
 CommandSpec SimulateSpec() {
   return {kName,
           "Simulate a multirotor flight through a tunnel (or a hall) with a spinning LiDAR and an\n"
-          "IMU. Writes DIR/NAME.bag (ROS1: Ouster PointCloud2 + sensor_msgs/Imu), DIR/NAME_gt.tum\n"
+          "IMU. Writes DIR/NAME.bag (ROS1: Ouster PointCloud2 + sensor_msgs/Imu; or NAME.mcap /\n"
+          "NAME.db3, ROS 2, with --format), DIR/NAME_gt.tum\n"
           "(true IMU pose in the world frame, 100 Hz) and DIR/NAME.yaml (sensor configuration for\n"
           "`rvlio run --config`). Deterministic: the same options and seed give the same files.\n"
           "Presets: " +
@@ -52,7 +56,10 @@ CommandSpec SimulateSpec() {
             "/livox/lidar unless sim lidar.topic is --set)", false, false},
            SetOption(),
            {"out", "DIR", "output directory (created if missing)", true, false},
-           {"name", "NAME", "output file stem (default: the preset name)", false, false}}};
+           {"name", "NAME", "output file stem (default: the preset name)", false, false},
+           {"format", "FMT", "bag (ROS1, default), mcap or db3 (ROS 2)", false, false},
+           {"mcap-compression", "C",
+            "MCAP chunks: zstd (default), lz4, none, or unchunked", false, false}}};
 }
 
 bool ParseDouble(const std::string& text, double* value) {
@@ -95,6 +102,22 @@ std::string ResolveOptions(const Args& args, SimOptions* options) {
   return s.ok() ? "" : s.message();
 }
 
+// --format and --mcap-compression -> writer options and the file extension.
+std::string ResolveFormat(const Args& args, BagWriterOptions* format, std::string* extension) {
+  const std::string name = args.Get("format", "bag");
+  if (name != "bag" && name != "mcap" && name != "db3")
+    return "--format '" + name + "' is not one of bag, mcap, db3";
+  format->format = name == "bag" ? "ros1" : name;
+  *extension = "." + name;
+  format->mcap_compression = args.Get("mcap-compression", "zstd");
+  const std::string& c = format->mcap_compression;
+  if (c != "zstd" && c != "lz4" && c != "none" && c != "unchunked")
+    return "--mcap-compression '" + c + "' is not one of zstd, lz4, none, unchunked";
+  if (args.Has("mcap-compression") && name != "mcap")
+    return "--mcap-compression applies to --format mcap only";
+  return "";
+}
+
 std::string Num(double v) {
   std::ostringstream os;
   os.precision(10);
@@ -104,13 +127,14 @@ std::string Num(double v) {
 
 // The estimator's sensor keys (odometry/options.h) as simulated. The noise
 // densities must be positive there; a noise-free simulation gets a tiny value.
-std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox) {
+std::string SensorYaml(const SimOptions& o, const std::string& name, const std::string& bag_file,
+                       bool livox) {
   auto density = [](double v) { return Num(std::max(v, 1e-9)); };
   const auto& t = o.extrinsics.imu_T_lidar.translation;
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
   std::ostringstream y;
   y << "# Sensor configuration of the simulated sequence '" << name << "' (rvlio simulate, seed "
-    << o.seed << ").\n# Use: rvlio run --bag " << name << ".bag --config " << name
+    << o.seed << ").\n# Use: rvlio run --bag " << bag_file << " --config " << name
     << ".yaml --out DIR\n"
     << "lidar:\n"
     << "  topic: " << o.lidar.topic << "\n"
@@ -139,23 +163,30 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox)
 }
 
 // Streams the simulation into the bag; the first write error stops the run.
-Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox) {
-  StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path);
+// An interrupt stops it too and leaves no bag: the writer's temporary file
+// (path + ".tmp") is removed when the writer goes, or by the abort of a
+// second signal (interrupt.h).
+Status WriteBag(const sim::Simulator& simulator, const std::string& path,
+                const BagWriterOptions& format, bool livox) {
+  StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
   if (!writer.ok()) return writer.status();
+  SetAbortRemovePath(path + ".tmp");
   const SimOptions& o = simulator.options();
   Status error;
   simulator.Run(
       [&](const ImuSample& m) {
         error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
-        return error.ok();
+        return error.ok() && !Interrupted();
       },
       [&](const Scan& scan, int rows, int cols) {
         error = livox ? (*writer)->WriteLivoxScan(o.lidar.topic, o.lidar.frame_id, scan)
                       : (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
-        return error.ok();
+        return error.ok() && !Interrupted();
       });
-  if (!error.ok()) return error;
-  return (*writer)->Close();
+  if (error.ok() && !Interrupted()) error = (*writer)->Close();
+  writer->reset();  // removes the temporary file unless Close() renamed it
+  SetAbortRemovePath("");
+  return error;
 }
 
 std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
@@ -169,6 +200,7 @@ int CmdSimulate(int argc, char** argv) {
   const CommandSpec spec = SimulateSpec();
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop, leave no half bag, exit 130/143
   SimOptions options;
   if (std::string err = ResolveOptions(args, &options); !err.empty()) return Fail(kName, err);
   const std::string name = args.Get("name", args.Get("preset", "tunnel"));
@@ -181,9 +213,13 @@ int CmdSimulate(int argc, char** argv) {
     return Fail(kName, "cannot create output directory '" + dir.string() + "'" +
                            (ec ? " (" + ec.message() + ")" : ""));
 
+  BagWriterOptions format;
+  std::string extension;
+  if (std::string err = ResolveFormat(args, &format, &extension); !err.empty())
+    return Fail(kName, err);
   // The sensor configuration must be one that `rvlio run` accepts.
   const bool livox = args.Get("lidar-msg") == "livox";
-  const std::string yaml = SensorYaml(options, name, livox);
+  const std::string yaml = SensorYaml(options, name, name + extension, livox);
   OdometryOptions check;
   if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
       !s.ok() || !(s = check.Validate()).ok())
@@ -193,9 +229,14 @@ int CmdSimulate(int argc, char** argv) {
   const std::clock_t cpu0 = std::clock();
   StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
   if (!simulator.ok()) return Fail(kName, simulator.status().message());
-  const std::string bag_path = (dir / (name + ".bag")).string();
-  if (Status s = WriteBag(**simulator, bag_path, livox); !s.ok())
+  const std::string bag_path = (dir / (name + extension)).string();
+  if (Status s = WriteBag(**simulator, bag_path, format, livox); !s.ok())
     return Fail(kName, s.message(), s.exit_code());
+  if (Interrupted()) {
+    std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",
+                 InterruptSignalName().c_str());
+    return InterruptExitCode();
+  }
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const double cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;

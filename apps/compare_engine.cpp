@@ -18,6 +18,8 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "interrupt.h"
+#include "divergence_cli.h"
 #include "plot_runner.h"
 #include "run_pipeline.h"
 #include "window_options.h"
@@ -59,8 +61,14 @@ struct Row {
   double ms_per_scan = kNaN;       // run: median CPU ms; refine: wall ms per scan (batch)
   double real_time_factor = kNaN;  // sequence duration / compute time
   double wall_s = 0.0;             // whole step, including reading the bag
+  bool interrupted = false;        // a signal stopped it or came before it started
+  bool diverged = false;           // the divergence monitor fired: metrics shown, marked
 
-  bool ok() const { return exit_code == 0 && eval.has_value(); }
+  bool measured() const { return exit_code == 0 && eval.has_value(); }
+  bool ok() const { return measured() && !diverged; }
+  const char* StatusName() const {
+    return interrupted ? "interrupted" : ok() ? "ok" : (measured() ? "diverged" : "failed");
+  }
 };
 
 double SecondsSince(Clock::time_point t0) {
@@ -189,12 +197,13 @@ void EvaluateRow(const Trajectory& truth, const std::string& dir, Row* row) {
 }
 
 std::string ResultLine(const Row& row) {
-  if (!row.ok())
+  if (row.interrupted) return row.name + " interrupted (its folder holds the scans it finished)";
+  if (!row.measured())
     return row.name + " failed (exit " + std::to_string(row.exit_code) + ")" +
            (row.error.empty() ? "" : ": " + row.error);
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "ATE %.4f m, %d scans, %.1f s", row.eval->ape_m.rmse, row.scans,
-                row.wall_s);
+  std::snprintf(buf, sizeof(buf), "ATE %.4f m, %d scans, %.1f s%s", row.eval->ape_m.rmse,
+                row.scans, row.wall_s, row.diverged ? ", DIVERGED (summary.json divergence)" : "");
   return buf;
 }
 
@@ -206,15 +215,18 @@ Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& tr
   std::vector<std::string> sets = req.overrides;
   sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
   RunRequest run{req.bag, req.out_dir + "/" + v.name, req.config_files, sets, req.quiet,
+                 /*allow_divergence=*/true,  // the row is marked instead
                  req.window};
   RunOutcome outcome;
   const auto t0 = Clock::now();
   row.exit_code = RunOdometryOnBag(run, &outcome);
   row.wall_s = SecondsSince(t0);
+  row.interrupted = Interrupted() && IsInterruptExit(row.exit_code);
   if (row.exit_code == 0) {
     row.scans = outcome.scans;
     row.ms_per_scan = outcome.median_ms;
     row.real_time_factor = outcome.real_time_factor;
+    row.diverged = outcome.diverged;
     EvaluateRow(truth, run.out_dir, &row);
   }
   steps->Detail(ResultLine(row));
@@ -238,6 +250,7 @@ void ReadRefineTiming(const std::string& dir, Row* row) {
   row->scans = j.value("scan_count", 0);
   if (row->scans > 0 && refine_s > 0) row->ms_per_scan = 1000.0 * refine_s / row->scans;
   if (refine_s > 0) row->real_time_factor = duration_s / refine_s;
+  row->diverged = j.value(nlohmann::json::json_pointer("/divergence/detected"), false);
 }
 
 Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& truth, Steps* steps) {
@@ -249,7 +262,7 @@ Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& tru
   row.init = start.name;
   std::vector<std::string> args = {"rvlio", "refine", "--bag", req.bag, "--init",
                                    req.out_dir + "/" + start.name + "/trajectory.tum",
-                                   "--out", dir};
+                                   "--out", dir, "--allow-divergence"};
   for (const auto& c : req.config_files) args.insert(args.end(), {"--config", c});
   for (const auto& s : req.overrides) args.insert(args.end(), {"--set", s});
   for (const auto& w : WindowArgs(req.window)) args.push_back(w);
@@ -261,6 +274,7 @@ Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& tru
     row.exit_code = Invoke(CmdRefine, args);
   }
   row.wall_s = SecondsSince(t0);
+  row.interrupted = Interrupted() && IsInterruptExit(row.exit_code);
   if (row.exit_code == 0) {
     ReadRefineTiming(dir, &row);
     EvaluateRow(truth, dir, &row);
@@ -288,9 +302,9 @@ std::string CsvText(const std::vector<Row>& rows) {
   std::ostringstream os;
   os << kCsvHeader;
   for (const Row& r : rows) {
-    os << r.name << "," << CsvField(r.label) << "," << (r.ok() ? "ok" : "failed") << ","
+    os << r.name << "," << CsvField(r.label) << "," << r.StatusName() << ","
        << r.exit_code << "," << r.init << "," << r.scans;
-    if (r.ok()) {
+    if (r.measured()) {
       os << "," << Exact(r.eval->ape_m.rmse) << "," << Exact(r.eval->rpe.trans_m.rmse) << ","
          << Exact(r.eval->along_axis.max_abs_m) << "," << Exact(r.eval->end_point_error_m) << ","
          << Exact(r.ms_per_scan) << "," << Exact(r.real_time_factor);
@@ -304,7 +318,7 @@ std::string CsvText(const std::vector<Row>& rows) {
 
 std::string AlignName(const std::vector<Row>& rows) {
   for (const Row& r : rows)
-    if (r.ok()) return AlignModeName(r.eval->align);
+    if (r.measured()) return AlignModeName(r.eval->align);
   return "se3";
 }
 
@@ -313,8 +327,12 @@ std::string MarkdownText(const CompareRequest& req, const std::vector<Row>& rows
   os << "| variant | ATE [m] | RPE [m] | along-axis max [m] | end-point [m] | ms/scan | "
         "real-time factor |\n|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
-    os << "| " << r.label << " | ";
-    if (!r.ok()) {
+    os << "| " << r.label << (r.diverged ? " (**diverged**)" : "") << " | ";
+    if (r.interrupted) {
+      os << "interrupted | | | | | |\n";
+      continue;
+    }
+    if (!r.measured()) {
       os << "failed (exit " << r.exit_code << ") | | | | | |\n";
       continue;
     }
@@ -336,13 +354,18 @@ void PrintTable(const std::vector<Row>& rows) {
   std::printf("\n  %-30s %9s %9s %12s %9s %9s %8s\n", "variant", "ATE [m]", "RPE [m]",
               "axis max [m]", "end [m]", "ms/scan", "speed");
   for (const Row& r : rows) {
-    if (!r.ok()) {
+    if (r.interrupted) {
+      std::printf("  %-30s interrupted\n", r.label.c_str());
+      continue;
+    }
+    if (!r.measured()) {
       std::printf("  %-30s failed (exit %d)\n", r.label.c_str(), r.exit_code);
       continue;
     }
-    std::printf("  %-30s %9.4f %9.4f %12.4f %9.4f %9.2f %7.1fx\n", r.label.c_str(),
+    std::printf("  %-30s %9.4f %9.4f %12.4f %9.4f %9.2f %7.1fx%s\n", r.label.c_str(),
                 r.eval->ape_m.rmse, r.eval->rpe.trans_m.rmse, r.eval->along_axis.max_abs_m,
-                r.eval->end_point_error_m, r.ms_per_scan, r.real_time_factor);
+                r.eval->end_point_error_m, r.ms_per_scan, r.real_time_factor,
+                r.diverged ? "  DIVERGED" : "");
   }
   std::printf("\n  ATE: RMSE after %s alignment; RPE: 1-frame translation RMSE; axis max: largest\n"
               "  error along the tunnel axis; end: end-point error. ms/scan: median CPU time per\n"
@@ -359,14 +382,15 @@ nlohmann::json RowJson(const CompareRequest& req, const Row& r,
                        const std::vector<std::string>& overrides) {
   nlohmann::json j = {{"variant", r.name},
                       {"label", r.label},
-                      {"status", r.ok() ? "ok" : "failed"},
+                      {"status", r.StatusName()},
+                      {"diverged", r.diverged},
                       {"exit_code", r.exit_code},
                       {"dir", req.out_dir + "/" + r.name},
                       {"overrides", overrides},
                       {"wall_s", Num(r.wall_s)}};
   if (!r.init.empty()) j["init"] = r.init;
   if (!r.error.empty()) j["error"] = r.error;
-  if (!r.ok()) return j;
+  if (!r.measured()) return j;
   const EvalResult& e = *r.eval;
   j["scans"] = r.scans;
   j["ate_rmse_m"] = Num(e.ape_m.rmse);
@@ -475,6 +499,30 @@ Status WriteJson(const CompareRequest& req, const std::vector<Row>& rows,
   return WriteFileAtomically(req.out_dir + "/compare.json", JsonText(j) + "\n");
 }
 
+// A row for a step a signal came before.
+Row NotRun(const std::string& name, const std::string& label) {
+  Row row;
+  row.name = name;
+  row.label = label;
+  row.exit_code = InterruptExitCode();
+  row.interrupted = true;
+  return row;
+}
+
+// compare.json without plots, and the one line; returns 130 / 143.
+int ReportInterrupt(const CompareRequest& req, const std::vector<Row>& rows) {
+  PlotReport plots;
+  plots.status = "skipped";
+  plots.message = "interrupted";
+  if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kName, s.message(), 1);
+  int finished = 0;
+  for (const Row& r : rows) finished += r.interrupted ? 0 : 1;
+  std::fprintf(stderr, "rvlio compare: interrupted by %s: %d of %zu steps finished; wrote "
+               "compare.{csv,md,json} (the rest marked interrupted) to %s\n",
+               InterruptSignalName().c_str(), finished, rows.size(), req.out_dir.c_str());
+  return InterruptExitCode();
+}
+
 }  // namespace
 
 int CompareSteps(const CompareRequest& request) {
@@ -482,12 +530,16 @@ int CompareSteps(const CompareRequest& request) {
 }
 
 int RunCompare(const CompareRequest& req) {
+  InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop the running variant, tabulate, 130/143
   Trajectory truth;
   if (int rc = CheckInputs(req, &truth); rc != 0) return rc;
   Steps steps(req);
   std::vector<Row> rows;
-  for (const Variant& v : StandardVariants()) rows.push_back(RunVariant(req, v, truth, &steps));
-  if (const Row* best = BestRow(rows); req.refine && best != nullptr) {
+  for (const Variant& v : StandardVariants())
+    rows.push_back(Interrupted() ? NotRun(v.name, v.label) : RunVariant(req, v, truth, &steps));
+  if (const Row* best = BestRow(rows); req.refine && Interrupted()) {
+    rows.push_back(NotRun(kRefine, "refine"));
+  } else if (req.refine && best != nullptr) {
     const Row start = *best;  // rows grows below
     rows.push_back(RunRefine(req, start, truth, &steps));
   }
@@ -499,12 +551,21 @@ int RunCompare(const CompareRequest& req) {
   }
   PrintTable(rows);
   PlotReport plots;
+  if (Interrupted()) return ReportInterrupt(req, rows);
   if (req.plots && any_ok) plots = DrawPlots(req, rows);
   if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kName, s.message(), 1);
   std::printf("\n  tables: %s/compare.{csv,md,json}; runs: %s/<variant>/\n", req.out_dir.c_str(),
               req.out_dir.c_str());
   if (req.plots) PrintPlotReport(req, plots);
+  int diverged = 0;
+  for (const Row& r : rows) diverged += r.diverged ? 1 : 0;
+  if (!any_ok && diverged > 0)
+    return Fail(kName, "every variant failed or diverged (see the table and each run's summary.json "
+                "divergence)", kExitDiverged);
   if (!any_ok) return Fail(kName, "every variant failed (see the table)", 1);
+  if (diverged > 0)
+    std::fprintf(stderr, "rvlio %s: warning: %d run(s) diverged, marked in the table\n", kName,
+                 diverged);
   return 0;
 }
 

@@ -30,9 +30,11 @@ struct CompareRequest {
 // Number of steps (runs) compare makes for `request`: 4 variants + refine.
 int CompareSteps(const CompareRequest& request);
 
-// Runs the comparison; returns the exit status (0: at least one variant ran,
-// 1: every variant failed, 2: bad input before any run, with one line on
-// stderr and nothing written).
+// Runs the comparison; returns the exit status (0: at least one variant ran
+// without diverging, 1: every variant failed, 3: none ran cleanly but some
+// ran to the end and diverged, 2: bad input before any run, with one line on
+// stderr and nothing written). Diverged runs are rows with status
+// "diverged", their metrics shown but not used as refine's start.
 int RunCompare(const CompareRequest& request);
 
 }  // namespace rvlio::cli

@@ -1,12 +1,14 @@
 #include "run_pipeline.h"
 #include "json_text.h"
 
+#include <signal.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -14,17 +16,21 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "interrupt.h"
+#include "divergence_cli.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/run_outputs.h"
 #include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/trajectory_io.h"
+#include "rvlio/io/tum_stream.h"
 #include "rvlio/odometry/odometry.h"
 
 namespace rvlio::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr const char* kPartialTrajectory = "trajectory.partial.tum";
 
 double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -89,6 +95,7 @@ struct RunData {
   std::vector<double> rss_mb;  // resident memory when each result came out
   TimeNs first_ns = -1, last_ns = -1;
   double wall_s = 0.0;
+  std::string interrupted_by;  // "SIGINT"/"SIGTERM" when a signal stopped the run
 };
 
 Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const Odometry& odo,
@@ -123,8 +130,15 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   j["peak_memory_mb"] = PeakMemoryMb();
   j["rv_active_scans"] = RvActiveScans(data.results);
   j["stats"] = StatsJson(odo.stats(), reader_stats);
+  j["divergence"] = DivergenceJson(odo.divergence());
   j["warnings"] = warnings;
+  j["interrupted"] = !data.interrupted_by.empty();
+  if (!data.interrupted_by.empty()) {
+    j["signal"] = data.interrupted_by;
+    j["last_stamp_s"] = data.results.empty() ? 0.0 : NsToSeconds(data.results.back().t_ns);
+  }
   outcome->scans = static_cast<int>(data.results.size());
+  outcome->diverged = odo.divergence().detected;
   outcome->median_ms = t.median_ms;
   outcome->real_time_factor = j["real_time_factor"];
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(j) + "\n"); !s.ok())
@@ -132,9 +146,10 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   return stage.Commit();
 }
 
-// Why a run produced no scan at all, naming the topic and the keys to look at.
+// Why a run produced no scan at all, naming the topic and the keys to look at
+// (nothing is written then, so the counts are in the message).
 std::string NoScanMessage(const RunRequest& req, const OdometryOptions& o,
-                          const SensorReaderStats& r) {
+                          const SensorReaderStats& r, const OdometryStats& odo) {
   const std::string topic = "lidar.topic '" + o.lidar.topic + "' in " + req.bag;
   if (r.scans == 0 && r.empty_scans > 0) {
     char range[96];
@@ -145,10 +160,43 @@ std::string NoScanMessage(const RunRequest& req, const OdometryOptions& o,
            std::to_string(r.out_of_range_points) + " out-of-range points (" + range + ")";
   }
   if (r.imu_samples == 0)
-    return "no usable IMU sample on imu.topic '" + o.imu.topic + "' in " + req.bag +
-           " (see summary.json stats.reader)";
-  return "no scan could be processed from " + req.bag +
-         " (see summary.json stats: IMU coverage, points per scan)";
+    return "no usable IMU sample on imu.topic '" + o.imu.topic + "' in " + req.bag + " (" +
+           std::to_string(r.imu_invalid) + " invalid, " + std::to_string(r.imu_duplicates) +
+           " repeated, " + std::to_string(r.imu_non_monotonic) + " out of order)";
+  return "no scan could be processed from " + req.bag + ": " + std::to_string(r.scans) +
+         " scans read, " + std::to_string(r.scans_before_first_imu) +
+         " before the first IMU sample, " + std::to_string(odo.scans_too_few_points) +
+         " with too few points, " + std::to_string(odo.scans_before_imu) +
+         " during the IMU initialization";
+}
+
+// Appends the poses of the results not streamed yet to trajectory.partial.tum;
+// a write error stops the streaming with one warning (the run goes on).
+void StreamNewPoses(const std::vector<ScanResult>& results, size_t* streamed, TumStream* stream,
+                    std::vector<std::string>* warnings) {
+  for (; *streamed < results.size(); ++*streamed) {
+    if (!stream->is_open()) continue;
+    StampedPose pose;
+    pose.t_ns = results[*streamed].t_ns;
+    pose.p_world_imu = results[*streamed].T_world_imu.t;
+    pose.q_world_imu = results[*streamed].T_world_imu.quaternion();
+    if (Status s = stream->Append(pose); !s.ok())
+      warnings->push_back(s.message() + "; the partial trajectory is no longer written");
+  }
+}
+
+// The one line of an interrupted run; returns its exit status (130 / 143).
+int ReportInterrupt(const RunRequest& req, const RunData& data) {
+  if (data.results.empty()) {
+    std::fprintf(stderr, "rvlio run: interrupted by %s before the first scan was done; nothing "
+                 "written\n", data.interrupted_by.c_str());
+  } else {
+    std::fprintf(stderr, "rvlio run: interrupted by %s after %zu scans (up to t = %.3f s): wrote "
+                 "trajectory.tum, map.pcd, scans.csv and summary.json to %s\n",
+                 data.interrupted_by.c_str(), data.results.size(),
+                 NsToSeconds(data.results.back().t_ns), req.out_dir.c_str());
+  }
+  return InterruptExitCode();
 }
 
 // A number in its shortest form ("0.1", "2e-05").
@@ -197,16 +245,34 @@ OutputStage::~OutputStage() {
   std::filesystem::remove_all(stage_dir_, ec);
 }
 
-Status OutputStage::Open() {
-  stage_dir_ = (std::filesystem::path(out_dir_) / (".rvlio_stage." + std::to_string(::getpid())))
-                   .string();
+// Staging folders of processes that no longer exist (killed, or aborted by a
+// second signal while writing) are removed when the next run stages there.
+void RemoveStaleStages(const std::string& out_dir) {
+  const std::string prefix = ".rvlio_stage.";
   std::error_code ec;
-  std::filesystem::remove_all(stage_dir_, ec);  // left by a killed run with our pid
-  if (!std::filesystem::create_directory(stage_dir_, ec)) {
-    const std::string why = ec.message();
-    stage_dir_.clear();
+  for (const auto& e : std::filesystem::directory_iterator(out_dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const long pid = std::strtol(name.c_str() + prefix.size(), nullptr, 10);
+    if (pid <= 0 || (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)) {
+      std::error_code ignored;
+      std::filesystem::remove_all(e.path(), ignored);
+    }
+  }
+}
+
+Status OutputStage::Open() {
+  RemoveStaleStages(out_dir_);
+  // Unique per run, not per process: compare runs several variants in one
+  // process, and two runs of one process may share an output folder.
+  std::string name = (std::filesystem::path(out_dir_) /
+                      (".rvlio_stage." + std::to_string(::getpid()) + ".XXXXXX"))
+                         .string();
+  if (::mkdtemp(name.data()) == nullptr) {
+    const std::string why = std::strerror(errno);
     return Status::InvalidInput("cannot write to output folder " + out_dir_ + ": " + why);
   }
+  stage_dir_ = name;
   return Status::Ok();
 }
 
@@ -285,16 +351,29 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(req.bag, options->lidar, options->imu, req.window, options->io);
   if (!reader.ok()) return Fail("run", reader.status().message());
+  std::error_code ec;
+  const bool out_dir_existed = std::filesystem::exists(req.out_dir, ec);
   if (!PrepareOutputDir("run", req.out_dir)) return 2;
   StatusOr<BagInfo> info = ReadBagInfo(req.bag);
   Progress progress(!req.quiet, info.ok() ? info->start_s : 0.0, info.ok() ? info->end_s : 1.0);
 
   RunData data;
+  std::vector<std::string> stream_warnings;
+  TumStream partial;  // trajectory.partial.tum: what a killed run leaves (tum_stream.h)
+  if (Status s = partial.Open((std::filesystem::path(req.out_dir) / kPartialTrajectory).string());
+      !s.ok())
+    stream_warnings.push_back(s.message() + "; the partial trajectory is not written");
+  size_t streamed = 0;
   const auto t0 = Clock::now();
   ImuSample imu;
   Scan scan;
   Status read_error;
+  size_t divergence_warned = 0;
   for (;;) {
+    if (Interrupted()) {  // the scans done so far are the outputs; pending ones are dropped
+      data.interrupted_by = InterruptSignalName();
+      break;
+    }
     StatusOr<SensorMessage> m = (*reader)->Next(&imu, &scan);
     if (!m.ok()) {
       read_error = m.status();  // keep what was read: outputs are still written
@@ -307,24 +386,42 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     if (*m == SensorMessage::kImu) (*odo)->AddImu(imu);
     else (*odo)->AddScan(std::move(scan));
     (*odo)->Poll(&data.results);
+    StreamNewPoses(data.results, &streamed, &partial, &stream_warnings);
+    (void)partial.SyncIfDue();  // a failure surfaces at the next Append
     if (data.rss_mb.size() < data.results.size())
       data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
     progress.Update(static_cast<int>(data.results.size()), t);
+    WarnDivergence("run", (*odo)->divergence(), &divergence_warned);
   }
-  (*odo)->Finish(&data.results);
+  if (data.interrupted_by.empty()) {
+    (*odo)->Finish(&data.results);
+    WarnDivergence("run", (*odo)->divergence(), &divergence_warned);
+  }
   data.rss_mb.resize(data.results.size(), CurrentMemoryMb());
   data.wall_s = SecondsSince(t0);
   const SensorReaderStats& reader_stats = (*reader)->stats();
   std::vector<std::string> warnings = ReaderWarnings(reader_stats, options->lidar, options->imu);
   for (const auto& w : (*odo)->warnings()) warnings.push_back(w);
+  for (const auto& w : (*reader)->warnings()) warnings.push_back(w);
+  for (const auto& w : stream_warnings) warnings.push_back(w);
+  if (data.results.empty()) {  // nothing to write: nothing new in the output folder
+    partial.Remove();
+    if (!out_dir_existed) std::filesystem::remove(req.out_dir, ec);  // only if empty
+    if (!data.interrupted_by.empty()) return ReportInterrupt(req, data);
+    if (!read_error.ok()) return Fail("run", read_error.message());
+    return Fail("run", NoScanMessage(req, *options, reader_stats, (*odo)->stats()));
+  }
   const Status written = WriteOutputs(req, *options, **odo, reader_stats, data,
                                       (*reader)->lidar_layout(), warnings, outcome);
+  partial.Remove();  // the complete outputs (or the folder as it was) replace it
   // A failed run says one line (the warnings are in summary.json when written).
   if (!written.ok()) return Fail("run", written.message(), written.exit_code());
   if (!read_error.ok())
     return Fail("run", read_error.message() + " (outputs hold the scans read before it)");
-  if (data.results.empty()) return Fail("run", NoScanMessage(req, *options, reader_stats));
   for (const auto& w : warnings) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
+  if (!data.interrupted_by.empty()) return ReportInterrupt(req, data);
+  if ((*odo)->divergence().detected)
+    return FinishDiverged("run", (*odo)->divergence(), req.out_dir, req.allow_divergence);
   return 0;
 }
 

@@ -17,6 +17,7 @@ struct RunRequest {
   std::vector<std::string> config_files;
   std::vector<std::string> overrides;  // --set key=value
   bool quiet = false;                  // no progress line even on a terminal
+  bool allow_divergence = false;       // exit 0 even if the divergence monitor fired
   ReadWindow window;                   // --start / --duration
 };
 
@@ -24,10 +25,18 @@ struct RunOutcome {
   int scans = 0;
   double median_ms = 0.0;
   double real_time_factor = 0.0;
+  bool diverged = false;  // the divergence monitor fired (summary.json divergence)
 };
 
 // Reads the bag, runs the odometry and writes the outputs of DESIGN.md
 // section 6. Returns the exit status; errors are printed as one line.
+// While it runs, trajectory.partial.tum in the output folder receives each
+// pose as it is estimated (removed at an orderly end). Under an InterruptScope
+// (interrupt.h) a signal stops the reading: the outputs of the scans done so
+// far are written (summary.json "interrupted": true) and the status is 130 /
+// 143. Nothing is written when no scan was done. A run the divergence
+// monitor flagged writes every output and returns kExitDiverged
+// (divergence_cli.h) unless request.allow_divergence.
 int RunOdometryOnBag(const RunRequest& request, RunOutcome* outcome);
 
 // Creates `dir` if needed and proves it writable; false with a message if not.
@@ -52,7 +61,9 @@ class OutputStage {
   OutputStage(const OutputStage&) = delete;
   OutputStage& operator=(const OutputStage&) = delete;
 
-  Status Open();  // creates OUT/.rvlio_stage.<pid>
+  // Creates OUT/.rvlio_stage.<pid>.<random> (mkdtemp: unique per run) and
+  // removes staging folders that processes no longer running left behind.
+  Status Open();
   // Where to write output `name` (a plain file name); Commit() moves it.
   std::string Path(const std::string& name);
   // Renames every staged file into the output folder.

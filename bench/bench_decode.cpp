@@ -5,6 +5,10 @@
 // reported per scan. Neither is inside `rvlio run`'s per-scan time: the reader
 // decodes the next scan before the estimator sees it.
 //
+// BM_ReadMcap reads the same 20 sweeps + 400 IMU-sized payloads from an MCAP
+// file (io/mcap.h) with chunks uncompressed, zstd and lz4: the container's
+// cost per message (decompression, CRC, copy; no CDR decoding).
+//
 //   build-bench/bin/bench_decode
 #include <cmath>
 #include <cstdio>
@@ -19,6 +23,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "rvlio/io/mcap.h"
 #include "rvlio/io/pointcloud2.h"
 #include "rvlio/io/sensor_bag.h"
 
@@ -184,6 +189,81 @@ void BM_ReadBagPerScan(benchmark::State& state) {
   state.SetLabel("20 scans + 400 IMU samples per iteration");
 }
 BENCHMARK(BM_ReadBagPerScan)->Unit(benchmark::kMillisecond);
+
+// The sweep message of BM_DecodePointCloud2 20 times and 400 IMU-sized
+// (300-byte) payloads, as an MCAP file with chunk compression `compression`.
+class McapFile {
+ public:
+  explicit McapFile(const std::string& compression) {
+    path_ = (std::filesystem::temp_directory_path() /
+             ("rvlio_bench_decode_" + std::to_string(::getpid()) + "_" +
+              (compression.empty() ? "none" : compression) + ".mcap"))
+                .string();
+    std::mt19937 rng(1);
+    const Message cloud = OusterMessage(Sweep(&rng));
+    mcap::WriterOptions options;
+    options.compression = compression;
+    auto writer = mcap::Writer::Create(path_, options);
+    if (!writer.ok()) return;
+    auto schema = (*writer)->AddSchema("sensor_msgs/msg/PointCloud2", "ros2msg", "");
+    auto imu_schema = (*writer)->AddSchema("sensor_msgs/msg/Imu", "ros2msg", "");
+    if (!schema.ok() || !imu_schema.ok()) return;
+    auto lidar = (*writer)->AddChannel(*schema, "/points", "cdr");
+    auto imu = (*writer)->AddChannel(*imu_schema, "/imu", "cdr");
+    if (!lidar.ok() || !imu.ok()) return;
+    uint64_t t_ns = 1700000000000000000ull;
+    for (int k = 0; k < 20; ++k) {
+      for (int j = 0; j < 20; ++j) {
+        mcap::Message m{*imu, 0, t_ns + j * 5000000ull, 0, std::vector<uint8_t>(300, uint8_t(j))};
+        if (!(*writer)->Write(m).ok()) return;
+      }
+      if (!(*writer)->Write(mcap::Message{*lidar, 0, t_ns, 0, cloud.data}).ok()) return;
+      t_ns += 100000000ull;
+    }
+    ok_ = (*writer)->Close().ok();
+    bytes_ = ok_ ? std::filesystem::file_size(path_) : 0;
+  }
+  ~McapFile() { std::filesystem::remove(path_); }
+  bool ok() const { return ok_; }
+  const std::string& path() const { return path_; }
+  uint64_t bytes() const { return bytes_; }
+
+ private:
+  std::string path_;
+  bool ok_ = false;
+  uint64_t bytes_ = 0;
+};
+
+void BM_ReadMcap(benchmark::State& state) {
+  static const char* kCompressions[] = {"", "zstd", "lz4"};
+  const std::string compression = kCompressions[state.range(0)];
+  const McapFile file(compression);
+  if (!file.ok()) {
+    state.SkipWithError("could not write the temporary MCAP file");
+    return;
+  }
+  int64_t messages = 0, payload_bytes = 0;
+  for (auto _ : state) {
+    auto reader = mcap::Reader::Open(file.path());
+    if (!reader.ok()) {
+      state.SkipWithError(reader.status().message().c_str());
+      return;
+    }
+    mcap::Message m;
+    for (;;) {
+      StatusOr<bool> more = (*reader)->Next(&m);
+      if (!more.ok() || !*more) break;
+      ++messages;
+      payload_bytes += static_cast<int64_t>(m.data.size());
+    }
+  }
+  // items = messages (20 sweeps + 400 IMU payloads per iteration).
+  state.SetItemsProcessed(messages);
+  state.SetBytesProcessed(payload_bytes);
+  state.counters["file_MB"] = static_cast<double>(file.bytes()) / 1e6;
+  state.SetLabel(compression.empty() ? "chunks uncompressed" : "chunks " + compression);
+}
+BENCHMARK(BM_ReadMcap)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace rvlio

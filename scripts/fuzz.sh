@@ -11,7 +11,7 @@
 #                 same on every machine (a slower machine stops at --seconds
 #                 after a prefix of the same inputs). Without --ci the seed is
 #                 random and new inputs accumulate: use that to hunt for bugs.
-#   TARGET        pointcloud2, config, trajectory (default: all three)
+#   TARGET        pointcloud2, config, trajectory, mcap, cdr (default: all)
 #
 # Seeds: fuzz/corpus/<target>/ (read only; refresh with fuzz/make_seeds.py).
 # New interesting inputs go to build-fuzz/corpus/<target>/, which later runs
@@ -35,16 +35,17 @@ while [[ $# -gt 0 ]]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[[ ${#targets[@]} -eq 0 ]] && targets=(pointcloud2 config trajectory)
+[[ ${#targets[@]} -eq 0 ]] && targets=(pointcloud2 config trajectory mcap cdr)
 if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [[ "$seconds" -lt 1 ]]; then
   echo "fuzz.sh: --seconds must be a positive integer (got '$seconds')" >&2
   exit 2
 fi
 
 # Longest input per target: a few times the largest seed.
-declare -A max_len=([pointcloud2]=8192 [config]=8192 [trajectory]=4096)
+declare -A max_len=([pointcloud2]=8192 [config]=8192 [trajectory]=4096 [mcap]=8192)
 # --ci: inputs per target, about 60 s each on the 2-core machine of bench/RESULTS.md.
-declare -A ci_runs=([pointcloud2]=600000 [config]=10000 [trajectory]=500000)
+declare -A ci_runs=([pointcloud2]=600000 [config]=10000 [trajectory]=500000 [mcap]=200000 [cdr]=500000)
+max_len[cdr]=8192
 for t in "${targets[@]}"; do
   [[ -n "${max_len[$t]:-}" ]] || { echo "fuzz.sh: unknown target '$t'" >&2; exit 2; }
 done

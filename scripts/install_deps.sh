@@ -8,16 +8,18 @@ packages=(
   build-essential cmake pkg-config git ccache
   libeigen3-dev libceres-dev libsuitesparse-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
-  libpcl-dev
+  libpcl-dev libzstd-dev liblz4-dev
+  libsqlite3-dev
   librosbag-storage-dev libsensor-msgs-dev libroscpp-core-dev
   pluginlib-dev libclass-loader-dev librcpputils-dev libament-index-cpp-dev
   python3-rosbag python3-matplotlib python3-yaml
 )
 # Extra packages the test command needs (Snakemake workflow test; clang with
 # the libFuzzer/ASan runtimes and llvm-symbolizer for scripts/fuzz.sh — gcc's
-# ASan/UBSan runtimes for scripts/sanitize.sh come with build-essential).
+# ASan/UBSan runtimes for scripts/sanitize.sh come with build-essential; a
+# Slurm controller, node daemon, client and munge for scripts/slurm_local.sh).
 if [[ "${1:-}" == "--with-test-tools" ]]; then
-  packages+=(snakemake clang-14 libclang-rt-14-dev llvm-14)
+  packages+=(snakemake clang-14 libclang-rt-14-dev llvm-14 munge slurmctld slurmd slurm-client)
 fi
 
 missing=()

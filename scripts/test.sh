@@ -8,18 +8,23 @@
 #   fuzz      scripts/fuzz.sh --ci: the libFuzzer targets of fuzz/ (clang) in
 #             build-fuzz/, seed 1, a fixed number of inputs (about 60 s) per
 #             target, at most $RVLIO_FUZZ_SECONDS (default 60) s each
+#   slurm     scripts/slurm_test.sh: a single-node Slurm cluster started
+#             here (scripts/slurm_local.sh), config/grids/tiny.yaml through
+#             the Snakemake workflow on it, the table compared with the one
+#             of `rvlio ablate`, a failing cell and cancelled jobs (about
+#             2 minutes); the cluster is stopped afterwards, also on failure
 #
 # A developer may run a subset: RVLIO_CI_STAGES=release (or "release,fuzz",
 # ...) bash scripts/test.sh. RVLIO_FUZZ_SECONDS=10 shortens the fuzz stage.
 # Each stage's wall time is printed at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-stages=${RVLIO_CI_STAGES:-release,sanitize,fuzz}
+stages=${RVLIO_CI_STAGES:-release,sanitize,fuzz,slurm}
 jobs=$(nproc 2>/dev/null || echo 2)
 for s in ${stages//,/ }; do
   case "$s" in
-    release|sanitize|fuzz) ;;
-    *) echo "test.sh: unknown stage '$s' in RVLIO_CI_STAGES (release, sanitize, fuzz)" >&2; exit 2 ;;
+    release|sanitize|fuzz|slurm) ;;
+    *) echo "test.sh: unknown stage '$s' in RVLIO_CI_STAGES (release, sanitize, fuzz, slurm)" >&2; exit 2 ;;
   esac
 done
 want() { [[ ",$stages," == *",$1,"* ]]; }
@@ -33,7 +38,7 @@ trap 'rm -f "$log"' EXIT
 passed=0
 count_tests() {
   local n
-  n=$(grep -Eo '(tests failed out of [0-9]+|^fuzz: [0-9]+ passed)' "$log" | grep -Eo '[0-9]+' | tail -1 || true)
+  n=$(grep -Eo '(tests failed out of [0-9]+|^(fuzz|slurm): [0-9]+ passed)' "$log" | grep -Eo '[0-9]+' | tail -1 || true)
   passed=$((passed + ${n:-0}))
 }
 
@@ -55,6 +60,11 @@ if want fuzz; then
   bash scripts/fuzz.sh --ci 2>&1 | tee "$log"
   count_tests
   finish_stage fuzz
+fi
+if want slurm; then
+  bash scripts/slurm_test.sh 2>&1 | tee "$log"
+  count_tests
+  finish_stage slurm
 fi
 
 echo "test.sh: stages $stages passed; wall time per stage: $(IFS=,; echo "${times[*]}" | sed 's/,/, /g')"

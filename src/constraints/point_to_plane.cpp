@@ -1,5 +1,9 @@
 #include "rvlio/constraints/point_to_plane.h"
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 namespace rvlio {
 
 // Derivation (paper Eq. 3). With p_imu = R_il p_l + t_il and
@@ -42,6 +46,26 @@ double PointToPlaneResidualWithExtrinsics(const Constraint& c, const Pose3& T_wo
     J->block<1, 3>(0, 9) = u_imu.transpose();
   }
   return u.dot(p_world - c.q_world);
+}
+
+ResidualStats ComputeResidualStats(const ConstraintList& constraints, const Pose3& T_world_imu,
+                                   const Pose3& T_imu_lidar) {
+  ResidualStats s;
+  if (constraints.empty()) return s;
+  std::vector<double> abs_r;
+  abs_r.reserve(constraints.size());
+  double sum_sq = 0.0;
+  for (const Constraint& c : constraints) {
+    const double r = PointToPlaneResidual(c, T_world_imu, T_imu_lidar);
+    abs_r.push_back(std::abs(r));
+    sum_sq += r * r;
+  }
+  const auto mid = abs_r.begin() + static_cast<std::ptrdiff_t>(abs_r.size() / 2);
+  std::nth_element(abs_r.begin(), mid, abs_r.end());
+  s.count = static_cast<int>(abs_r.size());
+  s.median_abs_m = *mid;
+  s.rms_m = std::sqrt(sum_sq / static_cast<double>(abs_r.size()));
+  return s;
 }
 
 }  // namespace rvlio

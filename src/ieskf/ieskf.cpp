@@ -39,14 +39,16 @@ bool IsHealthy(const FilterState& x, const Matrix24d& P) {
 // Columns: [dtheta, dp] and, when extrinsics are estimated, [dphi, dt].
 int AccumulateNormalEquations(const ConstraintList& constraints, const FilterState& x,
                               bool with_extrinsics, double inv_sigma2, Matrix12d* HtRinvH,
-                              Vector12d* HtRinvz) {
+                              Vector12d* HtRinvz, double* zRinvz) {
   HtRinvH->setZero();
   HtRinvz->setZero();
+  *zRinvz = 0.0;
   const Pose3 T_world_imu = x.T_world_imu(), T_imu_lidar = x.T_imu_lidar();
   Eigen::Matrix<double, 1, 12> h;
   for (const Constraint& c : constraints) {
     const double r = PointToPlaneResidualWithExtrinsics(c, T_world_imu, T_imu_lidar, &h);
     const double w = c.weight * inv_sigma2;
+    *zRinvz += w * r * r;
     if (with_extrinsics) {
       HtRinvH->noalias() += w * h.transpose() * h;
       HtRinvz->noalias() += w * r * h.transpose();
@@ -172,7 +174,8 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
     result.rv = ApplyRv(rv_, x.T_world_lidar(), &constraints, &rv_workspace_);
     result.num_constraints = static_cast<int>(constraints.size());
     if (result.num_constraints < kMinConstraints) break;
-    AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz);
+    double zRinvz = 0.0;
+    AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
 
     const Matrix24d J_inv = BoxminusJacobianInverse(x, x0);
     const Matrix24d J = BoxminusJacobian(x, x0);
@@ -185,6 +188,8 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
     const Eigen::LDLT<Matrix24d> ldlt(A);
     const Vector24d dx = -ldlt.solve(b);
     S = ldlt.solve(Matrix24d::Identity());
+    // At x = x0 (e = 0): z^T (H P0 H^T + R)^-1 z = z^T R^-1 z - b^T A^-1 b = z^T R^-1 z + b^T dx.
+    if (it == 0) result.nis_per_dof = (zRinvz + b.dot(dx)) / result.num_constraints;
     x = Boxplus(x, dx);
     result.iterations = it + 1;
     result.last_step_norm = dx.norm();
@@ -200,6 +205,7 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
   x_ = x;
   P_ = S;
   result.ok = true;
+  result.residuals = ComputeResidualStats(constraints, x.T_world_imu(), x.T_imu_lidar());
   return result;
 }
 

@@ -1,5 +1,8 @@
-// ReadBagInfo: what `rvlio info` prints about a bag.
+// ReadBagInfo: what `rvlio info` prints about a recording (ROS1 bag through
+// rosbag_storage; ROS 2 .db3 / .mcap / bag folder through io/recording).
+#include <algorithm>
 #include <exception>
+#include <functional>
 #include <limits>
 
 #include <rosbag/bag.h>
@@ -7,6 +10,8 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include "rosbag_common.h"
+#include "rvlio/io/cdr.h"
+#include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
 
 namespace rvlio {
@@ -14,34 +19,67 @@ namespace {
 
 constexpr int kScansToSample = 5;
 
-// Layout, fields and mean point count from the first few messages.
-void DescribeCloudTopic(const rosbag::Bag& bag, BagTopicInfo* info) {
-  LidarOptions lidar;  // auto layout and stamp; no range crop: count every valid point
-  lidar.min_range = 0.0;
-  lidar.max_range = std::numeric_limits<double>::max();
-  rosbag::View view(bag, rosbag::TopicQuery(info->topic));
-  int64_t points = 0;
-  for (const rosbag::MessageInstance& m : view) {
-    if (info->scans_sampled >= kScansToSample) break;
-    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
-    if (!msg) break;
-    const PointCloud2View cloud = bag_detail::ToView(*msg, info->topic);
-    if (info->fields.empty()) {
-      for (const auto& f : cloud.fields) info->fields.push_back(f.name);
+// Accumulates layout, fields and mean point count over the first few clouds.
+class CloudSampler {
+ public:
+  explicit CloudSampler(BagTopicInfo* info) : info_(info) {
+    lidar_.min_range = 0.0;  // auto layout and stamp; no range crop: count every valid point
+    lidar_.max_range = std::numeric_limits<double>::max();
+  }
+  bool Full() const { return done_ || info_->scans_sampled >= kScansToSample; }
+
+  // A cloud or why it could not be deserialized.
+  void Add(const StatusOr<PointCloud2View>& cloud) {
+    if (!cloud.ok()) return Fail(cloud.status().message());
+    if (info_->fields.empty()) {
+      for (const auto& f : cloud->fields) info_->fields.push_back(f.name);
     }
     DecodeStats stats;
-    StatusOr<Scan> scan = DecodePointCloud2(cloud, lidar, &stats);
-    if (!scan.ok()) {
-      info->lidar_layout = "unknown";
-      info->decode_error = scan.status().message();
-      return;
-    }
-    info->lidar_layout = stats.layout;
-    info->header_stamp = stats.stamp_is_end ? "end" : "start";
-    points += static_cast<int64_t>(scan->points.size());
-    ++info->scans_sampled;
+    StatusOr<Scan> scan = DecodePointCloud2(*cloud, lidar_, &stats);
+    if (!scan.ok()) return Fail(scan.status().message());
+    info_->lidar_layout = stats.layout;
+    info_->header_stamp = stats.stamp_is_end ? "end" : "start";
+    points_ += static_cast<int64_t>(scan->points.size());
+    ++info_->scans_sampled;
   }
-  if (info->scans_sampled > 0) info->points_per_scan = double(points) / info->scans_sampled;
+
+  void Finish() {
+    if (info_->scans_sampled > 0 && info_->decode_error.empty())
+      info_->points_per_scan = double(points_) / info_->scans_sampled;
+  }
+
+ private:
+  void Fail(const std::string& why) {
+    info_->lidar_layout = "unknown";
+    info_->decode_error = why;
+    done_ = true;
+  }
+
+  BagTopicInfo* info_;
+  LidarOptions lidar_;
+  int64_t points_ = 0;
+  bool done_ = false;
+};
+
+void SetRate(BagTopicInfo* info, TimeNs first_ns, TimeNs last_ns) {
+  if (info->count < 2) return;
+  const double span = NsToSeconds(last_ns - first_ns);
+  if (span > 0.0) info->rate_hz = double(info->count - 1) / span;
+}
+
+// ---------------------------------------------------------------------------
+// ROS1
+
+void DescribeCloudTopic(const rosbag::Bag& bag, BagTopicInfo* info) {
+  CloudSampler sampler(info);
+  rosbag::View view(bag, rosbag::TopicQuery(info->topic));
+  for (const rosbag::MessageInstance& m : view) {
+    if (sampler.Full()) break;
+    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
+    if (!msg) break;
+    sampler.Add(bag_detail::ToView(*msg, info->topic));
+  }
+  sampler.Finish();
 }
 
 BagTopicInfo DescribeTopic(const rosbag::Bag& bag, const std::string& topic,
@@ -51,11 +89,8 @@ BagTopicInfo DescribeTopic(const rosbag::Bag& bag, const std::string& topic,
   info.type = type;
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   info.count = view.size();
-  if (info.count > 1) {
-    const double span = NsToSeconds(bag_detail::ToNs(view.getEndTime()) -
-                                    bag_detail::ToNs(view.getBeginTime()));
-    if (span > 0.0) info.rate_hz = double(info.count - 1) / span;
-  }
+  if (info.count > 0)
+    SetRate(&info, bag_detail::ToNs(view.getBeginTime()), bag_detail::ToNs(view.getEndTime()));
   if (decode_clouds && type == bag_detail::kPointCloud2Type) DescribeCloudTopic(bag, &info);
   return info;
 }
@@ -70,6 +105,7 @@ StatusOr<BagInfo> Describe(const std::string& path, const rosbag::Bag& bag,
   }
   BagInfo info;
   info.path = path;
+  info.storage = "ros1";
   rosbag::View all(bag);
   info.messages = all.size();
   if (info.messages > 0) {
@@ -85,9 +121,7 @@ StatusOr<BagInfo> Describe(const std::string& path, const rosbag::Bag& bag,
   return info;
 }
 
-}  // namespace
-
-StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic) {
+StatusOr<BagInfo> ReadRos1Info(const std::string& path, const std::string& lidar_topic) {
   rosbag::Bag bag;
   if (Status s = bag_detail::OpenForRead(path, &bag); !s.ok()) return s;
   try {
@@ -96,6 +130,81 @@ StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_
     return Status::InvalidInput("reading bag '" + path + "' failed (" + e.what() +
                                 "); truncated or corrupt?");
   }
+}
+
+// ---------------------------------------------------------------------------
+// ROS 2
+
+bool IsCloudType(const std::string& type) { return type == cdr::kPointCloud2Type; }
+
+// Samples the first clouds of one topic from a fresh source.
+Status DescribeRos2Cloud(const std::string& path, int topic, BagTopicInfo* info) {
+  StatusOr<std::unique_ptr<RecordingSource>> source = RecordingSource::Open(path);
+  if (!source.ok()) return source.status();
+  if (Status s = (*source)->SetTopicFilter({topic}); !s.ok()) return s;
+  CloudSampler sampler(info);
+  RawMessage m;
+  while (!sampler.Full()) {
+    StatusOr<bool> got = (*source)->Next(&m);
+    if (!got.ok()) return got.status();
+    if (!*got) break;
+    sampler.Add(cdr::DecodePointCloud2(m.data.data(), m.data.size(), info->topic));
+  }
+  sampler.Finish();
+  return Status::Ok();
+}
+
+StatusOr<BagInfo> ReadRos2Info(const std::string& path, const std::string& lidar_topic) {
+  StatusOr<std::unique_ptr<RecordingSource>> source = RecordingSource::Open(path);
+  if (!source.ok()) return source.status();
+  const std::vector<RecordingTopic>& topics = (*source)->topics();
+  std::map<std::string, std::string> types;
+  for (const RecordingTopic& t : topics) types[t.name] = t.type;
+  if (!lidar_topic.empty()) {
+    Status s = bag_detail::RequireTopic(path, types, lidar_topic, cdr::kPointCloud2Type,
+                                        "--lidar-topic");
+    if (!s.ok()) return s;
+  }
+  StatusOr<std::vector<RecordingTopicStats>> stats = (*source)->TopicStats();
+  if (!stats.ok()) return stats.status();
+  BagInfo info;
+  info.path = path;
+  info.storage = (*source)->storage();
+  info.compressions = (*source)->compressions();
+  bool any = false;
+  for (size_t i = 0; i < topics.size(); ++i) {
+    const RecordingTopicStats& st = (*stats)[i];
+    BagTopicInfo t;
+    t.topic = topics[i].name;
+    t.type = topics[i].type;
+    t.count = st.count;
+    SetRate(&t, st.first_ns, st.last_ns);
+    const bool decode = lidar_topic.empty() || lidar_topic == t.topic;
+    if (decode && IsCloudType(t.type) && t.count > 0) {
+      if (Status s = DescribeRos2Cloud(path, static_cast<int>(i), &t); !s.ok()) return s;
+    }
+    info.topics.push_back(std::move(t));
+    if (st.count == 0) continue;
+    info.start_ns = any ? std::min(info.start_ns, st.first_ns) : st.first_ns;
+    info.end_ns = any ? std::max(info.end_ns, st.last_ns) : st.last_ns;
+    info.messages += st.count;
+    any = true;
+  }
+  info.start_s = NsToSeconds(info.start_ns);
+  info.end_s = NsToSeconds(info.end_ns);
+  std::sort(info.topics.begin(), info.topics.end(),
+            [](const BagTopicInfo& a, const BagTopicInfo& b) { return a.topic < b.topic; });
+  info.warnings = (*source)->warnings();
+  return info;
+}
+
+}  // namespace
+
+StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic) {
+  StatusOr<RecordingKind> kind = DetectRecording(path);
+  if (!kind.ok()) return kind.status();
+  if (*kind == RecordingKind::kRos1Bag) return ReadRos1Info(path, lidar_topic);
+  return ReadRos2Info(path, lidar_topic);
 }
 
 }  // namespace rvlio

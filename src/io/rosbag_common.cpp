@@ -28,27 +28,6 @@ std::map<std::string, std::string> TopicTypes(const rosbag::Bag& bag) {
   return topics;
 }
 
-std::string DescribeTopics(const std::map<std::string, std::string>& topics) {
-  std::string out;
-  for (const auto& [topic, type] : topics) out += (out.empty() ? "" : ", ") + topic + " (" + type + ")";
-  return out.empty() ? "none" : out;
-}
-
-Status RequireTopic(const std::string& path, const std::map<std::string, std::string>& topics,
-                    const std::string& topic, const std::string& type, const std::string& key) {
-  auto it = topics.find(topic);
-  if (it == topics.end()) {
-    return Status::InvalidInput(key + " '" + topic + "' is not in bag '" + path +
-                                "'; topics present: " + DescribeTopics(topics));
-  }
-  if (it->second != type) {
-    return Status::InvalidInput(key + " '" + topic + "' in bag '" + path + "' has type " +
-                                it->second + ", expected " + type +
-                                "; topics present: " + DescribeTopics(topics));
-  }
-  return Status::Ok();
-}
-
 TimeNs ToNs(const ros::Time& t) { return static_cast<TimeNs>(t.toNSec()); }
 
 ros::Time RecordTime(TimeNs t_ns) {

@@ -12,6 +12,7 @@
 #include "rvlio/common/status.h"
 #include "rvlio/common/time.h"
 #include "rvlio/io/pointcloud2.h"
+#include "sensor_reader_common.h"
 
 namespace rvlio::bag_detail {
 
@@ -24,12 +25,7 @@ Status OpenForRead(const std::string& path, rosbag::Bag* bag);
 
 // topic -> message type of every connection in the bag.
 std::map<std::string, std::string> TopicTypes(const rosbag::Bag& bag);
-// "/a (sensor_msgs/Imu), /b (sensor_msgs/PointCloud2)" or "none".
-std::string DescribeTopics(const std::map<std::string, std::string>& topics);
-
-// InvalidInput unless `topic` is in the bag with message type `type`.
-Status RequireTopic(const std::string& path, const std::map<std::string, std::string>& topics,
-                    const std::string& topic, const std::string& type, const std::string& key);
+// DescribeTopics and RequireTopic: sensor_reader_common.h.
 
 TimeNs ToNs(const ros::Time& t);
 // The record time of a message at t_ns: rosbag rejects times below

@@ -59,13 +59,24 @@ Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& 
   return writer.Commit();
 }
 
+namespace {
+// A statistic that may be unknown (NaN): an empty field.
+std::string Optional(double v) {
+  if (!std::isfinite(v)) return "";
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+}  // namespace
+
 Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
                      const std::vector<double>& rss_mb) {
   std::ostringstream os;
   os.precision(9);
   os << "t,status,raw_points,points,constraints,iterations,rv_active,n_alpha_x,n_alpha_y,"
         "n_alpha_z,scv,coplanar,repaired,K,rv_iterations,coplanar_fraction,localizability,"
-        "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb,reinforced\n";
+        "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb,reinforced,nis,residual_median_m,diverged\n";
   for (size_t i = 0; i < results.size(); ++i) {
     const ScanResult& r = results[i];
     const RvReport& v = r.rv;
@@ -77,7 +88,9 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
        << v.localizability << ',' << r.ms << ',' << r.T_world_imu.t.x() << ','
        << r.T_world_imu.t.y() << ',' << r.T_world_imu.t.z() << ',' << r.mean_acc_imu.x() << ','
        << r.mean_acc_imu.y() << ',' << r.mean_acc_imu.z() << ','
-       << (i < rss_mb.size() ? rss_mb[i] : std::nan("")) << ',' << v.num_reinforced << '\n';
+       << (i < rss_mb.size() ? rss_mb[i] : std::nan("")) << ',' << v.num_reinforced << ','
+       << Optional(r.health.nis_per_dof) << ',' << Optional(r.health.residual_median_m) << ','
+       << DivergenceKindNames(r.health.divergence_mask) << '\n';
   }
   return WriteFileAtomically(path, os.str());
 }

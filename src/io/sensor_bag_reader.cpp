@@ -11,6 +11,7 @@
 
 #include "livox_ros1.h"
 #include "rosbag_common.h"
+#include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
 
 namespace rvlio {
@@ -18,10 +19,6 @@ namespace {
 
 using bag_detail::ToNs;
 using bag_detail::ToView;
-
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
-
-bool AllFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
 
 // Reads the first message of the LiDAR topic so that a cloud without a
 // usable time field fails at Open, not minutes into a run.
@@ -38,7 +35,7 @@ StatusOr<std::string> PeekLayout(const rosbag::Bag& bag, const LidarOptions& lid
 class RosbagSensorReader final : public SensorBagReader {
  public:
   RosbagSensorReader(std::string path, LidarOptions lidar, ImuOptions imu)
-      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)) {}
+      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_) {}
 
   Status Init() {
     if (Status s = bag_detail::OpenForRead(path_, &bag_); !s.ok()) return s;
@@ -86,7 +83,7 @@ class RosbagSensorReader final : public SensorBagReader {
     return SensorMessage::kEnd;
   }
 
-  const SensorReaderStats& stats() const override { return stats_; }
+  const SensorReaderStats& stats() const override { return gate_.stats(); }
   std::string lidar_layout() const override { return layout_; }
 
  private:
@@ -100,38 +97,10 @@ class RosbagSensorReader final : public SensorBagReader {
     auto msg = m.instantiate<sensor_msgs::Imu>();
     if (!msg) return Status::InvalidInput("imu.topic '" + imu_.topic + "' in '" + path_ +
                                           "' does not hold sensor_msgs/Imu");
-    ImuSample s;
-    s.t_ns = ToNs(msg->header.stamp);
-    const double scale = imu_.accel_unit == "g" ? kStandardGravity : 1.0;
     const auto& a = msg->linear_acceleration;
     const auto& w = msg->angular_velocity;
-    s.acc_imu = scale * Eigen::Vector3d(a.x, a.y, a.z);
-    s.gyro_imu = Eigen::Vector3d(w.x, w.y, w.z);
-    if (!AllFinite(s.acc_imu) || !AllFinite(s.gyro_imu)) {
-      ++stats_.imu_invalid;
-      return false;
-    }
-    if (have_imu_ && !AcceptImuStamp(s.t_ns)) return false;
-    have_imu_ = true;
-    last_imu_ns_ = s.t_ns;
-    ++stats_.imu_samples;
-    *out = s;
-    return true;
-  }
-
-  bool AcceptImuStamp(TimeNs t_ns) {
-    if (t_ns == last_imu_ns_) {
-      ++stats_.imu_duplicates;
-      return false;
-    }
-    if (t_ns < last_imu_ns_) {
-      ++stats_.imu_non_monotonic;
-      return false;
-    }
-    const double gap_s = NsToSeconds(t_ns - last_imu_ns_);
-    stats_.imu_max_gap_s = std::max(stats_.imu_max_gap_s, gap_s);
-    if (gap_s > imu_.max_gap) ++stats_.imu_gaps;
-    return true;
+    return gate_.AcceptImu(ToNs(msg->header.stamp), Eigen::Vector3d(a.x, a.y, a.z),
+                           Eigen::Vector3d(w.x, w.y, w.z), out);
   }
 
   // True when *out holds a scan with points; false for an empty scan.
@@ -140,16 +109,7 @@ class RosbagSensorReader final : public SensorBagReader {
     StatusOr<Scan> scan = livox_ ? DecodeLivox(m, &decode) : DecodeCloud(m, &decode);
     if (!scan.ok()) return scan.status();
     layout_ = decode.layout;
-    stats_.invalid_points += decode.invalid_points;
-    stats_.out_of_range_points += decode.out_of_range_points;
-    if (scan->points.empty()) {
-      ++stats_.empty_scans;
-      return false;
-    }
-    ++stats_.scans;
-    if (!have_imu_) ++stats_.scans_before_first_imu;
-    *out = std::move(scan).value();
-    return true;
+    return gate_.AcceptScan(decode, std::move(scan).value(), out);
   }
 
   StatusOr<Scan> DecodeCloud(const rosbag::MessageInstance& m, DecodeStats* decode) const {
@@ -182,10 +142,8 @@ class RosbagSensorReader final : public SensorBagReader {
   std::unique_ptr<rosbag::View> view_;
   rosbag::View::iterator it_;
   std::string layout_;
-  SensorReaderStats stats_;
+  bag_detail::SensorGate gate_;
   Status error_;
-  bool have_imu_ = false;
-  TimeNs last_imu_ns_ = 0;
 };
 
 }  // namespace
@@ -193,6 +151,9 @@ class RosbagSensorReader final : public SensorBagReader {
 StatusOr<std::unique_ptr<SensorBagReader>> SensorBagReader::Open(const std::string& path,
                                                                  const LidarOptions& lidar,
                                                                  const ImuOptions& imu) {
+  StatusOr<RecordingKind> kind = DetectRecording(path);
+  if (!kind.ok()) return kind.status();
+  if (*kind != RecordingKind::kRos1Bag) return bag_detail::OpenRos2SensorReader(path, lidar, imu);
   auto reader = std::make_unique<RosbagSensorReader>(path, lidar, imu);
   if (Status s = reader->Init(); !s.ok()) return s;
   return std::unique_ptr<SensorBagReader>(std::move(reader));

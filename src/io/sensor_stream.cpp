@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 #include <utility>
+#include <vector>
 
 namespace rvlio {
 namespace {
@@ -51,6 +52,7 @@ class WindowedReader final : public SensorBagReader {
     return stats_;
   }
   std::string lidar_layout() const override { return inner_->lidar_layout(); }
+  std::vector<std::string> warnings() const override { return inner_->warnings(); }
 
  private:
   std::unique_ptr<SensorBagReader> inner_;
@@ -71,7 +73,8 @@ class ThreadedReader final : public SensorBagReader {
         max_messages_(static_cast<size_t>(io.queue_messages)),
         max_bytes_(io.queue_mb * 1e6),
         stats_(inner_->stats()),
-        layout_(inner_->lidar_layout()) {
+        layout_(inner_->lidar_layout()),
+        warnings_(inner_->warnings()) {
     thread_ = std::thread([this] { Produce(); });
   }
   ~ThreadedReader() override {
@@ -99,7 +102,10 @@ class ThreadedReader final : public SensorBagReader {
     }
     not_full_.notify_one();
     stats_ = item.stats;
-    if (item.kind != SensorMessage::kImu) layout_ = std::move(item.layout);
+    if (item.kind != SensorMessage::kImu) {
+      layout_ = std::move(item.layout);
+      warnings_ = std::move(item.warnings);
+    }
     if (!item.error.ok()) return error_ = item.error;
     if (item.kind == SensorMessage::kEnd) ended_ = true;
     if (item.kind == SensorMessage::kImu) *imu = item.imu;
@@ -109,6 +115,7 @@ class ThreadedReader final : public SensorBagReader {
 
   const SensorReaderStats& stats() const override { return stats_; }
   std::string lidar_layout() const override { return layout_; }
+  std::vector<std::string> warnings() const override { return warnings_; }
 
  private:
   struct Item {
@@ -117,7 +124,8 @@ class ThreadedReader final : public SensorBagReader {
     Scan scan;
     Status error;
     SensorReaderStats stats;
-    std::string layout;  // scans, end and errors only
+    std::string layout;                 // scans, end and errors only
+    std::vector<std::string> warnings;  // scans, end and errors only
     double bytes = 0.0;
   };
 
@@ -130,7 +138,10 @@ class ThreadedReader final : public SensorBagReader {
       if (m.ok()) item.kind = *m;
       else item.error = m.status();
       item.stats = inner_->stats();
-      if (item.kind != SensorMessage::kImu || !m.ok()) item.layout = inner_->lidar_layout();
+      if (item.kind != SensorMessage::kImu || !m.ok()) {
+        item.layout = inner_->lidar_layout();
+        item.warnings = inner_->warnings();
+      }
       item.bytes = static_cast<double>(item.scan.points.size() * sizeof(LidarPoint));
       const bool last = !m.ok() || *m == SensorMessage::kEnd;
       {
@@ -160,6 +171,7 @@ class ThreadedReader final : public SensorBagReader {
   // Consumer side.
   SensorReaderStats stats_;
   std::string layout_;
+  std::vector<std::string> warnings_;
   Status error_;
   bool ended_ = false;
 };

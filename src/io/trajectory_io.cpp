@@ -408,7 +408,7 @@ Status WriteTum(const std::string& path, const Trajectory& trajectory, const std
     block += "# " + header.substr(start, end - start) + "\n";
     start = end + 1;
   }
-  block += "# t x y z qx qy qz qw\n";
+  block += kTumColumnsComment;
   for (const StampedPose& pose : trajectory) {
     block += FormatTumLine(pose);
     if (block.size() > (1 << 16)) {

@@ -16,6 +16,7 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
+      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity),
       initializer_(options.imu.init_duration) {}
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {
@@ -78,6 +79,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.T_world_imu = filter_.state().T_world_imu();
   r.v_world_imu = filter_.state().v_world_imu;
   r.ms = ThreadCpuMs() - start_ms;
+  r.health.divergence_mask = monitor_.Check(HealthSampleOf(r));
   ++stats_.scans_processed;
   out->push_back(std::move(r));
 }
@@ -114,6 +116,11 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   r->constraints = u.num_constraints;
   r->iterations = u.iterations;
   r->rv = u.rv;
+  r->health.nis_per_dof = u.nis_per_dof;
+  if (u.ok) {
+    r->health.residual_median_m = u.residuals.median_abs_m;
+    r->health.residual_rms_m = u.residuals.rms_m;
+  }
   if (u.diverged) {
     ++stats_.diverged_resets;
     return ScanStatus::kDiverged;

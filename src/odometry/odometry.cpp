@@ -15,6 +15,19 @@ const char* ScanStatusName(ScanStatus s) {
   return "unknown";
 }
 
+HealthSample HealthSampleOf(const ScanResult& r) {
+  HealthSample s;
+  s.t_ns = r.t_ns;
+  s.p_world_imu = r.T_world_imu.t;
+  s.v_world_imu = r.v_world_imu;
+  s.associated = r.status != ScanStatus::kMapInit;
+  s.points = r.downsampled_points;
+  s.constraints = r.constraints;
+  if (r.mean_acc_imu.squaredNorm() > 0.0) s.specific_force_mps2 = r.mean_acc_imu.norm();
+  s.health = r.health;
+  return s;
+}
+
 StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& options) {
   OdometryOptions checked = options;
   if (Status s = checked.Validate(); !s.ok()) return s;

@@ -5,6 +5,7 @@
 
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/lidar/deskew.h"
 
@@ -52,7 +53,8 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
       initializer_(options.imu.init_duration),
-      T_imu_lidar_(ImuTLidar(options.extrinsics)) {}
+      T_imu_lidar_(ImuTLidar(options.extrinsics)),
+      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity) {}
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
   if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
@@ -132,6 +134,7 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.T_world_imu = Pose3(newest_.R_world_imu, newest_.p_world_imu);
   r.v_world_imu = newest_.v_world_imu;
   r.ms = ThreadCpuMs() - start_ms;
+  r.health.divergence_mask = monitor_.Check(HealthSampleOf(r));
   ++stats_.scans_processed;
   out->push_back(std::move(r));
 }
@@ -198,6 +201,14 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
     InsertIntoWorkingMap(window_->state(window_->size() - 1), p_lidar_end_);
   stats_.diverged_resets += report.failures;  // each failed round was restored
   if (!report.ok) return ScanStatus::kDiverged;
+  // What the newest state's constraints leave after the solve (divergence monitor).
+  const int newest = window_->size() - 1;
+  const ResidualStats residuals = ComputeResidualStats(
+      window_->constraints(newest), window_->state(newest).pose.ToPose3(), T_imu_lidar_);
+  if (residuals.count > 0) {
+    r->health.residual_median_m = residuals.median_abs_m;
+    r->health.residual_rms_m = residuals.rms_m;
+  }
   if (report.newest_constraints < kMinConstraints) {
     ++stats_.predict_only;
     return ScanStatus::kPredictOnly;

@@ -7,10 +7,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <thread>
 #include <utility>
 
+#include <ceres/iteration_callback.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 #include <ceres/types.h>
@@ -119,7 +121,7 @@ class BatchRefiner {
     result_.threads = threads_;
   }
 
-  StatusOr<RefineResult> Run(const RefineRoundCallback& on_round);
+  StatusOr<RefineResult> Run(const RefineHooks& hooks);
 
  private:
   Status SelectScans();
@@ -127,7 +129,10 @@ class BatchRefiner {
   void InitGravity();
   void InitStates();
   void SolveVelocityAndBias();
-  RefineRound RunRound(int round);
+  Status Resume(const RefineRoundState& state);
+  RefineRoundState State() const;
+  bool StopRequested() const { return stop_ && stop_(); }
+  bool RunRound(int round, RefineRound* report);
   void DeskewAll();
   void BuildMap();
   void SolveChunk(int begin, int end, RefineRound* report);
@@ -151,7 +156,21 @@ class BatchRefiner {
   std::vector<RefineState> states_;                // per refined scan
   std::vector<std::vector<Eigen::Vector3d>> p_lidar_end_;  // deskewed, per refined scan
   std::vector<Pose3> map_poses_;  // T_world_imu of each scan when the map was built
+  std::function<bool()> stop_;    // RefineHooks::stop
   RefineResult result_;
+};
+
+// Ends a Ceres solve when the refinement is asked to stop (the round is
+// dropped then, so the partial solve is never used).
+class StopCallback : public ceres::IterationCallback {
+ public:
+  explicit StopCallback(const std::function<bool()>& stop) : stop_(stop) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return stop_ && stop_() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::function<bool()>& stop_;
 };
 
 Status BatchRefiner::CheckInput() const {
@@ -387,6 +406,7 @@ void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
   std::vector<char> active(n, 0);
   std::vector<AssociationWorkspace> workspaces(threads_);
   ParallelFor(begin, end, threads_, [&](int k, int t) {
+    if (StopRequested()) return;  // the round is dropped
     bool a = false;
     factors[k - begin] = AssociateOne(k, begin, end, &workspaces[t], &stats[k - begin], &a);
     active[k - begin] = a;
@@ -397,6 +417,7 @@ void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
     report->rv_active_scans += active[i];
   }
   report->associate_s += SecondsSince(t0);
+  if (StopRequested()) return;
 
   // One problem: PlaneFactor per scan, ImuFactor between consecutive scans.
   t0 = Clock::now();
@@ -416,7 +437,10 @@ void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
   problem.SetParameterBlockConstant(states_[begin].pose.data());  // gauge / previous chunk
   const std::vector<RefineState> before(states_.begin() + begin, states_.begin() + end);
   ceres::Solver::Summary summary;
-  ceres::Solve(SolverOptions(config_.smoother.refine_solver_iterations), &problem, &summary);
+  ceres::Solver::Options options = SolverOptions(config_.smoother.refine_solver_iterations);
+  StopCallback stop(stop_);
+  options.callbacks.push_back(&stop);
+  ceres::Solve(options, &problem, &summary);
   const bool finite = std::all_of(states_.begin() + begin, states_.begin() + end, AllFinite);
   if (!summary.IsSolutionUsable() || !finite || !std::isfinite(summary.final_cost)) {
     std::copy(before.begin(), before.end(), states_.begin() + begin);
@@ -432,22 +456,37 @@ void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
   report->solve_s += SecondsSince(t0);
 }
 
-RefineRound BatchRefiner::RunRound(int round) {
+// False (states and warnings as before the round) when a stop was requested.
+bool BatchRefiner::RunRound(int round, RefineRound* out) {
   const auto t_round = Clock::now();
   RefineRound report;
   report.round = round;
   const std::vector<RefineState> start = states_;
+  const size_t warnings_before = result_.warnings.size();
+  const RefineStats stats_before = result_.stats;
+  auto stopped = [&] {
+    if (!StopRequested()) return false;
+    states_ = start;
+    result_.warnings.resize(warnings_before);
+    result_.stats = stats_before;
+    return true;
+  };
   auto t0 = Clock::now();
   DeskewAll();
   report.deskew_s = SecondsSince(t0);
+  if (stopped()) return false;
   t0 = Clock::now();
   BuildMap();
   report.map_s = SecondsSince(t0);
+  if (stopped()) return false;
   const auto chunks = MakeChunks(static_cast<int>(states_.size()),
                                  config_.smoother.refine_chunk_scans);
   report.chunks = static_cast<int>(chunks.size());
   result_.stats.chunks = report.chunks;
-  for (const auto& [begin, end] : chunks) SolveChunk(begin, end, &report);
+  for (const auto& [begin, end] : chunks) {
+    SolveChunk(begin, end, &report);
+    if (stopped()) return false;
+  }
   for (size_t k = 0; k < states_.size(); ++k) {
     const Pose3 a = start[k].T_world_imu(), b = states_[k].T_world_imu();
     report.max_translation_change_m =
@@ -456,7 +495,44 @@ RefineRound BatchRefiner::RunRound(int round) {
         std::max(report.max_rotation_change_deg, RotationDifferenceDeg(a, b));
   }
   report.total_s = SecondsSince(t_round);
-  return report;
+  *out = report;
+  return true;
+}
+
+Status BatchRefiner::Resume(const RefineRoundState& state) {
+  if (state.states.size() != states_.size())
+    return Status::InvalidInput("the resumed state has " + std::to_string(state.states.size()) +
+                                " scan states, this input refines " +
+                                std::to_string(states_.size()) + " scans");
+  for (size_t k = 0; k < states_.size(); ++k)
+    if (state.states[k].t_ns != states_[k].t_ns || !AllFinite(state.states[k]))
+      return Status::InvalidInput("the resumed state of scan " + std::to_string(k) +
+                                  " does not belong to this input (stamp " +
+                                  Seconds(state.states[k].t_ns) + " s, expected " +
+                                  Seconds(states_[k].t_ns) + " s)");
+  states_ = state.states;
+  result_.g_world = state.g_world;
+  result_.rounds = state.rounds;
+  result_.warnings = state.warnings;
+  result_.converged = state.converged;
+  result_.init_solve_s = state.init_solve_s;
+  result_.stats.map_entries = state.map_entries;
+  result_.stats.chunks = state.chunks;
+  return Status::Ok();
+}
+
+RefineRoundState BatchRefiner::State() const {
+  RefineRoundState s;
+  s.rounds_done = result_.rounds.empty() ? 0 : result_.rounds.back().round;
+  s.converged = result_.converged;
+  s.states = states_;
+  s.g_world = result_.g_world;
+  s.rounds = result_.rounds;
+  s.warnings = result_.warnings;
+  s.init_solve_s = result_.init_solve_s;
+  s.map_entries = result_.stats.map_entries;
+  s.chunks = result_.stats.chunks;
+  return s;
 }
 
 // Trajectory, velocities, biases and the output map at the final estimate.
@@ -483,22 +559,33 @@ void BatchRefiner::Finish() {
   result_.map_points = output.Points();
 }
 
-StatusOr<RefineResult> BatchRefiner::Run(const RefineRoundCallback& on_round) {
+StatusOr<RefineResult> BatchRefiner::Run(const RefineHooks& hooks) {
   const auto t0 = Clock::now();
+  stop_ = hooks.stop;
   if (Status s = CheckInput(); !s.ok()) return s;
   if (Status s = SelectScans(); !s.ok()) return s;
   InitGravity();
-  InitStates();
-  SolveVelocityAndBias();
-  for (int round = 1; round <= config_.smoother.refine_rounds; ++round) {
-    result_.rounds.push_back(RunRound(round));
-    const RefineRound& r = result_.rounds.back();
-    if (on_round) on_round(r);
-    if (r.max_translation_change_m < kConvergedTranslationM &&
-        r.max_rotation_change_deg < kConvergedRotationDeg) {
-      result_.converged = true;
+  InitStates();  // the scans' stamps; a resumed state replaces the rest
+  if (hooks.resume != nullptr) {
+    if (Status s = Resume(*hooks.resume); !s.ok()) return s;
+  } else {
+    SolveVelocityAndBias();
+    if (hooks.on_state)
+      if (Status s = hooks.on_state(State()); !s.ok()) return s;
+  }
+  const int first = hooks.resume != nullptr ? hooks.resume->rounds_done + 1 : 1;
+  for (int round = first; !result_.converged && round <= config_.smoother.refine_rounds; ++round) {
+    RefineRound r;
+    if (StopRequested() || !RunRound(round, &r)) {
+      result_.stopped = true;
       break;
     }
+    result_.rounds.push_back(r);
+    if (hooks.on_round) hooks.on_round(r);
+    result_.converged = r.max_translation_change_m < kConvergedTranslationM &&
+                        r.max_rotation_change_deg < kConvergedRotationDeg;
+    if (hooks.on_state)
+      if (Status s = hooks.on_state(State()); !s.ok()) return s;
   }
   Finish();
   result_.total_s = SecondsSince(t0);
@@ -509,12 +596,19 @@ StatusOr<RefineResult> BatchRefiner::Run(const RefineRoundCallback& on_round) {
 
 StatusOr<RefineResult> Refine(const RefineConfig& config, RefineInput input,
                               const RefineRoundCallback& on_round) {
+  RefineHooks hooks;
+  hooks.on_round = on_round;
+  return Refine(config, std::move(input), hooks);
+}
+
+StatusOr<RefineResult> Refine(const RefineConfig& config, RefineInput input,
+                              const RefineHooks& hooks) {
   RefineConfig checked = config;
   for (Status s : {checked.imu.Validate(), checked.map.Validate(), checked.constraints.Validate(),
                    checked.rv.Validate(), checked.smoother.Validate()})
     if (!s.ok()) return s;
   BatchRefiner refiner(config, std::move(input));
-  return refiner.Run(on_round);
+  return refiner.Run(hooks);
 }
 
 }  // namespace rvlio

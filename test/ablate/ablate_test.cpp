@@ -197,6 +197,23 @@ TEST_F(AblatePlanTest, PlanIsStableAndTheHashFollowsTheConfiguration) {
   EXPECT_NE(edited["cells"][0]["hash"], before["cells"][0]["hash"]);
 }
 
+// The grid's `resources:` block reaches the plan (the Snakefile's Slurm jobs)
+// and does not change any cell: it is not part of the configuration hash.
+TEST_F(AblatePlanTest, ResourcesReachThePlanWithoutChangingTheCells) {
+  const json defaults = PlanJson(Grid(kGrid));
+  ASSERT_TRUE(defaults.is_object());
+  EXPECT_EQ(defaults["resources"], json({{"cpus", 1}, {"mem_mb", 4000}, {"runtime", 120}}));
+  const json sized = PlanJson(
+      Grid(std::string(kGrid) + "resources: {cpus: 2, mem_mb: 900, runtime: 15}\n", "r.yaml"));
+  ASSERT_TRUE(sized.is_object());
+  EXPECT_EQ(sized["resources"], json({{"cpus", 2}, {"mem_mb", 900}, {"runtime", 15}}));
+  const json partial = PlanJson(Grid(std::string(kGrid) + "resources:\n  mem_mb: 700\n", "p.yaml"));
+  EXPECT_EQ(partial["resources"], json({{"cpus", 1}, {"mem_mb", 700}, {"runtime", 120}}));
+  ASSERT_EQ(sized["cells"].size(), defaults["cells"].size());
+  for (size_t i = 0; i < defaults["cells"].size(); ++i)
+    EXPECT_EQ(sized["cells"][i]["id"], defaults["cells"][i]["id"]) << i;
+}
+
 TEST_F(AblatePlanTest, BadGridsStopWithExit2AndOneLineNamingFileAndKey) {
   const std::string seq = "sequences:\n  - {name: r, bag: rec.bag}\n";
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -211,6 +228,11 @@ TEST_F(AblatePlanTest, BadGridsStopWithExit2AndOneLineNamingFileAndKey) {
       {seq + "config: [nope.yaml]\n", "config: file not found"},
       {"sequences:\n  - {name: s, simulate: {preset: tunel}}\n", "sequences[0].simulate.preset"},
       {"sequences:\n  - {name: s, simulate: {preset: tunnel}, seeds: [-1]}\n", "seeds"},
+      {seq + "resources: {cpu: 2}\n", "resources.cpu: unknown key"},
+      {seq + "resources: {cpus: 0}\n", "resources.cpus: '0' is not a whole number of CPUs"},
+      {seq + "resources: {mem_mb: 1.5}\n", "resources.mem_mb: '1.5' is not a whole number"},
+      {seq + "resources: {runtime: [1]}\n", "resources.runtime"},
+      {seq + "resources: 4\n", "resources: expected a mapping"},
   };
   for (const auto& [body, expected] : cases) {
     const std::string grid = Grid(body, "bad.yaml");

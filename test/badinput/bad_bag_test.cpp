@@ -174,29 +174,36 @@ TEST_F(BadBagTest, NanInfAndZeroPointsAreDroppedAndCountedSilently) {
   EXPECT_TRUE(s["warnings"].empty()) << s["warnings"];
 }
 
-TEST_F(BadBagTest, AllPointsOutOfRangeStopsNamingTheRangeKeys) {
+// No scan survives: one line with the counts, and nothing written (no output
+// folder; an existing one keeps its earlier outputs as they were).
+TEST_F(BadBagTest, AllPointsOutOfRangeStopsNamingTheRangeKeysAndWritesNothing) {
+  const std::string range = "--set lidar.min_range=0.5 --set lidar.max_range=0.6";
   const std::string out = dir_ + "/out_range";
-  const ToolRun r = Run(Bag(), out, "--set lidar.min_range=0.5 --set lidar.max_range=0.6");
+  const ToolRun r = Run(Bag(), out, range);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   const auto clean = Summary(dir_ + "/clean");
   const int64_t scans = clean["stats"]["reader"]["scans"].get<int64_t>();
-  const auto s = Summary(out);
-  ASSERT_FALSE(s.is_discarded());
-  const int64_t invalid = s["stats"]["reader"]["invalid_points"].get<int64_t>();
-  const int64_t out_of_range = s["stats"]["reader"]["out_of_range_points"].get<int64_t>();
-  EXPECT_EQ(r.err, "rvlio run: error: every one of the " + std::to_string(scans) +
-                       " scans on lidar.topic '/os_cloud_node/points' in " + Bag() +
-                       " is empty after dropping " + std::to_string(invalid) + " invalid and " +
-                       std::to_string(out_of_range) +
-                       " out-of-range points (lidar.min_range 0.5 m, lidar.max_range 0.6 m)\n");
-  EXPECT_EQ(invalid, clean["stats"]["reader"]["invalid_points"].get<int64_t>());
-  EXPECT_GT(out_of_range, 100000);
-  // The outputs are complete and say what happened: no pose, every scan empty.
-  ExpectCompleteOutputs(out);
-  EXPECT_EQ(TumPoses(out + "/trajectory.tum"), 0);
-  EXPECT_EQ(s["scan_count"], 0);
-  EXPECT_EQ(s["stats"]["reader"]["empty_scans"].get<int64_t>(), scans);
+  const int64_t invalid = clean["stats"]["reader"]["invalid_points"].get<int64_t>();
+  const std::string head = "rvlio run: error: every one of the " + std::to_string(scans) +
+                           " scans on lidar.topic '/os_cloud_node/points' in " + Bag() +
+                           " is empty after dropping " + std::to_string(invalid) + " invalid and ";
+  const std::string tail = " out-of-range points (lidar.min_range 0.5 m, lidar.max_range 0.6 m)\n";
+  ASSERT_EQ(r.err.rfind(head, 0), 0u) << r.err;
+  ASSERT_GT(r.err.size(), head.size() + tail.size()) << r.err;
+  EXPECT_EQ(r.err.substr(r.err.size() - tail.size()), tail) << r.err;
+  const std::string count = r.err.substr(head.size(), r.err.size() - head.size() - tail.size());
+  EXPECT_GT(std::stoll(count), 100000) << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "no scan was done, so nothing may be written";
+
+  const std::string earlier = dir_ + "/out_range_earlier";
+  fs::create_directories(earlier);
+  for (const std::string& name : OutputNames()) fs::copy_file(Clean(name), earlier + "/" + name);
+  const ToolRun again = Run(Bag(), earlier, range);
+  EXPECT_EQ(again.exit_code, 2) << again.err;
+  EXPECT_EQ(Entries(earlier), OutputNames());
+  for (const std::string& name : OutputNames())
+    EXPECT_EQ(ReadFile(earlier + "/" + name), ReadFile(Clean(name))) << name;
 }
 
 TEST_F(BadBagTest, EmptyScansAreSkippedCountedAndWarnedOnce) {

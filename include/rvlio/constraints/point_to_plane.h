@@ -30,4 +30,14 @@ double PointToPlaneResidualWithExtrinsics(const Constraint& c, const Pose3& T_wo
                                           const Pose3& T_imu_lidar,
                                           Eigen::Matrix<double, 1, 12>* J = nullptr);
 
+// Unweighted |r| of a scan's constraints at the given poses: what is left
+// after an estimator's update (divergence monitor, odometry/divergence.h).
+struct ResidualStats {
+  int count = 0;
+  double median_abs_m = 0.0;
+  double rms_m = 0.0;
+};
+ResidualStats ComputeResidualStats(const ConstraintList& constraints, const Pose3& T_world_imu,
+                                   const Pose3& T_imu_lidar);
+
 }  // namespace rvlio

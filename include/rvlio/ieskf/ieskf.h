@@ -4,11 +4,13 @@
 // covariance, and the iterated point-to-plane update of paper Eq. (1) with
 // re-association and the RV modules inside every iteration (Alg. 3).
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "rvlio/common/types.h"
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/constraints/options.h"
+#include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/lidar/deskew.h"
@@ -29,6 +31,11 @@ struct IeskfUpdateResult {
   int num_constraints = 0;    // of the last iteration
   double last_step_norm = 0.0;
   RvReport rv;                // of the last iteration
+  // For the divergence monitor (odometry/divergence.h); no effect on the update.
+  // Normalized innovation squared of the first iteration's constraints at the
+  // prediction, z^T (H P H^T + R)^-1 z / n (Woodbury form); NaN if no iteration.
+  double nis_per_dof = std::numeric_limits<double>::quiet_NaN();
+  ResidualStats residuals;    // last iteration's constraints at the updated state (ok only)
 };
 
 class Ieskf {

@@ -65,6 +65,9 @@ class Reader {
   // Fails for a missing file, bad magic, or a corrupt summary. A file without
   // a summary (cut short) opens; summary().truncated tells.
   static StatusOr<std::unique_ptr<Reader>> Open(const std::string& path);
+  // The same on bytes in memory (`name` stands for the path in messages):
+  // one code path for files, tests and the fuzzer.
+  static StatusOr<std::unique_ptr<Reader>> OpenBuffer(std::string bytes, const std::string& name);
 
   virtual const FileSummary& summary() const = 0;
   virtual const std::map<uint16_t, Schema>& schemas() const = 0;
@@ -80,6 +83,9 @@ class Reader {
   // Problems that did not stop reading (e.g. "no summary section: read by a
   // linear scan; the file may have been cut short").
   virtual std::vector<std::string> warnings() const = 0;
+  // Chunks Next() has decompressed so far (chunks the channel filter rules
+  // out by the summary's message indexes are not).
+  virtual uint64_t chunks_loaded() const = 0;
 };
 
 struct WriterOptions {
@@ -93,8 +99,9 @@ struct WriterOptions {
 class Writer {
  public:
   virtual ~Writer() = default;
-  // Writes to path + ".tmp" and renames on Close(): a failed write leaves no
-  // half file behind.
+  // Writes to a temporary file next to `path` (AtomicFileWriter) and renames
+  // it on Close(): a failed write (a full disk) returns its Status and leaves
+  // no half file behind.
   static StatusOr<std::unique_ptr<Writer>> Create(const std::string& path,
                                                   const WriterOptions& options);
   virtual StatusOr<uint16_t> AddSchema(const std::string& name, const std::string& encoding,

@@ -1,5 +1,6 @@
 #pragma once
-// ROS1 bag access for sensor data, through Debian's rosbag storage library.
+// Recording access for sensor data: ROS1 bags through Debian's rosbag storage
+// library, ROS 2 bags (.db3, .mcap, bag folders) through io/recording.h.
 // The estimators never see ROS types: scans and IMU samples come out as the
 // library's own types (common/types.h).
 #include <cstdint>
@@ -52,14 +53,31 @@ class SensorBagReader {
   virtual const SensorReaderStats& stats() const = 0;
   // "ouster", "velodyne", "hesai" or "livox" (PointCloud2), "livox_custom" (CustomMsg)
   virtual std::string lidar_layout() const = 0;
+  // Problems of the recording that did not stop reading (e.g. an MCAP file
+  // cut short: its complete part is read); each names the file.
+  virtual std::vector<std::string> warnings() const { return {}; }
 };
 
-// Writes sensor data as ROS1 messages (used by the simulator and the tests).
+// How SensorBagWriter::Create writes.
+struct BagWriterOptions {
+  // "ros1": a ROS1 .bag (sensor_msgs/PointCloud2, sensor_msgs/Imu);
+  // "mcap": a ROS 2 .mcap file; "db3": a ROS 2 sqlite3 .db3 file (both CDR,
+  // sensor_msgs/msg/PointCloud2 and sensor_msgs/msg/Imu, ros2msg definitions).
+  std::string format = "ros1";
+  // MCAP only: chunk compression "zstd", "lz4" or "none", or "unchunked"
+  // (messages directly in the data section).
+  std::string mcap_compression = "zstd";
+};
+
+// Writes sensor data as ROS1 or ROS 2 messages (used by the simulator and
+// the tests). Messages are stamped with their receive time: a scan when its
+// sweep ends, an IMU sample at its stamp.
 class SensorBagWriter {
  public:
   virtual ~SensorBagWriter() = default;
   // Writes to path + ".tmp" and renames on Close(): a failed run leaves no half bag.
-  static StatusOr<std::unique_ptr<SensorBagWriter>> Create(const std::string& path);
+  static StatusOr<std::unique_ptr<SensorBagWriter>> Create(const std::string& path,
+                                                           const BagWriterOptions& options = {});
   // Ouster driver layout (x y z intensity float32, t uint32 ns from scan start,
   // reflectivity uint16, ring uint16, ambient uint16, range uint32 mm). When
   // scan.points.size() == rows * cols the cloud is organized (rows x cols,
@@ -92,13 +110,18 @@ struct BagTopicInfo {
 };
 struct BagInfo {
   std::string path;
+  std::string storage;                    // "ros1", "sqlite3" or "mcap"
+  std::vector<std::string> compressions;  // MCAP chunk compressions ("zstd", "lz4", "none")
+  std::vector<std::string> warnings;      // problems that did not stop reading
   double start_s = 0.0, end_s = 0.0;
   TimeNs start_ns = 0, end_ns = 0;  // the same, exact
   int64_t messages = 0;
   std::vector<BagTopicInfo> topics;
 };
-// Lists every topic; decodes the first few messages of each PointCloud2 topic
-// (only of `lidar_topic` when it is given; it must then be a PointCloud2 topic).
+// Lists every topic of any recording SensorBagReader::Open takes (ROS1 bag,
+// .db3, .mcap, ROS 2 bag folder); decodes the first few messages of each
+// PointCloud2 topic (only of `lidar_topic` when it is given; it must then be a
+// PointCloud2 topic).
 StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic = "");
 
 }  // namespace rvlio

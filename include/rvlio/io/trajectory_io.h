@@ -50,6 +50,9 @@ StatusOr<Trajectory> ParseTrajectoryText(const std::string& text, const std::str
 // with 9 decimals (nm), quaternion with 12 decimals.
 std::string FormatTumLine(const StampedPose& pose);
 
+// The comment line naming the columns, after the header of every TUM file we write.
+inline constexpr const char* kTumColumnsComment = "# t x y z qx qy qz qw\n";
+
 // Writes a TUM file atomically (io/atomic_file.h); `header`, when not empty,
 // is written first as '#' comment lines.
 Status WriteTum(const std::string& path, const Trajectory& trajectory,

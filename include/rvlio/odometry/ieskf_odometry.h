@@ -23,6 +23,7 @@ class IeskfOdometry : public Odometry {
 
   const OdometryStats& stats() const override { return stats_; }
   std::vector<std::string> warnings() const override { return warnings_; }
+  const DivergenceReport& divergence() const override { return monitor_.report(); }
   std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
 
   const FilterState& state() const { return filter_.state(); }
@@ -43,6 +44,7 @@ class IeskfOdometry : public Odometry {
   Pose3 T_imu_lidar_;
   OdometryStats stats_;
   std::vector<std::string> warnings_;
+  DivergenceMonitor monitor_;
   StaticInitializer initializer_;
   std::deque<ImuSample> imu_buffer_;
   ScanQueue scans_;

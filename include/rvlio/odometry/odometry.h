@@ -11,6 +11,7 @@
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
 #include "rvlio/math/pose.h"
+#include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/options.h"
 #include "rvlio/rv/rv.h"
 
@@ -36,7 +37,11 @@ struct ScanResult {
   RvReport rv;
   double ms = 0.0;  // processing time of this scan: CPU time of the calling thread
   Eigen::Vector3d mean_acc_imu = Eigen::Vector3d::Zero();  // mean specific force over the scan, m/s^2
+  ScanHealth health;  // what the divergence monitor read, and what it flagged
 };
+
+// The monitor's view of a scan result (odometry/divergence.h).
+HealthSample HealthSampleOf(const ScanResult& r);
 
 // Counts of what was skipped or repaired, reported in summary.json.
 struct OdometryStats {
@@ -74,6 +79,8 @@ class Odometry {
 
   virtual const OdometryStats& stats() const = 0;
   virtual std::vector<std::string> warnings() const = 0;
+  // The divergence monitor's findings over the scans processed so far.
+  virtual const DivergenceReport& divergence() const = 0;
   // The full map for output (coarse resolution), world frame.
   virtual std::vector<Eigen::Vector3d> MapPoints() const = 0;
 };

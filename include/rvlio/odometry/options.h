@@ -10,6 +10,7 @@
 #include "rvlio/io/reader_options.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/options.h"
+#include "rvlio/odometry/divergence.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/smoother/options.h"
 
@@ -25,6 +26,7 @@ struct OdometryOptions {
   RvOptions rv;
   IeskfOptions ieskf;
   SmootherOptions smoother;
+  DivergenceOptions divergence;
   ReaderOptions io;
 
   template <class V>
@@ -38,6 +40,7 @@ struct OdometryOptions {
     v.Section("rv", rv);
     v.Section("ieskf", ieskf);
     v.Section("smoother", smoother);
+    v.Section("divergence", divergence);
     v.Section("io", io);
   }
 
@@ -47,7 +50,7 @@ struct OdometryOptions {
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate(),
-                     io.Validate()})
+                     divergence.Validate(), io.Validate()})
       if (!m.ok()) return m;
     return Status::Ok();
   }

@@ -61,6 +61,7 @@ class SmootherOdometry : public Odometry {
   void Finish(std::vector<ScanResult>* out) override;
 
   const OdometryStats& stats() const override { return stats_; }
+  const DivergenceReport& divergence() const override { return monitor_.report(); }
   std::vector<std::string> warnings() const override;
   std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
 
@@ -92,6 +93,7 @@ class SmootherOdometry : public Odometry {
   Pose3 T_imu_lidar_;
   OdometryStats stats_;
   std::vector<std::string> warnings_;
+  DivergenceMonitor monitor_;
   std::deque<ImuSample> imu_buffer_;
   ScanQueue scans_;
   // The newest estimate: where the next prediction starts.

@@ -72,6 +72,7 @@
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/smoother/options.h"
+#include "rvlio/smoother/refine_states.h"
 
 namespace rvlio {
 
@@ -130,6 +131,7 @@ struct RefineResult {
   std::string linear_solver;  // e.g. "SPARSE_NORMAL_CHOLESKY (SUITE_SPARSE)"
   int threads = 1;
   bool converged = false;     // stopped on the pose-change threshold before the round cap
+  bool stopped = false;       // RefineHooks::stop ended it: the last completed round's result
   double init_solve_s = 0.0;  // the IMU-only velocity and bias solve
   double total_s = 0.0;       // wall time of Refine()
   std::vector<std::string> warnings;
@@ -140,11 +142,45 @@ constexpr int kRefineMinScanPoints = 50;
 // Called after each round (e.g. to print the convergence line).
 using RefineRoundCallback = std::function<void(const RefineRound&)>;
 
+// What a completed round hands to the next one: everything a refinement
+// started from it (RefineHooks::resume) needs to end with the result of an
+// uninterrupted run, bit for bit (the input and the configuration being the
+// same). The rest (map, associations, deskewed points) is rebuilt from these
+// each round.
+struct RefineRoundState {
+  int rounds_done = 0;  // 0: the initialization (velocity and bias solve) only
+  bool converged = false;
+  std::vector<RefineState> states;  // per refined scan
+  Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);
+  std::vector<RefineRound> rounds;  // the reports of the rounds done
+  std::vector<std::string> warnings;
+  double init_solve_s = 0.0;
+  int64_t map_entries = 0;  // RefineStats of the last round
+  int chunks = 0;
+};
+
+struct RefineHooks {
+  RefineRoundCallback on_round;  // after each round, with its report
+  // After each completed round, with the state to continue from (e.g. to
+  // write a checkpoint). An error ends the refinement with that status.
+  std::function<Status(const RefineRoundState&)> on_state;
+  // Polled between the steps of a round and between solver iterations: true
+  // ends the refinement with the result of the last completed round
+  // (RefineResult::stopped); a round in progress is dropped.
+  std::function<bool()> stop;
+  // Continue from this state (rounds_done + 1 onwards) instead of
+  // initializing from RefineInput::init; InvalidInput if its states are not
+  // those of this input's refined scans.
+  const RefineRoundState* resume = nullptr;
+};
+
 // Refines the trajectory. InvalidInput when there is nothing to refine (no
 // scans, no IMU samples, no initial poses, or fewer than 2 usable scans, e.g.
 // an initial trajectory that does not overlap the scans; the message gives
 // both time spans). The input is consumed (moved from) to save memory.
 StatusOr<RefineResult> Refine(const RefineConfig& config, RefineInput input,
                               const RefineRoundCallback& on_round = nullptr);
+StatusOr<RefineResult> Refine(const RefineConfig& config, RefineInput input,
+                              const RefineHooks& hooks);
 
 }  // namespace rvlio

@@ -1,0 +1,48 @@
+#include "divergence_cli.h"
+
+#include <cstdio>
+
+namespace rvlio::cli {
+
+nlohmann::json DivergenceJson(const DivergenceReport& r) {
+  nlohmann::json events = nlohmann::json::object();
+  for (int k = 0; k < kNumDivergenceKinds; ++k)
+    events[DivergenceKindName(static_cast<DivergenceKind>(k))] = r.episodes[k];
+  nlohmann::json episodes = nlohmann::json::array();
+  for (const DivergenceEvent& e : r.events)
+    episodes.push_back({{"kind", DivergenceKindName(e.kind)},
+                        {"time_s", NsToSeconds(e.t_ns)},
+                        {"value", e.value},
+                        {"threshold", e.threshold}});
+  return {{"detected", r.detected},
+          {"first_time_s", r.detected ? nlohmann::json(NsToSeconds(r.first_t_ns)) : nlohmann::json()},
+          {"scans_flagged", r.scans_flagged},
+          {"events", events},
+          {"episodes", episodes}};
+}
+
+void WarnDivergence(const std::string& command, const DivergenceReport& r, size_t* printed) {
+  for (; *printed < r.events.size(); ++*printed) {
+    const DivergenceEvent& e = r.events[*printed];
+    std::fprintf(stderr, "rvlio %s: warning: divergence at bag time %.3f s: %s\n", command.c_str(),
+                 NsToSeconds(e.t_ns), e.Describe().c_str());
+  }
+}
+
+int FinishDiverged(const std::string& command, const DivergenceReport& r,
+                   const std::string& out_dir, bool allow) {
+  char when[64];
+  std::snprintf(when, sizeof(when), "%.3f", NsToSeconds(r.first_t_ns));
+  const std::string what = "the estimate diverged from bag time " + std::string(when) + " s (" +
+                           std::to_string(r.events.size()) + " episode(s), " +
+                           std::to_string(r.scans_flagged) +
+                           " scans flagged; summary.json divergence, scans.csv column diverged); "
+                           "outputs written to " + out_dir + " for inspection";
+  if (allow) {
+    std::fprintf(stderr, "rvlio %s: warning: %s\n", command.c_str(), what.c_str());
+    return 0;
+  }
+  return Fail(command, what + "; --allow-divergence to exit 0", kExitDiverged);
+}
+
+}  // namespace rvlio::cli

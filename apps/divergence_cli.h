@@ -1,0 +1,36 @@
+#pragma once
+// How the commands report the divergence monitor (odometry/divergence.h):
+// one warning line per episode while running, a `divergence` object in
+// summary.json, and exit status kExitDiverged unless --allow-divergence.
+#include <cstddef>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "rvlio/odometry/divergence.h"
+
+namespace rvlio::cli {
+
+// "Ran to the end but diverged": every output is written for inspection.
+constexpr int kExitDiverged = 3;
+
+inline OptionSpec AllowDivergenceOption() {
+  return {"allow-divergence", "",
+          "exit 0 even when the divergence monitor fired (the warnings and summary.json still "
+          "say so; without it such a run exits 3)"};
+}
+
+// {detected, first_time_s, scans_flagged, events: {kind: episodes}, episodes: [...]}.
+nlohmann::json DivergenceJson(const DivergenceReport& report);
+
+// Prints "rvlio CMD: warning: divergence at bag time T s: WHAT" for every
+// episode start after the first *printed ones; updates *printed.
+void WarnDivergence(const std::string& command, const DivergenceReport& report, size_t* printed);
+
+// The closing line of a diverged run; returns kExitDiverged, or 0 when
+// allowed (the line is then a warning).
+int FinishDiverged(const std::string& command, const DivergenceReport& report,
+                   const std::string& out_dir, bool allow);
+
+}  // namespace rvlio::cli

@@ -1,0 +1,35 @@
+#pragma once
+// `rvlio refine --checkpoint DIR` / `--resume DIR`: the state after each
+// round (smoother/refine.h RefineRoundState) in DIR/refine.checkpoint, CBOR
+// with every double bit for bit, written atomically. A checkpoint carries the
+// fingerprint of what the refinement depends on (the input read from the bag,
+// the initial trajectory and the configuration except smoother.refine_rounds,
+// so a resumed run may also go on for more rounds); resuming with another
+// input is refused.
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "rvlio/common/status.h"
+#include "rvlio/io/config.h"
+#include "rvlio/smoother/refine.h"
+
+namespace rvlio::cli {
+
+constexpr const char* kCheckpointFile = "refine.checkpoint";
+
+uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input);
+
+Status WriteRefineCheckpoint(const std::string& dir, uint64_t fingerprint,
+                             const RefineRoundState& state);
+// InvalidInput naming DIR when there is no checkpoint, it cannot be read or it
+// belongs to another input (fingerprint).
+StatusOr<RefineRoundState> ReadRefineCheckpoint(const std::string& dir, uint64_t fingerprint);
+// InvalidInput naming the file when DIR holds no checkpoint (checked before the bag is read).
+Status CheckpointExists(const std::string& dir);
+
+// One round's report as in summary.json "rounds".
+nlohmann::json RoundJson(const RefineRound& r);
+
+}  // namespace rvlio::cli

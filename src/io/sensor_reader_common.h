@@ -1,0 +1,58 @@
+#pragma once
+// Private, ROS-free pieces shared by the ROS1 and ROS 2 sensor readers and
+// `rvlio info` (src/io only): topic checks with their messages, and the one
+// place that decides which IMU samples and scans are delivered and counts
+// what was dropped (SensorReaderStats).
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/time.h"
+#include "rvlio/common/types.h"
+#include "rvlio/imu/options.h"
+#include "rvlio/io/pointcloud2.h"
+#include "rvlio/io/sensor_bag.h"
+
+namespace rvlio::bag_detail {
+
+// "/a (sensor_msgs/Imu), /b (sensor_msgs/PointCloud2)" or "none".
+std::string DescribeTopics(const std::map<std::string, std::string>& topics);
+
+// InvalidInput unless `topic` is in the bag with message type `type`.
+Status RequireTopic(const std::string& path, const std::map<std::string, std::string>& topics,
+                    const std::string& topic, const std::string& type, const std::string& key);
+
+// Applies the reader's acceptance rules and keeps SensorReaderStats.
+class SensorGate {
+ public:
+  explicit SensorGate(const ImuOptions& imu) : imu_(imu) {}
+  // An IMU message: acc in imu.accel_unit (scaled to m/s^2 here), gyro in
+  // rad/s. True when *out holds a new sample; false when it was dropped
+  // (non-finite, duplicate or older stamp).
+  bool AcceptImu(TimeNs t_ns, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro,
+                 ImuSample* out);
+  // A decoded scan: counts the dropped points; true (and moves the scan into
+  // *out) when it has points, false for an empty scan.
+  bool AcceptScan(const DecodeStats& decode, Scan&& scan, Scan* out);
+  const SensorReaderStats& stats() const { return stats_; }
+
+ private:
+  bool AcceptImuStamp(TimeNs t_ns);
+
+  ImuOptions imu_;
+  SensorReaderStats stats_;
+  bool have_imu_ = false;
+  TimeNs last_imu_ns_ = 0;
+};
+
+// The SensorBagReader of a ROS 2 recording (.db3, .mcap or bag folder);
+// src/io/ros2_sensor_reader.cpp.
+StatusOr<std::unique_ptr<SensorBagReader>> OpenRos2SensorReader(const std::string& path,
+                                                                const LidarOptions& lidar,
+                                                                const ImuOptions& imu);
+
+}  // namespace rvlio::bag_detail

@@ -1,0 +1,41 @@
+#pragma once
+// Private, ROS-free pieces shared by the ROS1 and ROS 2 sensor writers
+// (src/io only): the Ouster and Livox driver layouts and stamp checks.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/types.h"
+#include "rvlio/io/livox.h"
+#include "rvlio/io/pointcloud2.h"
+#include "rvlio/io/sensor_bag.h"
+
+namespace rvlio::bag_detail {
+
+// A PointCloud2 that owns its bytes (view.data points into data).
+struct OwnedCloud {
+  PointCloud2View view;
+  std::vector<uint8_t> data;
+  bool is_dense = false;
+};
+
+// The Ouster driver layout of SensorBagWriter::WriteOusterScan, without the
+// header stamp (set by the caller). InvalidInput for a point whose time does
+// not fit the uint32 ns field.
+Status BuildOusterCloud(const Scan& scan, int rows, int cols, OwnedCloud* out);
+
+// The Livox driver message of SensorBagWriter::WriteLivoxScan (io/livox.h).
+// InvalidInput for a point whose time does not fit the uint32 ns offset_time.
+StatusOr<LivoxCustomMsg> BuildLivoxMsg(const Scan& scan, const std::string& frame_id);
+
+// InvalidInput unless 0 <= t_ns <= max_ns ("... outside the <range_text>").
+Status CheckStamp(TimeNs t_ns, TimeNs max_ns, const std::string& range_text,
+                  const std::string& what);
+
+// The ROS 2 writers (options.format "mcap" or "db3"); ros2_sensor_writer.cpp.
+StatusOr<std::unique_ptr<SensorBagWriter>> CreateRos2Writer(const std::string& path,
+                                                            const BagWriterOptions& options);
+
+}  // namespace rvlio::bag_detail
