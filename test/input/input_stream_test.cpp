@@ -34,6 +34,7 @@ class InputStreamTest : public ::testing::Test {
         "simulate --preset tunnel --seed 4 --duration 10 --set lidar.columns=512 --out " + dir_;
     for (const std::string& extra :
          {std::string(" --name pc"), std::string(" --name lx --lidar-msg livox"),
+          std::string(" --name lxm --lidar-msg livox --format mcap"),
           " --name off --set lidar.time_offset=" + std::to_string(kInjectedOffsetS)}) {
       const ToolRun sim = RunTool(common + extra, dir_);
       ASSERT_EQ(sim.exit_code, 0) << sim.err;
@@ -44,7 +45,8 @@ class InputStreamTest : public ::testing::Test {
   static std::string Data(const std::string& name) { return dir_ + "/" + name; }
   // `rvlio run NAME.bag --config NAME.yaml --out dir_/OUT ARGS`.
   static ToolRun Run(const std::string& name, const std::string& out, const std::string& args = "") {
-    return RunTool("run --quiet --bag " + Data(name + ".bag") + " --config " +
+    const std::string bag = Data(name + (fs::exists(Data(name + ".mcap")) ? ".mcap" : ".bag"));
+    return RunTool("run --quiet --bag " + bag + " --config " +
                        Data(name + ".yaml") + " --out " + Data(out) + " " + args,
                    dir_);
   }
@@ -59,9 +61,10 @@ class InputStreamTest : public ::testing::Test {
 std::string InputStreamTest::dir_;
 
 // The simulator writes the same scans either way; CustomMsg carries the same
-// coordinates and times (offset_time in ns), so the runs agree to the byte.
-// Only the intensity differs (uint8 reflectivity), which the estimator does
-// not use.
+// coordinates and times (offset_time in ns), so the runs agree to the byte,
+// from a ROS1 bag (livox_ros_driver/CustomMsg) and from a ROS 2 MCAP file
+// (livox_ros_driver2/msg/CustomMsg). Only the intensity differs (uint8
+// reflectivity), which the estimator does not use.
 TEST_F(InputStreamTest, LivoxCustomMsgGivesThePointCloud2Trajectory) {
   EXPECT_NE(ReadFile(Data("lx.yaml")).find("topic: /livox/lidar"), std::string::npos);
   const ToolRun pc = Run("pc", "pc_out");
@@ -79,6 +82,9 @@ TEST_F(InputStreamTest, LivoxCustomMsgGivesThePointCloud2Trajectory) {
     EXPECT_LT(((*a)[i].p_world_imu - (*b)[i].p_world_imu).norm(), 1e-6) << i;
   }
   EXPECT_LT(Ate("lx_out"), 0.05);
+  const ToolRun lxm = Run("lxm", "lxm_out");
+  ASSERT_EQ(lxm.exit_code, 0) << lxm.err;
+  EXPECT_TRUE(ReadFile(Data("lxm_out/trajectory.tum")) == ReadFile(Data("lx_out/trajectory.tum")));
 }
 
 // Stamps written 30 ms early: uncorrected the ATE grows; lidar.time_offset
