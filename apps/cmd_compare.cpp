@@ -16,7 +16,7 @@ int CmdCompare(int argc, char** argv) {
       "compare.md, compare.json and OUT/plots/ (trajectories, RV profile, bar chart; needs\n"
       "python3 with matplotlib). Exit 0 when at least one variant ran, 1 when all failed,\n"
       "2 on bad input (before any run).",
-      {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
+      {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
        {"gt", "TUM", "ground-truth trajectory (TUM or KITTI, as rvlio eval)", true},
        ConfigOption(),
        SetOption(),

@@ -69,11 +69,11 @@ void Print(const BagInfo& info) {
 int CmdInfo(int argc, char** argv) {
   CommandSpec spec{"info",
                    "Lists the topics of a recording (ROS1 bag, ROS 2 .db3 / .mcap / bag folder:\n"
-                   "type, count, rate; storage and chunk compression) and, for PointCloud2\n"
-                   "topics, the detected per-point time layout, the fields and the mean\n"
-                   "number of valid points per scan (from the first few messages).",
+                   "type, count, rate; storage and chunk compression) and, for PointCloud2 and\n"
+                   "Livox CustomMsg topics, the detected per-point time layout, the fields and\n"
+                   "the mean number of valid points per scan (from the first few messages).",
                    {{"bag", "PATH", "ROS1 bag, .db3, .mcap or ROS 2 bag folder", true, false},
-                    {"lidar-topic", "TOPIC", "analyse only this PointCloud2 topic", false, false}}};
+                    {"lidar-topic", "TOPIC", "analyse only this PointCloud2 or CustomMsg topic", false, false}}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   StatusOr<BagInfo> info = ReadBagInfo(args.Get("bag"), args.Get("lidar-topic"));

@@ -3,7 +3,6 @@
 #include "commands.h"
 #include "common_options.h"
 #include "interrupt.h"
-#include "divergence_cli.h"
 #include "run_pipeline.h"
 #include "window_options.h"
 
@@ -11,15 +10,17 @@ namespace rvlio::cli {
 
 int CmdRun(int argc, char** argv) {
   CommandSpec spec{"run",
-                   "Runs the odometry on a ROS1 bag and writes trajectory.tum, map.pcd, scans.csv "
-                   "and summary.json to the output folder.",
-                   {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
+                   "Runs the odometry on a recording (ROS1 or ROS 2 bag) and writes trajectory.tum, "
+                   "map.pcd, scans.csv and summary.json to the output folder (and "
+                   "trajectory.partial.tum while it runs). SIGINT/SIGTERM write the outputs of the "
+                   "scans done and exit 130/143.",
+                   {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
-                    {"quiet", "", "no progress line"},
                     StartOption(),
                     DurationOption(),
+                    {"quiet", "", "no progress line"},
                     AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;

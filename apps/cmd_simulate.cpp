@@ -127,8 +127,8 @@ std::string Num(double v) {
 
 // The estimator's sensor keys (odometry/options.h) as simulated. The noise
 // densities must be positive there; a noise-free simulation gets a tiny value.
-std::string SensorYaml(const SimOptions& o, const std::string& name, const std::string& bag_file,
-                       bool livox) {
+std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
+                       const std::string& bag_file) {
   auto density = [](double v) { return Num(std::max(v, 1e-9)); };
   const auto& t = o.extrinsics.imu_T_lidar.translation;
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
@@ -166,8 +166,8 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, const std::
 // An interrupt stops it too and leaves no bag: the writer's temporary file
 // (path + ".tmp") is removed when the writer goes, or by the abort of a
 // second signal (interrupt.h).
-Status WriteBag(const sim::Simulator& simulator, const std::string& path,
-                const BagWriterOptions& format, bool livox) {
+Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
+                const BagWriterOptions& format) {
   StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
   if (!writer.ok()) return writer.status();
   SetAbortRemovePath(path + ".tmp");
@@ -219,7 +219,7 @@ int CmdSimulate(int argc, char** argv) {
     return Fail(kName, err);
   // The sensor configuration must be one that `rvlio run` accepts.
   const bool livox = args.Get("lidar-msg") == "livox";
-  const std::string yaml = SensorYaml(options, name, name + extension, livox);
+  const std::string yaml = SensorYaml(options, name, livox, name + extension);
   OdometryOptions check;
   if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
       !s.ok() || !(s = check.Validate()).ok())
@@ -230,7 +230,7 @@ int CmdSimulate(int argc, char** argv) {
   StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
   if (!simulator.ok()) return Fail(kName, simulator.status().message());
   const std::string bag_path = (dir / (name + extension)).string();
-  if (Status s = WriteBag(**simulator, bag_path, format, livox); !s.ok())
+  if (Status s = WriteBag(**simulator, bag_path, livox, format); !s.ok())
     return Fail(kName, s.message(), s.exit_code());
   if (Interrupted()) {
     std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",

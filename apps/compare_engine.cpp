@@ -214,9 +214,9 @@ Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& tr
   row.label = v.label;
   std::vector<std::string> sets = req.overrides;
   sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
-  RunRequest run{req.bag, req.out_dir + "/" + v.name, req.config_files, sets, req.quiet,
-                 /*allow_divergence=*/true,  // the row is marked instead
-                 req.window};
+  RunRequest run{req.bag, req.out_dir + "/" + v.name, req.config_files, sets, req.quiet};
+  run.allow_divergence = true;  // the row is marked instead
+  run.window = req.window;
   RunOutcome outcome;
   const auto t0 = Clock::now();
   row.exit_code = RunOdometryOnBag(run, &outcome);

@@ -36,8 +36,8 @@ int FinishDiverged(const std::string& command, const DivergenceReport& r,
   const std::string what = "the estimate diverged from bag time " + std::string(when) + " s (" +
                            std::to_string(r.events.size()) + " episode(s), " +
                            std::to_string(r.scans_flagged) +
-                           " scans flagged; summary.json divergence, scans.csv column diverged); "
-                           "outputs written to " + out_dir + " for inspection";
+                           " scans flagged; see divergence in summary.json); outputs written to " +
+                           out_dir + " for inspection";
   if (allow) {
     std::fprintf(stderr, "rvlio %s: warning: %s\n", command.c_str(), what.c_str());
     return 0;

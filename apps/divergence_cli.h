@@ -1,7 +1,8 @@
 #pragma once
 // How the commands report the divergence monitor (odometry/divergence.h):
 // one warning line per episode while running, a `divergence` object in
-// summary.json, and exit status kExitDiverged unless --allow-divergence.
+// summary.json, and exit status kExitDiverged unless --allow-divergence
+// (common_options.h).
 #include <cstddef>
 #include <string>
 
@@ -14,12 +15,6 @@ namespace rvlio::cli {
 
 // "Ran to the end but diverged": every output is written for inspection.
 constexpr int kExitDiverged = 3;
-
-inline OptionSpec AllowDivergenceOption() {
-  return {"allow-divergence", "",
-          "exit 0 even when the divergence monitor fired (the warnings and summary.json still "
-          "say so; without it such a run exits 3)"};
-}
 
 // {detected, first_time_s, scans_flagged, events: {kind: episodes}, episodes: [...]}.
 nlohmann::json DivergenceJson(const DivergenceReport& report);

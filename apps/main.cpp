@@ -15,17 +15,17 @@ struct Subcommand {
 };
 
 constexpr Subcommand kSubcommands[] = {
-    {"run", "run the odometry (IESKF or smoother) on a ROS1 bag", rvlio::cli::CmdRun},
+    {"run", "run the odometry (IESKF or smoother) on a ROS1 or ROS 2 bag", rvlio::cli::CmdRun},
     {"refine", "offline batch refinement of a whole sequence from an initial trajectory",
      rvlio::cli::CmdRefine},
-    {"simulate", "simulate a tunnel flight: ROS1 bag, ground truth and sensor config",
+    {"simulate", "simulate a tunnel flight: ROS1/ROS 2 bag, ground truth and sensor config",
      rvlio::cli::CmdSimulate},
     {"eval", "ATE/RPE of an estimated trajectory against ground truth (evo definitions)",
      rvlio::cli::CmdEval},
     {"compare", "run the standard variants on one sequence and tabulate their accuracy",
      rvlio::cli::CmdCompare},
     {"ablate", "run a grid of sequences x variants x parameters, resumable", rvlio::cli::CmdAblate},
-    {"info", "list the topics, rates and point layouts of a ROS1 bag", rvlio::cli::CmdInfo},
+    {"info", "list the topics, rates and point layouts of a ROS1 or ROS 2 bag", rvlio::cli::CmdInfo},
     {"demo", "simulate the default tunnel and show what rvlio does with it", rvlio::cli::CmdDemo},
 };
 
@@ -39,7 +39,8 @@ void PrintHelp() {
     for (size_t i = std::strlen(c.name); i < 10; ++i) std::cout << ' ';
     std::cout << c.summary << "\n";
   }
-  std::cout << "\nexit status: 0 success, 2 bad input or configuration, 1 internal failure\n";
+  std::cout << "\nexit status: 0 success, 2 bad input or configuration, 1 internal failure,\n"
+               "130 / 143 stopped by SIGINT / SIGTERM (run, refine, compare, ablate, simulate)\n";
 }
 
 }  // namespace

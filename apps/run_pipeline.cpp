@@ -354,7 +354,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   std::error_code ec;
   const bool out_dir_existed = std::filesystem::exists(req.out_dir, ec);
   if (!PrepareOutputDir("run", req.out_dir)) return 2;
-  StatusOr<BagInfo> info = ReadBagInfo(req.bag);
+  StatusOr<BagInfo> info = ReadBagSpan(req.bag);
   Progress progress(!req.quiet, info.ok() ? info->start_s : 0.0, info.ok() ? info->end_s : 1.0);
 
   RunData data;

@@ -3,7 +3,8 @@
 //
 // Input layout: byte 0 picks the message (0 sensor_msgs/msg/PointCloud2, then
 // DecodePointCloud2 with lidar.type auto as the reader does; 1
-// sensor_msgs/msg/Imu; 2 livox_ros_driver2/msg/CustomMsg; 3
+// sensor_msgs/msg/Imu; 2 livox_ros_driver2/msg/CustomMsg, then
+// DecodeLivoxCustomMsg; 3
 // std_msgs/msg/String), the rest is the CDR payload (encapsulation header
 // first). Seeds (fuzz/corpus/cdr/) are real payloads: the first cloud and IMU
 // message of a small `rvlio simulate --format db3` sequence, big-endian
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "rvlio/io/cdr.h"
+#include "rvlio/io/livox.h"
 
 namespace {
 
@@ -84,7 +86,13 @@ void FuzzLivox(const uint8_t* data, size_t size) {
   for (size_t i = 0; i < msg->points.size(); ++i)
     Require(back->points[i].offset_time == msg->points[i].offset_time &&
                 back->points[i].line == msg->points[i].line,
-            "CustomMsg point round trip differs");
+            "CustomMsg point round trip differs");  // Then as the reader does: the CustomMsg -> Scan conversion.
+  rvlio::LidarOptions lidar;
+  rvlio::DecodeStats stats;
+  const rvlio::StatusOr<rvlio::Scan> scan = rvlio::DecodeLivoxCustomMsg(*msg, lidar, &stats);
+  if (!CheckError(scan)) return;
+  Require(scan->points.size() <= msg->points.size(), "more points than the message");
+  Require(scan->t_start_ns <= scan->t_end_ns, "t_start > t_end");
 }
 
 void FuzzString(const uint8_t* data, size_t size) {

@@ -1,7 +1,9 @@
 // ReadBagInfo: what `rvlio info` prints about a recording (ROS1 bag through
 // rosbag_storage; ROS 2 .db3 / .mcap / bag folder through io/recording).
 #include <algorithm>
+#include <cstring>
 #include <exception>
+#include <fstream>
 #include <functional>
 #include <limits>
 
@@ -9,8 +11,10 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include "livox_ros1.h"
 #include "rosbag_common.h"
 #include "rvlio/io/cdr.h"
+#include "rvlio/io/livox.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
 
@@ -35,12 +39,16 @@ class CloudSampler {
       for (const auto& f : cloud->fields) info_->fields.push_back(f.name);
     }
     DecodeStats stats;
-    StatusOr<Scan> scan = DecodePointCloud2(*cloud, lidar_, &stats);
-    if (!scan.ok()) return Fail(scan.status().message());
-    info_->lidar_layout = stats.layout;
-    info_->header_stamp = stats.stamp_is_end ? "end" : "start";
-    points_ += static_cast<int64_t>(scan->points.size());
-    ++info_->scans_sampled;
+    Record(DecodePointCloud2(*cloud, lidar_, &stats), stats);
+  }
+
+  // A Livox CustomMsg (ROS1 or ROS 2) or why it could not be deserialized.
+  void Add(const StatusOr<LivoxCustomMsg>& msg) {
+    if (!msg.ok()) return Fail(msg.status().message());
+    if (info_->fields.empty())
+      info_->fields = {"offset_time", "x", "y", "z", "reflectivity", "tag", "line"};
+    DecodeStats stats;
+    Record(DecodeLivoxCustomMsg(*msg, lidar_, &stats), stats);
   }
 
   void Finish() {
@@ -49,6 +57,14 @@ class CloudSampler {
   }
 
  private:
+  void Record(const StatusOr<Scan>& scan, const DecodeStats& stats) {
+    if (!scan.ok()) return Fail(scan.status().message());
+    info_->lidar_layout = stats.layout;
+    info_->header_stamp = stats.stamp_is_end ? "end" : "start";
+    points_ += static_cast<int64_t>(scan->points.size());
+    ++info_->scans_sampled;
+  }
+
   void Fail(const std::string& why) {
     info_->lidar_layout = "unknown";
     info_->decode_error = why;
@@ -75,11 +91,27 @@ void DescribeCloudTopic(const rosbag::Bag& bag, BagTopicInfo* info) {
   rosbag::View view(bag, rosbag::TopicQuery(info->topic));
   for (const rosbag::MessageInstance& m : view) {
     if (sampler.Full()) break;
+    if (m.getDataType() == kLivoxRos1Type) {
+      const std::vector<uint8_t> bytes = bag_detail::RawMessageBytes(m);
+      sampler.Add(ParseLivoxRos1(bytes.data(), bytes.size(), info->topic));
+      continue;
+    }
     auto msg = m.instantiate<sensor_msgs::PointCloud2>();
     if (!msg) break;
     sampler.Add(bag_detail::ToView(*msg, info->topic));
   }
   sampler.Finish();
+}
+
+bool IsRos1ScanType(const std::string& type) {
+  return type == bag_detail::kPointCloud2Type || type == kLivoxRos1Type;
+}
+
+// The type --lidar-topic must have: the topic's own when it is a LiDAR type.
+std::string LidarTypeOf(const std::map<std::string, std::string>& topics, const std::string& topic,
+                        const char* livox_type, const char* cloud_type) {
+  auto it = topics.find(topic);
+  return it != topics.end() && it->second == livox_type ? livox_type : cloud_type;
 }
 
 BagTopicInfo DescribeTopic(const rosbag::Bag& bag, const std::string& topic,
@@ -91,7 +123,7 @@ BagTopicInfo DescribeTopic(const rosbag::Bag& bag, const std::string& topic,
   info.count = view.size();
   if (info.count > 0)
     SetRate(&info, bag_detail::ToNs(view.getBeginTime()), bag_detail::ToNs(view.getEndTime()));
-  if (decode_clouds && type == bag_detail::kPointCloud2Type) DescribeCloudTopic(bag, &info);
+  if (decode_clouds && IsRos1ScanType(type)) DescribeCloudTopic(bag, &info);
   return info;
 }
 
@@ -99,8 +131,10 @@ StatusOr<BagInfo> Describe(const std::string& path, const rosbag::Bag& bag,
                            const std::string& lidar_topic) {
   const auto topics = bag_detail::TopicTypes(bag);
   if (!lidar_topic.empty()) {
-    Status s = bag_detail::RequireTopic(path, topics, lidar_topic, bag_detail::kPointCloud2Type,
-                                        "--lidar-topic");
+    Status s = bag_detail::RequireTopic(
+        path, topics, lidar_topic,
+        LidarTypeOf(topics, lidar_topic, kLivoxRos1Type, bag_detail::kPointCloud2Type),
+        "--lidar-topic");
     if (!s.ok()) return s;
   }
   BagInfo info;
@@ -121,11 +155,54 @@ StatusOr<BagInfo> Describe(const std::string& path, const rosbag::Bag& bag,
   return info;
 }
 
+// ROS1 bag format 2.0: after the "#ROSBAG V2.0\n" line, records of
+// header_len (u32 LE), header fields (u32 length + "name=value"), data_len
+// (u32), data. Chunk records (op 0x05) name their "compression" (none, bz2,
+// lz4). Walks the record headers only (one seek per record) up to the index.
+std::vector<std::string> Ros1ChunkCompressions(const std::string& path) {
+  std::vector<std::string> found;
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(13);
+  auto u32 = [&in](uint32_t* v) {
+    unsigned char b[4];
+    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+    *v = b[0] | (b[1] << 8) | (b[2] << 16) | (uint32_t{b[3]} << 24);
+    return true;
+  };
+  constexpr uint32_t kMaxHeader = 1 << 20;
+  uint32_t header_len = 0, data_len = 0;
+  while (u32(&header_len) && header_len <= kMaxHeader) {
+    std::string header(header_len, '\0');
+    if (!in.read(header.data(), header_len) || !u32(&data_len)) break;
+    std::map<std::string, std::string> fields;
+    for (size_t at = 0; at + 4 <= header.size();) {
+      uint32_t n = 0;
+      std::memcpy(&n, header.data() + at, 4);  // little endian on every supported host
+      if (n > header.size() - at - 4) break;
+      const std::string field = header.substr(at + 4, n);
+      const size_t eq = field.find('=');
+      if (eq != std::string::npos) fields[field.substr(0, eq)] = field.substr(eq + 1);
+      at += 4 + n;
+    }
+    const std::string op = fields["op"];
+    if (op == std::string(1, '\x05')) {
+      const std::string& c = fields["compression"];
+      if (std::find(found.begin(), found.end(), c) == found.end()) found.push_back(c);
+    } else if (op == std::string(1, '\x07') || op == std::string(1, '\x06')) {
+      break;  // connection or chunk-info records: the index section, no chunks after
+    }
+    in.seekg(data_len, std::ios::cur);
+  }
+  return found;
+}
+
 StatusOr<BagInfo> ReadRos1Info(const std::string& path, const std::string& lidar_topic) {
   rosbag::Bag bag;
   if (Status s = bag_detail::OpenForRead(path, &bag); !s.ok()) return s;
   try {
-    return Describe(path, bag, lidar_topic);
+    StatusOr<BagInfo> info = Describe(path, bag, lidar_topic);
+    if (info.ok()) info->compressions = Ros1ChunkCompressions(path);
+    return info;
   } catch (const std::exception& e) {
     return Status::InvalidInput("reading bag '" + path + "' failed (" + e.what() +
                                 "); truncated or corrupt?");
@@ -135,7 +212,9 @@ StatusOr<BagInfo> ReadRos1Info(const std::string& path, const std::string& lidar
 // ---------------------------------------------------------------------------
 // ROS 2
 
-bool IsCloudType(const std::string& type) { return type == cdr::kPointCloud2Type; }
+bool IsRos2ScanType(const std::string& type) {
+  return type == cdr::kPointCloud2Type || type == kLivoxRos2Type;
+}
 
 // Samples the first clouds of one topic from a fresh source.
 Status DescribeRos2Cloud(const std::string& path, int topic, BagTopicInfo* info) {
@@ -148,7 +227,10 @@ Status DescribeRos2Cloud(const std::string& path, int topic, BagTopicInfo* info)
     StatusOr<bool> got = (*source)->Next(&m);
     if (!got.ok()) return got.status();
     if (!*got) break;
-    sampler.Add(cdr::DecodePointCloud2(m.data.data(), m.data.size(), info->topic));
+    if (info->type == kLivoxRos2Type)
+      sampler.Add(cdr::DecodeLivoxCustomMsg(m.data.data(), m.data.size(), info->topic));
+    else
+      sampler.Add(cdr::DecodePointCloud2(m.data.data(), m.data.size(), info->topic));
   }
   sampler.Finish();
   return Status::Ok();
@@ -161,8 +243,9 @@ StatusOr<BagInfo> ReadRos2Info(const std::string& path, const std::string& lidar
   std::map<std::string, std::string> types;
   for (const RecordingTopic& t : topics) types[t.name] = t.type;
   if (!lidar_topic.empty()) {
-    Status s = bag_detail::RequireTopic(path, types, lidar_topic, cdr::kPointCloud2Type,
-                                        "--lidar-topic");
+    Status s = bag_detail::RequireTopic(
+        path, types, lidar_topic,
+        LidarTypeOf(types, lidar_topic, kLivoxRos2Type, cdr::kPointCloud2Type), "--lidar-topic");
     if (!s.ok()) return s;
   }
   StatusOr<std::vector<RecordingTopicStats>> stats = (*source)->TopicStats();
@@ -180,7 +263,7 @@ StatusOr<BagInfo> ReadRos2Info(const std::string& path, const std::string& lidar
     t.count = st.count;
     SetRate(&t, st.first_ns, st.last_ns);
     const bool decode = lidar_topic.empty() || lidar_topic == t.topic;
-    if (decode && IsCloudType(t.type) && t.count > 0) {
+    if (decode && IsRos2ScanType(t.type) && t.count > 0) {
       if (Status s = DescribeRos2Cloud(path, static_cast<int>(i), &t); !s.ok()) return s;
     }
     info.topics.push_back(std::move(t));
@@ -198,7 +281,53 @@ StatusOr<BagInfo> ReadRos2Info(const std::string& path, const std::string& lidar
   return info;
 }
 
+void SetSpan(BagInfo* info, int64_t messages, TimeNs start_ns, TimeNs end_ns) {
+  info->messages = messages;
+  if (messages == 0) return;
+  info->start_ns = start_ns;
+  info->end_ns = end_ns;
+  info->start_s = NsToSeconds(start_ns);
+  info->end_s = NsToSeconds(end_ns);
+}
+
+StatusOr<BagInfo> ReadRos1Span(const std::string& path) {
+  rosbag::Bag bag;
+  if (Status s = bag_detail::OpenForRead(path, &bag); !s.ok()) return s;
+  try {
+    BagInfo info;
+    info.path = path;
+    info.storage = "ros1";
+    rosbag::View all(bag);
+    SetSpan(&info, all.size(), bag_detail::ToNs(all.getBeginTime()),
+            bag_detail::ToNs(all.getEndTime()));
+    return info;
+  } catch (const std::exception& e) {
+    return Status::InvalidInput("reading bag '" + path + "' failed (" + e.what() +
+                                "); truncated or corrupt?");
+  }
+}
+
+StatusOr<BagInfo> ReadRos2Span(const std::string& path) {
+  StatusOr<std::unique_ptr<RecordingSource>> source = RecordingSource::Open(path);
+  if (!source.ok()) return source.status();
+  StatusOr<RecordingTopicStats> span = (*source)->Span();
+  if (!span.ok()) return span.status();
+  BagInfo info;
+  info.path = path;
+  info.storage = (*source)->storage();
+  SetSpan(&info, span->count, span->first_ns, span->last_ns);
+  info.warnings = (*source)->warnings();
+  return info;
+}
+
 }  // namespace
+
+StatusOr<BagInfo> ReadBagSpan(const std::string& path) {
+  StatusOr<RecordingKind> kind = DetectRecording(path);
+  if (!kind.ok()) return kind.status();
+  if (*kind == RecordingKind::kRos1Bag) return ReadRos1Span(path);
+  return ReadRos2Span(path);
+}
 
 StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic) {
   StatusOr<RecordingKind> kind = DetectRecording(path);

@@ -343,7 +343,7 @@ StatusOr<ImuMessage> DecodeImu(const uint8_t* data, size_t size, const std::stri
 
 StatusOr<LivoxCustomMsg> DecodeLivoxCustomMsg(const uint8_t* data, size_t size,
                                               const std::string& topic) {
-  Reader r(data, size, Where(kLivoxCustomMsgType, topic));
+  Reader r(data, size, Where(kLivoxRos2Type, topic));
   LivoxCustomMsg m;
   uint32_t count = 0;
   Status s = r.Begin();

@@ -99,6 +99,20 @@ class SqliteSource final : public RecordingSource {
     return true;
   }
 
+  StatusOr<RecordingTopicStats> Span() override {
+    sqlite3_stmt* q = nullptr;
+    if (sqlite3_prepare_v2(db_, "SELECT COUNT(*), MIN(timestamp), MAX(timestamp) FROM messages",
+                           -1, &q, nullptr) != SQLITE_OK)
+      return Error("has no readable messages table");
+    RecordingTopicStats span;
+    const int rc = sqlite3_step(q);
+    if (rc == SQLITE_ROW)
+      span = {sqlite3_column_int64(q, 0), sqlite3_column_int64(q, 1), sqlite3_column_int64(q, 2)};
+    sqlite3_finalize(q);
+    if (rc != SQLITE_ROW) return Error("reading the messages table failed");
+    return span;
+  }
+
   StatusOr<std::vector<RecordingTopicStats>> TopicStats() override {
     std::vector<RecordingTopicStats> stats(topics_.size());
     sqlite3_stmt* q = nullptr;
@@ -211,6 +225,18 @@ class McapSource final : public RecordingSource {
       out->data = std::move(message_.data);
       return true;
     }
+  }
+
+  // The summary's statistics (or what the linear scan at open counted).
+  StatusOr<RecordingTopicStats> Span() override {
+    const mcap::FileSummary& summary = reader_->summary();
+    RecordingTopicStats span;
+    span.count = static_cast<int64_t>(summary.message_count);
+    if (span.count > 0) {
+      span.first_ns = static_cast<TimeNs>(summary.message_start_time_ns);
+      span.last_ns = static_cast<TimeNs>(summary.message_end_time_ns);
+    }
+    return span;
   }
 
   // A second reader over the whole file: counts and spans per channel.
@@ -384,6 +410,19 @@ class FolderSource final : public RecordingSource {
     out->topic = to_merged_[best][out->topic];
     if (Status s = Advance(best); !s.ok()) return error_ = s;
     return true;
+  }
+
+  StatusOr<RecordingTopicStats> Span() override {
+    RecordingTopicStats span;
+    for (const auto& part : parts_) {
+      StatusOr<RecordingTopicStats> p = part->Span();
+      if (!p.ok()) return p.status();
+      if (p->count == 0) continue;
+      span.first_ns = span.count == 0 ? p->first_ns : std::min(span.first_ns, p->first_ns);
+      span.last_ns = span.count == 0 ? p->last_ns : std::max(span.last_ns, p->last_ns);
+      span.count += p->count;
+    }
+    return span;
   }
 
   StatusOr<std::vector<RecordingTopicStats>> TopicStats() override {

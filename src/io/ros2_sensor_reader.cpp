@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "rvlio/io/cdr.h"
+#include "rvlio/io/livox.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
 #include "sensor_reader_common.h"
@@ -45,10 +46,9 @@ class Ros2SensorReader final : public SensorBagReader {
     source_ = std::move(source).value();
     const auto types = TopicTypes(*source_);
     const auto lidar_type = types.find(lidar_.topic);
-    livox_ = lidar_type != types.end() && lidar_type->second == cdr::kLivoxCustomMsgType;
+    livox_ = lidar_type != types.end() && lidar_type->second == kLivoxRos2Type;
     if (Status s = RequireTopic(path_, types, lidar_.topic,
-                                livox_ ? cdr::kLivoxCustomMsgType : cdr::kPointCloud2Type,
-                                "lidar.topic");
+                                livox_ ? kLivoxRos2Type : cdr::kPointCloud2Type, "lidar.topic");
         !s.ok())
       return s;
     if (Status s = RequireTopic(path_, types, imu_.topic, cdr::kImuType, "imu.topic"); !s.ok())
@@ -57,7 +57,8 @@ class Ros2SensorReader final : public SensorBagReader {
     imu_index_ = TopicIndex(*source_, imu_.topic);
     if (Status s = RequireCdr(*source_, lidar_index_, "lidar.topic"); !s.ok()) return s;
     if (Status s = RequireCdr(*source_, imu_index_, "imu.topic"); !s.ok()) return s;
-    if (Status s = PeekLayout(); !s.ok()) return s;
+    if (livox_) layout_ = "livox_custom";
+    else if (Status s = PeekLayout(); !s.ok()) return s;
     return source_->SetTopicFilter({lidar_index_, imu_index_});
   }
 
@@ -83,10 +84,6 @@ class Ros2SensorReader final : public SensorBagReader {
   // Decodes the first LiDAR message so that a cloud without a usable time
   // field fails at Open, not minutes into a run.
   Status PeekLayout() {
-    if (livox_) {
-      layout_ = "livox_custom";
-      return Status::Ok();
-    }
     StatusOr<std::unique_ptr<RecordingSource>> peek = RecordingSource::Open(path_);
     if (!peek.ok()) return peek.status();
     if (Status s = (*peek)->SetTopicFilter({lidar_index_}); !s.ok()) return s;
@@ -137,8 +134,8 @@ class Ros2SensorReader final : public SensorBagReader {
     if (!msg.ok()) return InFile(msg.status());
     StatusOr<Scan> scan = DecodeLivoxCustomMsg(*msg, lidar_, decode);
     if (!scan.ok())
-      return InFile(Status::InvalidInput("lidar.topic '" + lidar_.topic + "': " +
-                                         scan.status().message()));
+      return Status::InvalidInput("lidar.topic '" + lidar_.topic + "' in '" + path_ +
+                                  "': " + scan.status().message());
     return scan;
   }
 

@@ -11,6 +11,7 @@
 #include <sqlite3.h>
 
 #include "rvlio/io/cdr.h"
+#include "rvlio/io/livox.h"
 #include "rvlio/io/mcap.h"
 #include "rvlio/io/sensor_bag.h"
 #include "sensor_writer_common.h"
@@ -226,11 +227,11 @@ class Ros2SensorWriter final : public SensorBagWriter {
     if (Status s = CheckRos2Stamp(scan.t_start_ns, "scan start"); !s.ok()) return s;
     if (Status s = CheckRos2Stamp(scan.t_end_ns, "scan end"); !s.ok()) return s;
     if (scan.t_end_ns < scan.t_start_ns) return Status::InvalidInput("scan ends before it starts");
-    StatusOr<LivoxCustomMsg> msg = bag_detail::BuildLivoxMsg(scan, frame_id);
-    if (!msg.ok()) return msg.status();
-    // Recorded when the driver publishes it: at the end of the sweep.
-    return Write(topic, cdr::kLivoxCustomMsgType, cdr::LivoxCustomMsgDefinition(), scan.t_end_ns,
-                 cdr::EncodeLivoxCustomMsg(*msg));
+    // offset_time must fit uint32 ns after the timebase.
+    if (Status s = CheckRelativePointTimes(scan); !s.ok()) return s;
+    const LivoxCustomMsg msg = ScanToLivoxCustomMsg(scan, frame_id);
+    return Write(topic, kLivoxRos2Type, cdr::LivoxCustomMsgDefinition(), scan.t_end_ns,
+                 cdr::EncodeLivoxCustomMsg(msg));
   }
 
   Status WriteImu(const std::string& topic, const std::string& frame_id,

@@ -76,7 +76,8 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
   os.precision(9);
   os << "t,status,raw_points,points,constraints,iterations,rv_active,n_alpha_x,n_alpha_y,"
         "n_alpha_z,scv,coplanar,repaired,K,rv_iterations,coplanar_fraction,localizability,"
-        "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb,reinforced,nis,residual_median_m,diverged\n";
+        "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb,reinforced,nis,residual_median_m,"
+        "residual_rms_m,diverged\n";
   for (size_t i = 0; i < results.size(); ++i) {
     const ScanResult& r = results[i];
     const RvReport& v = r.rv;
@@ -90,7 +91,7 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
        << r.mean_acc_imu.y() << ',' << r.mean_acc_imu.z() << ','
        << (i < rss_mb.size() ? rss_mb[i] : std::nan("")) << ',' << v.num_reinforced << ','
        << Optional(r.health.nis_per_dof) << ',' << Optional(r.health.residual_median_m) << ','
-       << DivergenceKindNames(r.health.divergence_mask) << '\n';
+       << Optional(r.health.residual_rms_m) << ',' << DivergenceKindNames(r.health.divergence_mask) << '\n';
   }
   return WriteFileAtomically(path, os.str());
 }

@@ -93,9 +93,9 @@ class RosbagSensorWriter final : public SensorBagWriter {
     if (Status s = CheckRosStamp(scan.t_start_ns, "scan start"); !s.ok()) return s;
     if (Status s = CheckRosStamp(scan.t_end_ns, "scan end"); !s.ok()) return s;
     if (scan.t_end_ns < scan.t_start_ns) return Status::InvalidInput("scan ends before it starts");
-    StatusOr<LivoxCustomMsg> livox = bag_detail::BuildLivoxMsg(scan, frame_id);
-    if (!livox.ok()) return livox.status();
-    bag_detail::LivoxRos1Bytes msg{SerializeLivoxRos1(*livox)};
+    // offset_time must fit uint32 ns after the timebase.
+    if (Status s = bag_detail::CheckRelativePointTimes(scan); !s.ok()) return s;
+    bag_detail::LivoxRos1Bytes msg{SerializeLivoxRos1(ScanToLivoxCustomMsg(scan, frame_id))};
     // Recorded when the driver publishes it: at the end of the sweep.
     return Write(topic, bag_detail::RecordTime(scan.t_end_ns), msg);
   }

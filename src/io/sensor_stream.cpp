@@ -9,7 +9,6 @@
 #include <mutex>
 #include <thread>
 #include <utility>
-#include <vector>
 
 namespace rvlio {
 namespace {
@@ -104,10 +103,8 @@ class ThreadedReader final : public SensorBagReader {
     }
     not_full_.notify_one();
     stats_ = item.stats;
-    if (item.kind != SensorMessage::kImu) {
-      layout_ = std::move(item.layout);
-      warnings_ = std::move(item.warnings);
-    }
+    if (item.kind != SensorMessage::kImu) layout_ = std::move(item.layout);
+    if (item.kind == SensorMessage::kEnd || !item.error.ok()) warnings_ = std::move(item.warnings);
     if (!item.error.ok()) return error_ = item.error;
     if (item.kind == SensorMessage::kEnd) ended_ = true;
     if (item.kind == SensorMessage::kImu) *imu = item.imu;
@@ -126,8 +123,8 @@ class ThreadedReader final : public SensorBagReader {
     Scan scan;
     Status error;
     SensorReaderStats stats;
-    std::string layout;                 // scans, end and errors only
-    std::vector<std::string> warnings;  // scans, end and errors only
+    std::string layout;  // scans, end and errors only
+    std::vector<std::string> warnings;  // end and errors only
     double bytes = 0.0;
   };
 
@@ -140,10 +137,8 @@ class ThreadedReader final : public SensorBagReader {
       if (m.ok()) item.kind = *m;
       else item.error = m.status();
       item.stats = inner_->stats();
-      if (item.kind != SensorMessage::kImu || !m.ok()) {
-        item.layout = inner_->lidar_layout();
-        item.warnings = inner_->warnings();
-      }
+      if (item.kind != SensorMessage::kImu || !m.ok()) item.layout = inner_->lidar_layout();
+      if (item.kind == SensorMessage::kEnd || !m.ok()) item.warnings = inner_->warnings();
       item.bytes = static_cast<double>(item.scan.points.size() * sizeof(LidarPoint));
       const bool last = !m.ok() || *m == SensorMessage::kEnd;
       {
@@ -191,7 +186,7 @@ Status CheckWindow(const std::string& path, const ReadWindow& window) {
   if (!(window.duration_s >= 0.0) || !std::isfinite(window.duration_s))
     return Status::InvalidInput("--duration " + Seconds(window.duration_s) + " must be > 0 s");
   if (window.start_s == 0.0) return Status::Ok();
-  StatusOr<BagInfo> info = ReadBagInfo(path);
+  StatusOr<BagInfo> info = ReadBagSpan(path);
   if (!info.ok()) return info.status();
   const double length_s = NsToSeconds(info->end_ns - info->start_ns);
   if (window.start_s >= length_s)

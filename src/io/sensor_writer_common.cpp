@@ -39,23 +39,6 @@ uint16_t ClampU16(double v) {
   return v >= 65535.0 ? uint16_t{65535} : static_cast<uint16_t>(std::lround(v));
 }
 
-// Relative time field `t` of one point (ns from the scan start). A no-return
-// point keeps whatever time it has when it fits, else 0.
-Status RelativeTime(const Scan& scan, const LidarPoint& p, size_t index, uint32_t* t) {
-  const TimeNs dt = p.t_ns - scan.t_start_ns;
-  if (dt >= 0 && dt <= static_cast<TimeNs>(std::numeric_limits<uint32_t>::max())) {
-    *t = static_cast<uint32_t>(dt);
-    return Status::Ok();
-  }
-  if (IsNoReturn(p)) {
-    *t = 0;
-    return Status::Ok();
-  }
-  return Status::InvalidInput("point " + std::to_string(index) + " time " +
-                              std::to_string(p.t_ns) + " ns is not within 4.29 s after the scan "
-                              "start " + std::to_string(scan.t_start_ns) + " ns");
-}
-
 }  // namespace
 
 Status BuildOusterCloud(const Scan& scan, int rows, int cols, OwnedCloud* out) {
@@ -75,7 +58,7 @@ Status BuildOusterCloud(const Scan& scan, int rows, int cols, OwnedCloud* out) {
   for (size_t i = 0; i < n; ++i) {
     const LidarPoint& p = scan.points[i];
     uint32_t t = 0;
-    if (Status s = RelativeTime(scan, p, i, &t); !s.ok()) return s;
+    if (Status s = RelativePointTime(scan, p, i, &t); !s.ok()) return s;
     uint8_t* dst = out->data.data() + i * kOusterPointStep;
     Put<float>(dst, 0, p.p_lidar.x());
     Put<float>(dst, 4, p.p_lidar.y());
@@ -94,12 +77,27 @@ Status BuildOusterCloud(const Scan& scan, int rows, int cols, OwnedCloud* out) {
   return Status::Ok();
 }
 
-StatusOr<LivoxCustomMsg> BuildLivoxMsg(const Scan& scan, const std::string& frame_id) {
-  for (size_t i = 0; i < scan.points.size(); ++i) {
-    uint32_t t = 0;  // offset_time: uint32 ns after the timebase (the scan start)
-    if (Status s = RelativeTime(scan, scan.points[i], i, &t); !s.ok()) return s;
+Status RelativePointTime(const Scan& scan, const LidarPoint& p, size_t index, uint32_t* t) {
+  const TimeNs dt = p.t_ns - scan.t_start_ns;
+  if (dt >= 0 && dt <= static_cast<TimeNs>(std::numeric_limits<uint32_t>::max())) {
+    *t = static_cast<uint32_t>(dt);
+    return Status::Ok();
   }
-  return ScanToLivoxCustomMsg(scan, frame_id);
+  if (IsNoReturn(p)) {
+    *t = 0;
+    return Status::Ok();
+  }
+  return Status::InvalidInput("point " + std::to_string(index) + " time " +
+                              std::to_string(p.t_ns) + " ns is not within 4.29 s after the scan "
+                              "start " + std::to_string(scan.t_start_ns) + " ns");
+}
+
+Status CheckRelativePointTimes(const Scan& scan) {
+  for (size_t i = 0; i < scan.points.size(); ++i) {
+    uint32_t t = 0;
+    if (Status s = RelativePointTime(scan, scan.points[i], i, &t); !s.ok()) return s;
+  }
+  return Status::Ok();
 }
 
 Status CheckStamp(TimeNs t_ns, TimeNs max_ns, const std::string& range_text,

@@ -1,6 +1,6 @@
 #pragma once
 // Private, ROS-free pieces shared by the ROS1 and ROS 2 sensor writers
-// (src/io only): the Ouster and Livox driver layouts and stamp checks.
+// (src/io only): the Ouster driver cloud layout and stamp checks.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -8,7 +8,6 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
-#include "rvlio/io/livox.h"
 #include "rvlio/io/pointcloud2.h"
 #include "rvlio/io/sensor_bag.h"
 
@@ -26,9 +25,14 @@ struct OwnedCloud {
 // not fit the uint32 ns field.
 Status BuildOusterCloud(const Scan& scan, int rows, int cols, OwnedCloud* out);
 
-// The Livox driver message of SensorBagWriter::WriteLivoxScan (io/livox.h).
-// InvalidInput for a point whose time does not fit the uint32 ns offset_time.
-StatusOr<LivoxCustomMsg> BuildLivoxMsg(const Scan& scan, const std::string& frame_id);
+// Time of point `index` in ns from the scan start, as the uint32 relative
+// time fields (Ouster `t`, Livox `offset_time`) hold it. A no-return (zero)
+// point keeps whatever time it has when it fits, else 0; InvalidInput for any
+// other point more than 4.29 s from the start.
+Status RelativePointTime(const Scan& scan, const LidarPoint& p, size_t index, uint32_t* t);
+
+// Checks every point of a scan with RelativePointTime.
+Status CheckRelativePointTimes(const Scan& scan);
 
 // InvalidInput unless 0 <= t_ns <= max_ns ("... outside the <range_text>").
 Status CheckStamp(TimeNs t_ns, TimeNs max_ns, const std::string& range_text,

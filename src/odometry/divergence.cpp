@@ -49,7 +49,7 @@ std::string DivergenceEvent::Describe() const {
       break;
     case DivergenceKind::kResidual:
       std::snprintf(text, sizeof(text),
-                    "median point-to-plane residual %.3f m (window median) > %.3f m", value,
+                    "median point-to-plane residual %.4f m (window median) > %.4f m", value,
                     threshold);
       break;
     case DivergenceKind::kInliers:

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/odometry/divergence.h"
+#include "rvlio/smoother/refine.h"
 
 namespace rvlio {
 namespace {
@@ -97,7 +98,7 @@ TEST(DivergenceMonitor, NisIsAWindowTestNotASingleScan) {
   DivergenceMonitor single(o, kNoise, kGravity);
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
-    if (k == 50) s.health.nis_per_dof = 200.0;  // one bad scan: mean 200/20 + ~1.5 < 25
+    if (k == 50) s.health.nis_per_dof = 150.0;  // one bad scan: mean 150/20 + ~1.5 < 10
     single.Check(s);
   }
   EXPECT_FALSE(single.report().detected);
@@ -106,11 +107,11 @@ TEST(DivergenceMonitor, NisIsAWindowTestNotASingleScan) {
   int first = -1;
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
-    if (k >= 50) s.health.nis_per_dof = 60.0;
+    if (k >= 50) s.health.nis_per_dof = 30.0;
     if (persistent.Check(s) != 0 && first < 0) first = k;
   }
   EXPECT_EQ(Episodes(persistent.report(), DivergenceKind::kNis), 1);
-  // The window mean passes 25 once more than ~8 of its 20 scans are at 60.
+  // The window mean passes 10 once more than ~5 of its 20 scans are at 30.
   EXPECT_GT(first, 50);
   EXPECT_LT(first, 50 + o.window_scans);
 }
@@ -120,7 +121,7 @@ TEST(DivergenceMonitor, ResidualsAndInliersPersistent) {
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
     if (k >= 40) {
-      s.health.residual_median_m = 0.5;  // > 4 * 0.03
+      s.health.residual_median_m = 0.2;  // > 2 * 0.03
       s.constraints = 50;                // 5% of the points
     }
     m.Check(s);
@@ -170,6 +171,46 @@ TEST(DivergenceMonitor, DisabledNeverFires) {
 TEST(DivergenceMonitor, DescribeNamesTheOption) {
   DivergenceEvent e{DivergenceKind::kSpeed, 0, 73.24, 50.0};
   EXPECT_EQ(e.Describe(), "speed 73.2 m/s > divergence.max_speed 50 m/s");
+}
+
+// refine's result: speed and jump from its poses and velocities, inliers
+// from its last round.
+RefineResult Refined(int scans) {
+  RefineResult r;
+  for (int k = 0; k < scans; ++k) {
+    const HealthSample s = Healthy(k);
+    StampedPose p;
+    p.t_ns = s.t_ns;
+    p.p_world_imu = s.p_world_imu;
+    r.trajectory.push_back(p);
+    r.v_world_imu.push_back(s.v_world_imu);
+  }
+  RefineRound round;
+  round.points = 100000;
+  round.constraints = 60000;
+  r.rounds.push_back(round);
+  return r;
+}
+
+TEST(DivergenceMonitor, RefineResultChecked) {
+  const DivergenceOptions o;
+  EXPECT_FALSE(CheckRefineResult(Refined(100), o, kNoise, kGravity).detected);
+
+  RefineResult jumped = Refined(100);
+  for (int k = 60; k < 100; ++k) jumped.trajectory[k].p_world_imu.z() += 3.0;
+  const DivergenceReport j = CheckRefineResult(jumped, o, kNoise, kGravity);
+  EXPECT_EQ(Episodes(j, DivergenceKind::kJump), 1);
+  EXPECT_EQ(j.first_t_ns, jumped.trajectory[60].t_ns);
+
+  RefineResult fast = Refined(100);
+  fast.v_world_imu[30].x() = 70.0;
+  EXPECT_EQ(Episodes(CheckRefineResult(fast, o, kNoise, kGravity), DivergenceKind::kSpeed), 1);
+
+  RefineResult unmatched = Refined(100);
+  unmatched.rounds.back().constraints = 5000;  // 5% of the points
+  const DivergenceReport u = CheckRefineResult(unmatched, o, kNoise, kGravity);
+  EXPECT_EQ(Episodes(u, DivergenceKind::kInliers), 1);
+  EXPECT_EQ(u.scans_flagged, 100 - o.window_scans + 1);
 }
 
 TEST(DivergenceMonitor, KindNamesOfAMask) {

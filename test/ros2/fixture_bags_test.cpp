@@ -123,6 +123,13 @@ TEST_P(FixtureBagTest, InfoReportsStorageTopicsAndSpan) {
   EXPECT_EQ(info->messages, e.messages);
   EXPECT_EQ(info->start_ns, e.start_ns);
   EXPECT_EQ(info->end_ns - info->start_ns, e.duration_ns);
+  // The cheap span (indexes and summary only) agrees.
+  StatusOr<BagInfo> span = ReadBagSpan(folder);
+  ASSERT_TRUE(span.ok()) << span.status().message();
+  EXPECT_EQ(span->storage, e.storage);
+  EXPECT_EQ(span->messages, e.messages);
+  EXPECT_EQ(span->start_ns, e.start_ns);
+  EXPECT_EQ(span->end_ns - span->start_ns, e.duration_ns);
   for (const BagTopicInfo& t : info->topics) {
     ASSERT_EQ(e.topics.count(t.topic), 1u) << t.topic;
     EXPECT_EQ(t.type, e.topics.at(t.topic).type);

@@ -20,14 +20,14 @@ using testing_cli::ToolRun;
 
 constexpr int kRounds = 3;
 
-// An 8 s, 512-column simulated tunnel, its run (the initial trajectory) and
+// A 6 s, 512-column simulated tunnel, its run (the initial trajectory) and
 // the uninterrupted refinement of kRounds rounds (dir_/ref).
 class RefineSignalsTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = MakeTempDir("rvlio_signals_refine");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 6 --duration 8 --out " + dir_ +
+    const ToolRun sim = RunTool("simulate --preset tunnel --seed 6 --duration 6 --out " + dir_ +
                                     "/data --set lidar.columns=512", dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
     const ToolRun run = RunTool("run --quiet --bag " + Bag() + " --config " + Sensors() +

@@ -21,13 +21,13 @@ using testing_cli::ToolRun;
 const std::vector<std::string> kOutputs = {"map.pcd", "scans.csv", "summary.json",
                                            "trajectory.tum"};
 
-// A 12 s, 512-column simulated tunnel and its uninterrupted run (dir_/full).
+// An 8 s, 512-column simulated tunnel and its uninterrupted run (dir_/full).
 class RunSignalsTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = MakeTempDir("rvlio_signals_run");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 4 --duration 12 --out " + dir_ +
+    const ToolRun sim = RunTool("simulate --preset tunnel --seed 4 --duration 8 --out " + dir_ +
                                     "/data --set lidar.columns=512", dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
     const ToolRun full = RunTool("run --quiet " + Args(dir_ + "/full"), dir_);
@@ -90,7 +90,7 @@ TEST_F(RunSignalsTest, UninterruptedRunRemovesThePartialTrajectory) {
   EXPECT_FALSE(Exists(dir_ + "/full/trajectory.partial.tum"));
   const json s = json::parse(ReadFile(dir_ + "/full/summary.json"));
   EXPECT_EQ(s["interrupted"], false);
-  EXPECT_GT(FullLines().size(), 60u);
+  EXPECT_GT(FullLines().size(), 50u);
 }
 
 TEST_F(RunSignalsTest, SigintWritesThePrefixOfTheFullRunAndExits130) {
@@ -165,6 +165,36 @@ TEST_F(RunSignalsTest, SigkillLeavesAParseablePartialTrajectory) {
   ASSERT_LE(part.size(), full.size());
   for (size_t i = 0; i < part.size(); ++i) ASSERT_EQ(part[i], full[i]) << "line " << i;
   for (const std::string& name : kOutputs) EXPECT_FALSE(Exists(out + "/" + name)) << name;
+}
+
+// compare runs its variants in-process: the signal stops the running one,
+// which keeps what it did; it and the steps not run are marked interrupted.
+TEST_F(RunSignalsTest, InterruptedCompareTabulatesWhatItFinished) {
+  const std::string out = dir_ + "/cmp";
+  const pid_t pid = Spawn({"compare", "--bag", dir_ + "/data/tunnel.bag", "--gt",
+                           dir_ + "/data/tunnel_gt.tum", "--config", dir_ + "/data/tunnel.yaml",
+                           "--out", out, "--no-plots", "--quiet"},
+                          dir_ + "/cmp_stdout.txt", dir_ + "/cmp_stderr.txt");
+  const std::string second = out + "/ieskf_rv_on";
+  int status = -1;
+  const bool ready = WaitUntil(
+      pid, [&] { return CountLines(second + "/trajectory.partial.tum") >= 4; }, &status);
+  ASSERT_TRUE(ready) << "compare ended (status " << status << ") before its second variant";
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  ASSERT_EQ(Wait(pid), 130) << ReadFile(dir_ + "/cmp_stderr.txt");
+  EXPECT_NE(ReadFile(dir_ + "/cmp_stderr.txt")
+                .find("rvlio compare: interrupted by SIGINT: 1 of 5 steps finished"),
+            std::string::npos) << ReadFile(dir_ + "/cmp_stderr.txt");
+  const json j = json::parse(ReadFile(out + "/compare.json"), nullptr, false);
+  ASSERT_TRUE(j.is_object());
+  std::vector<std::string> statuses;
+  for (const json& v : j["variants"]) statuses.push_back(v["status"]);
+  EXPECT_EQ(statuses, (std::vector<std::string>{"ok", "interrupted", "interrupted",
+                                                "interrupted", "interrupted"}));
+  EXPECT_EQ(json::parse(ReadFile(second + "/summary.json"))["interrupted"], true);
+  EXPECT_NE(ReadFile(out + "/compare.csv").find("ieskf_rv_on,\"IESKF, RV on (RV-LIO)\",interrupted,130"),
+            std::string::npos);
+  EXPECT_FALSE(Exists(out + "/smoother_rv_off"));
 }
 
 }  // namespace

@@ -40,14 +40,14 @@ inline pid_t Spawn(const std::vector<std::string>& args, const std::string& out_
 }
 
 // The exit status of a child: its exit code, or 128 + the signal that killed it.
-inline int Status(int raw) {
+inline int ExitStatus(int raw) {
   return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
 }
 
 inline int Wait(pid_t pid) {
   int raw = 0;
   ::waitpid(pid, &raw, 0);
-  return Status(raw);
+  return ExitStatus(raw);
 }
 
 // Polls `ready` every 5 ms until it holds (true) or the child ends (false,
@@ -58,7 +58,7 @@ inline bool WaitUntil(pid_t pid, const std::function<bool()>& ready, int* exit_s
     if (ready()) return true;
     int raw = 0;
     if (::waitpid(pid, &raw, WNOHANG) == pid) {
-      *exit_status = Status(raw);
+      *exit_status = ExitStatus(raw);
       return false;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));

@@ -4,6 +4,7 @@
 // noise-free IMU samples. From a drifting, noisy initial trajectory the
 // refined one recovers the truth far better than where it started, with and
 // without chunking; bad input is InvalidInput.
+#include <atomic>
 #include <cmath>
 #include <random>
 
@@ -209,6 +210,65 @@ TEST(Refine, BadInputIsInvalidInputWithAClearMessage) {
     RefineInput empty;
     EXPECT_FALSE(Refine(Config(), std::move(empty)).ok());
   }
+}
+
+// RefineHooks: the state after a round continues bit for bit; a stop request
+// ends with the last completed round's result (what that many rounds give).
+TEST(Refine, ResumedFromARoundStateEqualsTheUninterruptedResult) {
+  RefineConfig config = Config();
+  config.smoother.refine_rounds = 3;
+  std::vector<RefineRoundState> states;
+  RefineHooks record;
+  record.on_state = [&](const RefineRoundState& s) {
+    states.push_back(s);
+    return Status::Ok();
+  };
+  StatusOr<RefineResult> full = Refine(config, MakeScene(12, 7).input, record);
+  ASSERT_TRUE(full.ok()) << full.status().message();
+  ASSERT_EQ(full->rounds.size(), 3u);
+  ASSERT_EQ(states.size(), 4u);  // the initialization, then each round
+  EXPECT_EQ(states[0].rounds_done, 0);
+  EXPECT_EQ(states[3].rounds_done, 3);
+  for (int from : {0, 1, 2}) {
+    RefineHooks hooks;
+    hooks.resume = &states[from];
+    StatusOr<RefineResult> resumed = Refine(config, MakeScene(12, 7).input, hooks);
+    ASSERT_TRUE(resumed.ok()) << resumed.status().message();
+    ASSERT_EQ(resumed->trajectory.size(), full->trajectory.size());
+    for (size_t k = 0; k < full->trajectory.size(); ++k) {
+      EXPECT_EQ(resumed->trajectory[k].p_world_imu, full->trajectory[k].p_world_imu) << from;
+      EXPECT_EQ(resumed->trajectory[k].q_world_imu.coeffs(), full->trajectory[k].q_world_imu.coeffs());
+      EXPECT_EQ(resumed->v_world_imu[k], full->v_world_imu[k]);
+    }
+    EXPECT_EQ(resumed->map_points, full->map_points);
+    EXPECT_EQ(resumed->rounds.size(), 3u);
+  }
+  // A state of another input is refused.
+  RefineHooks other;
+  other.resume = &states[1];
+  StatusOr<RefineResult> wrong = Refine(config, MakeScene(10, 7).input, other);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.status().message().find("scan states"), std::string::npos)
+      << wrong.status().message();
+
+  // Stop requested in the middle of round 2 (the 5th poll after round 1:
+  // within the association or the solve): round 2 is dropped, the result is
+  // round 1's.
+  int rounds_seen = 0;
+  std::atomic<int> polls_after_round_1{0};  // polled from the association threads too
+  RefineHooks stop;
+  stop.on_round = [&](const RefineRound&) { ++rounds_seen; };
+  stop.stop = [&] { return rounds_seen >= 1 && ++polls_after_round_1 >= 5; };
+  StatusOr<RefineResult> stopped = Refine(config, MakeScene(12, 7).input, stop);
+  ASSERT_TRUE(stopped.ok());
+  EXPECT_TRUE(stopped->stopped);
+  EXPECT_EQ(stopped->rounds.size(), 1u);
+  config.smoother.refine_rounds = 1;
+  StatusOr<RefineResult> one = Refine(config, MakeScene(12, 7).input);
+  ASSERT_TRUE(one.ok());
+  EXPECT_FALSE(one->stopped);
+  for (size_t k = 0; k < one->trajectory.size(); ++k)
+    EXPECT_EQ(stopped->trajectory[k].p_world_imu, one->trajectory[k].p_world_imu);
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ namespace rvlio::cdr {
 inline constexpr const char* kPointCloud2Type = "sensor_msgs/msg/PointCloud2";
 inline constexpr const char* kImuType = "sensor_msgs/msg/Imu";
 inline constexpr const char* kStringType = "std_msgs/msg/String";
-inline constexpr const char* kLivoxCustomMsgType = "livox_ros_driver2/msg/CustomMsg";
+// livox_ros_driver2/msg/CustomMsg: kLivoxRos2Type (io/livox.h).
 
 // The message definitions (ros2msg text, dependencies appended after
 // "=====" separator lines as rosbag2 stores them), for MCAP schemas and the

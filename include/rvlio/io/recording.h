@@ -71,6 +71,9 @@ class RecordingSource {
   // One entry per topic (same order as topics()), from a pass that leaves
   // Next() untouched.
   virtual StatusOr<std::vector<RecordingTopicStats>> TopicStats() = 0;
+  // All topics together (count, first and last receive time), from the
+  // storage's indexes or summary where it has them: no pass over the messages.
+  virtual StatusOr<RecordingTopicStats> Span() = 0;
   // Problems that did not stop reading (a cut-short MCAP file).
   virtual std::vector<std::string> warnings() const = 0;
 };

@@ -111,7 +111,8 @@ struct BagTopicInfo {
 struct BagInfo {
   std::string path;
   std::string storage;                    // "ros1", "sqlite3" or "mcap"
-  std::vector<std::string> compressions;  // MCAP chunk compressions ("zstd", "lz4", "none")
+  // Chunk compressions: MCAP ("zstd", "lz4", "none"), ROS1 ("none", "bz2", "lz4").
+  std::vector<std::string> compressions;
   std::vector<std::string> warnings;      // problems that did not stop reading
   double start_s = 0.0, end_s = 0.0;
   TimeNs start_ns = 0, end_ns = 0;  // the same, exact
@@ -123,5 +124,8 @@ struct BagInfo {
 // PointCloud2 topic (only of `lidar_topic` when it is given; it must then be a
 // PointCloud2 topic).
 StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic = "");
+// Only path, storage, messages and the start/end times of ReadBagInfo, from
+// the recording's index or summary (no pass over an MCAP file's chunks).
+StatusOr<BagInfo> ReadBagSpan(const std::string& path);
 
 }  // namespace rvlio
