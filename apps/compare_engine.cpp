@@ -214,7 +214,12 @@ Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& tr
   row.label = v.label;
   std::vector<std::string> sets = req.overrides;
   sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
-  RunRequest run{req.bag, req.out_dir + "/" + v.name, req.config_files, sets, req.quiet};
+  RunRequest run;
+  run.bag = req.bag;
+  run.out_dir = req.out_dir + "/" + v.name;
+  run.config_files = req.config_files;
+  run.overrides = sets;
+  run.quiet = req.quiet;
   run.allow_divergence = true;  // the row is marked instead
   run.window = req.window;
   RunOutcome outcome;

@@ -32,7 +32,8 @@ class WindowedReader final : public SensorBagReader {
       const bool is_imu = *m == SensorMessage::kImu;
       if (!is_imu && offset_ns_ != 0) ShiftScanTime(offset_ns_, scan);
       const TimeNs t = is_imu ? imu->t_ns : scan->t_end_ns;
-      if (first_ns_ < 0) first_ns_ = t;
+      if (!have_first_) first_ns_ = t;
+      have_first_ = true;
       const TimeNs rel = t - first_ns_;
       if (end_ns_ >= 0 && rel > end_ns_) {
         ended_ = true;  // the recording is in time order: nothing later is in the window
@@ -56,7 +57,8 @@ class WindowedReader final : public SensorBagReader {
  private:
   std::unique_ptr<SensorBagReader> inner_;
   TimeNs offset_ns_, start_ns_, end_ns_, lead_in_ns_;
-  TimeNs first_ns_ = -1;
+  TimeNs first_ns_ = 0;
+  bool have_first_ = false;
   bool ended_ = false;
   int64_t scans_delivered_ = 0, imu_delivered_ = 0;
   mutable SensorReaderStats stats_;

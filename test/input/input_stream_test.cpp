@@ -91,7 +91,10 @@ TEST_F(InputStreamTest, LivoxCustomMsgGivesThePointCloud2Trajectory) {
 // = 0.03 brings it back within 10 % of the synchronized run.
 TEST_F(InputStreamTest, TimeOffsetUndoesAnInjectedLidarDelay) {
   ASSERT_EQ(Run("pc", "sync_out").exit_code, 0);
-  ASSERT_EQ(Run("off", "raw_out").exit_code, 0);
+  // Uncorrected, the divergence monitor may flag the run (exit 3); the
+  // trajectory is what is measured here.
+  const ToolRun raw_run = Run("off", "raw_out", "--allow-divergence");
+  ASSERT_EQ(raw_run.exit_code, 0) << raw_run.err;
   const ToolRun fixed =
       Run("off", "fixed_out", "--set lidar.time_offset=" + std::to_string(kInjectedOffsetS));
   ASSERT_EQ(fixed.exit_code, 0) << fixed.err;
