@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "extrinsic_json.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/run_outputs.h"
@@ -123,6 +124,7 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   j["peak_memory_mb"] = PeakMemoryMb();
   j["rv_active_scans"] = RvActiveScans(data.results);
   j["stats"] = StatsJson(odo.stats(), reader_stats);
+  if (odo.stats().extrinsic.enabled) j["extrinsic"] = ExtrinsicJson(odo.stats().extrinsic);
   j["warnings"] = warnings;
   outcome->scans = static_cast<int>(data.results.size());
   outcome->median_ms = t.median_ms;
