@@ -447,6 +447,12 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
 
 namespace rvlio {
 
+void SlidingWindow::CountExcitationScan() {
+  if (nodes_.empty()) return;
+  const Node& newest = *nodes_.back();
+  excitation_.CountScan(newest.t_ns, newest.T_world_imu().R, T_imu_lidar().R);
+}
+
 // Marginal covariance of the extrinsic block under the marginalization
 // prior (H* = S^T S over the kept blocks; pseudo-inverse with the
 // marginalization's relative eigenvalue floor): the information of every scan

@@ -68,7 +68,9 @@ class Ieskf {
   // excited, judged on the covariance the updates would leave with all six
   // axes estimated (propagated and updated alongside P).
   const ExtrinsicExcitation& extrinsic_excitation() const { return excitation_; }
-  void CountExcitationScan() { excitation_.CountScan(); }
+  void CountExcitationScan() {
+    excitation_.CountScan(t_ns_, x_.R_world_imu, x_.R_imu_lidar);
+  }
   TimeNs time_ns() const { return t_ns_; }
 
  private:

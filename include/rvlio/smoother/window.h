@@ -178,7 +178,8 @@ class SlidingWindow {
   // The extrinsic in use: the estimate (estimate_extrinsics) or options.T_imu_lidar.
   Pose3 T_imu_lidar() const;
   const ExtrinsicExcitation& extrinsic_excitation() const { return excitation_; }
-  void CountExcitationScan() { excitation_.CountScan(); }
+  // One processed scan: the newest state's attitude feeds the rotational excitation.
+  void CountExcitationScan();
   const WindowOptions& options() const { return options_; }
 
  private:
