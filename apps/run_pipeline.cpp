@@ -18,6 +18,7 @@
 #include "cli.h"
 #include "interrupt.h"
 #include "divergence_cli.h"
+#include "extrinsic_json.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/run_outputs.h"
@@ -131,6 +132,7 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   j["rv_active_scans"] = RvActiveScans(data.results);
   j["stats"] = StatsJson(odo.stats(), reader_stats);
   j["divergence"] = DivergenceJson(odo.divergence());
+  if (odo.stats().extrinsic.enabled) j["extrinsic"] = ExtrinsicJson(odo.stats().extrinsic);
   j["warnings"] = warnings;
   j["interrupted"] = !data.interrupted_by.empty();
   if (!data.interrupted_by.empty()) {

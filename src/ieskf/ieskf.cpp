@@ -1,5 +1,6 @@
 #include "rvlio/ieskf/ieskf.h"
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -13,6 +14,17 @@ namespace {
 
 using Matrix12d = Eigen::Matrix<double, 12, 12>;
 using Vector12d = Eigen::Matrix<double, 12, 1>;
+using Matrix24x12d = Eigen::Matrix<double, 24, 12>;
+
+// Fixed extrinsics: a tiny std keeps P invertible; no update touches the block.
+constexpr double kFixedExtrinsicStd = 1e-5;  // rad and m
+
+Vector6d ExtrinsicPriorStd(const IeskfOptions& o) {
+  Vector6d sd;
+  sd << Eigen::Vector3d::Constant(o.init_extrinsic_rot_std),
+      Eigen::Vector3d::Constant(o.init_extrinsic_pos_std);
+  return sd;
+}
 
 // Prior covariance from the configured standard deviations.
 Matrix24d InitialCovariance(const IeskfOptions& o) {
@@ -22,7 +34,9 @@ Matrix24d InitialCovariance(const IeskfOptions& o) {
   sd.segment<3>(FilterState::kVel).setConstant(o.init_vel_std);
   sd.segment<3>(FilterState::kBg).setConstant(o.init_bias_gyro_std);
   sd.segment<3>(FilterState::kBa).setConstant(o.init_bias_acc_std);
-  sd.segment<6>(FilterState::kExtRot).setConstant(o.init_extrinsic_std);
+  // Estimated extrinsics start held too: an axis gets its prior std once the
+  // motion excites it (Ieskf::ReleaseExcitedAxes).
+  sd.segment<6>(FilterState::kExtRot).setConstant(kFixedExtrinsicStd);
   sd.segment<3>(FilterState::kGrav).setConstant(o.init_gravity_std);
   return sd.cwiseAbs2().asDiagonal();
 }
@@ -61,7 +75,46 @@ int AccumulateNormalEquations(const ConstraintList& constraints, const FilterSta
   return static_cast<int>(constraints.size());
 }
 
+void PropagateCovariance(const Matrix24d& F, const ImuOptions& imu, double dt_s, Matrix24d* P) {
+  *P = F * *P * F.transpose();
+  auto add_diag = [&](int index, double variance) {
+    for (int i = 0; i < 3; ++i) (*P)(index + i, index + i) += variance;
+  };
+  add_diag(FilterState::kRot, imu.gyro_noise_density * imu.gyro_noise_density * dt_s);
+  add_diag(FilterState::kVel, imu.accel_noise_density * imu.accel_noise_density * dt_s);
+  add_diag(FilterState::kBg, imu.gyro_bias_random_walk * imu.gyro_bias_random_walk * dt_s);
+  add_diag(FilterState::kBa, imu.accel_bias_random_walk * imu.accel_bias_random_walk * dt_s);
+}
+
+// The covariance the excitation monitor starts from: P0 with an uninformative
+// initial pose. The map is built from the first scans with the configured
+// extrinsic, so the start pose of the map frame carries no information on the
+// extrinsic; with the tight P0 pose block, the map (taken as exact by the
+// update) would make the extrinsic look determined by any scan. Loose, only
+// the relative motion (IMU) against the LiDAR's (map) informs it: the
+// hand-eye condition, which needs rotation.
+constexpr double kGaugeFreePoseStd = 1.0;  // rad and m
+
+Matrix24d ExcitationCovariance(const Matrix24d& P0, const Vector6d& extrinsic_std) {
+  Matrix24d P = P0;
+  for (int i = 0; i < 6; ++i) {
+    P(FilterState::kRot + i, FilterState::kRot + i) = kGaugeFreePoseStd * kGaugeFreePoseStd;
+    P(FilterState::kExtRot + i, FilterState::kExtRot + i) = extrinsic_std(i) * extrinsic_std(i);
+  }
+  return P;
+}
+
 }  // namespace
+
+// The extrinsic block is not adjacent to the pose block in the error state
+// (FilterState offsets), so the columns are placed one by one.
+Matrix24x12d ErrorStateColumns(const std::array<bool, 6>& free) {
+  Matrix24x12d E = Matrix24x12d::Zero();
+  E.block<6, 6>(FilterState::kRot, 0).setIdentity();  // kRot, kPos adjacent
+  for (int i = 0; i < 6; ++i)
+    if (free[i]) E(FilterState::kExtRot + i, 6 + i) = 1.0;  // kExtRot, kExtPos adjacent
+  return E;
+}
 
 Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
              const ConstraintOptions& constraints, const RvOptions& rv)
@@ -70,6 +123,9 @@ Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
 void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu) {
   x_ = x0;
   P_ = InitialCovariance(options_);
+  P_all_extrinsic_ = ExcitationCovariance(P_, ExtrinsicPriorStd(options_));
+  released_.fill(false);
+  excitation_ = ExtrinsicExcitation(ExtrinsicPriorStd(options_));
   t_ns_ = t_ns;
   last_imu_ = last_imu;
   ClearPoseHistory();
@@ -136,14 +192,8 @@ void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu
   x_.v_world_imu += a_world * dt_s;
   x_.R_world_imu = x_.R_world_imu * so3::Exp(w_dt);
 
-  P_ = F * P_ * F.transpose();
-  auto add_diag = [&](int index, double variance) {
-    for (int i = 0; i < 3; ++i) P_(index + i, index + i) += variance;
-  };
-  add_diag(FilterState::kRot, imu_.gyro_noise_density * imu_.gyro_noise_density * dt_s);
-  add_diag(FilterState::kVel, imu_.accel_noise_density * imu_.accel_noise_density * dt_s);
-  add_diag(FilterState::kBg, imu_.gyro_bias_random_walk * imu_.gyro_bias_random_walk * dt_s);
-  add_diag(FilterState::kBa, imu_.accel_bias_random_walk * imu_.accel_bias_random_walk * dt_s);
+  PropagateCovariance(F, imu_, dt_s, &P_);
+  if (options_.estimate_extrinsics) PropagateCovariance(F, imu_, dt_s, &P_all_extrinsic_);
 }
 
 // Iterated update, paper Eq. (1), in information form. With
@@ -154,6 +204,7 @@ void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu
 // (I - K H) Pv equals (H^T R^-1 H + Pv^-1)^-1.
 IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
   IeskfUpdateResult result;
+  if (options_.estimate_extrinsics) ReleaseExcitedAxes();
   const FilterState x0 = x_;
   const Matrix24d P0 = P_;
   const Matrix24d P0_inv = P0.ldlt().solve(Matrix24d::Identity());
@@ -161,6 +212,10 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
   const double inv_sigma2 = 1.0 / (constraints_.lidar_noise * constraints_.lidar_noise);
   const int cols = with_ext ? 12 : 6;
   const int kMinConstraints = 6;
+  std::array<bool, 6> free{};
+  for (int i = 0; i < 6; ++i) free[i] = with_ext && excitation_.excited(i);
+  const Matrix24x12d E = ErrorStateColumns(free);
+  Matrix24d J = Matrix24d::Identity();
 
   FilterState x = x0;
   Matrix24d S = P0;
@@ -178,13 +233,18 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
     AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
 
     const Matrix24d J_inv = BoxminusJacobianInverse(x, x0);
-    const Matrix24d J = BoxminusJacobian(x, x0);
+    J = BoxminusJacobian(x, x0);
     const Vector24d e = J_inv * Boxminus(x, x0);
     const Matrix24d Pv_inv = J.transpose() * P0_inv * J;
     Matrix24d A = Pv_inv;
-    A.topLeftCorner(cols, cols) += HtRinvH.topLeftCorner(cols, cols);
     Vector24d b = Pv_inv * e;
-    b.head(cols) += HtRinvz.head(cols);
+    if (with_ext) {
+      A.noalias() += E * HtRinvH * E.transpose();
+      b.noalias() += E * HtRinvz;
+    } else {
+      A.topLeftCorner(cols, cols) += HtRinvH.topLeftCorner(cols, cols);
+      b.head(cols) += HtRinvz.head(cols);
+    }
     const Eigen::LDLT<Matrix24d> ldlt(A);
     const Vector24d dx = -ldlt.solve(b);
     S = ldlt.solve(Matrix24d::Identity());
@@ -204,9 +264,42 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
   }
   x_ = x;
   P_ = S;
+  if (with_ext) UpdateExcitation(HtRinvH, J);
   result.ok = true;
   result.residuals = ComputeResidualStats(constraints, x.T_world_imu(), x.T_imu_lidar());
   return result;
+}
+
+// A held extrinsic axis carries the tiny kFixedExtrinsicStd in P (a loose
+// variance on an axis without a Jacobian column would still let the
+// increments leak into it through the rotation Jacobians of the iteration);
+// once excited it gets its prior variance, uncorrelated, and its column.
+void Ieskf::ReleaseExcitedAxes() {
+  const Vector6d prior_std = ExtrinsicPriorStd(options_);
+  for (int i = 0; i < 6; ++i) {
+    if (released_[i] || !excitation_.excited(i)) continue;
+    const int k = FilterState::kExtRot + i;
+    P_.row(k).setZero();
+    P_.col(k).setZero();
+    P_(k, k) = prior_std(i) * prior_std(i);
+    released_[i] = true;
+  }
+}
+
+// The covariance the update would leave with every extrinsic axis estimated
+// (same linearization as the last iteration), in information form as in
+// Update(); its extrinsic block drives the excitation monitor.
+void Ieskf::UpdateExcitation(const Eigen::Matrix<double, 12, 12>& HtRinvH, const Matrix24d& J) {
+  std::array<bool, 6> all;
+  all.fill(true);
+  const Matrix24x12d E = ErrorStateColumns(all);
+  const Matrix24d prior_inv = P_all_extrinsic_.ldlt().solve(Matrix24d::Identity());
+  const Matrix24d A = J.transpose() * prior_inv * J + E * HtRinvH * E.transpose();
+  Matrix24d S = A.ldlt().solve(Matrix24d::Identity());
+  S = 0.5 * (S + S.transpose());
+  if (!S.allFinite()) return;
+  P_all_extrinsic_ = S;
+  excitation_.Observe(S.block<6, 6>(FilterState::kExtRot, FilterState::kExtRot));
 }
 
 }  // namespace rvlio

@@ -73,6 +73,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.mean_acc_imu = mean_acc_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.status = map_.Empty() ? ScanStatus::kMapInit : Correct(&r);
+  ReportExtrinsic();
   InsertIntoMap();
   filter_.ClearPoseHistory();
   r.t_ns = scan.t_end_ns;
@@ -130,6 +131,13 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
     return ScanStatus::kPredictOnly;
   }
   return ScanStatus::kUpdated;
+}
+
+void IeskfOdometry::ReportExtrinsic() {
+  if (!options_.ieskf.estimate_extrinsics) return;
+  filter_.CountExcitationScan();
+  stats_.extrinsic = MakeExtrinsicReport(filter_.extrinsic_excitation(), T_imu_lidar_,
+                                         filter_.state().T_imu_lidar());
 }
 
 void IeskfOdometry::InsertIntoMap() {

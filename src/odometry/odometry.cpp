@@ -28,6 +28,19 @@ HealthSample HealthSampleOf(const ScanResult& r) {
   return s;
 }
 
+ExtrinsicReport MakeExtrinsicReport(const ExtrinsicExcitation& excitation,
+                                    const Pose3& T_imu_lidar_prior, const Pose3& T_imu_lidar) {
+  ExtrinsicReport r;
+  r.enabled = true;
+  r.estimated = excitation.any_excited();
+  r.excited_fraction = excitation.excited_fraction();
+  for (int i = 0; i < 6; ++i) r.axis_excited[i] = excitation.excited(i);
+  r.std_ratio = excitation.std_ratio();
+  r.T_imu_lidar_prior = T_imu_lidar_prior;
+  r.T_imu_lidar = T_imu_lidar;
+  return r;
+}
+
 StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& options) {
   OdometryOptions checked = options;
   if (Status s = checked.Validate(); !s.ok()) return s;

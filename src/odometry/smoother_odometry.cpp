@@ -97,7 +97,7 @@ void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
   flushed_ = true;
   for (int k = 0; k < window_->size(); ++k) {
     const WindowState s = window_->state(k);
-    TransformPoints(s.pose.ToPose3() * T_imu_lidar_, window_->points(k), &p_world_);
+    TransformPoints(s.pose.ToPose3() * CurrentTImuLidar(), window_->points(k), &p_world_);
     output_map_.Insert(p_world_);
   }
 }
@@ -119,7 +119,7 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
     ++stats_.scans_too_few_points;  // the next state's IMU factor spans this scan
     return;
   }
-  DeskewToScanEnd(ImuPoseSamplesFromKnots(knots, samples, bg_, ba_, g), T_imu_lidar_,
+  DeskewToScanEnd(ImuPoseSamplesFromKnots(knots, samples, bg_, ba_, g), CurrentTImuLidar(),
                   downsampled_.points, scan.t_end_ns, &p_lidar_end_);
   ScanResult r;
   r.raw_points = static_cast<int>(scan.points.size());
@@ -129,6 +129,7 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
                               : UpdateWindow(scan.t_end_ns, knots.back(), samples, &r);
   SetNewestFromWindow();
   MarginalizeIfFull();
+  ReportExtrinsic();
   DropImuBefore(scan.t_end_ns);
   r.t_ns = scan.t_end_ns;
   r.T_world_imu = Pose3(newest_.R_world_imu, newest_.p_world_imu);
@@ -188,7 +189,7 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
                SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, std::move(imu), p_lidar_end_);
   const ScanAssociateFn associate = [this](const std::vector<Eigen::Vector3d>& p_lidar,
                                            const Pose3& T_world_imu, ConstraintList* out) {
-    Associate(p_lidar, T_world_imu, T_imu_lidar_, map_.map(), options_.constraints, out, nullptr);
+    Associate(p_lidar, T_world_imu, CurrentTImuLidar(), map_.map(), options_.constraints, out, nullptr);
   };
   const WindowSolveReport report = window_->Optimize(associate);
   stats_.association_ms += report.association_ms;
@@ -218,7 +219,7 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
 
 void SmootherOdometry::InsertIntoWorkingMap(const WindowState& s,
                                             const std::vector<Eigen::Vector3d>& p_lidar) {
-  const Pose3 T_world_lidar = s.pose.ToPose3() * T_imu_lidar_;
+  const Pose3 T_world_lidar = s.pose.ToPose3() * CurrentTImuLidar();
   TransformPoints(T_world_lidar, p_lidar, &p_world_);
   map_.Insert(p_world_, T_world_lidar.t);
 }
@@ -231,11 +232,22 @@ void SmootherOdometry::MarginalizeIfFull() {
   if (!m) return;
   stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   window_filled_ = true;
-  const Pose3 T_world_lidar = m->state.pose.ToPose3() * T_imu_lidar_;
+  const Pose3 T_world_lidar = m->state.pose.ToPose3() * CurrentTImuLidar();
   TransformPoints(T_world_lidar, m->p_lidar, &p_world_);
   output_map_.Insert(p_world_);
   if (options_.smoother.map_update == "marginalized") map_.Insert(p_world_, T_world_lidar.t);
   stats_.marginalization_failures = window_->stats().marginalization_failures;
+}
+
+Pose3 SmootherOdometry::CurrentTImuLidar() const {
+  return window_ ? window_->T_imu_lidar() : T_imu_lidar_;
+}
+
+void SmootherOdometry::ReportExtrinsic() {
+  if (!options_.smoother.estimate_extrinsics) return;
+  window_->CountExcitationScan();
+  stats_.extrinsic =
+      MakeExtrinsicReport(window_->extrinsic_excitation(), T_imu_lidar_, window_->T_imu_lidar());
 }
 
 void SmootherOdometry::SetNewestFromWindow() {

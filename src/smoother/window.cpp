@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
@@ -12,6 +14,7 @@
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/math/so3.h"
 #include "rvlio/smoother/imu_factor.h"
+#include "rvlio/smoother/plane_extrinsic_factor.h"
 #include "rvlio/smoother/plane_summary_factor.h"
 
 namespace rvlio {
@@ -26,6 +29,7 @@ struct SlidingWindow::Node {
   Pose3 associated_at;  // T_world_imu of the last association
   bool associated = false;
   std::unique_ptr<PlaneSummaryFactor> plane;         // null: too few constraints
+  std::unique_ptr<PlaneExtrinsicFactor> plane_ext;   // instead of plane: estimate_extrinsics
   std::unique_ptr<ImuFactor> imu;                    // from the previous node, or null
   std::unique_ptr<SpeedBiasContinuityFactor> gap;    // from the previous node when imu is null
 
@@ -93,6 +97,15 @@ ceres::LinearSolverType WindowLinearSolver(const std::string& name) {
 SlidingWindow::SlidingWindow(const WindowOptions& options) : options_(options) {
   RVLIO_CHECK(options_.smoother.window_size >= 2);
   RVLIO_CHECK(options_.lidar_noise > 0.0 && options_.smoother.online_huber_delta > 0.0);
+  PoseBlock(options_.T_imu_lidar.quaternion(), options_.T_imu_lidar.t).ToArray(extrinsic_);
+  Vector6d prior_std;
+  prior_std << Eigen::Vector3d::Constant(options_.smoother.extrinsic_rot_std),
+      Eigen::Vector3d::Constant(options_.smoother.extrinsic_pos_std);
+  excitation_ = ExtrinsicExcitation(prior_std);
+}
+
+Pose3 SlidingWindow::T_imu_lidar() const {
+  return estimate_extrinsics() ? PoseBlock::FromArray(extrinsic_).ToPose3() : options_.T_imu_lidar;
 }
 
 SlidingWindow::~SlidingWindow() = default;
@@ -113,6 +126,10 @@ void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlo
   nodes_.clear();
   marginal_prior_.reset();
   state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, options_.first_prior);
+  if (estimate_extrinsics())
+    extrinsic_prior_ = std::make_unique<PosePriorFactor>(
+        PoseBlock::FromArray(extrinsic_), options_.smoother.extrinsic_rot_std,
+        options_.smoother.extrinsic_pos_std);
   nodes_.push_back(MakeNode(t_ns, pose, speed_bias, std::move(p_lidar)));
 }
 
@@ -209,16 +226,21 @@ void SlidingWindow::AssociateRound(const ScanAssociateFn& associate, WindowSolve
 // Associate -> RV (Alg. 1-3 on this scan's list) -> Huber weights -> factor.
 void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) {
   const Pose3 T_world_imu = node->T_world_imu();
+  const Pose3 T_imu_lidar = this->T_imu_lidar();
   associate(node->p_lidar, T_world_imu, &node->constraints);
   RemoveNonFinite(&node->constraints);
-  node->rv = ApplyRv(options_.rv, T_world_imu * options_.T_imu_lidar, &node->constraints,
-                     &rv_workspace_);
-  ApplyHuberWeights(options_.smoother.online_huber_delta, T_world_imu, options_.T_imu_lidar,
+  node->rv = ApplyRv(options_.rv, T_world_imu * T_imu_lidar, &node->constraints, &rv_workspace_);
+  ApplyHuberWeights(options_.smoother.online_huber_delta, T_world_imu, T_imu_lidar,
                     &node->constraints);
   node->associated_at = T_world_imu;
   node->associated = true;
   node->plane.reset();
+  node->plane_ext.reset();
   if (static_cast<int>(node->constraints.size()) < options_.min_constraints) return;
+  if (estimate_extrinsics()) {
+    node->plane_ext = std::make_unique<PlaneExtrinsicFactor>(node->constraints, options_.lidar_noise);
+    return;
+  }
   node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, options_.T_imu_lidar,
                                                      options_.lidar_noise, T_world_imu.t);
   // Finite but absurd records (a plane 1e300 m away) overflow the summary:
@@ -257,12 +279,16 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   Backup();
   ceres::Problem problem(ProblemOptions());
   std::vector<bool> pose_used(nodes_.size(), false);
+  if (estimate_extrinsics()) AddExtrinsicBlock(&problem);
   for (size_t k = 0; k < nodes_.size(); ++k) {
     Node& n = *nodes_[k];
     problem.AddParameterBlock(n.pose, PoseBlock::kNumParams, &pose_manifold_);
     problem.AddParameterBlock(n.sb, SpeedBiasBlock::kNumParams);
     if (n.plane) {
       problem.AddResidualBlock(n.plane.get(), nullptr, n.pose);
+      pose_used[k] = true;
+    } else if (n.plane_ext) {
+      problem.AddResidualBlock(n.plane_ext.get(), nullptr, n.pose, extrinsic_);
       pose_used[k] = true;
     }
     if (k == 0) continue;
@@ -284,6 +310,7 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
     problem.AddResidualBlock(marginal_prior_.get(), nullptr, blocks);
     if (std::find(blocks.begin(), blocks.end(), first.pose) != blocks.end()) pose_used[0] = true;
   }
+  if (extrinsic_prior_) problem.AddResidualBlock(extrinsic_prior_.get(), nullptr, extrinsic_);
   // A pose no factor touches (IMU gap and no scan constraints) keeps its
   // prediction.
   for (size_t k = 0; k < nodes_.size(); ++k)
@@ -306,7 +333,25 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   return false;
 }
 
+// The extrinsic block: axes not yet excited held fixed (see window.h).
+void SlidingWindow::AddExtrinsicBlock(ceres::Problem* problem) {
+  problem->AddParameterBlock(extrinsic_, PoseBlock::kNumParams);
+  std::array<bool, 6> free;
+  int num_free = 0;
+  for (int i = 0; i < 6; ++i) num_free += (free[i] = excitation_.excited(i)) ? 1 : 0;
+  if (num_free == 0) {
+    problem->SetParameterBlockConstant(extrinsic_);
+  } else if (num_free == 6) {
+    problem->SetManifold(extrinsic_, &pose_manifold_);
+  } else {
+    extrinsic_manifold_ = std::make_unique<PoseSubsetManifold>(free);
+    problem->SetManifold(extrinsic_, extrinsic_manifold_.get());
+  }
+}
+
 bool SlidingWindow::Healthy() const {
+  const Eigen::Map<const Eigen::Matrix<double, 7, 1>> extrinsic(extrinsic_);
+  if (!extrinsic.allFinite() || std::abs(extrinsic.head<4>().norm() - 1.0) > 1e-3) return false;
   for (const auto& n : nodes_) {
     const Eigen::Map<const Eigen::Matrix<double, 7, 1>> pose(n->pose);
     const Eigen::Map<const Eigen::Matrix<double, 9, 1>> sb(n->sb);
@@ -318,8 +363,8 @@ bool SlidingWindow::Healthy() const {
 }
 
 void SlidingWindow::Backup() {
-  backup_.resize(nodes_.size() * kBlockSize);
-  double* out = backup_.data();
+  backup_.resize(nodes_.size() * kBlockSize + PoseBlock::kNumParams);
+  double* out = std::copy(extrinsic_, extrinsic_ + PoseBlock::kNumParams, backup_.data());
   for (const auto& n : nodes_) {
     out = std::copy(n->pose, n->pose + PoseBlock::kNumParams, out);
     out = std::copy(n->sb, n->sb + SpeedBiasBlock::kNumParams, out);
@@ -327,8 +372,10 @@ void SlidingWindow::Backup() {
 }
 
 void SlidingWindow::Restore() {
-  RVLIO_CHECK(backup_.size() == nodes_.size() * kBlockSize);
+  RVLIO_CHECK(backup_.size() == nodes_.size() * kBlockSize + PoseBlock::kNumParams);
   const double* in = backup_.data();
+  std::copy(in, in + PoseBlock::kNumParams, extrinsic_);
+  in += PoseBlock::kNumParams;
   for (auto& n : nodes_) {
     std::copy(in, in + PoseBlock::kNumParams, n->pose);
     in += PoseBlock::kNumParams;
@@ -348,6 +395,7 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   MarginalizationInfo info;
   info.SetManifold(old.pose, &pose_manifold_);
   info.SetManifold(next.pose, &pose_manifold_);
+  if (estimate_extrinsics()) info.SetManifold(extrinsic_, &pose_manifold_);
   const auto dropped = [&old](const std::vector<double*>& blocks) {
     std::vector<int> indices;
     for (size_t i = 0; i < blocks.size(); ++i)
@@ -360,6 +408,9 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   }
   if (state_prior_) info.AddResidualBlock(state_prior_.get(), nullptr, {old.pose, old.sb}, {0, 1});
   if (old.plane) info.AddResidualBlock(old.plane.get(), nullptr, {old.pose}, {0});
+  if (old.plane_ext)
+    info.AddResidualBlock(old.plane_ext.get(), nullptr, {old.pose, extrinsic_}, {0});
+  if (extrinsic_prior_) info.AddResidualBlock(extrinsic_prior_.get(), nullptr, {extrinsic_}, {});
   if (next.imu)
     info.AddResidualBlock(next.imu.get(), nullptr, {old.pose, old.sb, next.pose, next.sb}, {0, 1});
   else
@@ -371,18 +422,61 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   marginal_prior_.reset();
   if (status.ok() && info.prior()->rank > 0) {
     marginal_prior_ = std::make_unique<MarginalizationFactor>(info.prior());
+    extrinsic_prior_.reset();  // now inside the marginalization prior
+    if (estimate_extrinsics()) ObserveExtrinsicExcitation();
   } else {
     // Keep the window anchored: a prior at the next state's estimate.
     ++stats_.marginalization_failures;
     state_prior_ = std::make_unique<StatePriorFactor>(PoseBlock::FromArray(next.pose),
                                                       SpeedBiasBlock::FromArray(next.sb),
                                                       options_.first_prior);
+    // The extrinsic's information went with the failed prior: its prior again.
+    if (estimate_extrinsics())
+      extrinsic_prior_ = std::make_unique<PosePriorFactor>(
+          PoseBlock::FromArray(extrinsic_), options_.smoother.extrinsic_rot_std,
+          options_.smoother.extrinsic_pos_std);
   }
   ++stats_.marginalizations;
   next.imu.reset();
   next.gap.reset();
   nodes_.pop_front();
   return out;
+}
+
+}  // namespace rvlio
+
+namespace rvlio {
+
+void SlidingWindow::CountExcitationScan() {
+  if (nodes_.empty()) return;
+  const Node& newest = *nodes_.back();
+  excitation_.CountScan(newest.t_ns, newest.T_world_imu().R, T_imu_lidar().R);
+}
+
+// Marginal covariance of the extrinsic block under the marginalization
+// prior (H* = S^T S over the kept blocks; pseudo-inverse with the
+// marginalization's relative eigenvalue floor): the information of every scan
+// that left the window, judged as if all six axes were estimated.
+void SlidingWindow::ObserveExtrinsicExcitation() {
+  const MarginalizationPrior& prior = marginal_prior_->prior();
+  const auto it = std::find(prior.blocks.begin(), prior.blocks.end(), extrinsic_);
+  if (it == prior.blocks.end()) return;
+  const int offset = prior.tangent_offsets[it - prior.blocks.begin()];
+  const Eigen::MatrixXd H = prior.S.transpose() * prior.S;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  if (eig.info() != Eigen::Success) return;
+  const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 0.0);
+  const Eigen::VectorXd inv = eig.eigenvalues().unaryExpr(
+      [floor](double l) { return l > floor ? 1.0 / l : 0.0; });
+  const Eigen::MatrixXd C = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  // An axis with no information (zero eigenvalue) has infinite variance, not zero.
+  Matrix6d C_ext = C.block<6, 6>(offset, offset);
+  const Eigen::MatrixXd V_ext = eig.eigenvectors().middleRows(offset, 6);
+  for (int k = 0; k < eig.eigenvalues().size(); ++k)
+    if (eig.eigenvalues()(k) <= floor)
+      for (int i = 0; i < 6; ++i)
+        if (std::abs(V_ext(i, k)) > 1e-6) C_ext(i, i) = std::numeric_limits<double>::infinity();
+  excitation_.Observe(C_ext);
 }
 
 }  // namespace rvlio

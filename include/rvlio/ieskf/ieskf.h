@@ -3,6 +3,7 @@
 // Section 2 (FAST-LIO2 structure): per-sample IMU propagation of state and
 // covariance, and the iterated point-to-plane update of paper Eq. (1) with
 // re-association and the RV modules inside every iteration (Alg. 3).
+#include <array>
 #include <functional>
 #include <limits>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/lidar/deskew.h"
+#include "rvlio/math/extrinsic_excitation.h"
 #include "rvlio/math/state.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/rv/rv.h"
@@ -37,6 +39,12 @@ struct IeskfUpdateResult {
   double nis_per_dof = std::numeric_limits<double>::quiet_NaN();
   ResidualStats residuals;    // last iteration's constraints at the updated state (ok only)
 };
+
+// The error-state rows (FilterState offsets) of the 12 columns of
+// PointToPlaneResidualWithExtrinsics()'s Jacobian [dtheta, dp, dphi, dt]:
+// the error-state Jacobian of a residual is h * ErrorStateColumns(free)^T.
+// Extrinsic axes with free[i] false get no row (held fixed).
+Eigen::Matrix<double, 24, 12> ErrorStateColumns(const std::array<bool, 6>& free_extrinsic_axes);
 
 class Ieskf {
  public:
@@ -62,11 +70,21 @@ class Ieskf {
 
   const FilterState& state() const { return x_; }
   const Matrix24d& covariance() const { return P_; }
+  // Excitation of the extrinsic block (estimate_extrinsics; see
+  // math/extrinsic_excitation.h): an axis takes part in the update only once
+  // excited, judged on the covariance the updates would leave with all six
+  // axes estimated (propagated and updated alongside P).
+  const ExtrinsicExcitation& extrinsic_excitation() const { return excitation_; }
+  void CountExcitationScan() {
+    excitation_.CountScan(t_ns_, x_.R_world_imu, x_.R_imu_lidar);
+  }
   TimeNs time_ns() const { return t_ns_; }
 
  private:
   void Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s);
   void RecordPose(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu);
+  void ReleaseExcitedAxes();
+  void UpdateExcitation(const Eigen::Matrix<double, 12, 12>& HtRinvH, const Matrix24d& J);
 
   IeskfOptions options_;
   ImuOptions imu_;
@@ -74,6 +92,9 @@ class Ieskf {
   RvOptions rv_;
   FilterState x_;
   Matrix24d P_ = Matrix24d::Identity();
+  Matrix24d P_all_extrinsic_ = Matrix24d::Identity();  // as P_, every extrinsic axis estimated
+  ExtrinsicExcitation excitation_;
+  std::array<bool, 6> released_{};  // extrinsic axes given their prior variance in P_
   TimeNs t_ns_ = 0;
   ImuSample last_imu_;
   std::vector<ImuPoseSample> pose_history_;

@@ -13,20 +13,26 @@ struct IeskfOptions {
   double init_vel_std = 0.1;          // m/s
   double init_bias_gyro_std = 1e-3;   // rad/s
   double init_bias_acc_std = 0.05;    // m/s^2
-  double init_extrinsic_std = 1e-5;   // rad and m
+  double init_extrinsic_rot_std = 0.05;  // rad, prior std of R_imu_lidar (estimate_extrinsics)
+  double init_extrinsic_pos_std = 0.1;   // m, prior std of t_imu_lidar (estimate_extrinsics)
   double init_gravity_std = 1e-4;     // m/s^2
 
   template <class V>
   void Visit(V& v) {
     v.Field("max_iterations", max_iterations, Spec().Range(1, 50));
     v.Field("convergence_eps", convergence_eps, Spec().Positive());
-    v.Field("estimate_extrinsics", estimate_extrinsics, Spec());
+    v.Field("estimate_extrinsics", estimate_extrinsics, Spec().Help(
+        "estimate R_imu_lidar, t_imu_lidar online; an axis the motion does not excite stays at "
+        "the configured value (summary.json: extrinsic)"));
     v.Field("init_pos_std", init_pos_std, Spec().Unit("m").Positive());
     v.Field("init_rot_std", init_rot_std, Spec().Unit("rad").Positive());
     v.Field("init_vel_std", init_vel_std, Spec().Unit("m/s").Positive());
     v.Field("init_bias_gyro_std", init_bias_gyro_std, Spec().Unit("rad/s").Positive());
     v.Field("init_bias_acc_std", init_bias_acc_std, Spec().Unit("m/s^2").Positive());
-    v.Field("init_extrinsic_std", init_extrinsic_std, Spec().Unit("rad, m").Positive());
+    v.Field("init_extrinsic_rot_std", init_extrinsic_rot_std, Spec().Unit("rad").Positive()
+        .Help("prior std of the configured extrinsic rotation when estimate_extrinsics is on"));
+    v.Field("init_extrinsic_pos_std", init_extrinsic_pos_std, Spec().Unit("m").Positive()
+        .Help("prior std of the configured extrinsic translation when estimate_extrinsics is on"));
     v.Field("init_gravity_std", init_gravity_std, Spec().Unit("m/s^2").Positive());
   }
   Status Validate() { return ValidateFields(*this, "ieskf"); }

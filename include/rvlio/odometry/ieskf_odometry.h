@@ -35,6 +35,7 @@ class IeskfOdometry : public Odometry {
   Eigen::Vector3d Predict(TimeNs t_end_ns);
   ScanStatus Correct(ScanResult* r);
   void InsertIntoMap();
+  void ReportExtrinsic();  // ieskf.estimate_extrinsics: stats_.extrinsic
 
   OdometryOptions options_;
   Ieskf filter_;

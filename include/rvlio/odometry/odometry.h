@@ -3,6 +3,7 @@
 // Per scan it reads like the recipe of DESIGN.md section 8:
 //   Predict -> Downsample -> Deskew -> Associate -> RV -> Update -> Insert.
 // It owns one estimator and the map; no I/O.
+#include <array>
 #include <deque>
 #include <memory>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/math/extrinsic_excitation.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/options.h"
@@ -43,6 +45,22 @@ struct ScanResult {
 // The monitor's view of a scan result (odometry/divergence.h).
 HealthSample HealthSampleOf(const ScanResult& r);
 
+// Online extrinsic estimation (ieskf.estimate_extrinsics or
+// smoother.estimate_extrinsics), reported in summary.json ("extrinsic").
+struct ExtrinsicReport {
+  bool enabled = false;             // the backend's option is on
+  bool estimated = false;           // some axis was excited and took part in the estimate
+  double excited_fraction = 0.0;    // of (scan, axis) pairs with the axis free
+  std::array<bool, 6> axis_excited{};  // [rot x y z, pos x y z] at the end of the run
+  Vector6d std_ratio = Vector6d::Ones();  // posterior / prior std per axis, all axes estimated
+  Pose3 T_imu_lidar_prior;          // configured
+  Pose3 T_imu_lidar;                // final estimate
+};
+
+// The report of a backend's excitation monitor and its current estimate.
+ExtrinsicReport MakeExtrinsicReport(const ExtrinsicExcitation& excitation,
+                                    const Pose3& T_imu_lidar_prior, const Pose3& T_imu_lidar);
+
 // Counts of what was skipped or repaired, reported in summary.json.
 struct OdometryStats {
   int64_t scans_received = 0;
@@ -62,6 +80,7 @@ struct OdometryStats {
   double association_ms = 0.0;           // CPU ms in association, RV and robust weights (total)
   double solve_ms = 0.0;                 // CPU ms in building and solving the window (total)
   double marginalization_ms = 0.0;       // CPU ms in marginalization (total)
+  ExtrinsicReport extrinsic;
 };
 
 class Odometry {

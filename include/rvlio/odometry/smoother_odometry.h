@@ -82,6 +82,8 @@ class SmootherOdometry : public Odometry {
   void InsertIntoWorkingMap(const WindowState& s, const std::vector<Eigen::Vector3d>& p_lidar);
   void MarginalizeIfFull();
   void SetNewestFromWindow();
+  Pose3 CurrentTImuLidar() const;  // the window's extrinsic (estimate or configured)
+  void ReportExtrinsic();          // smoother.estimate_extrinsics: stats_.extrinsic
 
   OdometryOptions options_;
   WindowOptions window_options_;
@@ -90,7 +92,7 @@ class SmootherOdometry : public Odometry {
   OutputMap output_map_;
   ScanPreprocessor preprocessor_;
   StaticInitializer initializer_;
-  Pose3 T_imu_lidar_;
+  Pose3 T_imu_lidar_;  // configured (the prior when smoother.estimate_extrinsics)
   OdometryStats stats_;
   std::vector<std::string> warnings_;
   DivergenceMonitor monitor_;

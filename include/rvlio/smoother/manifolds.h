@@ -20,6 +20,9 @@
 // mixed with these factors on the same pose blocks.
 //
 // SpeedBiasBlock is Euclidean (9): use no manifold or ceres::EuclideanManifold<9>.
+#include <array>
+#include <vector>
+
 #include <Eigen/Core>
 #include <ceres/manifold.h>
 
@@ -33,6 +36,25 @@ class PoseManifold final : public ceres::Manifold {
   bool PlusJacobian(const double* x, double* jacobian) const override;
   bool Minus(const double* y, const double* x, double* y_minus_x) const override;
   bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
+// PoseSubsetManifold: PoseManifold with some tangent axes held fixed (the
+// extrinsic axes the motion has not excited yet). Tangent = the free axes e:
+//   x [+] d = PoseManifold::Plus(x, E d),  E: 6 x k selection of the free axes,
+//   Minus(y, x) = E^T PoseManifold::Minus(y, x); Jacobians PlusJacobian E and
+// E^T MinusJacobian. At least one axis must be free (else: a constant block).
+class PoseSubsetManifold final : public ceres::Manifold {
+ public:
+  explicit PoseSubsetManifold(const std::array<bool, 6>& free);
+  int AmbientSize() const override { return 7; }
+  int TangentSize() const override { return static_cast<int>(axes_.size()); }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+
+ private:
+  std::vector<int> axes_;  // the free tangent axes, ascending
 };
 
 // J_a = J_t MinusJacobian(x): the ambient (rows x 7) Jacobian of a pose block

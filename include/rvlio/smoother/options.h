@@ -21,6 +21,9 @@ struct SmootherOptions {
   std::string map_update = "marginalized";    // when a window scan enters the working map
   double reassociate_min_motion = 0.01;       // m, re-associate a window scan that moved more
   double online_huber_delta = 0.03;           // m, Huber width of the window (huber_delta: refine)
+  bool estimate_extrinsics = false;           // T_imu_lidar as a window parameter block
+  double extrinsic_rot_std = 0.05;            // rad, prior std of the configured extrinsic rotation
+  double extrinsic_pos_std = 0.1;             // m, prior std of the configured extrinsic translation
 
   template <class V>
   void Visit(V& v) {
@@ -42,6 +45,13 @@ struct SmootherOptions {
                 .Help("re-associate a window scan when it moved more than this (translation + 10 m x rotation in rad)"));
     v.Field("online_huber_delta", online_huber_delta, Spec().Unit("m").Positive()
                 .Help("Huber width on the point-to-plane residuals of the sliding window (backend: smoother)"));
+    v.Field("estimate_extrinsics", estimate_extrinsics, Spec().Help(
+        "estimate T_imu_lidar in the sliding window (backend: smoother); an axis the motion does "
+        "not excite stays at the configured value (summary.json: extrinsic)"));
+    v.Field("extrinsic_rot_std", extrinsic_rot_std, Spec().Unit("rad").Positive()
+        .Help("prior std of the configured extrinsic rotation (estimate_extrinsics)"));
+    v.Field("extrinsic_pos_std", extrinsic_pos_std, Spec().Unit("m").Positive()
+        .Help("prior std of the configured extrinsic translation (estimate_extrinsics)"));
   }
   Status Validate() { return ValidateFields(*this, "smoother"); }
 };

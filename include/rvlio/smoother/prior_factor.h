@@ -48,6 +48,22 @@ class StatePriorFactor final : public ceres::SizedCostFunction<15, 7, 9> {
   Eigen::Matrix<double, 15, 1> inv_sigma_;
 };
 
+// PosePriorFactor: a Gaussian prior on one pose block alone (the LiDAR-IMU
+// extrinsic when smoother.estimate_extrinsics is on):
+//   r = diag(1/sigma_rot x3, 1/sigma_pos x3) (pose [-] pose0),
+// tangent Jacobian W blockdiag(JrInv(Log(R0^T R)), I3).
+class PosePriorFactor final : public ceres::SizedCostFunction<6, 7> {
+ public:
+  PosePriorFactor(const PoseBlock& pose0, double sigma_rot, double sigma_pos);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  PoseBlock pose0_;
+  Eigen::Matrix<double, 6, 1> inv_sigma_;
+};
+
 class SpeedBiasContinuityFactor final : public ceres::SizedCostFunction<9, 9, 9> {
  public:
   // sigma_v m/s, sigma_bg rad/s, sigma_ba m/s^2; all > 0.

@@ -31,6 +31,17 @@
 // once the window holds window_size states and hands its final estimate and
 // points back (for the map).
 //
+// With smoother.estimate_extrinsics the extrinsic T_imu_lidar is one more
+// parameter block (PoseBlock, PoseManifold) shared by every scan's plane
+// factor (PlaneExtrinsicFactor instead of the summary). Its prior
+// (PosePriorFactor at options.T_imu_lidar, smoother.extrinsic_*_std) enters
+// the first marginalization; from then on the extrinsic is a kept block of
+// the marginalization prior, which carries the information of every scan that
+// left the window (the same Schur complement, no double counting). Its
+// excitation (math/extrinsic_excitation.h) is judged on that prior's marginal
+// covariance of the extrinsic block: an axis not yet excited is held fixed
+// (PoseSubsetManifold; all fixed: a constant block).
+//
 // The window owns no map: association is a callback, so the window can be
 // driven by the odometry's voxel map or by an exact synthetic world.
 #include <deque>
@@ -47,6 +58,7 @@
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/imu/noise.h"
 #include "rvlio/imu/preintegration.h"
+#include "rvlio/math/extrinsic_excitation.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/math/smoother_blocks.h"
 #include "rvlio/rv/options.h"
@@ -56,9 +68,14 @@
 #include "rvlio/smoother/options.h"
 #include "rvlio/smoother/prior_factor.h"
 
+namespace ceres {
+class Problem;
+}  // namespace ceres
+
 namespace rvlio {
 
 class ImuFactor;
+class PlaneExtrinsicFactor;
 class PlaneSummaryFactor;
 
 struct WindowOptions {
@@ -68,7 +85,7 @@ struct WindowOptions {
   double lidar_noise = 0.03;         // m, sigma of one point-to-plane residual
   int min_constraints = 6;           // fewer: the scan gets no plane factor
   Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);  // m/s^2
-  Pose3 T_imu_lidar;                 // fixed extrinsics
+  Pose3 T_imu_lidar;                 // extrinsics: fixed, or the prior (smoother.estimate_extrinsics)
   StatePriorStd first_prior;         // prior of the first state of the run
   // Weak continuity across an IMU gap (SpeedBiasContinuityFactor).
   double gap_vel_std = 1.0;          // m/s
@@ -158,6 +175,11 @@ class SlidingWindow {
   const ConstraintList& constraints(int k) const;
   bool has_imu_factor(int k) const;  // between states k - 1 and k
   const WindowStats& stats() const { return stats_; }
+  // The extrinsic in use: the estimate (estimate_extrinsics) or options.T_imu_lidar.
+  Pose3 T_imu_lidar() const;
+  const ExtrinsicExcitation& extrinsic_excitation() const { return excitation_; }
+  // One processed scan: the newest state's attitude feeds the rotational excitation.
+  void CountExcitationScan();
   const WindowOptions& options() const { return options_; }
 
  private:
@@ -172,6 +194,9 @@ class SlidingWindow {
   bool DropNewestImuFactor();
   bool SolveRound(WindowSolveReport* report);
   bool Healthy() const;
+  bool estimate_extrinsics() const { return options_.smoother.estimate_extrinsics; }
+  void AddExtrinsicBlock(ceres::Problem* problem);
+  void ObserveExtrinsicExcitation();
   void Backup();
   void Restore();
 
@@ -181,6 +206,10 @@ class SlidingWindow {
   std::unique_ptr<StatePriorFactor> state_prior_;        // on nodes_[0], or null
   std::unique_ptr<MarginalizationFactor> marginal_prior_;  // on nodes_[0], or null
   std::vector<double> backup_;
+  double extrinsic_[PoseBlock::kNumParams] = {0, 0, 0, 1, 0, 0, 0};  // T_imu_lidar
+  std::unique_ptr<PosePriorFactor> extrinsic_prior_;  // until the first marginalization
+  std::unique_ptr<PoseSubsetManifold> extrinsic_manifold_;  // partly excited extrinsic
+  ExtrinsicExcitation excitation_;
   RvWorkspace rv_workspace_;
   WindowStats stats_;
 };

@@ -1,0 +1,49 @@
+#include "extrinsic_json.h"
+
+#include <cmath>
+#include <vector>
+
+#include "rvlio/math/so3.h"
+
+namespace rvlio::cli {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+std::vector<double> ToList(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+nlohmann::json PoseJson(const Pose3& T) {
+  return {{"rpy_deg", ToList(RpyDeg(T.R))}, {"translation_m", ToList(T.t)}};
+}
+
+}  // namespace
+
+Eigen::Vector3d RpyDeg(const Eigen::Matrix3d& R) {
+  const double pitch = std::asin(std::max(-1.0, std::min(1.0, -R(2, 0))));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  return Eigen::Vector3d(roll, pitch, yaw) * kRadToDeg;
+}
+
+nlohmann::json ExtrinsicJson(const ExtrinsicReport& r) {
+  static const char* kAxes[6] = {"rot_x", "rot_y", "rot_z", "pos_x", "pos_y", "pos_z"};
+  nlohmann::json excited = nlohmann::json::object(), ratio = nlohmann::json::object();
+  for (int i = 0; i < 6; ++i) {
+    excited[kAxes[i]] = r.axis_excited[i];
+    ratio[kAxes[i]] = r.std_ratio(i);
+  }
+  const Eigen::Vector3d dphi = so3::Log(r.T_imu_lidar_prior.R.transpose() * r.T_imu_lidar.R);
+  const Eigen::Vector3d dt = r.T_imu_lidar.t - r.T_imu_lidar_prior.t;
+  return {{"estimated", r.estimated},
+          {"excited_fraction", r.excited_fraction},
+          {"axes_excited", excited},
+          {"std_ratio_posterior_to_prior", ratio},
+          {"T_imu_lidar", PoseJson(r.T_imu_lidar)},
+          {"prior_T_imu_lidar", PoseJson(r.T_imu_lidar_prior)},
+          {"change_from_prior",
+           {{"rotation_deg", dphi.norm() * kRadToDeg},
+            {"translation_m", dt.norm()},
+            {"translation_delta_m", ToList(dt)}}}};
+}
+
+}  // namespace rvlio::cli
