@@ -121,7 +121,7 @@ TEST(DivergenceMonitor, ResidualsAndInliersPersistent) {
   for (int k = 0; k < 100; ++k) {
     HealthSample s = Healthy(k);
     if (k >= 40) {
-      s.health.residual_median_m = 0.2;  // > 2 * 0.03
+      s.health.residual_median_m = 0.2;  // > 2.5 * 0.03
       s.constraints = 50;                // 5% of the points
     }
     m.Check(s);
