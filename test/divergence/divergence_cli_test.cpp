@@ -193,13 +193,14 @@ TEST_F(DivergenceCli, LidarTopicOfAnotherRobot) {
   ExpectDiverged(r, "other_lidar");
 }
 
-TEST_F(DivergenceCli, OnlineExtrinsicEstimationThatDiverges) {
-  // ieskf.estimate_extrinsics=true with exact extrinsics: the estimate drifts
-  // away (ATE ~97 m on `rvlio demo`'s tunnel, issue 15); the innovations stop
-  // being consistent with the filter's covariance long before that.
+TEST_F(DivergenceCli, OnlineExtrinsicEstimationWithExactExtrinsicsStaysHealthy) {
+  // ieskf.estimate_extrinsics=true used to drift away (ATE ~97 m on `rvlio
+  // demo`'s tunnel, NIS window mean 19.4 on this bag: flagged). With the
+  // extrinsic Jacobian columns in their state rows it must pass the monitor.
   const ToolRun r = Run(Bag("a"), Sensors("a"), "estext", "--set ieskf.estimate_extrinsics=true");
-  ExpectDiverged(r, "estext");
-  EXPECT_GT(Summary("estext")["divergence"]["events"]["nis"].get<int>(), 0);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json d = Summary("estext")["divergence"];
+  EXPECT_FALSE(d["detected"].get<bool>()) << d.dump();
 }
 
 TEST_F(DivergenceCli, AllowDivergenceExitsZeroButStillReports) {

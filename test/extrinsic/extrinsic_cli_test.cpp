@@ -72,7 +72,12 @@ TEST_F(ExtrinsicCliTest, SmootherExactStartKeepsTheAccuracy) {
 // flight rotates little about the IMU's y axis).
 TEST_F(ExtrinsicCliTest, SmootherPerturbedStartMovesTheExcitedAxesTowardTheTruth) {
   const std::string out = dir_ + "/smoother_pert";
-  const ToolRun r = Run(out, std::string("--set backend=smoother --set smoother.estimate_extrinsics=true") +
+  // --allow-divergence: with a 3 cm start error the window's median
+  // point-to-plane residual passes the divergence monitor's residual check
+  // (0.079 > 0.075 m) for a few seconds before the extrinsic converges; the
+  // monitor is tested in test/divergence, this test is about convergence.
+  const ToolRun r = Run(out, std::string("--set backend=smoother --set smoother.estimate_extrinsics=true"
+                                         " --allow-divergence") +
                                  kPerturbed);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json e = Extrinsic(out);
@@ -85,7 +90,9 @@ TEST_F(ExtrinsicCliTest, SmootherPerturbedStartMovesTheExcitedAxesTowardTheTruth
   EXPECT_LT(std::abs(rpy[2].get<double>()), 0.5);  // from 1.17 deg
   EXPECT_LT(std::abs(t[0].get<double>() - 0.05), 0.018);  // from 0.0289 m
   // Held axes keep the configured value exactly.
-  if (!ax["pos_y"].get<bool>()) EXPECT_DOUBLE_EQ(t[1].get<double>(), 0.028868);
+  if (!ax["pos_y"].get<bool>()) {
+    EXPECT_DOUBLE_EQ(t[1].get<double>(), 0.028868);
+  }
   EXPECT_LT(Ate(out), 0.03);
 }
 

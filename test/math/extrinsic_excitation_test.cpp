@@ -60,8 +60,9 @@ TEST(ExtrinsicExcitation, TwoRotationAxesExciteAllAndTheCovarianceStillGates) {
     const Eigen::Matrix3d R = so3::Exp(Eigen::Vector3d(0.3 * std::sin(t), 0.0, 0.3 * t));
     e.Observe(k < 100 ? loose : Tight(prior_std));
     e.CountScan(k * kScanNs, R, Eigen::Matrix3d::Identity());
-    if (k == 99)
+    if (k == 99) {
       for (int i = 0; i < 6; ++i) EXPECT_FALSE(e.excited(i)) << "covariance not yet tight, " << i;
+    }
   }
   for (int i = 0; i < 6; ++i) EXPECT_TRUE(e.excited(i)) << i;
 }
