@@ -207,7 +207,7 @@ int CmdRefine(int argc, char** argv) {
                    "(all scans, IMU factors, re-association rounds; sparse Cholesky) and writes "
                    "trajectory.tum, map.pcd and summary.json to the output folder. SIGINT/SIGTERM "
                    "write the last completed round's result and exit 130/143.",
-                   {{"bag", "FILE", "ROS1 bag with LiDAR and IMU topics", true},
+                   {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
                     {"init", "TUM", "initial trajectory (TUM format), e.g. rvlio run's", true},
                     ConfigOption(),
                     SetOption(),
