@@ -1,15 +1,18 @@
 // Bag decoding per scan: DecodePointCloud2 on one in-memory OS1-32 message
 // (32 x 1024, the Ouster driver layout the simulator writes, organized with
-// zero points for no-returns), and reading a small simulated bag through the
-// SensorBagReader (rosbag chunk reading + message deserialization + decode),
-// reported per scan. Neither is inside `rvlio run`'s per-scan time: the reader
-// decodes the next scan before the estimator sees it.
+// zero points for no-returns), and reading a small simulated recording through
+// the SensorBagReader (container reading + message deserialization + decode)
+// for every kind of recording: ROS1 bag, MCAP (chunks uncompressed, zstd,
+// lz4) and db3, reported per iteration of 20 scans. Neither is inside
+// `rvlio run`'s per-scan time: the reader decodes the next scan before the
+// estimator sees it.
 //
-// BM_ReadMcap reads the same 20 sweeps + 400 IMU-sized payloads from an MCAP
-// file (io/mcap.h) with chunks uncompressed, zstd and lz4: the container's
-// cost per message (decompression, CRC, copy; no CDR decoding).
+// BM_ReadMcap/<compression> reads the same 20 sweeps + 400 IMU-sized
+// payloads from an MCAP file (io/mcap.h) with chunks uncompressed, zstd and
+// lz4: the container's cost per message (decompression, CRC, copy; no CDR
+// decoding).
 //
-//   build-bench/bin/bench_decode
+//   build/bin/bench_decode --benchmark_filter='BM_ReadMcap|BM_ReadBag'
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -126,17 +129,37 @@ void BM_DecodePointCloud2(benchmark::State& state) {
 }
 BENCHMARK(BM_DecodePointCloud2)->Unit(benchmark::kMillisecond);
 
-// A 2 s bag: 20 scans of the sweep above and 200 Hz IMU, written once.
+// A 2 s recording: 20 scans of the sweep above and 200 Hz IMU, written once
+// per kind through SensorBagWriter (the simulator's writer), so every kind
+// holds the same messages.
+struct RecordingKind {
+  const char* name;         // label and file name part
+  const char* format;       // BagWriterOptions::format
+  const char* compression;  // BagWriterOptions::mcap_compression
+  const char* extension;
+};
+constexpr RecordingKind kRecordingKinds[] = {
+    {"ros1 bag", "ros1", "", ".bag"},
+    {"mcap chunks uncompressed", "mcap", "none", ".mcap"},
+    {"mcap chunks zstd", "mcap", "zstd", ".mcap"},
+    {"mcap chunks lz4", "mcap", "lz4", ".mcap"},
+    {"db3 (sqlite3)", "db3", "", ".db3"},
+};
+
 class BagFile {
  public:
   static constexpr int kScans = 20;
-  BagFile() {
+  explicit BagFile(const RecordingKind& kind) {
     path_ = (std::filesystem::temp_directory_path() /
-             ("rvlio_bench_decode_" + std::to_string(::getpid()) + ".bag"))
+             ("rvlio_bench_decode_" + std::to_string(::getpid()) + "_" + kind.format +
+              kind.compression + kind.extension))
                 .string();
     std::mt19937 rng(1);
     Scan scan = Sweep(&rng);
-    auto writer = SensorBagWriter::Create(path_);
+    BagWriterOptions options;
+    options.format = kind.format;
+    if (*kind.compression != '\0') options.mcap_compression = kind.compression;
+    auto writer = SensorBagWriter::Create(path_, options);
     if (!writer.ok()) return;
     const LidarOptions lidar;
     const ImuOptions imu_options;
@@ -153,20 +176,28 @@ class BagFile {
       scan.t_end_ns += 100000000LL;
     }
     ok_ = (*writer)->Close().ok();
+    bytes_ = ok_ ? std::filesystem::file_size(path_) : 0;
   }
   ~BagFile() { std::filesystem::remove(path_); }
   bool ok() const { return ok_; }
   const std::string& path() const { return path_; }
+  uint64_t bytes() const { return bytes_; }
 
  private:
   std::string path_;
   bool ok_ = false;
+  uint64_t bytes_ = 0;
 };
 
+// Read + decode every scan of the recording through the public reading path
+// (SensorBagReader::Open, Next), the same for every kind of recording.
+// Wall time ("Time") and the CPU time of the whole process ("CPU", worker
+// threads included) are both reported.
 void BM_ReadBagPerScan(benchmark::State& state) {
-  static const BagFile bag;
+  const RecordingKind& kind = kRecordingKinds[state.range(0)];
+  const BagFile bag(kind);
   if (!bag.ok()) {
-    state.SkipWithError("could not write the temporary bag");
+    state.SkipWithError("could not write the temporary recording");
     return;
   }
   int64_t scans = 0;
@@ -180,15 +211,24 @@ void BM_ReadBagPerScan(benchmark::State& state) {
     Scan scan;
     for (;;) {
       StatusOr<SensorMessage> m = (*reader)->Next(&imu, &scan);
-      if (!m.ok() || *m == SensorMessage::kEnd) break;
+      if (!m.ok()) {
+        state.SkipWithError(m.status().message().c_str());
+        return;
+      }
+      if (*m == SensorMessage::kEnd) break;
       scans += *m == SensorMessage::kScan ? 1 : 0;
     }
   }
   // items = scans: items_per_second is scans per second.
   state.SetItemsProcessed(scans);
-  state.SetLabel("20 scans + 400 IMU samples per iteration");
+  state.counters["file_MB"] = static_cast<double>(bag.bytes()) / 1e6;
+  state.SetLabel(std::string(kind.name) + ", 20 scans + 400 IMU samples per iteration");
 }
-BENCHMARK(BM_ReadBagPerScan)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadBagPerScan)
+    ->DenseRange(0, 4)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 // The sweep message of BM_DecodePointCloud2 20 times and 400 IMU-sized
 // (300-byte) payloads, as an MCAP file with chunk compression `compression`.
@@ -263,7 +303,11 @@ void BM_ReadMcap(benchmark::State& state) {
   state.counters["file_MB"] = static_cast<double>(file.bytes()) / 1e6;
   state.SetLabel(compression.empty() ? "chunks uncompressed" : "chunks " + compression);
 }
-BENCHMARK(BM_ReadMcap)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadMcap)
+    ->DenseRange(0, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace rvlio
