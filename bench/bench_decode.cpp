@@ -146,14 +146,38 @@ constexpr RecordingKind kRecordingKinds[] = {
     {"db3 (sqlite3)", "db3", "", ".db3"},
 };
 
-class BagFile {
+// A temporary file of this process, removed when it goes; ok() once the
+// derived class has written it completely (Finish).
+class TempFile {
+ public:
+  explicit TempFile(const std::string& stem)
+      : path_((std::filesystem::temp_directory_path() /
+               ("rvlio_bench_decode_" + std::to_string(::getpid()) + "_" + stem))
+                  .string()) {}
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  ~TempFile() { std::filesystem::remove(path_); }
+  bool ok() const { return ok_; }
+  const std::string& path() const { return path_; }
+  uint64_t bytes() const { return bytes_; }
+
+ protected:
+  void Finish(bool closed) {
+    ok_ = closed;
+    bytes_ = ok_ ? std::filesystem::file_size(path_) : 0;
+  }
+  const std::string path_;
+
+ private:
+  bool ok_ = false;
+  uint64_t bytes_ = 0;
+};
+
+class BagFile : public TempFile {
  public:
   static constexpr int kScans = 20;
-  explicit BagFile(const RecordingKind& kind) {
-    path_ = (std::filesystem::temp_directory_path() /
-             ("rvlio_bench_decode_" + std::to_string(::getpid()) + "_" + kind.format +
-              kind.compression + kind.extension))
-                .string();
+  explicit BagFile(const RecordingKind& kind)
+      : TempFile(std::string(kind.format) + kind.compression + kind.extension) {
     std::mt19937 rng(1);
     Scan scan = Sweep(&rng);
     BagWriterOptions options;
@@ -175,18 +199,8 @@ class BagFile {
       scan.t_start_ns += 100000000LL;
       scan.t_end_ns += 100000000LL;
     }
-    ok_ = (*writer)->Close().ok();
-    bytes_ = ok_ ? std::filesystem::file_size(path_) : 0;
+    Finish((*writer)->Close().ok());
   }
-  ~BagFile() { std::filesystem::remove(path_); }
-  bool ok() const { return ok_; }
-  const std::string& path() const { return path_; }
-  uint64_t bytes() const { return bytes_; }
-
- private:
-  std::string path_;
-  bool ok_ = false;
-  uint64_t bytes_ = 0;
 };
 
 // Read + decode every scan of the recording through the public reading path
@@ -232,13 +246,10 @@ BENCHMARK(BM_ReadBagPerScan)
 
 // The sweep message of BM_DecodePointCloud2 20 times and 400 IMU-sized
 // (300-byte) payloads, as an MCAP file with chunk compression `compression`.
-class McapFile {
+class McapFile : public TempFile {
  public:
-  explicit McapFile(const std::string& compression) {
-    path_ = (std::filesystem::temp_directory_path() /
-             ("rvlio_bench_decode_" + std::to_string(::getpid()) + "_" +
-              (compression.empty() ? "none" : compression) + ".mcap"))
-                .string();
+  explicit McapFile(const std::string& compression)
+      : TempFile((compression.empty() ? "none" : compression) + ".mcap") {
     std::mt19937 rng(1);
     const Message cloud = OusterMessage(Sweep(&rng));
     mcap::WriterOptions options;
@@ -260,18 +271,8 @@ class McapFile {
       if (!(*writer)->Write(mcap::Message{*lidar, 0, t_ns, 0, cloud.data}).ok()) return;
       t_ns += 100000000ull;
     }
-    ok_ = (*writer)->Close().ok();
-    bytes_ = ok_ ? std::filesystem::file_size(path_) : 0;
+    Finish((*writer)->Close().ok());
   }
-  ~McapFile() { std::filesystem::remove(path_); }
-  bool ok() const { return ok_; }
-  const std::string& path() const { return path_; }
-  uint64_t bytes() const { return bytes_; }
-
- private:
-  std::string path_;
-  bool ok_ = false;
-  uint64_t bytes_ = 0;
 };
 
 void BM_ReadMcap(benchmark::State& state) {
