@@ -61,6 +61,17 @@ inline ToolRun SimulateNoiseFreeHall(const std::string& dir) {
                  dir);
 }
 
+// `rvlio simulate --preset tunnel` of `duration_s` seconds, 512 columns, seed
+// `seed`, into `out` (tunnel.bag, tunnel.yaml, tunnel_gt.tum unless `extra`
+// renames or reformats them); `extra` holds further simulate arguments.
+inline ToolRun SimulateTunnel(const std::string& out, int seed, int duration_s,
+                              const std::string& scratch, const std::string& extra = "") {
+  return RunTool("simulate --preset tunnel --seed " + std::to_string(seed) + " --duration " +
+                     std::to_string(duration_s) + " --set lidar.columns=512 --out " + out +
+                     (extra.empty() ? "" : " " + extra),
+                 scratch);
+}
+
 // A suite sharing one seeded 14 s, 512-column simulated tunnel (tunnel.bag,
 // tunnel.yaml, tunnel_gt.tum under dir_/data), made once per suite.
 class SimulatedTunnelSuite : public ::testing::Test {
@@ -68,8 +79,7 @@ class SimulatedTunnelSuite : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = MakeTempDir("rvlio_cli");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 3 --duration 14 --out " + dir_ +
-                                    "/data --set lidar.columns=512", dir_);
+    const ToolRun sim = SimulateTunnel(dir_ + "/data", 3, 14, dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
   }
   static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }

@@ -24,8 +24,7 @@ class RefineCliTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = testing_cli::MakeTempDir("rvlio_refine_cli");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 3 --duration 14 --out " + dir_ +
-                                    "/data --set lidar.columns=512", dir_);
+    const ToolRun sim = testing_cli::SimulateTunnel(dir_ + "/data", 3, 14, dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
     const ToolRun run = RunTool("run --bag " + Bag() + " --config " + Sensors() +
                                     " --set backend=ieskf --out " + dir_ + "/ieskf", dir_);

@@ -100,9 +100,8 @@ TEST_F(ExtrinsicCliTest, SmootherPerturbedStartMovesTheExcitedAxesTowardTheTruth
 TEST(ExtrinsicCliStatic, MotionlessBagKeepsThePriorAndSaysSo) {
   const std::string dir = testing_cli::MakeTempDir("rvlio_extrinsic_static");
   ASSERT_FALSE(dir.empty());
-  const ToolRun sim = RunTool("simulate --preset tunnel --seed 4 --duration 6 --out " + dir +
-                                  "/data --set lidar.columns=512 --set trajectory.static_duration=100",
-                              dir);
+  const ToolRun sim = testing_cli::SimulateTunnel(dir + "/data", 4, 6, dir,
+                                                  "--set trajectory.static_duration=100");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   for (const std::string backend : {"ieskf", "smoother"}) {
     const std::string out = dir + "/" + backend;

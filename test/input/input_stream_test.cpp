@@ -30,13 +30,11 @@ class InputStreamTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = testing_cli::MakeTempDir("rvlio_input");
     ASSERT_FALSE(dir_.empty());
-    const std::string common =
-        "simulate --preset tunnel --seed 4 --duration 10 --set lidar.columns=512 --out " + dir_;
     for (const std::string& extra :
-         {std::string(" --name pc"), std::string(" --name lx --lidar-msg livox"),
-          std::string(" --name lxm --lidar-msg livox --format mcap"),
-          " --name off --set lidar.time_offset=" + std::to_string(kInjectedOffsetS)}) {
-      const ToolRun sim = RunTool(common + extra, dir_);
+         {std::string("--name pc"), std::string("--name lx --lidar-msg livox"),
+          std::string("--name lxm --lidar-msg livox --format mcap"),
+          "--name off --set lidar.time_offset=" + std::to_string(kInjectedOffsetS)}) {
+      const ToolRun sim = testing_cli::SimulateTunnel(dir_, 4, 10, dir_, extra);
       ASSERT_EQ(sim.exit_code, 0) << sim.err;
     }
   }

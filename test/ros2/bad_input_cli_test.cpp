@@ -54,9 +54,7 @@ class BadRos2InputTest : public ::testing::Test {
     ASSERT_FALSE(dir_.empty());
     for (const char* args : {"--format mcap --name zstd", "--format mcap --mcap-compression none --name none",
                              "--format db3 --name seq"}) {
-      const ToolRun sim = RunTool("simulate --preset tunnel --seed 3 --duration 4 --out " + dir_ +
-                                      " --set lidar.columns=512 " + args,
-                                  dir_);
+      const ToolRun sim = testing_cli::SimulateTunnel(dir_, 3, 4, dir_, args);
       ASSERT_EQ(sim.exit_code, 0) << sim.err;
     }
   }

@@ -60,9 +60,7 @@ class FormatsTest : public ::testing::Test {
     all.insert(all.end(), LivoxFormats().begin(), LivoxFormats().end());
     for (const Format& f : all) {
       const ToolRun sim =
-          RunTool(std::string("simulate --preset tunnel --seed 3 --duration 4 --out ") + dir_ +
-                      " --set lidar.columns=512 --name " + f.name + " " + f.options,
-                  dir_);
+          testing_cli::SimulateTunnel(dir_, 3, 4, dir_, "--name " + std::string(f.name) + " " + f.options);
       ASSERT_EQ(sim.exit_code, 0) << f.name << ": " << sim.err;
     }
   }

@@ -27,8 +27,7 @@ class RefineSignalsTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = MakeTempDir("rvlio_signals_refine");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 6 --duration 6 --out " + dir_ +
-                                    "/data --set lidar.columns=512", dir_);
+    const ToolRun sim = testing_cli::SimulateTunnel(dir_ + "/data", 6, 6, dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
     const ToolRun run = RunTool("run --quiet --bag " + Bag() + " --config " + Sensors() +
                                     " --out " + dir_ + "/run", dir_);

@@ -27,8 +27,7 @@ class RunSignalsTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = MakeTempDir("rvlio_signals_run");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 4 --duration 8 --out " + dir_ +
-                                    "/data --set lidar.columns=512", dir_);
+    const ToolRun sim = testing_cli::SimulateTunnel(dir_ + "/data", 4, 8, dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
     const ToolRun full = RunTool("run --quiet " + Args(dir_ + "/full"), dir_);
     ASSERT_EQ(full.exit_code, 0) << full.err;
