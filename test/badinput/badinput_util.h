@@ -103,10 +103,8 @@ class SimulatedSuite : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = testing_cli::MakeTempDir("rvlio_badinput");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = testing_cli::RunTool(
-        "simulate --preset tunnel --seed 3 --duration 4 --out " + dir_ +
-            "/data --set lidar.columns=512",
-        dir_);
+    const ToolRun sim = testing_cli::CachedSimulate(
+        "--preset tunnel --seed 3 --duration 4 --set lidar.columns=512", dir_ + "/data", dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
     const ToolRun clean = Run(Bag(), dir_ + "/clean");
     ASSERT_EQ(clean.exit_code, 0) << clean.err;

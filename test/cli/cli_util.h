@@ -1,8 +1,11 @@
 #pragma once
 // Helpers for end-to-end tests that run the built `rvlio` as a process.
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -61,15 +64,76 @@ inline ToolRun SimulateNoiseFreeHall(const std::string& dir) {
                  dir);
 }
 
+// Where CachedSimulate keeps its simulations: $RVLIO_TEST_CACHE, else
+// test-sim-cache/ next to the build's bin/ folder.
+inline std::filesystem::path SimulationCacheDir() {
+  if (const char* env = std::getenv("RVLIO_TEST_CACHE"); env != nullptr && *env != '\0') return env;
+  return std::filesystem::path(RVLIO_BIN).parent_path().parent_path() / "test-sim-cache";
+}
+
+// The cache key of a simulation: FNV-1a over the simulate arguments and the
+// size and modification time of the tool, so a rebuilt simulator simulates
+// again.
+inline std::string SimulationKey(const std::string& sim_args) {
+  struct stat st {};
+  const std::string text = sim_args + "|" +
+                           (::stat(RVLIO_BIN, &st) == 0
+                                ? std::to_string(st.st_size) + ":" + std::to_string(st.st_mtime)
+                                : std::string("?"));
+  uint64_t h = 1469598103934665603ull;
+  for (const unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+// `rvlio simulate SIM_ARGS --out OUT`, simulated once per build and copied
+// from the cache afterwards. gtest_discover_tests runs every test case in its
+// own process, so a suite's SetUpTestSuite simulation would otherwise run
+// once per case. A successful simulation is written into a private folder and
+// renamed into the cache (concurrent test processes race safely: the first
+// rename wins, the others use it); a failed one is returned as it is and not
+// cached. The files are copied, so a test may corrupt its copy.
+inline ToolRun CachedSimulate(const std::string& sim_args, const std::string& out,
+                              const std::string& scratch) {
+  namespace fs = std::filesystem;
+  const fs::path cache = SimulationCacheDir(), entry = cache / SimulationKey(sim_args);
+  std::error_code ec;
+  if (!fs::exists(entry / "stdout.txt")) {
+    fs::create_directories(cache, ec);
+    std::string tmpl = (cache / ("tmp_XXXXXX")).string();
+    if (::mkdtemp(tmpl.data()) == nullptr) return RunTool("simulate " + sim_args + " --out " + out, scratch);
+    const ToolRun sim = RunTool("simulate " + sim_args + " --out " + tmpl + "/out", tmpl);
+    if (sim.exit_code != 0) {
+      fs::remove_all(tmpl, ec);
+      return sim;
+    }
+    fs::rename(tmpl, entry, ec);  // fails when another process was first
+    if (ec) fs::remove_all(tmpl, ec);
+  }
+  ToolRun r;
+  fs::create_directories(out, ec);
+  fs::copy(entry / "out", out, fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
+  if (ec) {
+    r.err = "copying the cached simulation " + entry.string() + " to " + out + ": " + ec.message();
+    return r;
+  }
+  r.exit_code = 0;
+  r.out = ReadFile((entry / "stdout.txt").string());
+  r.err = ReadFile((entry / "stderr.txt").string());
+  return r;
+}
+
 // `rvlio simulate --preset tunnel` of `duration_s` seconds, 512 columns, seed
 // `seed`, into `out` (tunnel.bag, tunnel.yaml, tunnel_gt.tum unless `extra`
 // renames or reformats them); `extra` holds further simulate arguments.
+// Cached (CachedSimulate); `scratch` receives the tool's output on a miss.
 inline ToolRun SimulateTunnel(const std::string& out, int seed, int duration_s,
                               const std::string& scratch, const std::string& extra = "") {
-  return RunTool("simulate --preset tunnel --seed " + std::to_string(seed) + " --duration " +
-                     std::to_string(duration_s) + " --set lidar.columns=512 --out " + out +
-                     (extra.empty() ? "" : " " + extra),
-                 scratch);
+  return CachedSimulate("--preset tunnel --seed " + std::to_string(seed) + " --duration " +
+                            std::to_string(duration_s) + " --set lidar.columns=512" +
+                            (extra.empty() ? "" : " " + extra),
+                        out, scratch);
 }
 
 // A suite sharing one seeded 14 s, 512-column simulated tunnel (tunnel.bag,

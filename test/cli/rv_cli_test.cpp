@@ -30,11 +30,10 @@ class RvCliTest : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
   void Simulate(const std::string& preset, int seconds, int seed = 2, int columns = 512) {
-    const ToolRun r = RunTool("simulate --preset " + preset + " --seed " + std::to_string(seed) +
-                                  " --duration " + std::to_string(seconds) +
-                                  " --set lidar.columns=" + std::to_string(columns) + " --out " +
-                                  dir_ + "/data",
-                              dir_);
+    const ToolRun r = testing_cli::CachedSimulate(
+        "--preset " + preset + " --seed " + std::to_string(seed) + " --duration " +
+            std::to_string(seconds) + " --set lidar.columns=" + std::to_string(columns),
+        dir_ + "/data", dir_);
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   RvRun Run(const std::string& preset, const std::string& label, const std::string& sets) {

@@ -110,8 +110,8 @@ class CompareTest : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = MakeTempDir("rvlio_compare");
     ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = RunTool("simulate --preset tunnel --seed 3 --duration 10 --out " + dir_ +
-                                    "/data --set lidar.columns=512", dir_);
+    const ToolRun sim = testing_cli::CachedSimulate(
+        "--preset tunnel --seed 3 --duration 10 --set lidar.columns=512", dir_ + "/data", dir_);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }

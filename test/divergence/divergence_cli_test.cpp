@@ -54,10 +54,10 @@ class DivergenceCli : public ::testing::Test {
   // `rvlio simulate` of a short 512-column sequence into dir_/NAME/.
   static ToolRun Simulate(const std::string& name, const std::string& preset, int seed,
                           const std::string& extra, double duration_s = 15.0) {
-    return RunTool("simulate --preset " + preset + " --seed " + std::to_string(seed) +
-                       " --duration " + std::to_string(duration_s) + " --name " + preset +
-                       " --out " + dir_ + "/" + name + " --set lidar.columns=512 " + extra,
-                   dir_);
+    return testing_cli::CachedSimulate("--preset " + preset + " --seed " + std::to_string(seed) +
+                                            " --duration " + std::to_string(duration_s) +
+                                            " --name " + preset + " --set lidar.columns=512 " + extra,
+                                        dir_ + "/" + name, dir_);
   }
   static std::string Bag(const std::string& name, const std::string& preset = "tunnel") {
     return dir_ + "/" + name + "/" + preset + ".bag";
