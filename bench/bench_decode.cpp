@@ -17,7 +17,11 @@
 // alone (libzstd / liblz4 into one reused buffer; no CRC, no parsing). The
 // reading cost of a compressed recording is this + the reader's own work.
 //
-//   build/bin/bench_decode --benchmark_filter='BM_ReadMcap|BM_ReadBag|BM_Decompress'
+// BM_Crc32/<0|1>: the CRC-32 the MCAP reader checks on every chunk
+// (src/io/mcap_records.h, libdeflate) and, for reference, zlib's crc32 on
+// the same 32 MiB.
+//
+//   build/bin/bench_decode --benchmark_filter='BM_ReadMcap|BM_ReadBag|BM_Decompress|BM_Crc32'
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -32,8 +36,10 @@
 
 #include <benchmark/benchmark.h>
 #include <lz4frame.h>
+#include <zlib.h>
 #include <zstd.h>
 
+#include "../src/io/mcap_records.h"
 #include "rvlio/io/mcap.h"
 #include "rvlio/io/pointcloud2.h"
 #include "rvlio/io/sensor_bag.h"
@@ -334,6 +340,23 @@ BENCHMARK(BM_DecompressChunks)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
+
+void BM_Crc32(benchmark::State& state) {
+  std::string bytes(32 << 20, '\0');
+  std::mt19937 rng(1);
+  for (char& c : bytes) c = static_cast<char>(rng());
+  const bool zlib = state.range(0) == 1;
+  for (auto _ : state) {
+    const uint32_t crc =
+        zlib ? static_cast<uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(bytes.data()),
+                                           static_cast<uInt>(bytes.size())))
+             : mcap::detail::Crc32(bytes);
+    benchmark::DoNotOptimize(crc);
+  }
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * bytes.size()));
+  state.SetLabel(zlib ? "zlib crc32 (reference)" : "Crc32 (libdeflate), as the MCAP reader");
+}
+BENCHMARK(BM_Crc32)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The sweep message of BM_DecodePointCloud2 20 times and 400 IMU-sized
 // (300-byte) payloads, as an MCAP file with chunk compression `compression`.
