@@ -12,12 +12,22 @@
 // lz4: the container's cost per message (decompression, CRC, copy; no CDR
 // decoding).
 //
-//   build/bin/bench_decode --benchmark_filter='BM_ReadMcap|BM_ReadBag'
+// BM_DecompressChunks/<kind> is the floor under the compressed kinds: the
+// chunks of BM_ReadBagPerScan's zstd (2) and lz4 (3) recordings decompressed
+// alone (libzstd / liblz4 into one reused buffer; no CRC, no parsing). The
+// reading cost of a compressed recording is this + the reader's own work.
+//
+// BM_Crc32/<0|1>: the CRC-32 the MCAP reader checks on every chunk
+// (src/io/mcap_records.h, libdeflate) and, for reference, zlib's crc32 on
+// the same 32 MiB.
+//
+//   build/bin/bench_decode --benchmark_filter='BM_ReadMcap|BM_ReadBag|BM_Decompress|BM_Crc32'
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -25,7 +35,11 @@
 #include <unistd.h>
 
 #include <benchmark/benchmark.h>
+#include <lz4frame.h>
+#include <zlib.h>
+#include <zstd.h>
 
+#include "../src/io/mcap_records.h"
 #include "rvlio/io/mcap.h"
 #include "rvlio/io/pointcloud2.h"
 #include "rvlio/io/sensor_bag.h"
@@ -243,6 +257,106 @@ BENCHMARK(BM_ReadBagPerScan)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
+
+uint64_t LeField(const std::string& b, size_t at, int bytes) {
+  uint64_t v = 0;
+  for (int i = 0; i < bytes; ++i) v |= uint64_t{static_cast<uint8_t>(b[at + i])} << (8 * i);
+  return v;
+}
+
+// The compressed records of every Chunk record of an MCAP file (top-level
+// walk from the specification: opcode, uint64 length, content; a chunk's
+// content is start, end, uncompressed size (uint64 each), CRC (uint32),
+// compression (string), records (uint64 length + bytes)). Empty on a file it
+// cannot walk.
+std::vector<std::string> ChunkRecords(const std::string& path, uint64_t* uncompressed_bytes) {
+  std::string b;
+  if (FILE* f = std::fopen(path.c_str(), "rb")) {
+    char buf[1 << 16];
+    for (size_t n; (n = std::fread(buf, 1, sizeof(buf), f)) > 0;) b.append(buf, n);
+    std::fclose(f);
+  }
+  std::vector<std::string> chunks;
+  *uncompressed_bytes = 0;
+  for (size_t pos = 8; pos + 9 <= b.size();) {
+    const size_t content = pos + 9, end = content + LeField(b, pos + 1, 8);
+    if (end > b.size() || end < content) return {};
+    if (b[pos] == 0x06) {
+      *uncompressed_bytes += LeField(b, content + 16, 8);
+      const size_t name = content + 28, records = name + 4 + LeField(b, name, 4);
+      if (records + 8 > end) return {};
+      chunks.push_back(b.substr(records + 8, LeField(b, records, 8)));
+    }
+    pos = end;
+  }
+  return chunks;
+}
+
+// Decompresses `in` (zstd frame or LZ4 frame) into `out` (sized to the
+// uncompressed size by the caller); false on a decoder error.
+bool DecompressChunk(const std::string& in, bool zstd, ZSTD_DCtx* zctx, LZ4F_dctx* lctx,
+                     std::string* out) {
+  if (zstd) {
+    const size_t n = ZSTD_decompressDCtx(zctx, &(*out)[0], out->size(), in.data(), in.size());
+    return !ZSTD_isError(n);
+  }
+  size_t dst = out->size(), src = in.size();
+  const size_t r = LZ4F_decompress(lctx, &(*out)[0], &dst, in.data(), &src, nullptr);
+  return r == 0 && src == in.size();
+}
+
+void BM_DecompressChunks(benchmark::State& state) {
+  const RecordingKind& kind = kRecordingKinds[state.range(0)];
+  const BagFile bag(kind);
+  uint64_t uncompressed = 0;
+  const std::vector<std::string> chunks = bag.ok() ? ChunkRecords(bag.path(), &uncompressed)
+                                                   : std::vector<std::string>();
+  const bool zstd = std::string(kind.compression) == "zstd";
+  std::unique_ptr<ZSTD_DCtx, size_t (*)(ZSTD_DCtx*)> zctx(ZSTD_createDCtx(), ZSTD_freeDCtx);
+  LZ4F_dctx* raw = nullptr;
+  LZ4F_createDecompressionContext(&raw, LZ4F_VERSION);
+  std::unique_ptr<LZ4F_dctx, LZ4F_errorCode_t (*)(LZ4F_dctx*)> lctx(
+      raw, LZ4F_freeDecompressionContext);
+  if (chunks.empty() || !zctx || !lctx) {
+    state.SkipWithError("could not write or walk the temporary recording");
+    return;
+  }
+  std::string out(uncompressed, '\0');  // more than any chunk needs
+  for (auto _ : state) {
+    for (const std::string& chunk : chunks) {
+      if (!DecompressChunk(chunk, zstd, zctx.get(), lctx.get(), &out)) {
+        state.SkipWithError("decompression failed");
+        return;
+      }
+    }
+  }
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * uncompressed));
+  state.counters["chunks"] = static_cast<double>(chunks.size());
+  state.SetLabel(std::string(kind.name) + ", decompression alone");
+}
+BENCHMARK(BM_DecompressChunks)
+    ->Arg(2)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+void BM_Crc32(benchmark::State& state) {
+  std::string bytes(32 << 20, '\0');
+  std::mt19937 rng(1);
+  for (char& c : bytes) c = static_cast<char>(rng());
+  const bool zlib = state.range(0) == 1;
+  for (auto _ : state) {
+    const uint32_t crc =
+        zlib ? static_cast<uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(bytes.data()),
+                                           static_cast<uInt>(bytes.size())))
+             : mcap::detail::Crc32(bytes);
+    benchmark::DoNotOptimize(crc);
+  }
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * bytes.size()));
+  state.SetLabel(zlib ? "zlib crc32 (reference)" : "Crc32 (libdeflate), as the MCAP reader");
+}
+BENCHMARK(BM_Crc32)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // The sweep message of BM_DecodePointCloud2 20 times and 400 IMU-sized
 // (300-byte) payloads, as an MCAP file with chunk compression `compression`.

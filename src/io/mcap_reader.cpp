@@ -310,7 +310,10 @@ struct Segment {
   std::vector<uint16_t> channels;  // sorted; empty: unknown
 };
 
-// An opened segment: its messages one at a time.
+// An opened segment: its messages one at a time. Cursors of finished
+// segments are kept and reused, so the decompressed records and the message
+// buffer keep their capacity from chunk to chunk (no fresh multi-megabyte
+// allocation and page faults per chunk or per message).
 struct Cursor {
   size_t segment = 0;   // index in file order (ties go to the lower one)
   Message current;
@@ -320,6 +323,15 @@ struct Cursor {
   size_t next_entry = 0;
   // Loose run: the file position of the next record.
   uint64_t position = 0;
+
+  // Ready for segment `index` at file offset `offset`; buffers keep their
+  // capacity (records keeps its size too: Decompress overwrites it).
+  void Reset(size_t index, uint64_t offset) {
+    segment = index;
+    entries.clear();
+    next_entry = 0;
+    position = offset;
+  }
 };
 
 struct CursorAfter {
@@ -383,6 +395,8 @@ class McapReader : public Reader {
   bool Wanted(uint16_t channel) const { return !filtering_ || filter_.count(channel) > 0; }
   bool WantSegment(const Segment& s) const;
   Status OpenSegment(size_t index, std::unique_ptr<Cursor>* cursor);
+  // Ends a finished cursor; keeps it for reuse.
+  void Retire(Cursor* cursor);
   Status Advance(Cursor* cursor, bool* has_message);
 
   std::string path_;
@@ -397,6 +411,8 @@ class McapReader : public Reader {
   std::vector<size_t> open_order_;   // by (start_time, file order)
   size_t next_to_open_ = 0;
   std::vector<std::unique_ptr<Cursor>> cursors_;  // owners of the heap entries
+  std::vector<std::unique_ptr<Cursor>> spare_cursors_;  // finished, for reuse
+  std::string chunk_bytes_;  // the chunk record being opened (reused)
   std::priority_queue<Cursor*, std::vector<Cursor*>, CursorAfter> heap_;
   std::set<uint16_t> filter_;
   bool filtering_ = false;
@@ -774,15 +790,18 @@ bool McapReader::WantSegment(const Segment& s) const {
 
 Status McapReader::OpenSegment(size_t index, std::unique_ptr<Cursor>* cursor) {
   const Segment& segment = segments_[index];
-  *cursor = std::make_unique<Cursor>();
+  if (spare_cursors_.empty()) {
+    *cursor = std::make_unique<Cursor>();
+  } else {
+    *cursor = std::move(spare_cursors_.back());
+    spare_cursors_.pop_back();
+  }
   Cursor& c = **cursor;
-  c.segment = index;
-  c.position = segment.offset;
+  c.Reset(index, segment.offset);
   if (!segment.is_chunk) return Status::Ok();
-  std::string bytes;
-  if (Status s = ReadBytes(segment.offset, segment.end - segment.offset, &bytes); !s.ok())
+  if (Status s = ReadBytes(segment.offset, segment.end - segment.offset, &chunk_bytes_); !s.ok())
     return s;
-  FieldReader h(bytes);
+  FieldReader h(chunk_bytes_);
   const uint8_t opcode = h.U8();
   const std::string_view content = h.Bytes(h.U64());
   if (!h.ok() || opcode != detail::kChunk)
@@ -845,8 +864,14 @@ Status McapReader::Advance(Cursor* c, bool* has_message) {
     *has_message = true;
     return Status::Ok();
   }
-  c->records.clear();
   return Status::Ok();
+}
+
+void McapReader::Retire(Cursor* cursor) {
+  const auto it = std::find_if(cursors_.begin(), cursors_.end(),
+                               [&](const auto& p) { return p.get() == cursor; });
+  spare_cursors_.push_back(std::move(*it));
+  cursors_.erase(it);
 }
 
 StatusOr<bool> McapReader::Next(Message* out) {
@@ -863,7 +888,10 @@ StatusOr<bool> McapReader::Next(Message* out) {
       error_ = OpenSegment(index, &cursor);
       if (error_.ok()) error_ = Advance(cursor.get(), &has_message);
       if (!error_.ok()) return error_;
-      if (!has_message) continue;
+      if (!has_message) {
+        spare_cursors_.push_back(std::move(cursor));
+        continue;
+      }
       heap_.push(cursor.get());
       cursors_.push_back(std::move(cursor));
     }
@@ -871,15 +899,16 @@ StatusOr<bool> McapReader::Next(Message* out) {
     Cursor* top = heap_.top();
     heap_.pop();
     const bool wanted = Wanted(top->current.channel_id);
-    if (wanted) *out = std::move(top->current);
+    // Swapped, not moved: the cursor gets the caller's previous buffer to
+    // copy its next message into.
+    if (wanted) std::swap(*out, top->current);
     bool has_message = false;
     error_ = Advance(top, &has_message);
     if (!error_.ok()) return error_;
     if (has_message) {
       heap_.push(top);
     } else {
-      cursors_.erase(std::find_if(cursors_.begin(), cursors_.end(),
-                                  [&](const auto& p) { return p.get() == top; }));
+      Retire(top);
     }
     if (wanted) return true;
   }

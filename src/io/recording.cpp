@@ -222,7 +222,7 @@ class McapSource final : public RecordingSource {
       if (it == channel_index_.end()) continue;  // a channel not known up front: skipped
       out->topic = it->second;
       out->stamp_ns = static_cast<TimeNs>(message_.log_time_ns);
-      out->data = std::move(message_.data);
+      out->data.swap(message_.data);  // both buffers keep their capacity for reuse
       return true;
     }
   }

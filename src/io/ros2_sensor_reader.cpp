@@ -1,6 +1,7 @@
 // SensorBagReader over a ROS 2 recording (io/recording.h): CDR IMU samples
 // and scans of two topics in receive-time order, with the same topic checks,
 // acceptance rules and statistics as the ROS1 reader (sensor_reader_common).
+#include <deque>
 #include <map>
 #include <memory>
 
@@ -57,16 +58,17 @@ class Ros2SensorReader final : public SensorBagReader {
     imu_index_ = TopicIndex(*source_, imu_.topic);
     if (Status s = RequireCdr(*source_, lidar_index_, "lidar.topic"); !s.ok()) return s;
     if (Status s = RequireCdr(*source_, imu_index_, "imu.topic"); !s.ok()) return s;
+    if (Status s = source_->SetTopicFilter({lidar_index_, imu_index_}); !s.ok()) return s;
     if (livox_) layout_ = "livox_custom";
     else if (Status s = PeekLayout(); !s.ok()) return s;
-    return source_->SetTopicFilter({lidar_index_, imu_index_});
+    return Status::Ok();
   }
 
   StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override {
     RVLIO_CHECK(imu != nullptr && scan != nullptr);
     if (!error_.ok()) return error_;
     while (true) {
-      StatusOr<bool> more = source_->Next(&message_);
+      StatusOr<bool> more = NextRaw();
       if (!more.ok()) return error_ = more.status();
       if (!*more) return SensorMessage::kEnd;
       const bool is_imu = message_.topic == imu_index_;
@@ -81,22 +83,45 @@ class Ros2SensorReader final : public SensorBagReader {
   std::vector<std::string> warnings() const override { return source_->warnings(); }
 
  private:
-  // Decodes the first LiDAR message so that a cloud without a usable time
-  // field fails at Open, not minutes into a run.
+  // Bytes of messages PeekLayout may hold before the first LiDAR message
+  // (about two minutes of 400 Hz IMU samples).
+  static constexpr size_t kPeekBytes = size_t{16} << 20;
+
+  // Reads ahead to the first LiDAR message and detects its layout, so that a
+  // cloud without a usable time field fails at Open, not minutes into a run.
+  // The messages read ahead are kept for Next: the recording is read once
+  // (a second reader would decompress the first MCAP chunk again). When the
+  // first kPeekBytes hold no LiDAR message, the first scan Next decodes
+  // detects the layout instead.
   Status PeekLayout() {
-    StatusOr<std::unique_ptr<RecordingSource>> peek = RecordingSource::Open(path_);
-    if (!peek.ok()) return peek.status();
-    if (Status s = (*peek)->SetTopicFilter({lidar_index_}); !s.ok()) return s;
-    RawMessage m;
-    StatusOr<bool> got = (*peek)->Next(&m);
-    if (!got.ok()) return got.status();
-    if (!*got) return Status::Ok();
+    size_t held_bytes = 0;
+    while (held_bytes < kPeekBytes) {
+      RawMessage m;
+      StatusOr<bool> got = source_->Next(&m);
+      if (!got.ok()) return got.status();
+      if (!*got) return Status::Ok();
+      held_bytes += sizeof(RawMessage) + m.data.size();
+      peeked_.push_back(std::move(m));
+      if (peeked_.back().topic == lidar_index_) return DetectLayout(peeked_.back());
+    }
+    return Status::Ok();
+  }
+
+  Status DetectLayout(const RawMessage& m) {
     StatusOr<PointCloud2View> cloud = cdr::DecodePointCloud2(m.data.data(), m.data.size(), lidar_.topic);
     if (!cloud.ok()) return InFile(cloud.status());
     StatusOr<std::string> layout = DetectPointCloud2Layout(*cloud, lidar_.type);
     if (!layout.ok()) return layout.status();
     layout_ = *layout;
     return Status::Ok();
+  }
+
+  // The next message: those PeekLayout read ahead first, then the source's.
+  StatusOr<bool> NextRaw() {
+    if (peeked_.empty()) return source_->Next(&message_);
+    message_ = std::move(peeked_.front());
+    peeked_.pop_front();
+    return true;
   }
 
   Status InFile(const Status& s) const {
@@ -147,6 +172,7 @@ class Ros2SensorReader final : public SensorBagReader {
   std::unique_ptr<RecordingSource> source_;
   int lidar_index_ = -1, imu_index_ = -1;
   RawMessage message_;
+  std::deque<RawMessage> peeked_;  // read ahead by PeekLayout, not yet returned
   std::string layout_;
   Status error_;
 };
