@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <functional>
 #include <utility>
 
@@ -30,12 +29,6 @@ constexpr double kConvergedRotationDeg = 5e-3;
 
 double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-std::string Seconds(TimeNs t_ns) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.3f", NsToSeconds(t_ns));
-  return buf;
 }
 
 // The rounds over one sequence: owns the states and the round's map; each
@@ -167,16 +160,7 @@ bool BatchRefiner::RunRound(int round, RefineRound* out) {
 }
 
 Status BatchRefiner::Resume(const RefineRoundState& state) {
-  if (state.states.size() != states_.size())
-    return Status::InvalidInput("the resumed state has " + std::to_string(state.states.size()) +
-                                " scan states, this input refines " +
-                                std::to_string(states_.size()) + " scans");
-  for (size_t k = 0; k < states_.size(); ++k)
-    if (state.states[k].t_ns != states_[k].t_ns || !AllFinite(state.states[k]))
-      return Status::InvalidInput("the resumed state of scan " + std::to_string(k) +
-                                  " does not belong to this input (stamp " +
-                                  Seconds(state.states[k].t_ns) + " s, expected " +
-                                  Seconds(states_[k].t_ns) + " s)");
+  if (Status s = CheckResumedStates(state.states, states_); !s.ok()) return s;
   states_ = state.states;
   result_.g_world = state.g_world;
   result_.rounds = state.rounds;

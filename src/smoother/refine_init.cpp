@@ -117,6 +117,21 @@ std::vector<RefineState> InitialRefineStates(const RefineSequence& sequence,
   return states;
 }
 
+Status CheckResumedStates(const std::vector<RefineState>& resumed,
+                          const std::vector<RefineState>& initial) {
+  if (resumed.size() != initial.size())
+    return Status::InvalidInput("the resumed state has " + std::to_string(resumed.size()) +
+                                " scan states, this input refines " +
+                                std::to_string(initial.size()) + " scans");
+  for (size_t k = 0; k < initial.size(); ++k)
+    if (resumed[k].t_ns != initial[k].t_ns || !AllFinite(resumed[k]))
+      return Status::InvalidInput("the resumed state of scan " + std::to_string(k) +
+                                  " does not belong to this input (stamp " +
+                                  Seconds(resumed[k].t_ns) + " s, expected " +
+                                  Seconds(initial[k].t_ns) + " s)");
+  return Status::Ok();
+}
+
 bool AllFinite(const RefineState& s) {
   for (double x : s.pose) if (!std::isfinite(x)) return false;
   for (double x : s.speed_bias) if (!std::isfinite(x)) return false;

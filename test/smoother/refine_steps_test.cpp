@@ -112,6 +112,23 @@ TEST(RefineInit, InitialStatesFollowTheInitialTrajectory) {
   }
 }
 
+TEST(RefineInit, AResumedStateMustMatchTheRefinedScans) {
+  const Scene s = MakeScene(4, 2);
+  RefineStats stats;
+  const RefineSequence seq = SelectRefineScans(s.input, &stats).value();
+  const std::vector<RefineState> initial = InitialRefineStates(seq, s.input.init, Vector3d::Zero());
+  EXPECT_TRUE(CheckResumedStates(initial, initial).ok());
+  std::vector<RefineState> shorter(initial.begin(), initial.end() - 1);
+  EXPECT_NE(CheckResumedStates(shorter, initial).message().find("3 scan states"), std::string::npos);
+  std::vector<RefineState> shifted = initial;
+  shifted[2].t_ns += 1000;
+  EXPECT_NE(CheckResumedStates(shifted, initial).message().find("state of scan 2"),
+            std::string::npos);
+  std::vector<RefineState> nan = initial;
+  nan[1].speed_bias[4] = std::nan("");
+  EXPECT_EQ(CheckResumedStates(nan, initial).code(), StatusCode::kInvalidInput);
+}
+
 // ---- chunking ----
 
 TEST(RefineChunks, ChunksCoverTheSequenceWithOverlap) {

@@ -59,6 +59,12 @@ RefineGravity InitRefineGravity(const std::vector<ImuSample>& imu, const Traject
 std::vector<RefineState> InitialRefineStates(const RefineSequence& sequence,
                                              const Trajectory& init, const Eigen::Vector3d& bg);
 
+// A resumed refinement (RefineHooks::resume) starts from `resumed` instead:
+// InvalidInput unless it holds one finite state per refined scan with the
+// stamps of `initial` (InitialRefineStates of this input).
+Status CheckResumedStates(const std::vector<RefineState>& resumed,
+                          const std::vector<RefineState>& initial);
+
 // The states as the Ceres solves need them: all components finite.
 bool AllFinite(const RefineState& s);
 
