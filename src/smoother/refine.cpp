@@ -86,8 +86,8 @@ Status BatchRefiner::Initialize() {
 
 void BatchRefiner::SolveChunk(const ScanRange& chunk, RefineRound* report) {
   auto t0 = Clock::now();
-  ChunkAssociation a = AssociateRefineChunk(config_, round_map_, states_, chunk, solver_.threads,
-                                            stop_);
+  ChunkAssociation a =
+      AssociateRefineChunk(config_, round_map_, states_, chunk, solver_.threads, stop_);
   report->points += a.points;
   report->constraints += a.constraints;
   report->rv_active_scans += a.rv_active_scans;
@@ -99,8 +99,7 @@ void BatchRefiner::SolveChunk(const ScanRange& chunk, RefineRound* report) {
   BuildRefineChunkProblem(sequence_, noise_, result_.g_world, chunk, &a.factors, &pose_manifold_,
                           &states_, &problem);
   const RefineSolveReport r = SolveRefineProblem(
-      &problem, solver_.Options(config_.smoother.refine_solver_iterations), chunk, stop_,
-      &states_);
+      &problem, solver_.Options(config_.smoother.refine_solver_iterations), chunk, stop_, &states_);
   if (!r.accepted) {
     ++report->solve_failures;
     result_.warnings.push_back("round " + std::to_string(report->round) + ": the solve of scans " +

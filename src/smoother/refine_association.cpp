@@ -115,8 +115,8 @@ ChunkAssociation AssociateRefineChunk(const RefineConfig& config, const RefineRo
   ParallelFor(chunk.begin, chunk.end, threads, [&](int k, int slot) {
     if (stop && stop()) return;  // the round is dropped
     bool a = false;
-    out.factors[k - chunk.begin] =
-        AssociateRefineScan(config, round, states, k, chunk, &workspaces[slot], &stats[k - chunk.begin], &a);
+    out.factors[k - chunk.begin] = AssociateRefineScan(
+        config, round, states, k, chunk, &workspaces[slot], &stats[k - chunk.begin], &a);
     active[k - chunk.begin] = a;
   });
   for (int i = 0; i < n; ++i) {

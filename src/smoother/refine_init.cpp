@@ -100,8 +100,8 @@ RefineGravity InitRefineGravity(const std::vector<ImuSample>& imu, const Traject
   return g;
 }
 
-std::vector<RefineState> InitialRefineStates(const RefineSequence& sequence,
-                                             const Trajectory& init, const Eigen::Vector3d& bg) {
+std::vector<RefineState> InitialRefineStates(const RefineSequence& sequence, const Trajectory& init,
+                                             const Eigen::Vector3d& bg) {
   std::vector<RefineState> states(sequence.size());
   for (int k = 0; k < sequence.size(); ++k) {
     RefineState& s = states[k];
@@ -133,8 +133,10 @@ Status CheckResumedStates(const std::vector<RefineState>& resumed,
 }
 
 bool AllFinite(const RefineState& s) {
-  for (double x : s.pose) if (!std::isfinite(x)) return false;
-  for (double x : s.speed_bias) if (!std::isfinite(x)) return false;
+  for (double x : s.pose)
+    if (!std::isfinite(x)) return false;
+  for (double x : s.speed_bias)
+    if (!std::isfinite(x)) return false;
   return true;
 }
 

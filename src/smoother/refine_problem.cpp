@@ -54,9 +54,9 @@ void AddRefineImuFactors(const RefineSequence& sequence, const ImuNoise& noise,
     const SpeedBiasBlock sb = a.SpeedBias();
     auto pre = ImuPreintegration::FromSamples(SliceImu(sequence.imu(), a.t_ns, b.t_ns), a.t_ns,
                                               b.t_ns, noise, sb.bg, sb.ba);
-    problem->AddResidualBlock(new ImuFactor(std::move(pre), g_world), nullptr,
-                              {a.pose.data(), a.speed_bias.data(), b.pose.data(),
-                               b.speed_bias.data()});
+    problem->AddResidualBlock(
+        new ImuFactor(std::move(pre), g_world), nullptr,
+        {a.pose.data(), a.speed_bias.data(), b.pose.data(), b.speed_bias.data()});
   }
 }
 
@@ -100,8 +100,7 @@ ceres::Solver::Options RefineSolver::Options(int iterations) const {
 RefineSolveReport SolveRefineProblem(ceres::Problem* problem, ceres::Solver::Options options,
                                      const ScanRange& range, const std::function<bool()>& stop,
                                      std::vector<RefineState>* states) {
-  const std::vector<RefineState> before(states->begin() + range.begin,
-                                        states->begin() + range.end);
+  const std::vector<RefineState> before(states->begin() + range.begin, states->begin() + range.end);
   StopCallback stop_callback(stop);
   if (stop) options.callbacks.push_back(&stop_callback);
   ceres::Solver::Summary summary;

@@ -66,8 +66,7 @@ TEST(ImuPoseHistory, BackwardIntegrationIsSortedAndAgreesWithForward) {
   const std::vector<ImuSample> imu = Signal(0, 200000000);
   const TimeNs t0 = 12000000, t1 = 113000000;
   const ImuPoseHistory fwd = ImuPoseHistory::Integrate(Start(t0), imu, t1, kBg, kBa, kGravity);
-  const ImuPoseHistory bwd =
-      ImuPoseHistory::Integrate(fwd.Newest(), imu, t0, kBg, kBa, kGravity);
+  const ImuPoseHistory bwd = ImuPoseHistory::Integrate(fwd.Newest(), imu, t0, kBg, kBa, kGravity);
   ASSERT_EQ(bwd.samples().size(), fwd.samples().size());
   EXPECT_EQ(bwd.samples().front().t_ns, t0);
   EXPECT_EQ(bwd.samples().back().t_ns, t1);

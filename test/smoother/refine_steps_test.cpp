@@ -28,10 +28,10 @@ using namespace refine_scene;  // MakeScene, Config, kT0, kScanNs
 TEST(RefineInit, SelectionKeepsUsableScansAndCountsTheOthers) {
   Scene s = MakeScene(7, 3);
   RefineInput& in = s.input;
-  in.scans[1].points.resize(kRefineMinScanPoints - 1);         // too few points
-  in.scans[4].t_end_ns = in.scans[3].t_end_ns;                 // not after scan 3
-  in.init.resize(6);                                           // scan 6 outside
-  in.imu.erase(in.imu.begin(),                                 // scan 0 not covered
+  in.scans[1].points.resize(kRefineMinScanPoints - 1);  // too few points
+  in.scans[4].t_end_ns = in.scans[3].t_end_ns;          // not after scan 3
+  in.init.resize(6);                                    // scan 6 outside
+  in.imu.erase(in.imu.begin(),                          // scan 0 not covered
                std::find_if(in.imu.begin(), in.imu.end(),
                             [&](const ImuSample& m) { return m.t_ns > in.scans[0].t_start_ns; }));
   ASSERT_TRUE(CheckRefineInput(in).ok());
@@ -106,8 +106,8 @@ TEST(RefineInit, InitialStatesFollowTheInitialTrajectory) {
     const SpeedBiasBlock sb = states[k].SpeedBias();
     EXPECT_EQ(sb.bg, bg);
     EXPECT_EQ(sb.ba, Vector3d::Zero());
-    EXPECT_EQ(sb.v_world_imu, FiniteDifferenceVelocity(s.input.init, states[k].t_ns,
-                                                       kRefineVelocityHalfWindowNs));
+    EXPECT_EQ(sb.v_world_imu,
+              FiniteDifferenceVelocity(s.input.init, states[k].t_ns, kRefineVelocityHalfWindowNs));
     EXPECT_TRUE(AllFinite(states[k]));
   }
 }
@@ -119,7 +119,8 @@ TEST(RefineInit, AResumedStateMustMatchTheRefinedScans) {
   const std::vector<RefineState> initial = InitialRefineStates(seq, s.input.init, Vector3d::Zero());
   EXPECT_TRUE(CheckResumedStates(initial, initial).ok());
   std::vector<RefineState> shorter(initial.begin(), initial.end() - 1);
-  EXPECT_NE(CheckResumedStates(shorter, initial).message().find("3 scan states"), std::string::npos);
+  EXPECT_NE(CheckResumedStates(shorter, initial).message().find("3 scan states"),
+            std::string::npos);
   std::vector<RefineState> shifted = initial;
   shifted[2].t_ns += 1000;
   EXPECT_NE(CheckResumedStates(shifted, initial).message().find("state of scan 2"),
@@ -259,12 +260,14 @@ TEST(RefineProblem, ChunkProblemHoldsItsFirstPoseAndLinksEveryScan) {
   Round r = MakeRound(8);
   const RefineConfig config = Config();
   RefineRoundMap round(config.map);
-  DeskewRefineScans(r.sequence, r.states, test::Gravity(), config.T_imu_lidar, 2, &round.p_lidar_end);
+  DeskewRefineScans(r.sequence, r.states, test::Gravity(), config.T_imu_lidar, 2,
+                    &round.p_lidar_end);
   BuildRefineMap(r.states, config.T_imu_lidar, &round);
   const ScanRange chunk{3, 8};
   ChunkAssociation a = AssociateRefineChunk(config, round, r.states, chunk, 2, nullptr);
   int plane_blocks = 0;
-  for (const ScanFactors& f : a.factors) plane_blocks += (f.fixed ? 1 : 0) + static_cast<int>(f.pairs.size());
+  for (const ScanFactors& f : a.factors)
+    plane_blocks += (f.fixed ? 1 : 0) + static_cast<int>(f.pairs.size());
   PoseManifold manifold;
   ceres::Problem problem(RefineProblemOptions());
   const ImuNoise noise = ImuNoise::FromOptions(config.imu);
@@ -277,12 +280,12 @@ TEST(RefineProblem, ChunkProblemHoldsItsFirstPoseAndLinksEveryScan) {
   EXPECT_FALSE(problem.HasParameterBlock(r.states[2].pose.data()));
 
   const std::vector<RefineState> before = r.states;
-  const RefineSolveReport rep = SolveRefineProblem(
-      &problem, RefineSolver::Make(2).Options(10), chunk, nullptr, &r.states);
+  const RefineSolveReport rep =
+      SolveRefineProblem(&problem, RefineSolver::Make(2).Options(10), chunk, nullptr, &r.states);
   EXPECT_TRUE(rep.accepted) << rep.message;
   EXPECT_LT(rep.cost_after, rep.cost_before);
   EXPECT_GT(rep.iterations, 0);
-  EXPECT_EQ(r.states[3].pose, before[3].pose);  // held
+  EXPECT_EQ(r.states[3].pose, before[3].pose);              // held
   EXPECT_EQ(r.states[2].speed_bias, before[2].speed_bias);  // outside the chunk
   EXPECT_NE(r.states[5].pose, before[5].pose);
 }
@@ -299,11 +302,12 @@ TEST(RefineProblem, ARejectedSolveRestoresTheStates) {
   const std::vector<RefineState> before = r.states;
   ceres::Problem problem;
   problem.AddResidualBlock(new FailingCost, nullptr, r.states[1].speed_bias.data());
-  const RefineSolveReport rep = SolveRefineProblem(
-      &problem, RefineSolver::Make(1).Options(5), ScanRange{0, 4}, nullptr, &r.states);
+  const RefineSolveReport rep = SolveRefineProblem(&problem, RefineSolver::Make(1).Options(5),
+                                                   ScanRange{0, 4}, nullptr, &r.states);
   EXPECT_FALSE(rep.accepted);
   EXPECT_FALSE(rep.message.empty());
-  for (size_t k = 0; k < before.size(); ++k) EXPECT_EQ(r.states[k].speed_bias, before[k].speed_bias);
+  for (size_t k = 0; k < before.size(); ++k)
+    EXPECT_EQ(r.states[k].speed_bias, before[k].speed_bias);
 }
 
 // With the true poses held, the IMU-only solve recovers the velocities from

@@ -34,7 +34,8 @@ namespace rvlio {
 struct RefineRoundMap {
   explicit RefineRoundMap(const MapOptions& options) : map(options) {}
 
-  std::vector<std::vector<Eigen::Vector3d>> p_lidar_end;  // per refined scan, LiDAR frame at its end
+  std::vector<std::vector<Eigen::Vector3d>>
+      p_lidar_end;               // per refined scan, LiDAR frame at its end
   std::vector<Pose3> map_poses;  // T_world_imu of each scan when the map was built
   RefineMap map;
 };

@@ -56,8 +56,8 @@ RefineGravity InitRefineGravity(const std::vector<ImuSample>& imu, const Traject
 
 // Per refined scan: its end stamp, the initial trajectory's pose there,
 // central-difference velocity, gyro bias `bg`, zero accelerometer bias.
-std::vector<RefineState> InitialRefineStates(const RefineSequence& sequence,
-                                             const Trajectory& init, const Eigen::Vector3d& bg);
+std::vector<RefineState> InitialRefineStates(const RefineSequence& sequence, const Trajectory& init,
+                                             const Eigen::Vector3d& bg);
 
 // A resumed refinement (RefineHooks::resume) starts from `resumed` instead:
 // InvalidInput unless it holds one finite state per refined scan with the

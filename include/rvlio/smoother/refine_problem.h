@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 #include <ceres/types.h>
+#include <Eigen/Core>
 
 #include "rvlio/imu/noise.h"
 #include "rvlio/smoother/manifolds.h"
@@ -59,7 +59,7 @@ struct RefineSolver {
 };
 
 struct RefineSolveReport {
-  bool accepted = false;  // false: the states of the range were restored
+  bool accepted = false;                       // false: the states of the range were restored
   double cost_before = 0.0, cost_after = 0.0;  // Ceres 1/2 |r|^2
   int iterations = 0;
   std::string message;  // Ceres' summary message
