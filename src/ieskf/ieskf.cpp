@@ -132,7 +132,7 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
 }
 
 void Ieskf::ClearPoseHistory() {
-  pose_history_.clear();
+  pose_history_.Clear();
   RecordPose(last_imu_.gyro_imu, last_imu_.acc_imu);
 }
 
@@ -144,7 +144,7 @@ void Ieskf::RecordPose(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& a
   s.v_world_imu = x_.v_world_imu;
   s.gyro_imu = gyro_imu - x_.bg;
   s.acc_world = x_.R_world_imu * (acc_imu - x_.ba) + x_.g_world;
-  pose_history_.push_back(s);
+  pose_history_.Append(s);
 }
 
 void Ieskf::Propagate(const ImuSample& imu) {

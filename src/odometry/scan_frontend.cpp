@@ -30,29 +30,6 @@ std::string MovingStartWarning(const StaticAlignment& a) {
          std::to_string(a.gyro_std) + " rad/s); initialized from the mean IMU values";
 }
 
-std::vector<ImuPoseSample> ImuPoseSamplesFromKnots(const std::vector<ImuKinematics>& knots,
-                                                   const std::vector<ImuSample>& samples,
-                                                   const Eigen::Vector3d& bg,
-                                                   const Eigen::Vector3d& ba,
-                                                   const Eigen::Vector3d& g_world) {
-  std::vector<ImuPoseSample> out(knots.size());
-  std::vector<ImuSample> signal(knots.size());
-  for (size_t i = 0; i < knots.size(); ++i) signal[i] = InterpolateImu(samples, knots[i].t_ns);
-  for (size_t i = 0; i < knots.size(); ++i) {
-    const size_t j = i + 1 < knots.size() ? i + 1 : i;
-    ImuPoseSample& s = out[i];
-    s.t_ns = knots[i].t_ns;
-    s.R_world_imu = knots[i].R_world_imu;
-    s.p_world_imu = knots[i].p_world_imu;
-    s.v_world_imu = knots[i].v_world_imu;
-    s.gyro_imu = 0.5 * (signal[i].gyro_imu + signal[j].gyro_imu) - bg;
-    s.acc_world = 0.5 * (knots[i].R_world_imu * (signal[i].acc_imu - ba) +
-                         knots[j].R_world_imu * (signal[j].acc_imu - ba)) +
-                  g_world;
-  }
-  return out;
-}
-
 void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector3d>& p_lidar,
                      std::vector<Eigen::Vector3d>* p_world) {
   p_world->resize(p_lidar.size());

@@ -6,6 +6,7 @@
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/constraints/associate.h"
 #include "rvlio/constraints/point_to_plane.h"
+#include "rvlio/imu/pose_history.h"
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/lidar/deskew.h"
 
@@ -112,21 +113,22 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   }
   const Eigen::Vector3d& g = window_options_.g_world;
   const std::vector<ImuSample> samples = ImuCovering(newest_.t_ns, scan.t_end_ns);
-  const std::vector<ImuKinematics> knots =
-      IntegrateTrajectory(newest_, samples, scan.t_end_ns, bg_, ba_, g);
+  const ImuPoseHistory history =
+      ImuPoseHistory::Integrate(newest_, samples, scan.t_end_ns, bg_, ba_, g);
   preprocessor_.Downsample(scan, &downsampled_);
   if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {
     ++stats_.scans_too_few_points;  // the next state's IMU factor spans this scan
     return;
   }
-  DeskewToScanEnd(ImuPoseSamplesFromKnots(knots, samples, bg_, ba_, g), CurrentTImuLidar(),
+  DeskewToScanEnd(history.samples(), CurrentTImuLidar(),
                   downsampled_.points, scan.t_end_ns, &p_lidar_end_);
   ScanResult r;
   r.raw_points = static_cast<int>(scan.points.size());
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
-  r.status = window_->empty() ? StartWindow(scan.t_end_ns, knots.back())
-                              : UpdateWindow(scan.t_end_ns, knots.back(), samples, &r);
+  const ImuKinematics predicted = history.Newest();
+  r.status = window_->empty() ? StartWindow(scan.t_end_ns, predicted)
+                              : UpdateWindow(scan.t_end_ns, predicted, samples, &r);
   SetNewestFromWindow();
   MarginalizeIfFull();
   ReportExtrinsic();

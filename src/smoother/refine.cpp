@@ -1,458 +1,115 @@
 // Batch refinement: Deskew -> Map -> Associate -> RV -> Solve, a few rounds
-// (see refine.h).
+// (see refine.h). This file runs the rounds; the steps are
+//   refine_init.h         state initialization (scans, gravity, states),
+//   refine_association.h  the association round (deskew, map, plane factors),
+//   refine_problem.h      problem build and solve (chunks, IMU-only solve),
+//   refine_chunks.h       the chunks of a round.
 #include "rvlio/smoother/refine.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <functional>
-#include <memory>
-#include <thread>
 #include <utility>
 
-#include <ceres/iteration_callback.h>
-#include <ceres/problem.h>
-#include <ceres/solver.h>
-#include <ceres/types.h>
-
-#include "rvlio/common/check.h"
+#include "rvlio/common/parallel.h"
 #include "rvlio/imu/noise.h"
-#include "rvlio/imu/preintegration.h"
-#include "rvlio/imu/static_init.h"
 #include "rvlio/map/output_map.h"
-#include "rvlio/rv/rv.h"
-#include "rvlio/smoother/imu_factor.h"
-#include "rvlio/smoother/manifolds.h"
-#include "rvlio/smoother/plane_factor.h"
-#include "rvlio/smoother/refine_map.h"
-#include "rvlio/smoother/refine_pair_factor.h"
-#include "rvlio/smoother/refine_states.h"
+#include "rvlio/smoother/refine_association.h"
+#include "rvlio/smoother/refine_chunks.h"
+#include "rvlio/smoother/refine_init.h"
+#include "rvlio/smoother/refine_problem.h"
 
 namespace rvlio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr TimeNs kVelocityHalfWindowNs = 50000000;  // 50 ms central differences
-constexpr double kConvergedTranslationM = 5e-4;     // rounds stop below both changes
+constexpr double kConvergedTranslationM = 5e-4;  // rounds stop below both changes
 constexpr double kConvergedRotationDeg = 5e-3;
-constexpr double kChunkOverlap = 0.1;               // fraction of refine_chunk_scans
 
 double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-std::string Seconds(TimeNs t_ns) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.3f", NsToSeconds(t_ns));
-  return buf;
-}
-
-// fn(i, thread) for i in [begin, end) on `threads` threads; each index is
-// processed exactly once, so results written per index are deterministic.
-template <class Fn>
-void ParallelFor(int begin, int end, int threads, const Fn& fn) {
-  threads = std::max(1, std::min(threads, end - begin));
-  if (threads == 1) {
-    for (int i = begin; i < end; ++i) fn(i, 0);
-    return;
-  }
-  std::atomic<int> next(begin);
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t)
-    pool.emplace_back([&, t] {
-      for (int i = next++; i < end; i = next++) fn(i, t);
-    });
-  for (auto& th : pool) th.join();
-}
-
-bool AllFinite(const RefineState& s) {
-  for (double x : s.pose) if (!std::isfinite(x)) return false;
-  for (double x : s.speed_bias) if (!std::isfinite(x)) return false;
-  return true;
-}
-
-// [begin, end) scan ranges: chunk_scans long, each starting `overlap` scans
-// before the previous one ends.
-std::vector<std::pair<int, int>> MakeChunks(int n, int chunk_scans) {
-  const int overlap = std::max(2, static_cast<int>(std::lround(kChunkOverlap * chunk_scans)));
-  std::vector<std::pair<int, int>> chunks;
-  for (int begin = 0;;) {
-    const int end = std::min(n, begin + chunk_scans);
-    chunks.emplace_back(begin, end);
-    if (end == n) break;
-    begin = end - overlap;
-  }
-  return chunks;
-}
-
-// The plane factors of one scan: world-fixed planes, and planes attached to
-// their source scans (refine_pair_factor.h).
-struct ScanFactors {
-  std::unique_ptr<PlaneFactor> fixed;
-  std::vector<std::pair<int, std::unique_ptr<ScanPairPlaneFactor>>> pairs;  // source scan, factor
-};
-
-// Per-thread scratch of association.
-struct AssociationWorkspace {
-  ConstraintList list, fixed;
-  std::vector<int32_t> sources;
-  std::vector<std::pair<int32_t, int>> attached;  // source scan, constraint index
-  RvWorkspace rv;
-};
-
+// The rounds over one sequence: owns the states and the round's map; each
+// step is a function of refine_*.h.
 class BatchRefiner {
  public:
   BatchRefiner(const RefineConfig& config, RefineInput input)
       : config_(config),
         input_(std::move(input)),
         noise_(ImuNoise::FromOptions(config.imu)),
-        map_(config.map) {
-    threads_ = config.smoother.refine_threads > 0
-                   ? config.smoother.refine_threads
-                   : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-    const bool suitesparse =
-        ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
-    sparse_library_ = suitesparse ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
-    result_.linear_solver = suitesparse ? "SPARSE_NORMAL_CHOLESKY (SuiteSparse CHOLMOD)"
-                                        : "SPARSE_NORMAL_CHOLESKY (Eigen sparse)";
-    result_.threads = threads_;
+        solver_(RefineSolver::Make(ResolveThreads(config.smoother.refine_threads))),
+        round_map_(config.map) {
+    result_.linear_solver = solver_.name;
+    result_.threads = solver_.threads;
   }
 
   StatusOr<RefineResult> Run(const RefineHooks& hooks);
 
  private:
-  Status SelectScans();
-  Status CheckInput() const;
-  void InitGravity();
-  void InitStates();
-  void SolveVelocityAndBias();
+  Status Initialize();
   Status Resume(const RefineRoundState& state);
   RefineRoundState State() const;
   bool StopRequested() const { return stop_ && stop_(); }
   bool RunRound(int round, RefineRound* report);
-  void DeskewAll();
-  void BuildMap();
-  void SolveChunk(int begin, int end, RefineRound* report);
-  ScanFactors AssociateOne(int k, int begin, int end, AssociationWorkspace* w,
-                           AssociationStats* stats, bool* rv_active) const;
-  ScanFactors SplitFactors(int k, int begin, int end, AssociationWorkspace* w) const;
-  void AddImuFactors(int begin, int end, ceres::Problem* problem);
-  ceres::Solver::Options SolverOptions(int iterations) const;
+  void SolveChunk(const ScanRange& chunk, RefineRound* report);
   void Finish();
 
   const RefineConfig& config_;
   RefineInput input_;
   ImuNoise noise_;
-  RefineMap map_;
+  RefineSolver solver_;
   PoseManifold pose_manifold_;
-  int threads_ = 1;
-  ceres::SparseLinearAlgebraLibraryType sparse_library_;
-  Eigen::Vector3d bg0_ = Eigen::Vector3d::Zero();
-
-  std::vector<int> kept_;                          // input scan index per refined scan
-  std::vector<RefineState> states_;                // per refined scan
-  std::vector<std::vector<Eigen::Vector3d>> p_lidar_end_;  // deskewed, per refined scan
-  std::vector<Pose3> map_poses_;  // T_world_imu of each scan when the map was built
-  std::function<bool()> stop_;    // RefineHooks::stop
+  RefineSequence sequence_;
+  std::vector<RefineState> states_;  // per refined scan
+  RefineRoundMap round_map_;
+  std::function<bool()> stop_;  // RefineHooks::stop
   RefineResult result_;
 };
 
-// Ends a Ceres solve when the refinement is asked to stop (the round is
-// dropped then, so the partial solve is never used).
-class StopCallback : public ceres::IterationCallback {
- public:
-  explicit StopCallback(const std::function<bool()>& stop) : stop_(stop) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
-    return stop_ && stop_() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  const std::function<bool()>& stop_;
-};
-
-Status BatchRefiner::CheckInput() const {
-  if (input_.init.empty()) return Status::InvalidInput("the initial trajectory has no poses");
-  if (input_.imu.empty()) return Status::InvalidInput("no IMU samples to refine with");
-  if (input_.scans.empty()) return Status::InvalidInput("no scans to refine");
+// Scans, gravity and the initial states (the scans' stamps; a resumed state
+// replaces the rest).
+Status BatchRefiner::Initialize() {
+  if (Status s = CheckRefineInput(input_); !s.ok()) return s;
+  StatusOr<RefineSequence> sequence = SelectRefineScans(input_, &result_.stats);
+  if (!sequence.ok()) return sequence.status();
+  sequence_ = std::move(sequence).value();
+  const RefineGravity g = InitRefineGravity(input_.imu, input_.init, config_.imu);
+  result_.g_world = g.g_world;
+  result_.stats.started_moving = g.started_moving;
+  result_.stats.gravity_from_static = g.from_static;
+  if (!g.warning.empty()) result_.warnings.push_back(g.warning);
+  states_ = InitialRefineStates(sequence_, input_.init, g.bg);
   return Status::Ok();
 }
 
-// Keeps the scans with enough points, inside the initial trajectory's span,
-// covered by IMU data and with increasing end times.
-Status BatchRefiner::SelectScans() {
-  RefineStats& st = result_.stats;
-  st.scans_input = static_cast<int64_t>(input_.scans.size());
-  st.imu_samples = static_cast<int64_t>(input_.imu.size());
-  const TimeNs init0 = input_.init.front().t_ns, init1 = input_.init.back().t_ns;
-  const TimeNs imu0 = input_.imu.front().t_ns, imu1 = input_.imu.back().t_ns;
-  for (size_t i = 0; i < input_.scans.size(); ++i) {
-    const Scan& s = input_.scans[i];
-    if (static_cast<int>(s.points.size()) < kRefineMinScanPoints) {
-      ++st.scans_too_few_points;
-    } else if (s.t_end_ns < init0 || s.t_end_ns > init1) {
-      ++st.scans_outside_init;
-    } else if (s.t_start_ns < imu0 || s.t_end_ns > imu1) {
-      ++st.scans_without_imu;
-    } else if (!kept_.empty() && s.t_end_ns <= input_.scans[kept_.back()].t_end_ns) {
-      ++st.scans_out_of_order;
-    } else {
-      kept_.push_back(static_cast<int>(i));
-    }
-  }
-  st.scans_refined = static_cast<int64_t>(kept_.size());
-  if (kept_.size() >= 2) return Status::Ok();
-  const TimeNs scan0 = input_.scans.front().t_end_ns, scan1 = input_.scans.back().t_end_ns;
-  std::string why = "only " + std::to_string(kept_.size()) + " of " +
-                    std::to_string(st.scans_input) + " scans can be refined (need 2): ";
-  if (init1 < scan0 || init0 > scan1)
-    return Status::InvalidInput(why + "the initial trajectory (" + Seconds(init0) + " .. " +
-                                Seconds(init1) + " s) does not overlap the scans (" +
-                                Seconds(scan0) + " .. " + Seconds(scan1) + " s)");
-  return Status::InvalidInput(
-      why + std::to_string(st.scans_outside_init) + " outside the initial trajectory (" +
-      Seconds(init0) + " .. " + Seconds(init1) + " s), " + std::to_string(st.scans_without_imu) +
-      " without IMU coverage (" + Seconds(imu0) + " .. " + Seconds(imu1) + " s), " +
-      std::to_string(st.scans_too_few_points) + " with fewer than " +
-      std::to_string(kRefineMinScanPoints) + " points");
-}
-
-// Static alignment of the first imu.init_duration of samples, carried into
-// the initial trajectory's world frame by its attitude there (refine.h).
-void BatchRefiner::InitGravity() {
-  const TimeNs t0 = input_.imu.front().t_ns;
-  const TimeNs t1 = t0 + SecondsToNs(config_.imu.init_duration);
-  std::vector<ImuSample> first;
-  for (const ImuSample& s : input_.imu) {
-    if (s.t_ns > t1) break;
-    first.push_back(s);
-  }
-  const StaticAlignment a = AlignStatic(first);
-  result_.stats.started_moving = a.moving;
-  if (a.moving) {
-    result_.g_world = Eigen::Vector3d(0.0, 0.0, -config_.imu.gravity);
-    result_.warnings.push_back(
-        "the sequence starts moving: gravity taken as (0, 0, -imu.gravity) in the initial "
-        "trajectory's frame (assumed gravity-aligned, z up) and gyro bias starting at zero");
-    return;
-  }
-  const TimeNs t_mid = std::clamp(first.front().t_ns + (first.back().t_ns - first.front().t_ns) / 2,
-                                  input_.init.front().t_ns, input_.init.back().t_ns);
-  Pose3 T;
-  InterpolatePose(input_.init, t_mid, &T);
-  const Eigen::Vector3d g_imu = a.R_world_imu.transpose() * a.g_world;
-  result_.g_world = T.R * g_imu;
-  result_.stats.gravity_from_static = true;
-  bg0_ = a.gyro_bias;
-}
-
-void BatchRefiner::InitStates() {
-  states_.resize(kept_.size());
-  for (size_t k = 0; k < kept_.size(); ++k) {
-    RefineState& s = states_[k];
-    s.t_ns = input_.scans[kept_[k]].t_end_ns;
-    Pose3 T;
-    InterpolatePose(input_.init, s.t_ns, &T);
-    PoseBlock(T).ToArray(s.pose.data());
-    SpeedBiasBlock sb;
-    sb.v_world_imu = FiniteDifferenceVelocity(input_.init, s.t_ns, kVelocityHalfWindowNs);
-    sb.bg = bg0_;
-    sb.ToArray(s.speed_bias.data());
-  }
-}
-
-void BatchRefiner::AddImuFactors(int begin, int end, ceres::Problem* problem) {
-  for (int k = begin + 1; k < end; ++k) {
-    RefineState& a = states_[k - 1];
-    RefineState& b = states_[k];
-    const SpeedBiasBlock sb = a.SpeedBias();
-    auto pre = ImuPreintegration::FromSamples(SliceImu(input_.imu, a.t_ns, b.t_ns), a.t_ns,
-                                              b.t_ns, noise_, sb.bg, sb.ba);
-    problem->AddResidualBlock(new ImuFactor(std::move(pre), result_.g_world), nullptr,
-                              {a.pose.data(), a.speed_bias.data(), b.pose.data(),
-                               b.speed_bias.data()});
-  }
-}
-
-ceres::Solver::Options BatchRefiner::SolverOptions(int iterations) const {
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  o.sparse_linear_algebra_library_type = sparse_library_;
-  o.max_num_iterations = iterations;
-  o.num_threads = threads_;
-  o.logging_type = ceres::SILENT;
-  o.minimizer_progress_to_stdout = false;
-  return o;
-}
-
-ceres::Problem::Options ProblemOptions() {
-  ceres::Problem::Options o;
-  o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one shared PoseManifold
-  return o;
-}
-
-// Velocities and biases consistent with the IMU and the initial poses: an
-// IMU-only solve with every pose held.
-void BatchRefiner::SolveVelocityAndBias() {
-  const auto t0 = Clock::now();
-  const std::vector<RefineState> before = states_;
-  ceres::Problem problem(ProblemOptions());
-  for (RefineState& s : states_) {
-    problem.AddParameterBlock(s.pose.data(), 7, &pose_manifold_);
-    problem.SetParameterBlockConstant(s.pose.data());
-    problem.AddParameterBlock(s.speed_bias.data(), 9);
-  }
-  AddImuFactors(0, static_cast<int>(states_.size()), &problem);
-  ceres::Solver::Summary summary;
-  ceres::Solve(SolverOptions(20), &problem, &summary);
-  if (!summary.IsSolutionUsable() || !std::all_of(states_.begin(), states_.end(), AllFinite)) {
-    states_ = before;
-    result_.warnings.push_back("the IMU-only velocity and bias solve failed (" +
-                               summary.message + "); kept finite differences and zero biases");
-  }
-  result_.init_solve_s = SecondsSince(t0);
-}
-
-void BatchRefiner::DeskewAll() {
-  p_lidar_end_.resize(states_.size());
-  ParallelFor(0, static_cast<int>(states_.size()), threads_, [&](int k, int) {
-    const Scan& scan = input_.scans[kept_[k]];
-    DeskewWithImu(SliceImu(input_.imu, scan.t_start_ns, scan.t_end_ns), states_[k],
-                  result_.g_world, config_.T_imu_lidar, scan.points, scan.t_start_ns,
-                  &p_lidar_end_[k]);
-  });
-}
-
-void BatchRefiner::BuildMap() {
-  map_.Clear();
-  map_poses_.resize(states_.size());
-  std::vector<Eigen::Vector3d> p_world;
-  for (size_t k = 0; k < states_.size(); ++k) {
-    map_poses_[k] = states_[k].T_world_imu();
-    const Pose3 T_world_lidar = map_poses_[k] * config_.T_imu_lidar;
-    p_world.resize(p_lidar_end_[k].size());
-    for (size_t i = 0; i < p_world.size(); ++i) p_world[i] = T_world_lidar * p_lidar_end_[k][i];
-    map_.Insert(static_cast<int32_t>(k), p_world);
-  }
-  result_.stats.map_entries = map_.stats().entries;
-}
-
-// Associate -> RV -> Huber weights -> the scan's plane factors.
-ScanFactors BatchRefiner::AssociateOne(int k, int begin, int end, AssociationWorkspace* w,
-                                       AssociationStats* stats, bool* rv_active) const {
-  const Pose3 T_world_lidar = states_[k].T_world_imu() * config_.T_imu_lidar;
-  AssociateScan(p_lidar_end_[k], T_world_lidar, k, map_, config_.constraints, &w->list, stats,
-                &w->sources);
-  *rv_active = false;
-  if (w->list.empty()) return ScanFactors();
-  *rv_active = ApplyRv(config_.rv, T_world_lidar, &w->list, &w->rv).active;
-  // Huber IRLS weight at the association estimate, min(1, delta / |r|): a
-  // ceres::LossFunction would act on the whole scan's squared norm.
-  const double delta = config_.smoother.huber_delta;
-  for (Constraint& c : w->list)
-    if (std::abs(c.residual) > delta) c.weight *= delta / std::abs(c.residual);
-  return SplitFactors(k, begin, end, w);
-}
-
-// A plane whose source scan j is in the chunk and within refine_plane_window
-// scans of k moves with j (expressed in j's IMU frame at the map's pose);
-// any other plane is world-fixed, at the current estimate of its source (a
-// source in an earlier chunk has already moved in this round).
-ScanFactors BatchRefiner::SplitFactors(int k, int begin, int end,
-                                       AssociationWorkspace* w) const {
-  const int window = config_.smoother.refine_plane_window;
-  const double sigma = config_.constraints.lidar_noise;
-  w->fixed.clear();
-  w->attached.clear();
-  for (size_t i = 0; i < w->list.size(); ++i) {
-    const int j = w->sources[i];
-    if (window > 0 && j >= begin && j < end && std::abs(j - k) <= window) {
-      w->attached.emplace_back(j, static_cast<int>(i));
-      continue;
-    }
-    Constraint c = w->list[i];
-    if (j < begin) {  // T_j,now T_j,map^-1 carries the plane along
-      const Pose3 moved = states_[j].T_world_imu() * map_poses_[j].Inverse();
-      c.normal_world = moved.R * c.normal_world;
-      c.q_world = moved * c.q_world;
-    }
-    w->fixed.push_back(c);
-  }
-  ScanFactors f;
-  if (!w->fixed.empty())
-    f.fixed = std::make_unique<PlaneFactor>(w->fixed, config_.T_imu_lidar, sigma);
-  std::sort(w->attached.begin(), w->attached.end());
-  for (size_t a = 0; a < w->attached.size(); ++a) {
-    const int j = w->attached[a].first;
-    if (a == 0 || w->attached[a - 1].first != j)
-      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>());
-    const Constraint& c = w->list[w->attached[a].second];
-    const Pose3& T_j = map_poses_[j];
-    f.pairs.back().second->Add(config_.T_imu_lidar * c.p_lidar, T_j.R.transpose() * c.normal_world,
-                               T_j.Inverse() * c.q_world, c.weight, sigma);
-  }
-  for (auto& [j, pair] : f.pairs) pair->Finalize();
-  return f;
-}
-
-void BatchRefiner::SolveChunk(int begin, int end, RefineRound* report) {
-  // Associate the chunk's scans (threads over scans, one workspace each).
+void BatchRefiner::SolveChunk(const ScanRange& chunk, RefineRound* report) {
   auto t0 = Clock::now();
-  const int n = end - begin;
-  std::vector<ScanFactors> factors(n);
-  std::vector<AssociationStats> stats(n);
-  std::vector<char> active(n, 0);
-  std::vector<AssociationWorkspace> workspaces(threads_);
-  ParallelFor(begin, end, threads_, [&](int k, int t) {
-    if (StopRequested()) return;  // the round is dropped
-    bool a = false;
-    factors[k - begin] = AssociateOne(k, begin, end, &workspaces[t], &stats[k - begin], &a);
-    active[k - begin] = a;
-  });
-  for (int i = 0; i < n; ++i) {
-    report->points += stats[i].num_points;
-    report->constraints += stats[i].num_accepted;
-    report->rv_active_scans += active[i];
-  }
+  ChunkAssociation a =
+      AssociateRefineChunk(config_, round_map_, states_, chunk, solver_.threads, stop_);
+  report->points += a.points;
+  report->constraints += a.constraints;
+  report->rv_active_scans += a.rv_active_scans;
   report->associate_s += SecondsSince(t0);
   if (StopRequested()) return;
 
-  // One problem: PlaneFactor per scan, ImuFactor between consecutive scans.
   t0 = Clock::now();
-  ceres::Problem problem(ProblemOptions());
-  for (int k = begin; k < end; ++k) {
-    problem.AddParameterBlock(states_[k].pose.data(), 7, &pose_manifold_);
-    problem.AddParameterBlock(states_[k].speed_bias.data(), 9);
-  }
-  for (int k = begin; k < end; ++k) {
-    ScanFactors& f = factors[k - begin];
-    if (f.fixed) problem.AddResidualBlock(f.fixed.release(), nullptr, states_[k].pose.data());
-    for (auto& [j, pair] : f.pairs)
-      problem.AddResidualBlock(pair.release(), nullptr, states_[k].pose.data(),
-                               states_[j].pose.data());
-  }
-  AddImuFactors(begin, end, &problem);
-  problem.SetParameterBlockConstant(states_[begin].pose.data());  // gauge / previous chunk
-  const std::vector<RefineState> before(states_.begin() + begin, states_.begin() + end);
-  ceres::Solver::Summary summary;
-  ceres::Solver::Options options = SolverOptions(config_.smoother.refine_solver_iterations);
-  StopCallback stop(stop_);
-  options.callbacks.push_back(&stop);
-  ceres::Solve(options, &problem, &summary);
-  const bool finite = std::all_of(states_.begin() + begin, states_.begin() + end, AllFinite);
-  if (!summary.IsSolutionUsable() || !finite || !std::isfinite(summary.final_cost)) {
-    std::copy(before.begin(), before.end(), states_.begin() + begin);
+  ceres::Problem problem(RefineProblemOptions());
+  BuildRefineChunkProblem(sequence_, noise_, result_.g_world, chunk, &a.factors, &pose_manifold_,
+                          &states_, &problem);
+  const RefineSolveReport r = SolveRefineProblem(
+      &problem, solver_.Options(config_.smoother.refine_solver_iterations), chunk, stop_, &states_);
+  if (!r.accepted) {
     ++report->solve_failures;
     result_.warnings.push_back("round " + std::to_string(report->round) + ": the solve of scans " +
-                               std::to_string(begin) + ".." + std::to_string(end - 1) +
-                               " failed (" + summary.message + "); kept the previous estimate");
+                               std::to_string(chunk.begin) + ".." + std::to_string(chunk.end - 1) +
+                               " failed (" + r.message + "); kept the previous estimate");
   } else {
-    report->cost_before += summary.initial_cost;
-    report->cost_after += summary.final_cost;
+    report->cost_before += r.cost_before;
+    report->cost_after += r.cost_after;
   }
-  report->iterations += static_cast<int>(summary.iterations.size()) - 1;
+  report->iterations += r.iterations;
   report->solve_s += SecondsSince(t0);
 }
 
@@ -472,19 +129,21 @@ bool BatchRefiner::RunRound(int round, RefineRound* out) {
     return true;
   };
   auto t0 = Clock::now();
-  DeskewAll();
+  DeskewRefineScans(sequence_, states_, result_.g_world, config_.T_imu_lidar, solver_.threads,
+                    &round_map_.p_lidar_end);
   report.deskew_s = SecondsSince(t0);
   if (stopped()) return false;
   t0 = Clock::now();
-  BuildMap();
+  BuildRefineMap(states_, config_.T_imu_lidar, &round_map_);
+  result_.stats.map_entries = round_map_.map.stats().entries;
   report.map_s = SecondsSince(t0);
   if (stopped()) return false;
-  const auto chunks = MakeChunks(static_cast<int>(states_.size()),
-                                 config_.smoother.refine_chunk_scans);
+  const std::vector<ScanRange> chunks =
+      MakeRefineChunks(sequence_.size(), config_.smoother.refine_chunk_scans);
   report.chunks = static_cast<int>(chunks.size());
   result_.stats.chunks = report.chunks;
-  for (const auto& [begin, end] : chunks) {
-    SolveChunk(begin, end, &report);
+  for (const ScanRange& chunk : chunks) {
+    SolveChunk(chunk, &report);
     if (stopped()) return false;
   }
   for (size_t k = 0; k < states_.size(); ++k) {
@@ -500,16 +159,7 @@ bool BatchRefiner::RunRound(int round, RefineRound* out) {
 }
 
 Status BatchRefiner::Resume(const RefineRoundState& state) {
-  if (state.states.size() != states_.size())
-    return Status::InvalidInput("the resumed state has " + std::to_string(state.states.size()) +
-                                " scan states, this input refines " +
-                                std::to_string(states_.size()) + " scans");
-  for (size_t k = 0; k < states_.size(); ++k)
-    if (state.states[k].t_ns != states_[k].t_ns || !AllFinite(state.states[k]))
-      return Status::InvalidInput("the resumed state of scan " + std::to_string(k) +
-                                  " does not belong to this input (stamp " +
-                                  Seconds(state.states[k].t_ns) + " s, expected " +
-                                  Seconds(states_[k].t_ns) + " s)");
+  if (Status s = CheckResumedStates(state.states, states_); !s.ok()) return s;
   states_ = state.states;
   result_.g_world = state.g_world;
   result_.rounds = state.rounds;
@@ -537,14 +187,16 @@ RefineRoundState BatchRefiner::State() const {
 
 // Trajectory, velocities, biases and the output map at the final estimate.
 void BatchRefiner::Finish() {
-  DeskewAll();
+  std::vector<std::vector<Eigen::Vector3d>>& p_lidar_end = round_map_.p_lidar_end;
+  DeskewRefineScans(sequence_, states_, result_.g_world, config_.T_imu_lidar, solver_.threads,
+                    &p_lidar_end);
   OutputMap output(config_.map.output_resolution);
   std::vector<Eigen::Vector3d> p_world;
   for (size_t k = 0; k < states_.size(); ++k) {
     const Pose3 T_world_imu = states_[k].T_world_imu();
     const Pose3 T_world_lidar = T_world_imu * config_.T_imu_lidar;
-    p_world.resize(p_lidar_end_[k].size());
-    for (size_t i = 0; i < p_world.size(); ++i) p_world[i] = T_world_lidar * p_lidar_end_[k][i];
+    p_world.resize(p_lidar_end[k].size());
+    for (size_t i = 0; i < p_world.size(); ++i) p_world[i] = T_world_lidar * p_lidar_end[k][i];
     output.Insert(p_world);
     StampedPose sp;
     sp.t_ns = states_[k].t_ns;
@@ -562,14 +214,17 @@ void BatchRefiner::Finish() {
 StatusOr<RefineResult> BatchRefiner::Run(const RefineHooks& hooks) {
   const auto t0 = Clock::now();
   stop_ = hooks.stop;
-  if (Status s = CheckInput(); !s.ok()) return s;
-  if (Status s = SelectScans(); !s.ok()) return s;
-  InitGravity();
-  InitStates();  // the scans' stamps; a resumed state replaces the rest
+  if (Status s = Initialize(); !s.ok()) return s;
   if (hooks.resume != nullptr) {
     if (Status s = Resume(*hooks.resume); !s.ok()) return s;
   } else {
-    SolveVelocityAndBias();
+    const auto t_init = Clock::now();
+    const RefineSolveReport r =
+        SolveVelocityAndBias(sequence_, noise_, result_.g_world, solver_, &states_);
+    if (!r.accepted)
+      result_.warnings.push_back("the IMU-only velocity and bias solve failed (" + r.message +
+                                 "); kept finite differences and zero biases");
+    result_.init_solve_s = SecondsSince(t_init);
     if (hooks.on_state)
       if (Status s = hooks.on_state(State()); !s.ok()) return s;
   }

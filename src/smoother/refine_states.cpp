@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "rvlio/common/check.h"
-#include "rvlio/imu/integrator.h"
+#include "rvlio/imu/pose_history.h"
 #include "rvlio/lidar/deskew.h"
 #include "rvlio/math/so3.h"
 
@@ -65,11 +65,7 @@ std::vector<ImuSample> SliceImu(const std::vector<ImuSample>& samples, TimeNs t0
   return std::vector<ImuSample>(first, last);
 }
 
-// Backward integration gives the states at the knots (scan end, samples,
-// scan start). Each knot becomes an ImuPoseSample carrying the mean motion of
-// the interval that follows it: the midpoint angular rate and trapezoidal
-// world acceleration of the integrator (imu/integrator.h), so that
-// InterpolateImuPose reproduces the integrated states at every knot.
+// The IMU integrated backwards from the scan-end state (imu/pose_history.h).
 void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_state,
                    const Eigen::Vector3d& g_world, const Pose3& T_imu_lidar,
                    const std::vector<LidarPoint>& points, TimeNs t_start_ns,
@@ -77,30 +73,14 @@ void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_sta
   RVLIO_CHECK(!imu.empty());
   const SpeedBiasBlock sb = end_state.SpeedBias();
   const Pose3 T_end = end_state.T_world_imu();
-  ImuKinematics start;
-  start.t_ns = end_state.t_ns;
-  start.R_world_imu = T_end.R;
-  start.p_world_imu = T_end.t;
-  start.v_world_imu = sb.v_world_imu;
-  std::vector<ImuKinematics> states =
-      IntegrateTrajectory(start, imu, std::min(t_start_ns, end_state.t_ns), sb.bg, sb.ba, g_world);
-  std::reverse(states.begin(), states.end());
-  std::vector<ImuPoseSample> samples(states.size());
-  for (size_t i = 0; i < states.size(); ++i) {
-    ImuPoseSample& s = samples[i];
-    s.t_ns = states[i].t_ns;
-    s.R_world_imu = states[i].R_world_imu;
-    s.p_world_imu = states[i].p_world_imu;
-    s.v_world_imu = states[i].v_world_imu;
-    if (i + 1 == states.size()) continue;  // the scan end: nothing follows
-    const ImuSample m0 = InterpolateImu(imu, states[i].t_ns);
-    const ImuSample m1 = InterpolateImu(imu, states[i + 1].t_ns);
-    s.gyro_imu = 0.5 * (m0.gyro_imu + m1.gyro_imu) - sb.bg;
-    s.acc_world = 0.5 * (states[i].R_world_imu * (m0.acc_imu - sb.ba) +
-                         states[i + 1].R_world_imu * (m1.acc_imu - sb.ba)) +
-                  g_world;
-  }
-  DeskewToScanEnd(samples, T_imu_lidar, points, end_state.t_ns, p_lidar_end);
+  ImuKinematics end;
+  end.t_ns = end_state.t_ns;
+  end.R_world_imu = T_end.R;
+  end.p_world_imu = T_end.t;
+  end.v_world_imu = sb.v_world_imu;
+  const ImuPoseHistory history = ImuPoseHistory::Integrate(
+      end, imu, std::min(t_start_ns, end_state.t_ns), sb.bg, sb.ba, g_world);
+  DeskewToScanEnd(history.samples(), T_imu_lidar, points, end_state.t_ns, p_lidar_end);
 }
 
 double RotationDifferenceDeg(const Pose3& a, const Pose3& b) {

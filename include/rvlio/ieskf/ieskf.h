@@ -14,7 +14,7 @@
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
-#include "rvlio/lidar/deskew.h"
+#include "rvlio/imu/pose_history.h"
 #include "rvlio/math/extrinsic_excitation.h"
 #include "rvlio/math/state.h"
 #include "rvlio/rv/options.h"
@@ -60,9 +60,9 @@ class Ieskf {
   // Propagates to t_ns holding the last IMU measurement (scan end).
   void PropagateTo(TimeNs t_ns);
 
-  // Pose samples recorded by propagation since the last ClearPoseHistory();
-  // the first entry is the state at the time of clearing.
-  const std::vector<ImuPoseSample>& pose_history() const { return pose_history_; }
+  // Pose samples recorded by propagation since the last ClearPoseHistory()
+  // (imu/pose_history.h); the first entry is the state at the time of clearing.
+  const std::vector<ImuPoseSample>& pose_history() const { return pose_history_.samples(); }
   void ClearPoseHistory();
 
   // Iterated update, paper Eq. (1): re-associates, applies RV, solves.
@@ -97,7 +97,7 @@ class Ieskf {
   std::array<bool, 6> released_{};  // extrinsic axes given their prior variance in P_
   TimeNs t_ns_ = 0;
   ImuSample last_imu_;
-  std::vector<ImuPoseSample> pose_history_;
+  ImuPoseHistory pose_history_;
   RvWorkspace rv_workspace_;
 };
 

@@ -1,7 +1,7 @@
 #pragma once
 // Pieces of the odometry pipeline shared by its backends (ieskf_odometry.h,
-// smoother_odometry.h): the extrinsics, static initialization, the IMU pose
-// samples that deskew needs, and the working map with its periodic trim.
+// smoother_odometry.h): the extrinsics, static initialization and the working
+// map with its periodic trim (the IMU poses for deskew: imu/pose_history.h).
 #include <deque>
 #include <optional>
 #include <string>
@@ -44,18 +44,6 @@ class StaticInitializer {
 
 // The warning for a start that does not look static (a.moving).
 std::string MovingStartWarning(const StaticAlignment& a);
-
-// Pose samples for deskew (lidar/deskew.h) from the states of
-// IntegrateTrajectory() (imu/integrator.h) over `samples` with biases bg, ba:
-// sample i carries the motion of the integration scheme up to knot i + 1,
-// rate (w_i + w_i+1)/2 - b_g and world acceleration
-// (R_i (a_i - b_a) + R_i+1 (a_i+1 - b_a))/2 + g, so InterpolateImuPose()
-// reproduces every knot exactly. The last one holds its own signal.
-std::vector<ImuPoseSample> ImuPoseSamplesFromKnots(const std::vector<ImuKinematics>& knots,
-                                                   const std::vector<ImuSample>& samples,
-                                                   const Eigen::Vector3d& bg,
-                                                   const Eigen::Vector3d& ba,
-                                                   const Eigen::Vector3d& g_world);
 
 // p_world[i] = T_world_lidar * p_lidar[i].
 void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector3d>& p_lidar,

@@ -56,6 +56,10 @@
 //
 // A solve that fails or produces non-finite values restores the chunk's
 // states from before the solve and is counted; the output never holds NaN.
+//
+// The steps, each with its own header: refine_init.h (state
+// initialization), refine_association.h (deskew, map, association round),
+// refine_problem.h (problem build and solve), refine_chunks.h (chunking).
 #include <array>
 #include <cstdint>
 #include <functional>

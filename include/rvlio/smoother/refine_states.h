@@ -42,9 +42,10 @@ std::vector<ImuSample> SliceImu(const std::vector<ImuSample>& samples, TimeNs t0
                                 TimeNs t1_ns);
 
 // Deskew of one scan with the state at its end: the IMU is integrated
-// backwards from the end state (pose, velocity, biases; imu/integrator.h) to
-// the earliest point time, and every point is moved to the LiDAR frame at the
-// scan end (lidar/deskew.h). `imu` must cover the scan (SliceImu).
+// backwards from the end state (pose, velocity, biases) to the earliest point
+// time (ImuPoseHistory::Integrate, imu/pose_history.h), and every point is
+// moved to the LiDAR frame at the scan end (lidar/deskew.h). `imu` must cover
+// the scan (SliceImu).
 void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_state,
                    const Eigen::Vector3d& g_world, const Pose3& T_imu_lidar,
                    const std::vector<LidarPoint>& points, TimeNs t_start_ns,

@@ -1,0 +1,130 @@
+#include "rvlio/smoother/refine_association.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rvlio/common/parallel.h"
+
+namespace rvlio {
+
+void DeskewRefineScans(const RefineSequence& sequence, const std::vector<RefineState>& states,
+                       const Eigen::Vector3d& g_world, const Pose3& T_imu_lidar, int threads,
+                       std::vector<std::vector<Eigen::Vector3d>>* p_lidar_end) {
+  p_lidar_end->resize(states.size());
+  ParallelFor(0, static_cast<int>(states.size()), threads, [&](int k, int) {
+    const Scan& scan = sequence.scan(k);
+    DeskewWithImu(SliceImu(sequence.imu(), scan.t_start_ns, scan.t_end_ns), states[k], g_world,
+                  T_imu_lidar, scan.points, scan.t_start_ns, &(*p_lidar_end)[k]);
+  });
+}
+
+void BuildRefineMap(const std::vector<RefineState>& states, const Pose3& T_imu_lidar,
+                    RefineRoundMap* round) {
+  round->map.Clear();
+  round->map_poses.resize(states.size());
+  std::vector<Eigen::Vector3d> p_world;
+  for (size_t k = 0; k < states.size(); ++k) {
+    round->map_poses[k] = states[k].T_world_imu();
+    const Pose3 T_world_lidar = round->map_poses[k] * T_imu_lidar;
+    const std::vector<Eigen::Vector3d>& p_lidar = round->p_lidar_end[k];
+    p_world.resize(p_lidar.size());
+    for (size_t i = 0; i < p_world.size(); ++i) p_world[i] = T_world_lidar * p_lidar[i];
+    round->map.Insert(static_cast<int32_t>(k), p_world);
+  }
+}
+
+void SplitScanConstraints(int k, const ScanRange& chunk, int plane_window,
+                          const ConstraintList& list, const std::vector<int32_t>& sources,
+                          const std::vector<RefineState>& states,
+                          const std::vector<Pose3>& map_poses, ConstraintList* fixed,
+                          std::vector<std::pair<int32_t, int>>* attached) {
+  fixed->clear();
+  attached->clear();
+  for (size_t i = 0; i < list.size(); ++i) {
+    const int j = sources[i];
+    if (plane_window > 0 && chunk.Contains(j) && std::abs(j - k) <= plane_window) {
+      attached->emplace_back(j, static_cast<int>(i));
+      continue;
+    }
+    Constraint c = list[i];
+    if (j < chunk.begin) {  // T_j,now T_j,map^-1 carries the plane along
+      const Pose3 moved = states[j].T_world_imu() * map_poses[j].Inverse();
+      c.normal_world = moved.R * c.normal_world;
+      c.q_world = moved * c.q_world;
+    }
+    fixed->push_back(c);
+  }
+  std::sort(attached->begin(), attached->end());
+}
+
+namespace {
+
+// The factors of the split: one PlaneFactor for the fixed planes, one
+// ScanPairPlaneFactor per source scan of attached planes (expressed in the
+// source's IMU frame at the map's pose).
+ScanFactors MakeScanFactors(const RefineAssociationWorkspace& w,
+                            const std::vector<Pose3>& map_poses, const Pose3& T_imu_lidar,
+                            double sigma) {
+  ScanFactors f;
+  if (!w.fixed.empty()) f.fixed = std::make_unique<PlaneFactor>(w.fixed, T_imu_lidar, sigma);
+  for (size_t a = 0; a < w.attached.size(); ++a) {
+    const int j = w.attached[a].first;
+    if (a == 0 || w.attached[a - 1].first != j)
+      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>());
+    const Constraint& c = w.list[w.attached[a].second];
+    const Pose3& T_j = map_poses[j];
+    f.pairs.back().second->Add(T_imu_lidar * c.p_lidar, T_j.R.transpose() * c.normal_world,
+                               T_j.Inverse() * c.q_world, c.weight, sigma);
+  }
+  for (auto& [j, pair] : f.pairs) pair->Finalize();
+  return f;
+}
+
+}  // namespace
+
+ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap& round,
+                                const std::vector<RefineState>& states, int k,
+                                const ScanRange& chunk, RefineAssociationWorkspace* w,
+                                AssociationStats* stats, bool* rv_active) {
+  const Pose3 T_world_lidar = states[k].T_world_imu() * config.T_imu_lidar;
+  AssociateScan(round.p_lidar_end[k], T_world_lidar, k, round.map, config.constraints, &w->list,
+                stats, &w->sources);
+  *rv_active = false;
+  if (w->list.empty()) return ScanFactors();
+  *rv_active = ApplyRv(config.rv, T_world_lidar, &w->list, &w->rv).active;
+  // Huber IRLS weight at the association estimate, min(1, delta / |r|): a
+  // ceres::LossFunction would act on the whole scan's squared norm.
+  const double delta = config.smoother.huber_delta;
+  for (Constraint& c : w->list)
+    if (std::abs(c.residual) > delta) c.weight *= delta / std::abs(c.residual);
+  SplitScanConstraints(k, chunk, config.smoother.refine_plane_window, w->list, w->sources, states,
+                       round.map_poses, &w->fixed, &w->attached);
+  return MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise);
+}
+
+ChunkAssociation AssociateRefineChunk(const RefineConfig& config, const RefineRoundMap& round,
+                                      const std::vector<RefineState>& states,
+                                      const ScanRange& chunk, int threads,
+                                      const std::function<bool()>& stop) {
+  const int n = chunk.size();
+  ChunkAssociation out;
+  out.factors.resize(n);
+  std::vector<AssociationStats> stats(n);
+  std::vector<char> active(n, 0);
+  std::vector<RefineAssociationWorkspace> workspaces(ParallelSlots(threads, n));
+  ParallelFor(chunk.begin, chunk.end, threads, [&](int k, int slot) {
+    if (stop && stop()) return;  // the round is dropped
+    bool a = false;
+    out.factors[k - chunk.begin] = AssociateRefineScan(
+        config, round, states, k, chunk, &workspaces[slot], &stats[k - chunk.begin], &a);
+    active[k - chunk.begin] = a;
+  });
+  for (int i = 0; i < n; ++i) {
+    out.points += stats[i].num_points;
+    out.constraints += stats[i].num_accepted;
+    out.rv_active_scans += active[i];
+  }
+  return out;
+}
+
+}  // namespace rvlio
