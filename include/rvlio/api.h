@@ -1,0 +1,167 @@
+#pragma once
+// The public C++ API of rvlio (target rvlio::io): the whole-recording calls
+// that the `rvlio` command runs -- `run`, `refine`, `simulate`, `eval` -- as
+// library functions. The command-line tool is a thin layer over them: given
+// the same inputs and an output folder, a call writes the same files, byte for
+// byte (except for timings and memory figures), as the command.
+//
+// For scan-by-scan use without a recording, see rvlio/odometry/odometry.h
+// (rvlio::Odometry, target rvlio::core): AddImu / AddScan / Poll / Finish.
+//
+// Conventions (as everywhere in rvlio): errors are Status::InvalidInput (bad
+// input or configuration; the message names the file/topic/key) or
+// Status::Internal; nothing is printed and the process is never exited. A
+// call that is stopped (`stop`) returns normally with `stopped` set.
+//
+// Configuration: LoadConfig (rvlio/io/config.h) gives OdometryOptions from
+// YAML files plus `key=value` overrides; DumpYaml / ToJson write it back.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rvlio/common/status.h"
+#include "rvlio/common/types.h"
+#include "rvlio/eval/evaluate.h"
+#include "rvlio/io/config.h"
+#include "rvlio/io/sensor_stream.h"
+#include "rvlio/odometry/divergence.h"
+#include "rvlio/odometry/odometry.h"
+#include "rvlio/odometry/options.h"
+#include "rvlio/smoother/refine.h"
+#include "rvlio/version.h"
+
+namespace rvlio {
+
+// Polled between messages (run, simulate) and between rounds (refine). An
+// empty string goes on; a non-empty one stops the call as SIGINT stops the
+// command and is recorded as the cause (summary.json "signal"), e.g.
+// "SIGINT" or "KeyboardInterrupt". Called on the calling thread.
+using StopFn = std::function<std::string()>;
+
+// ---------------------------------------------------------------------------
+// run: the odometry over a recording
+// ---------------------------------------------------------------------------
+
+struct RunProgress {
+  int scans = 0;         // results so far
+  double fraction = 0.0; // share of the recording's time span read (may pass 1 slightly)
+  double wall_s = 0.0;   // since the call started reading
+  const DivergenceReport* divergence = nullptr;  // the monitor's findings so far
+};
+
+struct RunArgs {
+  std::string bag;          // ROS1 .bag, ROS 2 .db3, .mcap or bag folder
+  OdometryOptions options;  // e.g. LoadConfig(files, overrides)
+  // When not empty: created if needed; receives trajectory.tum, map.pcd,
+  // scans.csv and summary.json (all or none, atomically) and, while the run
+  // goes, trajectory.partial.tum. Empty: nothing is written.
+  std::string out_dir;
+  ReadWindow window;  // part of the recording (default: all of it)
+  StopFn stop;
+  // Called after every message read and once after the end of the input.
+  std::function<void(const RunProgress&)> progress;
+};
+
+struct RunResult {
+  std::vector<ScanResult> scans;  // one per processed scan (the rows of scans.csv)
+  std::vector<double> rss_mb;     // process resident memory when each scan was done, MB
+  Trajectory trajectory;          // T_world_imu at each scan end (trajectory.tum)
+  nlohmann::json summary;         // summary.json
+  std::vector<std::string> warnings;  // reader, estimator and output warnings
+  DivergenceReport divergence;
+  std::string lidar_layout;       // the reader's name for the point layout
+  bool stopped = false;           // `stop` ended the run early (outputs hold the scans done)
+  std::string stop_reason;        // what `stop` returned
+  // A read error after some scans: the outputs hold the scans read before it.
+  Status read_error;
+  bool written = false;           // the outputs are in out_dir
+};
+
+// Errors: an unreadable recording or configuration, an output folder that
+// cannot be written, no scan processed (the message says why: topic, ranges,
+// IMU) -- nothing is written then. A stop before the first scan returns a
+// result with stopped set and no scans (nothing written).
+StatusOr<RunResult> RunRecording(const RunArgs& args);
+
+// ---------------------------------------------------------------------------
+// refine: offline batch refinement from an initial trajectory
+// ---------------------------------------------------------------------------
+
+struct RefineArgs {
+  std::string bag;
+  std::string init_path;  // TUM file, read when `init` is empty; summary.json "init"
+  Trajectory init;        // the initial trajectory (e.g. RunResult::trajectory)
+  OdometryOptions options;
+  std::string out_dir;    // empty: nothing written; else trajectory.tum, map.pcd, summary.json
+  ReadWindow window;
+  // When not empty, the state after each round goes to checkpoint_dir/refine.checkpoint;
+  // with resume, the refinement continues from it (same inputs required).
+  std::string checkpoint_dir;
+  bool resume = false;
+  StopFn stop;  // polled while reading and between rounds: the last completed round is the result
+  std::function<void(const RefineRound&)> on_round;  // after each round
+  std::function<void(int rounds_done)> on_resume;    // a checkpoint was loaded
+};
+
+struct RefineRunResult {
+  RefineResult refine;          // trajectory, map points, rounds, stats, warnings
+  DivergenceReport divergence;  // the checks of the refined result
+  nlohmann::json summary;       // summary.json
+  bool stopped = false;         // `stop` ended it (after a round, or while reading)
+  std::string stop_reason;
+  bool read_complete = true;    // false: stopped while reading; nothing refined or written
+  bool written = false;
+};
+
+// Errors: unreadable inputs, a checkpoint that is missing or belongs to other
+// inputs, a failed refinement (the message names the bag and init).
+StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args);
+
+// ---------------------------------------------------------------------------
+// simulate: a simulated recording with its ground truth and sensor config
+// ---------------------------------------------------------------------------
+
+struct SimulateArgs {
+  std::string preset = "tunnel";         // sim::PresetNames()
+  std::optional<int64_t> seed;           // default: the preset's
+  std::optional<double> duration_s;      // default: the preset's
+  std::vector<std::string> overrides;    // simulator "key=value", applied last
+  std::string lidar_msg = "pointcloud2"; // or "livox"
+  std::string out_dir;                   // created if missing (required)
+  std::string name;                      // file stem (default: the preset)
+  std::string format = "bag";            // bag (ROS1) | mcap | db3
+  std::string mcap_compression = "zstd"; // zstd | lz4 | none | unchunked (mcap only)
+  StopFn stop;                           // a stop leaves no recording
+};
+
+struct SimulateResult {
+  std::string bag_path, gt_path, config_path;  // NAME.bag|mcap|db3, NAME_gt.tum, NAME.yaml
+  int64_t scans = 0, imu_samples = 0;
+  int rows = 0, cols = 0;     // LiDAR rows x columns
+  double duration_s = 0.0;    // of simulated data
+  double wall_s = 0.0, cpu_s = 0.0;
+  bool stopped = false;       // nothing was written
+  std::string stop_reason;
+};
+
+StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args);
+// Where SimulateRecording writes the recording: OUT_DIR/NAME.FORMAT.
+std::string SimulatedRecordingPath(const SimulateArgs& args);
+
+// ---------------------------------------------------------------------------
+// eval: APE / RPE with the definitions of evo
+// ---------------------------------------------------------------------------
+
+// Reads both trajectories (TUM, or KITTI at 10 Hz, by column count) and
+// evaluates (rvlio/eval/evaluate.h; Evaluate() takes trajectories directly).
+StatusOr<EvalResult> EvaluateFiles(const std::string& gt_path, const std::string& est_path,
+                                   const EvalOptions& options);
+// `rvlio eval --json`: matched, align, scale, ape, ape_rot_deg, rpe,
+// rpe_rot_deg, end_point_error, along_axis, warnings (10 significant digits).
+nlohmann::json EvalJson(const EvalResult& result);
+
+}  // namespace rvlio
