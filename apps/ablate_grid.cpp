@@ -1,5 +1,5 @@
 #include "ablate_grid.h"
-#include "json_text.h"
+#include "rvlio/io/summary_json.h"
 
 #include <sys/stat.h>
 

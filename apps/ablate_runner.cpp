@@ -1,6 +1,6 @@
 #include "ablate_runner.h"
 #include "divergence_cli.h"
-#include "json_text.h"
+#include "rvlio/io/summary_json.h"
 
 #include <fcntl.h>
 #include <signal.h>

@@ -10,7 +10,7 @@
 #include <iostream>
 
 #include "ablate_grid.h"
-#include "json_text.h"
+#include "rvlio/io/summary_json.h"
 #include "ablate_runner.h"
 #include "ablate_summary.h"
 #include "commands.h"

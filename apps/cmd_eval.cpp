@@ -1,19 +1,16 @@
 // rvlio eval: ATE/RPE of an estimated trajectory against ground truth with the
 // definitions of evo (DESIGN.md section 7). Argument parsing and output only;
-// the metrics live in eval/, the file formats in io/trajectory_io.h.
+// EvaluateFiles and EvalJson (rvlio/api.h) do the work.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "commands.h"
-#include "json_text.h"
+#include "rvlio/io/summary_json.h"
 #include "common_options.h"
-#include "rvlio/eval/evaluate.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/api.h"
 
 namespace rvlio::cli {
 namespace {
@@ -58,35 +55,7 @@ std::string ReadOptions(const Args& args, EvalOptions* options) {
   return "";
 }
 
-// 10 significant digits; null for a non-finite value.
-nlohmann::json Num(double v) {
-  if (!std::isfinite(v)) return nullptr;
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.10g", v);
-  return std::strtod(buf, nullptr);
-}
-
-nlohmann::json StatsJson(const ErrorStats& s) {
-  return {{"rmse", Num(s.rmse)}, {"mean", Num(s.mean)}, {"median", Num(s.median)},
-          {"std", Num(s.std)},   {"min", Num(s.min)},   {"max", Num(s.max)}};
-}
-
-void PrintJson(const EvalResult& r) {
-  nlohmann::json rpe = StatsJson(r.rpe.trans_m);
-  rpe["pairs"] = r.rpe.pairs;
-  const nlohmann::json out = {
-      {"matched", r.matched},
-      {"align", AlignModeName(r.align)},
-      {"scale", Num(r.T_ref_est.scale)},
-      {"ape", StatsJson(r.ape_m)},
-      {"ape_rot_deg", StatsJson(r.ape_rot_deg)},
-      {"rpe", rpe},
-      {"rpe_rot_deg", StatsJson(r.rpe.rot_deg)},
-      {"end_point_error", Num(r.end_point_error_m)},
-      {"along_axis", {{"rmse", Num(r.along_axis.rmse_m)}, {"max", Num(r.along_axis.max_abs_m)}}},
-      {"warnings", r.warnings}};
-  std::cout << JsonText(out, -1) << "\n";
-}
+void PrintJson(const EvalResult& r) { std::cout << JsonText(EvalJson(r), -1) << "\n"; }
 
 void PrintRow(const char* label, const ErrorStats& s, const std::string& note = "") {
   std::printf("%-14s %12.6f %12.6f %12.6f %12.6f %12.6f %12.6f%s\n", label, s.rmse, s.mean,
@@ -119,11 +88,7 @@ int CmdEval(int argc, char** argv) {
   EvalOptions options;
   if (std::string error = ReadOptions(args, &options); !error.empty()) return Fail(kName, error);
 
-  StatusOr<Trajectory> gt = ReadTrajectory(args.Get("gt"));
-  if (!gt.ok()) return Fail(kName, gt.status().message(), gt.status().exit_code());
-  StatusOr<Trajectory> est = ReadTrajectory(args.Get("est"));
-  if (!est.ok()) return Fail(kName, est.status().message(), est.status().exit_code());
-  StatusOr<EvalResult> result = Evaluate(*gt, *est, options);
+  StatusOr<EvalResult> result = EvaluateFiles(args.Get("gt"), args.Get("est"), options);
   if (!result.ok()) return Fail(kName, result.status().message(), result.status().exit_code());
 
   for (const std::string& w : result->warnings)

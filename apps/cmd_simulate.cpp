@@ -4,34 +4,25 @@
 //                    ROS 2 CDR messages)
 //   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
-// Argument parsing, file output and the summary line only.
-#include <algorithm>
+// Argument parsing and the summary line only: SimulateRecording (rvlio/api.h)
+// does the work.
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
-#include <sstream>
 #include <string>
 
 #include "commands.h"
 #include "common_options.h"
 #include "interrupt.h"
-#include "rvlio/io/atomic_file.h"
-#include "rvlio/io/config.h"
-#include "rvlio/io/sensor_bag.h"
-#include "rvlio/io/trajectory_io.h"
-#include "rvlio/odometry/options.h"
+#include "rvlio/api.h"
 #include "rvlio/sim/presets.h"
-#include "rvlio/sim/simulator.h"
 
 namespace rvlio::cli {
 namespace {
 
 constexpr const char* kName = "simulate";
-constexpr double kGroundTruthRate = 100.0;  // Hz
 
 std::string PresetList() {
   std::string list;
@@ -76,122 +67,31 @@ bool ParseInt64(const std::string& text, int64_t* value) {
   return !text.empty() && *end == '\0' && errno == 0;
 }
 
-// Preset, then --seed / --duration, then each --set (applied last), then
-// validation. Returns "" or the error message.
-std::string ResolveOptions(const Args& args, SimOptions* options) {
-  StatusOr<SimOptions> preset = sim::PresetOptions(args.Get("preset", "tunnel"));
-  if (!preset.ok()) return preset.status().message();
-  *options = *preset;
-  const std::string lidar_msg = args.Get("lidar-msg", "pointcloud2");
-  if (lidar_msg != "pointcloud2" && lidar_msg != "livox")
-    return "--lidar-msg '" + lidar_msg + "' is not pointcloud2 or livox";
-  if (lidar_msg == "livox") {
-    options->lidar.topic = "/livox/lidar";
-    options->lidar.frame_id = "livox_frame";
+// --seed, --duration, --format, --mcap-compression as they were written
+// (SimulateRecording checks the values); "" or the error message.
+std::string ReadArgs(const Args& args, SimulateArgs* sim) {
+  sim->preset = args.Get("preset", "tunnel");
+  sim->lidar_msg = args.Get("lidar-msg", "pointcloud2");
+  int64_t seed = 0;
+  if (args.Has("seed")) {
+    if (!ParseInt64(args.Get("seed"), &seed) || seed < 0)
+      return "--seed '" + args.Get("seed") + "' is not a non-negative integer";
+    sim->seed = seed;
   }
-  if (args.Has("seed") && (!ParseInt64(args.Get("seed"), &options->seed) || options->seed < 0))
-    return "--seed '" + args.Get("seed") + "' is not a non-negative integer";
-  if (args.Has("duration") &&
-      (!ParseDouble(args.Get("duration"), &options->duration) || options->duration <= 0.0))
-    return "--duration '" + args.Get("duration") + "' is not a positive number of seconds";
-  for (const std::string& assignment : args.GetAll("set")) {
-    Status s = ApplyOverride(*options, assignment);
-    if (!s.ok()) return s.message();
+  double duration = 0.0;
+  if (args.Has("duration")) {
+    if (!ParseDouble(args.Get("duration"), &duration) || duration <= 0.0)
+      return "--duration '" + args.Get("duration") + "' is not a positive number of seconds";
+    sim->duration_s = duration;
   }
-  Status s = options->Validate();
-  return s.ok() ? "" : s.message();
-}
-
-// --format and --mcap-compression -> writer options and the file extension.
-std::string ResolveFormat(const Args& args, BagWriterOptions* format, std::string* extension) {
-  const std::string name = args.Get("format", "bag");
-  if (name != "bag" && name != "mcap" && name != "db3")
-    return "--format '" + name + "' is not one of bag, mcap, db3";
-  format->format = name == "bag" ? "ros1" : name;
-  *extension = "." + name;
-  format->mcap_compression = args.Get("mcap-compression", "zstd");
-  const std::string& c = format->mcap_compression;
-  if (c != "zstd" && c != "lz4" && c != "none" && c != "unchunked")
-    return "--mcap-compression '" + c + "' is not one of zstd, lz4, none, unchunked";
-  if (args.Has("mcap-compression") && name != "mcap")
+  sim->overrides = args.GetAll("set");
+  sim->out_dir = args.Get("out");
+  sim->name = args.Get("name", sim->preset);
+  sim->format = args.Get("format", "bag");
+  sim->mcap_compression = args.Get("mcap-compression", "zstd");
+  if (args.Has("mcap-compression") && sim->format != "mcap")
     return "--mcap-compression applies to --format mcap only";
   return "";
-}
-
-std::string Num(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
-// The estimator's sensor keys (odometry/options.h) as simulated. The noise
-// densities must be positive there; a noise-free simulation gets a tiny value.
-std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
-                       const std::string& bag_file) {
-  auto density = [](double v) { return Num(std::max(v, 1e-9)); };
-  const auto& t = o.extrinsics.imu_T_lidar.translation;
-  const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
-  std::ostringstream y;
-  y << "# Sensor configuration of the simulated sequence '" << name << "' (rvlio simulate, seed "
-    << o.seed << ").\n# Use: rvlio run --bag " << bag_file << " --config " << name
-    << ".yaml --out DIR\n"
-    << "lidar:\n"
-    << "  topic: " << o.lidar.topic << "\n"
-    << (livox ? "  type: livox\n" : "  type: ouster\n  header_stamp: start\n")
-    << "  min_range: " << Num(o.lidar.min_range) << "\n"
-    << "  max_range: " << Num(o.lidar.max_range) << "\n"
-    << "imu:\n"
-    << "  topic: " << o.imu.topic << "\n"
-    << "  gyro_noise_density: " << density(o.imu.gyro_noise_density) << "\n"
-    << "  accel_noise_density: " << density(o.imu.accel_noise_density) << "\n"
-    << "  gyro_bias_random_walk: " << density(o.imu.gyro_bias_random_walk) << "\n"
-    << "  accel_bias_random_walk: " << density(o.imu.accel_bias_random_walk) << "\n"
-    << "  gravity: " << Num(o.imu.gravity) << "\n"
-    << "extrinsics:\n"
-    << "  imu_T_lidar:\n"
-    << "    translation: [" << Num(t[0]) << ", " << Num(t[1]) << ", " << Num(t[2]) << "]\n"
-    << "    rotation_xyzw: [" << Num(q[0]) << ", " << Num(q[1]) << ", " << Num(q[2]) << ", "
-    << Num(q[3]) << "]\n";
-  // The resolved simulator options, as comments, so the sequence can be
-  // reproduced (rvlio simulate --set KEY=VALUE for any of them).
-  y << "\n# Simulator options of this sequence:\n";
-  std::istringstream dump(DumpYaml(o));
-  for (std::string line; std::getline(dump, line);)
-    y << (line.empty() ? "#" : "#   " + line) << "\n";
-  return y.str();
-}
-
-// Streams the simulation into the bag; the first write error stops the run.
-// An interrupt stops it too and leaves no bag: the writer's temporary file
-// (path + ".tmp") is removed when the writer goes, or by the abort of a
-// second signal (interrupt.h).
-Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
-                const BagWriterOptions& format) {
-  StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
-  if (!writer.ok()) return writer.status();
-  SetAbortRemovePath(path + ".tmp");
-  const SimOptions& o = simulator.options();
-  Status error;
-  simulator.Run(
-      [&](const ImuSample& m) {
-        error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
-        return error.ok() && !Interrupted();
-      },
-      [&](const Scan& scan, int rows, int cols) {
-        error = livox ? (*writer)->WriteLivoxScan(o.lidar.topic, o.lidar.frame_id, scan)
-                      : (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
-        return error.ok() && !Interrupted();
-      });
-  if (error.ok() && !Interrupted()) error = (*writer)->Close();
-  writer->reset();  // removes the temporary file unless Close() renamed it
-  SetAbortRemovePath("");
-  return error;
-}
-
-std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
-  return "ground truth of '" + name + "' (rvlio simulate, seed " + std::to_string(o.seed) +
-         "): T_world_imu, world = gravity-aligned, origin and yaw of the IMU at start";
 }
 
 }  // namespace
@@ -201,62 +101,28 @@ int CmdSimulate(int argc, char** argv) {
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop, leave no half bag, exit 130/143
-  SimOptions options;
-  if (std::string err = ResolveOptions(args, &options); !err.empty()) return Fail(kName, err);
-  const std::string name = args.Get("name", args.Get("preset", "tunnel"));
-  if (name.empty() || name.find('/') != std::string::npos)
-    return Fail(kName, "--name '" + name + "' must be a plain file stem");
-  const std::filesystem::path dir = args.Get("out");
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir))
-    return Fail(kName, "cannot create output directory '" + dir.string() + "'" +
-                           (ec ? " (" + ec.message() + ")" : ""));
-
-  BagWriterOptions format;
-  std::string extension;
-  if (std::string err = ResolveFormat(args, &format, &extension); !err.empty())
-    return Fail(kName, err);
-  // The sensor configuration must be one that `rvlio run` accepts.
-  const bool livox = args.Get("lidar-msg") == "livox";
-  const std::string yaml = SensorYaml(options, name, livox, name + extension);
-  OdometryOptions check;
-  if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
-      !s.ok() || !(s = check.Validate()).ok())
-    return Fail(kName, "internal: generated sensor configuration is rejected: " + s.message(), 1);
-
-  const auto wall0 = std::chrono::steady_clock::now();
-  const std::clock_t cpu0 = std::clock();
-  StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
-  if (!simulator.ok()) return Fail(kName, simulator.status().message());
-  const std::string bag_path = (dir / (name + extension)).string();
-  if (Status s = WriteBag(**simulator, bag_path, livox, format); !s.ok())
-    return Fail(kName, s.message(), s.exit_code());
-  if (Interrupted()) {
+  SimulateArgs sim;
+  if (std::string err = ReadArgs(args, &sim); !err.empty()) return Fail(kName, err);
+  sim.stop = [] { return InterruptSignalName(); };
+  // A second signal aborts at once: the writer's temporary file goes with it.
+  const std::string bag_path = SimulatedRecordingPath(sim);
+  SetAbortRemovePath(bag_path + ".tmp");
+  StatusOr<SimulateResult> r = SimulateRecording(sim);
+  SetAbortRemovePath("");
+  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  if (r->stopped) {
     std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",
-                 InterruptSignalName().c_str());
+                 r->stop_reason.c_str());
     return InterruptExitCode();
   }
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  const double cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-
-  const Trajectory gt = (*simulator)->GroundTruth(kGroundTruthRate);
-  if (Status s =
-          WriteTum((dir / (name + "_gt.tum")).string(), gt, GroundTruthHeader(options, name));
-      !s.ok())
-    return Fail(kName, s.message(), s.exit_code());
-  if (Status s = WriteFileAtomically((dir / (name + ".yaml")).string(), yaml); !s.ok())
-    return Fail(kName, s.message(), s.exit_code());
-
-  const double mb = static_cast<double>(std::filesystem::file_size(bag_path, ec)) / 1e6;
+  std::error_code ec;
+  const double mb = static_cast<double>(std::filesystem::file_size(r->bag_path, ec)) / 1e6;
   std::printf(
       "rvlio simulate: %s: %lld scans (%dx%d), %lld IMU samples, %.1f s of data -> %s "
       "(%.1f MB) in %.1f s (%.1f s CPU)\n",
-      name.c_str(), static_cast<long long>((*simulator)->scan_count()),
-      (*simulator)->lidar().rows(), (*simulator)->lidar().cols(),
-      static_cast<long long>((*simulator)->imu_count()), options.duration, bag_path.c_str(), mb,
-      wall_s, cpu_s);
+      sim.name.c_str(), static_cast<long long>(r->scans), r->rows, r->cols,
+      static_cast<long long>(r->imu_samples), r->duration_s, r->bag_path.c_str(), mb, r->wall_s,
+      r->cpu_s);
   return 0;
 }
 

@@ -1,5 +1,6 @@
 #include "compare_engine.h"
-#include "json_text.h"
+#include "rvlio/version.h"
+#include "rvlio//io/summary_json.h"
 
 #include <fcntl.h>
 #include <unistd.h>

@@ -4,23 +4,6 @@
 
 namespace rvlio::cli {
 
-nlohmann::json DivergenceJson(const DivergenceReport& r) {
-  nlohmann::json events = nlohmann::json::object();
-  for (int k = 0; k < kNumDivergenceKinds; ++k)
-    events[DivergenceKindName(static_cast<DivergenceKind>(k))] = r.episodes[k];
-  nlohmann::json episodes = nlohmann::json::array();
-  for (const DivergenceEvent& e : r.events)
-    episodes.push_back({{"kind", DivergenceKindName(e.kind)},
-                        {"time_s", NsToSeconds(e.t_ns)},
-                        {"value", e.value},
-                        {"threshold", e.threshold}});
-  return {{"detected", r.detected},
-          {"first_time_s", r.detected ? nlohmann::json(NsToSeconds(r.first_t_ns)) : nlohmann::json()},
-          {"scans_flagged", r.scans_flagged},
-          {"events", events},
-          {"episodes", episodes}};
-}
-
 void WarnDivergence(const std::string& command, const DivergenceReport& r, size_t* printed) {
   for (; *printed < r.events.size(); ++*printed) {
     const DivergenceEvent& e = r.events[*printed];

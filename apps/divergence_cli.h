@@ -2,22 +2,18 @@
 // How the commands report the divergence monitor (odometry/divergence.h):
 // one warning line per episode while running, a `divergence` object in
 // summary.json, and exit status kExitDiverged unless --allow-divergence
-// (common_options.h).
+// (common_options.h). DivergenceJson is in rvlio/io/summary_json.h.
 #include <cstddef>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "cli.h"
+#include "rvlio/io/summary_json.h"
 #include "rvlio/odometry/divergence.h"
 
 namespace rvlio::cli {
 
 // "Ran to the end but diverged": every output is written for inspection.
 constexpr int kExitDiverged = 3;
-
-// {detected, first_time_s, scans_flagged, events: {kind: episodes}, episodes: [...]}.
-nlohmann::json DivergenceJson(const DivergenceReport& report);
 
 // Prints "rvlio CMD: warning: divergence at bag time T s: WHAT" for every
 // episode start after the first *printed ones; updates *printed.

@@ -23,12 +23,12 @@
 # Each stage's wall time is printed at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-stages=${RVLIO_CI_STAGES:-release,python,sanitize,fuzz,slurm}
+stages=${RVLIO_CI_STAGES:-release,install,python,sanitize,fuzz,slurm}
 jobs=$(nproc 2>/dev/null || echo 2)
 for s in ${stages//,/ }; do
   case "$s" in
-    release|python|sanitize|fuzz|slurm) ;;
-    *) echo "test.sh: unknown stage '$s' in RVLIO_CI_STAGES (release, python, sanitize, fuzz, slurm)" >&2; exit 2 ;;
+    release|install|python|sanitize|fuzz|slurm) ;;
+    *) echo "test.sh: unknown stage '$s' in RVLIO_CI_STAGES (release, install, python, sanitize, fuzz, slurm)" >&2; exit 2 ;;
   esac
 done
 want() { [[ ",$stages," == *",$1,"* ]]; }
@@ -42,18 +42,23 @@ trap 'rm -f "$log"' EXIT
 passed=0
 count_tests() {
   local n
-  n=$(grep -Eo '(tests failed out of [0-9]+|^(python|fuzz|slurm): [0-9]+ passed)' "$log" | grep -Eo '[0-9]+' | tail -1 || true)
+  n=$(grep -Eo '(tests failed out of [0-9]+|^(fuzz|slurm|install|python): [0-9]+ passed)' "$log" | grep -Eo '[0-9]+' | tail -1 || true)
   passed=$((passed + ${n:-0}))
 }
 
 bash scripts/install_deps.sh --with-test-tools
-finish_stage install
+finish_stage deps
 
 if want release; then
   bash scripts/build.sh
   (cd build && ctest --output-on-failure -j "$jobs") 2>&1 | tee "$log"
   count_tests
   finish_stage release
+fi
+if want install; then
+  bash scripts/install_test.sh 2>&1 | tee "$log"
+  count_tests
+  finish_stage install
 fi
 if want python; then
   bash scripts/python_test.sh 2>&1 | tee "$log"

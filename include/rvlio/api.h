@@ -149,6 +149,8 @@ struct SimulateResult {
 };
 
 StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args);
+// Where SimulateRecording writes the recording: OUT_DIR/NAME.FORMAT.
+std::string SimulatedRecordingPath(const SimulateArgs& args);
 
 // ---------------------------------------------------------------------------
 // eval: APE / RPE with the definitions of evo

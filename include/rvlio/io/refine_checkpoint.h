@@ -15,7 +15,7 @@
 #include "rvlio/io/config.h"
 #include "rvlio/smoother/refine.h"
 
-namespace rvlio::cli {
+namespace rvlio {
 
 constexpr const char* kCheckpointFile = "refine.checkpoint";
 
@@ -32,4 +32,4 @@ Status CheckpointExists(const std::string& dir);
 // One round's report as in summary.json "rounds".
 nlohmann::json RoundJson(const RefineRound& r);
 
-}  // namespace rvlio::cli
+}  // namespace rvlio

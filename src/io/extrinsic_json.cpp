@@ -1,11 +1,11 @@
-#include "extrinsic_json.h"
+#include "rvlio/io/extrinsic_json.h"
 
 #include <cmath>
 #include <vector>
 
 #include "rvlio/math/so3.h"
 
-namespace rvlio::cli {
+namespace rvlio {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
@@ -46,4 +46,4 @@ nlohmann::json ExtrinsicJson(const ExtrinsicReport& r) {
             {"translation_delta_m", ToList(dt)}}}};
 }
 
-}  // namespace rvlio::cli
+}  // namespace rvlio

@@ -1,4 +1,4 @@
-#include "refine_checkpoint.h"
+#include "rvlio/io/refine_checkpoint.h"
 
 #include <sys/stat.h>
 
@@ -11,7 +11,7 @@
 
 #include "rvlio/io/atomic_file.h"
 
-namespace rvlio::cli {
+namespace rvlio {
 namespace {
 
 using nlohmann::json;
@@ -196,4 +196,4 @@ StatusOr<RefineRoundState> ReadRefineCheckpoint(const std::string& dir, uint64_t
   }
 }
 
-}  // namespace rvlio::cli
+}  // namespace rvlio

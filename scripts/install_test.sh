@@ -1,0 +1,158 @@
+#!/usr/bin/env bash
+# The `install` stage of scripts/test.sh: installs the Release build (build/)
+# into a fresh temporary prefix and uses it as an outside project would
+# (docs/library.md):
+#
+#   1. `cmake --install build --prefix P`: libraries with their SONAME,
+#      headers, version.h, CMake package, command, config files, plot script
+#   2. the installed `rvlio --version` and its libraries (from P, not build/)
+#   3. every installed rvlio::core header in one translation unit, compiled
+#      with only P + Eigen + Ceres include folders; the headers it pulls in
+#      include no PCL, ROS, yaml-cpp, sqlite, zstd, lz4 or nlohmann header;
+#      the rvlio::io headers likewise (nlohmann allowed there); the exported
+#      rvlio::core target names only Eigen and Ceres as interface libraries
+#   4. examples/consumer configured (find_package(rvlio) with P only) and
+#      built in its own folder, without the source tree's include folder;
+#      ieskf_tunnel (rvlio::core) runs the IESKF on a simulated tunnel
+#      within an ATE bound; run_recording (rvlio::io) simulates a bag, runs it
+#      and evaluates it
+#   5. the installed `rvlio run` on run_recording's bag gives its trajectory,
+#      map and per-scan table byte for byte (the CLI is that API)
+#
+# P is removed at the end, also on failure. Prints "ok - ..." / "FAIL - ..."
+# per check and ends with "install: N passed, M failed"; exit 1 on a failure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+repo=$PWD
+jobs=$(nproc 2>/dev/null || echo 2)
+work=$(mktemp -d "${TMPDIR:-/tmp}/rvlio-install-test.XXXXXX")
+prefix=$work/prefix
+passed=0
+failed=0
+trap 'rm -rf "$work"' EXIT
+
+check() {  # check NAME COMMAND...: one test
+  local name=$1; shift
+  if "$@"; then
+    echo "ok - $name"; passed=$((passed + 1))
+  else
+    echo "FAIL - $name"; failed=$((failed + 1))
+  fi
+}
+fatal() {
+  echo "install: error: $*" >&2
+  echo "install: $passed passed, $((failed + 1)) failed"
+  exit 1
+}
+
+if [[ ! -f build/CMakeCache.txt ]]; then
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+fi
+cmake --build build -j "$jobs" --target rvlio rvlio_core rvlio_io >/dev/null ||
+  fatal "the Release build failed (cmake --build build)"
+
+# 1. the install itself
+cmake --install build --prefix "$prefix" >"$work/install.log" || fatal "cmake --install failed"
+version=$(sed -n 's/^#define RVLIO_VERSION "\(.*\)"$/\1/p' build/include/rvlio/version.h)
+soversion=$(grep -o 'librvlio_core.so.[0-9.]*' "$work/install.log" | head -1 | cut -d. -f3-)
+installed_files() {
+  local f
+  for f in bin/rvlio include/rvlio/api.h include/rvlio/version.h include/rvlio/odometry/odometry.h \
+    lib/cmake/rvlio/rvlioConfig.cmake lib/cmake/rvlio/rvlioConfigVersion.cmake \
+    lib/cmake/rvlio/rvlioTargets.cmake share/rvlio/config/default.yaml \
+    share/rvlio/config/sensors/os1_32.yaml share/rvlio/rvlio_plot.py \
+    "lib/librvlio_core.so.$version" "lib/librvlio_io.so.$version" lib/librvlio_core.so; do
+    [[ -e $prefix/$f ]] || { echo "  missing: $f" >&2; return 1; }
+  done
+}
+check "cmake --install puts the command, libraries, headers, CMake package, config and plot script under the prefix" installed_files
+soname_ok() {
+  local lib so
+  for lib in core io; do
+    so=$(readelf -d "$prefix/lib/librvlio_$lib.so.$version" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')
+    [[ $so == "librvlio_$lib.so.$soversion" && -L $prefix/lib/$so ]] ||
+      { echo "  librvlio_$lib: SONAME '$so', expected librvlio_$lib.so.$soversion" >&2; return 1; }
+  done
+}
+check "librvlio_core and librvlio_io carry the SONAME lib*.so.$soversion (version $version)" soname_ok
+
+# 2. the installed command
+check "the installed rvlio --version prints $version" \
+  bash -c "[[ \$('$prefix/bin/rvlio' --version) == 'rvlio $version' ]]"
+libs_from_prefix() {
+  local found
+  found=$(ldd "$prefix/bin/rvlio" | grep -E 'librvlio_(core|io)' || true)
+  [[ $(grep -c "=> $prefix/lib/" <<<"$found") == 2 ]] || { echo "$found" >&2; return 1; }
+}
+check "the installed rvlio loads librvlio_core and librvlio_io from the prefix (RPATH \$ORIGIN/../lib)" libs_from_prefix
+
+# 3. the headers' dependencies
+eigen_inc=$(pkg-config --cflags-only-I eigen3)
+ceres_inc="-I/usr/include"  # Ceres and glog (Debian's libceres-dev)
+forbidden='/(pcl[^/]*|ros[^/]*|rosbag|sensor_msgs|yaml-cpp|nlohmann)/|sqlite3\.h|zstd\.h|lz4[a-z]*\.h'
+header_tu() {  # header_tu NAME FILTER: a .cpp including every installed header FILTER keeps
+  (cd "$prefix/include" && find rvlio -name '*.h' | sort | grep -E "$2" | sed 's/.*/#include "&"/') \
+    >"$work/$1.cpp"
+  echo 'int main() { return 0; }' >>"$work/$1.cpp"
+}
+compiles_alone() {  # compiles_alone NAME ALLOWED: syntax check, and the headers it opened
+  g++ -std=c++17 -fsyntax-only -H -I"$prefix/include" $eigen_inc $ceres_inc "$work/$1.cpp" \
+    2>"$work/$1.headers" || { cat "$work/$1.headers" >&2; return 1; }
+  local bad
+  bad=$(grep -E '^\.+ ' "$work/$1.headers" | grep -E "$forbidden" | grep -vE "${2:-^$}" || true)
+  [[ -z $bad ]] || { echo "  $1 pulls in: $(head -3 <<<"$bad")" >&2; return 1; }
+}
+header_tu core_headers '^rvlio/([^i]|i[^o])|^rvlio/io/reader_options\.h$'
+grep -q 'rvlio/api.h\|rvlio/io/config.h' "$work/core_headers.cpp" && fatal "core header list holds io headers"
+check "every rvlio::core header ($(grep -c include "$work/core_headers.cpp") of them) compiles with only the prefix, Eigen and Ceres, and pulls in no PCL/ROS/yaml-cpp/sqlite/zstd/lz4/nlohmann header" \
+  compiles_alone core_headers
+header_tu all_headers '.'
+check "every installed header ($(grep -c include "$work/all_headers.cpp"), rvlio::io's too) compiles; none pulls in PCL/ROS/yaml-cpp/sqlite/zstd/lz4 (nlohmann is rvlio::io's)" \
+  compiles_alone all_headers '/nlohmann/'
+core_interface() {
+  local libs
+  libs=$(awk '/add_library\(rvlio::core /,/^\)/' "$prefix/lib/cmake/rvlio/rvlioTargets.cmake" |
+    sed -n 's/.*INTERFACE_LINK_LIBRARIES "\(.*\)"/\1/p')
+  [[ $libs == "Eigen3::Eigen;Ceres::ceres" ]] || { echo "  rvlio::core interface: $libs" >&2; return 1; }
+}
+check "the exported rvlio::core links only Eigen3::Eigen and Ceres::ceres in its interface" core_interface
+
+# 4. the consumer example against the prefix
+consumer_builds() {
+  cmake -S examples/consumer -B "$work/consumer" -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_PREFIX_PATH="$prefix" >"$work/consumer.log" 2>&1 &&
+    cmake --build "$work/consumer" -j "$jobs" >>"$work/consumer.log" 2>&1 ||
+    { tail -30 "$work/consumer.log" >&2; return 1; }
+  # Its compile lines name the prefix's include folder, never the source tree's.
+  if grep -rq -- "-I$repo/include\|isystem $repo/include" "$work/consumer"; then
+    echo "  the consumer build used $repo/include" >&2; return 1
+  fi
+}
+check "examples/consumer configures (find_package(rvlio) from the prefix) and builds in its own folder" consumer_builds
+ieskf_tunnel_accurate() {
+  local line ate
+  line=$("$work/consumer/ieskf_tunnel" 8 | tee /dev/stderr | grep '^ieskf_tunnel:')
+  ate=$(sed -n 's/.*ATE rmse \([0-9.]*\) m.*/\1/p' <<<"$line")
+  # Measured 0.0xx m on this 8 s, 512-column tunnel; a broken estimator is metres off.
+  awk -v a="$ate" 'BEGIN { exit !(a != "" && a < 0.10) }'
+}
+check "consumer ieskf_tunnel (rvlio::core) runs the IESKF on an 8 s simulated tunnel with ATE < 0.10 m" \
+  ieskf_tunnel_accurate
+check "consumer run_recording (rvlio::io) simulates a bag, runs and evaluates it" \
+  bash -c "'$work/consumer/run_recording' '$work/api' 6 >&2 && [[ -s '$work/api/run/summary.json' ]]"
+
+# 5. the installed command gives the API's outputs
+cli_equals_api() {
+  "$prefix/bin/rvlio" run --bag "$work/api/data/tunnel.bag" --config "$work/api/data/tunnel.yaml" \
+    --set backend=ieskf --out "$work/cli" --quiet >&2 || return 1
+  local f
+  for f in trajectory.tum map.pcd; do cmp "$work/api/run/$f" "$work/cli/$f" || return 1; done
+  # scans.csv: equal but for the timing (ms) and memory (rss_mb) columns.
+  cmp <(cut -d, -f1-17,19-24,26- "$work/api/run/scans.csv") \
+    <(cut -d, -f1-17,19-24,26- "$work/cli/scans.csv")
+}
+check "the installed rvlio run writes run_recording's trajectory.tum, map.pcd and scans.csv (but timings) byte for byte" cli_equals_api
+
+echo "install: prefix $(du -sh "$prefix" | cut -f1) ($(du -sh "$prefix/lib" | cut -f1) in lib)"
+echo "install: $passed passed, $failed failed"
+[[ $failed == 0 ]]

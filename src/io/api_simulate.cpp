@@ -1,0 +1,203 @@
+// SimulateRecording (rvlio/api.h): runs the deterministic tunnel simulator
+// (sim/) and writes
+//   DIR/NAME.bag     ROS1 bag: Ouster-layout PointCloud2 + sensor_msgs/Imu
+//                    (format mcap: DIR/NAME.mcap, db3: DIR/NAME.db3, ROS 2 CDR)
+//   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
+//   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
+// `rvlio simulate` is this call plus argument parsing, signals and its line.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <sstream>
+
+#include "rvlio/api.h"
+#include "rvlio/io/atomic_file.h"
+#include "rvlio/io/sensor_bag.h"
+#include "rvlio/io/trajectory_io.h"
+#include "rvlio/sim/presets.h"
+#include "rvlio/sim/simulator.h"
+
+namespace rvlio {
+namespace {
+
+constexpr double kGroundTruthRate = 100.0;  // Hz
+
+// Preset, then seed / duration, then each override (applied last), then
+// validation.
+Status ResolveOptions(const SimulateArgs& args, SimOptions* options) {
+  StatusOr<SimOptions> preset = sim::PresetOptions(args.preset);
+  if (!preset.ok()) return preset.status();
+  *options = *preset;
+  if (args.lidar_msg != "pointcloud2" && args.lidar_msg != "livox")
+    return Status::InvalidInput("lidar message type '" + args.lidar_msg +
+                                "' is not pointcloud2 or livox");
+  if (args.lidar_msg == "livox") {
+    options->lidar.topic = "/livox/lidar";
+    options->lidar.frame_id = "livox_frame";
+  }
+  if (args.seed) {
+    if (*args.seed < 0)
+      return Status::InvalidInput("seed " + std::to_string(*args.seed) + " is negative");
+    options->seed = *args.seed;
+  }
+  if (args.duration_s) {
+    if (!(*args.duration_s > 0.0) || !std::isfinite(*args.duration_s))
+      return Status::InvalidInput("duration " + std::to_string(*args.duration_s) +
+                                  " s is not a positive number of seconds");
+    options->duration = *args.duration_s;
+  }
+  for (const std::string& assignment : args.overrides)
+    if (Status s = ApplyOverride(*options, assignment); !s.ok()) return s;
+  return options->Validate();
+}
+
+// The format and MCAP compression -> writer options and the file extension.
+Status ResolveFormat(const SimulateArgs& args, BagWriterOptions* format, std::string* extension) {
+  const std::string& name = args.format;
+  if (name != "bag" && name != "mcap" && name != "db3")
+    return Status::InvalidInput("format '" + name + "' is not one of bag, mcap, db3");
+  format->format = name == "bag" ? "ros1" : name;
+  *extension = "." + name;
+  format->mcap_compression = args.mcap_compression;
+  const std::string& c = format->mcap_compression;
+  if (c != "zstd" && c != "lz4" && c != "none" && c != "unchunked")
+    return Status::InvalidInput("MCAP compression '" + c +
+                                "' is not one of zstd, lz4, none, unchunked");
+  if (c != "zstd" && name != "mcap")
+    return Status::InvalidInput("MCAP compression '" + c + "' applies to format mcap only");
+  return Status::Ok();
+}
+
+std::string Num(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+// The estimator's sensor keys (odometry/options.h) as simulated. The noise
+// densities must be positive there; a noise-free simulation gets a tiny value.
+std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
+                       const std::string& bag_file) {
+  auto density = [](double v) { return Num(std::max(v, 1e-9)); };
+  const auto& t = o.extrinsics.imu_T_lidar.translation;
+  const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
+  std::ostringstream y;
+  y << "# Sensor configuration of the simulated sequence '" << name << "' (rvlio simulate, seed "
+    << o.seed << ").\n# Use: rvlio run --bag " << bag_file << " --config " << name
+    << ".yaml --out DIR\n"
+    << "lidar:\n"
+    << "  topic: " << o.lidar.topic << "\n"
+    << (livox ? "  type: livox\n" : "  type: ouster\n  header_stamp: start\n")
+    << "  min_range: " << Num(o.lidar.min_range) << "\n"
+    << "  max_range: " << Num(o.lidar.max_range) << "\n"
+    << "imu:\n"
+    << "  topic: " << o.imu.topic << "\n"
+    << "  gyro_noise_density: " << density(o.imu.gyro_noise_density) << "\n"
+    << "  accel_noise_density: " << density(o.imu.accel_noise_density) << "\n"
+    << "  gyro_bias_random_walk: " << density(o.imu.gyro_bias_random_walk) << "\n"
+    << "  accel_bias_random_walk: " << density(o.imu.accel_bias_random_walk) << "\n"
+    << "  gravity: " << Num(o.imu.gravity) << "\n"
+    << "extrinsics:\n"
+    << "  imu_T_lidar:\n"
+    << "    translation: [" << Num(t[0]) << ", " << Num(t[1]) << ", " << Num(t[2]) << "]\n"
+    << "    rotation_xyzw: [" << Num(q[0]) << ", " << Num(q[1]) << ", " << Num(q[2]) << ", "
+    << Num(q[3]) << "]\n";
+  // The resolved simulator options, as comments, so the sequence can be
+  // reproduced (rvlio simulate --set KEY=VALUE for any of them).
+  y << "\n# Simulator options of this sequence:\n";
+  std::istringstream dump(DumpYaml(o));
+  for (std::string line; std::getline(dump, line);)
+    y << (line.empty() ? "#" : "#   " + line) << "\n";
+  return y.str();
+}
+
+// Streams the simulation into the bag; the first write error stops the run,
+// and so does `stop` (*stop_reason set). Either leaves no bag: the writer's
+// temporary file (path + ".tmp") is removed when the writer goes.
+Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
+                const BagWriterOptions& format, const StopFn& stop, std::string* stop_reason) {
+  StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
+  if (!writer.ok()) return writer.status();
+  const SimOptions& o = simulator.options();
+  Status error;
+  auto go_on = [&] { return error.ok() && (!stop || (*stop_reason = stop()).empty()); };
+  simulator.Run(
+      [&](const ImuSample& m) {
+        error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
+        return go_on();
+      },
+      [&](const Scan& scan, int rows, int cols) {
+        error = livox ? (*writer)->WriteLivoxScan(o.lidar.topic, o.lidar.frame_id, scan)
+                      : (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
+        return go_on();
+      });
+  if (error.ok() && stop_reason->empty()) error = (*writer)->Close();
+  writer->reset();  // removes the temporary file unless Close() renamed it
+  return error;
+}
+
+std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
+  return "ground truth of '" + name + "' (rvlio simulate, seed " + std::to_string(o.seed) +
+         "): T_world_imu, world = gravity-aligned, origin and yaw of the IMU at start";
+}
+
+}  // namespace
+
+std::string SimulatedRecordingPath(const SimulateArgs& args) {
+  const std::string name = args.name.empty() ? args.preset : args.name;
+  return (std::filesystem::path(args.out_dir) / (name + "." + args.format)).string();
+}
+
+StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
+  SimOptions options;
+  if (Status s = ResolveOptions(args, &options); !s.ok()) return s;
+  const std::string name = args.name.empty() ? args.preset : args.name;
+  if (name.empty() || name.find('/') != std::string::npos)
+    return Status::InvalidInput("name '" + name + "' must be a plain file stem");
+  const std::filesystem::path dir = args.out_dir;
+  std::error_code ec;
+  if (!args.out_dir.empty()) std::filesystem::create_directories(dir, ec);
+  if (args.out_dir.empty() || ec || !std::filesystem::is_directory(dir))
+    return Status::InvalidInput("cannot create output directory '" + dir.string() + "'" +
+                                (ec ? " (" + ec.message() + ")" : ""));
+  BagWriterOptions format;
+  std::string extension;
+  if (Status s = ResolveFormat(args, &format, &extension); !s.ok()) return s;
+  // The sensor configuration must be one that `rvlio run` accepts.
+  const bool livox = args.lidar_msg == "livox";
+  const std::string yaml = SensorYaml(options, name, livox, name + extension);
+  OdometryOptions check;
+  if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
+      !s.ok() || !(s = check.Validate()).ok())
+    return Status::Internal("generated sensor configuration is rejected: " + s.message());
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
+  if (!simulator.ok()) return simulator.status();
+  SimulateResult r;
+  r.bag_path = (dir / (name + extension)).string();
+  if (Status s = WriteBag(**simulator, r.bag_path, livox, format, args.stop, &r.stop_reason);
+      !s.ok())
+    return s;
+  if ((r.stopped = !r.stop_reason.empty())) return r;
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+
+  r.gt_path = (dir / (name + "_gt.tum")).string();
+  const Trajectory gt = (*simulator)->GroundTruth(kGroundTruthRate);
+  if (Status s = WriteTum(r.gt_path, gt, GroundTruthHeader(options, name)); !s.ok()) return s;
+  r.config_path = (dir / (name + ".yaml")).string();
+  if (Status s = WriteFileAtomically(r.config_path, yaml); !s.ok()) return s;
+  r.scans = (*simulator)->scan_count();
+  r.imu_samples = (*simulator)->imu_count();
+  r.rows = (*simulator)->lidar().rows();
+  r.cols = (*simulator)->lidar().cols();
+  r.duration_s = options.duration;
+  return r;
+}
+
+}  // namespace rvlio
