@@ -5,6 +5,8 @@
 #include "config_py.h"
 #include "eval_py.h"
 #include "odometry_py.h"
+#include "run_py.h"
+#include "rvlio/version.h"
 
 PYBIND11_MODULE(_rvlio, m) {
   m.doc() = "rvlio: LiDAR-inertial odometry with reinforced vectors (RV-LIO)";
@@ -15,4 +17,5 @@ PYBIND11_MODULE(_rvlio, m) {
   rvlio::python::BindOdometry(m);
   rvlio::python::BindBag(m);
   rvlio::python::BindEval(m);
+  rvlio::python::BindRun(m);
 }
