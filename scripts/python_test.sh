@@ -63,6 +63,7 @@ installed_import() {
   (cd "$work" && PYTHONPATH="$work/prefix/lib/python3/dist-packages" "$python" -c '
 import sys, rvlio
 assert rvlio.__file__.startswith(sys.argv[1]), rvlio.__file__
+assert rvlio.Config.load(set={"backend": "smoother"}).to_dict()["backend"] == "smoother"
 print("installed rvlio", rvlio.__version__, "from", rvlio.__file__)
 ' "$work/prefix")
 }
