@@ -10,8 +10,7 @@ set(RVLIO_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/rvlio CACHE STRING
 
 install(TARGETS rvlio_core rvlio_io EXPORT rvlioTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT dev
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
-  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
 install(TARGETS rvlio RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 # Every header of include/rvlio is public: none includes PCL, ROS, sqlite or
 # yaml-cpp (checked by scripts/install_test.sh); rvlio/io/config.h and

@@ -1,0 +1,205 @@
+// The whole-recording API (rvlio/api.h) in-process: the same results with and
+// without an output folder, stop and progress callbacks, refine from an
+// in-memory trajectory, evaluation, and errors as Status (never a crash or
+// an exit). That the command writes the API's files byte for byte is checked
+// by scripts/install_test.sh against the installed tool.
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "../cli/cli_util.h"
+#include "rvlio/api.h"
+#include "rvlio/io/trajectory_io.h"
+
+namespace rvlio {
+namespace {
+
+using testing_cli::MakeTempDir;
+using testing_cli::ReadFile;
+
+class ApiTest : public ::testing::Test {
+ protected:
+  // One 5 s, 512-column simulated tunnel for the suite.
+  static void SetUpTestSuite() {
+    dir_ = MakeTempDir("rvlio_api");
+    SimulateArgs sim;
+    sim.out_dir = dir_ + "/data";
+    sim.seed = 5;
+    sim.duration_s = 5.0;
+    sim.overrides = {"lidar.columns=512"};
+    StatusOr<SimulateResult> r = SimulateRecording(sim);
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    recording_ = *r;
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+
+  static RunArgs Run(const std::string& out_dir) {
+    StatusOr<OdometryOptions> config = LoadConfig({recording_.config_path}, {});
+    EXPECT_TRUE(config.ok()) << config.status().message();
+    RunArgs args;
+    args.bag = recording_.bag_path;
+    args.options = config.ok() ? *config : OdometryOptions();
+    args.out_dir = out_dir;
+    return args;
+  }
+
+  static std::string dir_;
+  static SimulateResult recording_;
+};
+std::string ApiTest::dir_;
+SimulateResult ApiTest::recording_;
+
+TEST_F(ApiTest, SimulateReportsWhatItWrote) {
+  EXPECT_EQ(recording_.bag_path, dir_ + "/data/tunnel.bag");
+  EXPECT_EQ(recording_.bag_path, SimulatedRecordingPath([] {
+              SimulateArgs a;
+              a.out_dir = dir_ + "/data";
+              return a;
+            }()));
+  EXPECT_EQ(recording_.scans, 50);  // 5 s at 10 Hz
+  EXPECT_EQ(recording_.cols, 512);
+  EXPECT_FALSE(recording_.stopped);
+  for (const std::string& p : {recording_.bag_path, recording_.gt_path, recording_.config_path})
+    EXPECT_TRUE(std::filesystem::is_regular_file(p)) << p;
+}
+
+TEST_F(ApiTest, RunWithAndWithoutOutputFolderGivesTheSameTrajectory) {
+  StatusOr<RunResult> quiet = RunRecording(Run(""));
+  ASSERT_TRUE(quiet.ok()) << quiet.status().message();
+  EXPECT_FALSE(quiet->written);
+  const std::string out = dir_ + "/run";
+  int calls = 0;
+  double last_fraction = -1.0;
+  RunArgs args = Run(out);
+  args.progress = [&](const RunProgress& p) {
+    ++calls;
+    EXPECT_GE(p.fraction, last_fraction);
+    ASSERT_NE(p.divergence, nullptr);
+    last_fraction = p.fraction;
+  };
+  StatusOr<RunResult> written = RunRecording(args);
+  ASSERT_TRUE(written.ok()) << written.status().message();
+  EXPECT_TRUE(written->written);
+  EXPECT_GT(calls, 900);  // once per message: ~1000 IMU samples and 50 scans
+  EXPECT_NEAR(last_fraction, 1.0, 0.05);
+
+  ASSERT_EQ(quiet->trajectory.size(), written->trajectory.size());
+  ASSERT_GT(quiet->scans.size(), 30u);
+  EXPECT_EQ(quiet->scans.size(), quiet->trajectory.size());
+  EXPECT_EQ(quiet->rss_mb.size(), quiet->scans.size());
+  for (size_t i = 0; i < quiet->trajectory.size(); ++i) {
+    EXPECT_EQ(quiet->trajectory[i].t_ns, written->trajectory[i].t_ns);
+    EXPECT_EQ(quiet->trajectory[i].p_world_imu, written->trajectory[i].p_world_imu) << i;
+  }
+  // The files are what the result holds.
+  StatusOr<Trajectory> tum = ReadTum(out + "/trajectory.tum");
+  ASSERT_TRUE(tum.ok()) << tum.status().message();
+  ASSERT_EQ(tum->size(), written->trajectory.size());
+  EXPECT_NEAR((tum->back().p_world_imu - written->trajectory.back().p_world_imu).norm(), 0.0, 1e-6);
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  EXPECT_EQ(summary["scan_count"], written->scans.size());
+  EXPECT_EQ(summary["version"], RVLIO_VERSION);
+  EXPECT_EQ(summary["config"], written->summary["config"]);
+  EXPECT_FALSE(summary["interrupted"].get<bool>());
+  for (const char* f : {"map.pcd", "scans.csv"})
+    EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << f;
+  EXPECT_FALSE(std::filesystem::exists(out + "/trajectory.partial.tum"));
+
+  // Evaluation of the written file equals that of the in-memory trajectory.
+  StatusOr<EvalResult> from_files = EvaluateFiles(recording_.gt_path, out + "/trajectory.tum", {});
+  ASSERT_TRUE(from_files.ok()) << from_files.status().message();
+  StatusOr<Trajectory> gt = ReadTum(recording_.gt_path);
+  ASSERT_TRUE(gt.ok());
+  StatusOr<EvalResult> direct = Evaluate(*gt, *tum, {});
+  ASSERT_TRUE(direct.ok());
+  EXPECT_EQ(from_files->ape_m.rmse, direct->ape_m.rmse);
+  EXPECT_LT(from_files->ape_m.rmse, 0.05);  // measured ~0.01 m on this short tunnel
+  const nlohmann::json j = EvalJson(*from_files);
+  EXPECT_EQ(j["matched"], from_files->matched);
+  EXPECT_NEAR(j["ape"]["rmse"].get<double>(), from_files->ape_m.rmse, 1e-9);
+}
+
+TEST_F(ApiTest, StopEndsTheRunAndRecordsTheReason) {
+  const std::string out = dir_ + "/stopped";
+  RunArgs args = Run(out);
+  int polls = 0;
+  args.stop = [&polls] { return ++polls > 800 ? std::string("test stop") : std::string(); };
+  StatusOr<RunResult> r = RunRecording(args);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(r->stopped);
+  EXPECT_EQ(r->stop_reason, "test stop");
+  EXPECT_FALSE(r->scans.empty());
+  EXPECT_LT(r->scans.size(), 45u);
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  EXPECT_TRUE(summary["interrupted"].get<bool>());
+  EXPECT_EQ(summary["signal"], "test stop");
+
+  // Stopped before the first scan: a result without scans, nothing written.
+  RunArgs early = Run(dir_ + "/stopped_early");
+  early.stop = [] { return std::string("now"); };
+  StatusOr<RunResult> e = RunRecording(early);
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  EXPECT_TRUE(e->stopped);
+  EXPECT_TRUE(e->scans.empty());
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/stopped_early"));
+}
+
+TEST_F(ApiTest, RefineFromAnInMemoryTrajectory) {
+  StatusOr<RunResult> run = RunRecording(Run(""));
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  RefineArgs args;
+  args.bag = recording_.bag_path;
+  args.init = run->trajectory;
+  args.options = Run("").options;
+  args.options.smoother.refine_rounds = 1;
+  args.out_dir = dir_ + "/refine";
+  int rounds = 0;
+  args.on_round = [&rounds](const RefineRound&) { ++rounds; };
+  StatusOr<RefineRunResult> r = RefineRecording(args);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(rounds, 1);
+  EXPECT_TRUE(r->read_complete);
+  EXPECT_FALSE(r->stopped);
+  EXPECT_TRUE(r->written);
+  EXPECT_EQ(r->refine.trajectory.size(), run->trajectory.size());
+  EXPECT_EQ(r->summary["command"], "refine");
+  EXPECT_TRUE(std::filesystem::is_regular_file(args.out_dir + "/trajectory.tum"));
+}
+
+TEST_F(ApiTest, BadInputIsAStatus) {
+  RunArgs missing = Run("");
+  missing.bag = dir_ + "/no_such.bag";
+  StatusOr<RunResult> r = RunRecording(missing);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidInput);
+  EXPECT_NE(r.status().message().find("no_such.bag"), std::string::npos) << r.status().message();
+
+  RunArgs wrong_topic = Run(dir_ + "/wrong_topic");
+  wrong_topic.options.lidar.topic = "/nothing";
+  r = RunRecording(wrong_topic);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("/nothing"), std::string::npos) << r.status().message();
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/wrong_topic/summary.json"));
+
+  SimulateArgs sim;
+  sim.out_dir = dir_ + "/sim_bad";
+  sim.format = "zip";
+  StatusOr<SimulateResult> s = SimulateRecording(sim);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.status().message().find("'zip'"), std::string::npos) << s.status().message();
+
+  RefineArgs refine;
+  refine.bag = recording_.bag_path;
+  refine.init_path = dir_ + "/no_init.tum";
+  StatusOr<RefineRunResult> f = RefineRecording(refine);
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.status().message().find("no_init.tum"), std::string::npos) << f.status().message();
+
+  StatusOr<EvalResult> e = EvaluateFiles(recording_.gt_path, dir_ + "/none.tum", {});
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.status().code(), StatusCode::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace rvlio
