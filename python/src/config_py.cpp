@@ -7,14 +7,6 @@
 
 namespace rvlio::python {
 namespace {
-std::string OverrideText(const py::handle& value);
-}  // namespace
-
-std::string OverrideAssignment(const py::handle& key, const py::handle& value) {
-  return py::str(key).cast<std::string>() + "=" + OverrideText(value);
-}
-
-namespace {
 
 // The text of one `--set` value: YAML scalar or flow sequence.
 std::string OverrideText(const py::handle& value) {
@@ -32,18 +24,27 @@ std::string OverrideText(const py::handle& value) {
   return py::repr(py::float_(py::reinterpret_borrow<py::object>(value))).cast<std::string>();
 }
 
+}  // namespace
+
+std::vector<std::string> Overrides(const py::handle& set) {
+  std::vector<std::string> assignments;
+  if (set.is_none()) return assignments;
+  if (!py::isinstance<py::dict>(set))
+    throw py::type_error("set must be a dict of 'section.key': value");
+  for (const auto& [key, value] : py::reinterpret_borrow<py::dict>(set))
+    assignments.push_back(py::str(key).cast<std::string>() + "=" + OverrideText(value));
+  return assignments;
+}
+
+namespace {
+
 Config Load(const py::args& files, const py::object& set) {
   Config c;
   for (const py::handle f : files) {
     c.files.push_back(PathText(f));
     RequireExisting(c.files.back(), "configuration file");
   }
-  if (!set.is_none()) {
-    if (!py::isinstance<py::dict>(set))
-      throw py::type_error("set must be a dict of 'section.key': value");
-    for (const auto& [key, value] : set.cast<py::dict>())
-      c.overrides.push_back(OverrideAssignment(key, value));
-  }
+  c.overrides = Overrides(set);
   c.options = Take(LoadConfig(c.files, c.overrides));
   return c;
 }

@@ -17,9 +17,9 @@ struct Config {
 
 void BindConfig(py::module_& m);
 
-// "key=value" as `--set` takes it: bool -> true/false, numbers exactly,
-// lists and tuples -> [a,b,c], str as is.
-std::string OverrideAssignment(const py::handle& key, const py::handle& value);
+// A `set={...}` dict (or None) as `--set` arguments "key=value": bool ->
+// true/false, numbers exactly, lists and tuples -> [a,b,c], str as is.
+std::vector<std::string> Overrides(const py::handle& set);
 
 // A `config` argument: an rvlio.Config, a YAML path (loaded alone) or None
 // (the defaults, *storage as constructed). Returns the Config to use.

@@ -170,18 +170,21 @@ std::vector<ScanResult> OdometrySession::Finish() {
   return out;
 }
 
-py::array_t<double> TumArray(const std::vector<ScanResult>& results) {
-  const Trajectory trajectory = ToTrajectory(results);
+py::array_t<double> TrajectoryArray(const Trajectory& trajectory) {
   py::array_t<double> a({static_cast<py::ssize_t>(trajectory.size()), py::ssize_t{8}});
   auto w = a.mutable_unchecked<2>();
   for (size_t i = 0; i < trajectory.size(); ++i) {
     const StampedPose& p = trajectory[i];
-    const double row[8] = {NsToSeconds(p.t_ns),  p.p_world_imu.x(),  p.p_world_imu.y(),
-                           p.p_world_imu.z(),    p.q_world_imu.x(),  p.q_world_imu.y(),
-                           p.q_world_imu.z(),    p.q_world_imu.w()};
+    const double row[8] = {NsToSeconds(p.t_ns), p.p_world_imu.x(), p.p_world_imu.y(),
+                           p.p_world_imu.z(),   p.q_world_imu.x(), p.q_world_imu.y(),
+                           p.q_world_imu.z(),   p.q_world_imu.w()};
     for (int k = 0; k < 8; ++k) w(static_cast<py::ssize_t>(i), k) = row[k];
   }
   return a;
+}
+
+py::array_t<double> TumArray(const std::vector<ScanResult>& results) {
+  return TrajectoryArray(ToTrajectory(results));
 }
 
 namespace {

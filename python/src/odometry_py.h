@@ -15,7 +15,8 @@ struct Config;
 Scan ScanFromArrays(TimeNs t_ns, const py::handle& points, const py::handle& times,
                     const py::handle& intensity);
 
-// The (N, 8) TUM rows [t_s x y z qx qy qz qw] of the results.
+// The (N, 8) TUM rows [t_s x y z qx qy qz qw] of a trajectory, of results.
+py::array_t<double> TrajectoryArray(const Trajectory& trajectory);
 py::array_t<double> TumArray(const std::vector<ScanResult>& results);
 
 // rvlio.Odometry: the library's Odometry plus the checks of what Python feeds

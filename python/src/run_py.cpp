@@ -19,19 +19,6 @@ constexpr const char* kStopReason = "KeyboardInterrupt";
 // rvlio.run calls its `progress` function at most this often.
 constexpr std::chrono::milliseconds kProgressPeriod{200};
 
-py::array_t<double> TumRows(const Trajectory& trajectory) {
-  py::array_t<double> a({static_cast<py::ssize_t>(trajectory.size()), py::ssize_t{8}});
-  auto w = a.mutable_unchecked<2>();
-  for (size_t i = 0; i < trajectory.size(); ++i) {
-    const StampedPose& p = trajectory[i];
-    const double row[8] = {NsToSeconds(p.t_ns), p.p_world_imu.x(), p.p_world_imu.y(),
-                           p.p_world_imu.z(),   p.q_world_imu.x(), p.q_world_imu.y(),
-                           p.q_world_imu.z(),   p.q_world_imu.w()};
-    for (int k = 0; k < 8; ++k) w(static_cast<py::ssize_t>(i), k) = row[k];
-  }
-  return a;
-}
-
 // The per-scan table: the columns of scans.csv as numpy arrays (one row per scan).
 py::dict ScanTable(const std::vector<ScanResult>& scans) {
   const auto n = static_cast<py::ssize_t>(scans.size());
@@ -151,7 +138,7 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
   RunResult r = Take(std::move(result));
   if (!r.read_error.ok()) Raise(r.read_error);
   RunOutput o;
-  o.trajectory = TumRows(r.trajectory);
+  o.trajectory = TrajectoryArray(r.trajectory);
   o.scans = ScanTable(r.scans);
   o.summary = ToPython(r.summary);
   o.results = std::move(r.scans);
@@ -200,7 +187,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   signals.Rethrow();
   RefineRunResult r = Take(std::move(result));
   RefineOutput o;
-  o.trajectory = TumRows(r.refine.trajectory);
+  o.trajectory = TrajectoryArray(r.refine.trajectory);
   o.summary = ToPython(r.summary);
   for (const RefineRound& round : r.refine.rounds) o.rounds.append(RoundDict(round));
   o.converged = r.refine.converged;
@@ -216,12 +203,7 @@ py::dict Simulate(const std::string& preset, const py::handle& seed, const py::h
   args.preset = preset;
   if (!seed.is_none()) args.seed = seed.cast<int64_t>();
   if (!duration.is_none()) args.duration_s = duration.cast<double>();
-  if (!set.is_none()) {
-    if (!py::isinstance<py::dict>(set))
-      throw py::type_error("set must be a dict of 'section.key': value");
-    for (const auto& [key, value] : set.cast<py::dict>())
-      args.overrides.push_back(OverrideAssignment(key, value));
-  }
+  args.overrides = Overrides(set);
   args.lidar_msg = lidar_msg;
   args.out_dir = PathText(out);
   args.name = name;
