@@ -8,7 +8,8 @@
 #   2. examples/compare_backends.py on a short simulated tunnel (6 s, 512
 #      columns): the four variants run and the plot is written
 #   3. cmake --install into a temporary prefix, `import rvlio` from there
-#      (PYTHONPATH=PREFIX/lib/python3/dist-packages), prefix removed
+#      (PYTHONPATH=PREFIX/RVLIO_PYTHON_INSTALL_DIR, lib/python3.11/dist-packages
+#      on Debian 12), prefix removed
 # Ends with "python: N passed, M failed" (pytest's tests + the two checks).
 # RVLIO_PYTHON picks the interpreter (default /usr/bin/python3, Debian's, with
 # python3-numpy), RVLIO_BUILD_DIR the build tree.
@@ -59,8 +60,10 @@ check "examples/compare_backends.py --duration 6 --columns 512 writes its plot" 
 
 # 3. The installed module imports from the prefix (not from the build tree).
 installed_import() {
+  local dir
+  dir=$(sed -n 's/^RVLIO_PYTHON_INSTALL_DIR:STRING=//p' "$build/CMakeCache.txt")
   cmake --install "$build" --prefix "$work/prefix" >"$work/install.log" || return 1
-  (cd "$work" && PYTHONPATH="$work/prefix/lib/python3/dist-packages" "$python" -c '
+  (cd "$work" && PYTHONPATH="$work/prefix/$dir" "$python" -c '
 import sys, rvlio
 assert rvlio.__file__.startswith(sys.argv[1]), rvlio.__file__
 assert rvlio.Config.load(set={"backend": "smoother"}).to_dict()["backend"] == "smoother"
