@@ -16,7 +16,8 @@ namespace rvlio::python {
 namespace {
 
 constexpr const char* kStopReason = "KeyboardInterrupt";
-// rvlio.run calls its `progress` function at most this often.
+// rvlio.run calls its `progress` function after each new scan result, and
+// while reading without new results at most this often.
 constexpr std::chrono::milliseconds kProgressPeriod{200};
 
 // The per-scan table: the columns of scans.csv as numpy arrays (one row per scan).
@@ -122,11 +123,13 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
   SignalCheck signals;
   args.stop = StopOn(&signals);
   auto last_progress = std::chrono::steady_clock::now();
+  int last_scans = 0;
   if (!progress.is_none())
     args.progress = [&](const RunProgress& p) {
       const auto now = std::chrono::steady_clock::now();
-      if (now - last_progress < kProgressPeriod) return;
+      if (p.scans == last_scans && now - last_progress < kProgressPeriod) return;
       last_progress = now;
+      last_scans = p.scans;
       signals.CallPython([&] { progress(p.scans, p.fraction); });
     };
   StatusOr<RunResult> result = Status::Internal("not run");
@@ -260,7 +263,8 @@ void BindRun(py::module_& m) {
         py::arg("progress") = py::none(),
         "`rvlio run`: the odometry over a recording. With `out`, writes trajectory.tum, map.pcd, "
         "scans.csv and summary.json there, as the command does. progress(scans, fraction) is "
-        "called at most every 0.2 s; an exception it raises stops the run and is raised. Ctrl-C "
+        "called after each new scan result (and every 0.2 s while reading without one); an "
+        "exception it raises stops the run and is raised. Ctrl-C "
         "raises KeyboardInterrupt (with `out`, the outputs of the scans done are written first).");
   m.def("refine", &Refine, py::arg("bag"), py::arg("init"), py::arg("config") = py::none(),
         py::arg("out") = py::none(), py::kw_only(), py::arg("start") = 0.0,

@@ -90,3 +90,16 @@ def test_run_bad_arguments(tunnel, tmp_path):
         rvlio.refine(tunnel["bag"], tmp_path / "init.tum", tunnel["config"])
     with pytest.raises(ValueError, match="preset"):
         rvlio.simulate("atlantis", out=tmp_path)
+
+
+def test_an_exception_in_progress_stops_the_run(tunnel):
+    calls = []
+
+    def progress(scans, fraction):
+        calls.append((scans, fraction))
+        if scans >= 1:
+            raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        rvlio.run(tunnel["bag"], tunnel["config"], progress=progress)
+    assert calls and all(0.0 <= f <= 1.1 for _, f in calls)
