@@ -280,8 +280,11 @@ void BindOdometry(py::module_& m) {
              const py::handle& acc) {
             if (py::isinstance<py::array>(t_ns) && py::reinterpret_borrow<py::array>(t_ns).ndim() == 1)
               return o.AddImuArrays(t_ns, gyro, acc);
+            if (py::isinstance<py::float_>(t_ns) || !py::hasattr(t_ns, "__index__"))
+              throw py::type_error("t_ns must be an integer number of nanoseconds (or an (M,) "
+                                   "int64 array), got " + py::repr(t_ns).cast<std::string>());
             ImuSample s;
-            s.t_ns = t_ns.cast<int64_t>();
+            s.t_ns = py::int_(py::reinterpret_borrow<py::object>(t_ns)).cast<int64_t>();
             s.gyro_imu = Vector3(gyro, "gyro");
             s.acc_imu = Vector3(acc, "acc");
             o.AddImu(s);

@@ -138,6 +138,8 @@ def test_non_monotonic_times(odo):
 
 
 def test_bad_imu_values(odo):
+    with pytest.raises(TypeError, match="t_ns must be an integer number of nanoseconds"):
+        odo.add_imu(2.5e9, [0, 0, 0], [0, 0, 9.81])
     with pytest.raises(ValueError, match="gyro must be 3 numbers"):
         odo.add_imu(2_000_000_000, [0, 0], [0, 0, 9.81])
     with pytest.raises(ValueError, match="is not finite"):
