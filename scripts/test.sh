@@ -3,6 +3,10 @@
 # missing, then runs the stages in order and stops at the first failure:
 #
 #   release   Release build in build/ + ctest (every test)
+#   python    scripts/python_test.sh: pytest of the Python module against
+#             the Release build tree, examples/compare_backends.py on a 6 s
+#             tunnel, and `import rvlio` from a temporary install prefix
+#             (about 2 minutes)
 #   sanitize  scripts/sanitize.sh: the test suite built with gcc
 #             ASan + UBSan (-O1 -g) in build-asan/ + ctest there
 #   fuzz      scripts/fuzz.sh --ci: the libFuzzer targets of fuzz/ (clang) in
@@ -19,12 +23,12 @@
 # Each stage's wall time is printed at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-stages=${RVLIO_CI_STAGES:-release,install,sanitize,fuzz,slurm}
+stages=${RVLIO_CI_STAGES:-release,install,python,sanitize,fuzz,slurm}
 jobs=$(nproc 2>/dev/null || echo 2)
 for s in ${stages//,/ }; do
   case "$s" in
-    release|install|sanitize|fuzz|slurm) ;;
-    *) echo "test.sh: unknown stage '$s' in RVLIO_CI_STAGES (release, install, sanitize, fuzz, slurm)" >&2; exit 2 ;;
+    release|install|python|sanitize|fuzz|slurm) ;;
+    *) echo "test.sh: unknown stage '$s' in RVLIO_CI_STAGES (release, install, python, sanitize, fuzz, slurm)" >&2; exit 2 ;;
   esac
 done
 want() { [[ ",$stages," == *",$1,"* ]]; }
@@ -38,7 +42,7 @@ trap 'rm -f "$log"' EXIT
 passed=0
 count_tests() {
   local n
-  n=$(grep -Eo '(tests failed out of [0-9]+|^(fuzz|slurm|install): [0-9]+ passed)' "$log" | grep -Eo '[0-9]+' | tail -1 || true)
+  n=$(grep -Eo '(tests failed out of [0-9]+|^(fuzz|slurm|install|python): [0-9]+ passed)' "$log" | grep -Eo '[0-9]+' | tail -1 || true)
   passed=$((passed + ${n:-0}))
 }
 
@@ -55,6 +59,11 @@ if want install; then
   bash scripts/install_test.sh 2>&1 | tee "$log"
   count_tests
   finish_stage install
+fi
+if want python; then
+  bash scripts/python_test.sh 2>&1 | tee "$log"
+  count_tests
+  finish_stage python
 fi
 if want sanitize; then
   bash scripts/sanitize.sh 2>&1 | tee "$log"

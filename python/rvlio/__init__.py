@@ -1,0 +1,24 @@
+"""rvlio: LiDAR-inertial odometry with reinforced vectors (RV-LIO).
+
+The estimator, the recording readers, the evaluation and the simulator of the
+`rvlio` command, from Python. See docs/python.md.
+"""
+from ._rvlio import (  # noqa: F401
+    BagReader,
+    Config,
+    LIDAR_POINT_BYTES,
+    ImuSample,
+    LidarScan,
+    Odometry,
+    RefineResult,
+    RunResult,
+    RvReport,
+    ScanResult,
+    __version__,
+    evaluate,
+    read_bag,
+    refine,
+    run,
+    simulate,
+    tum_array,
+)

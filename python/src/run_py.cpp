@@ -1,0 +1,283 @@
+// rvlio.run, rvlio.refine, rvlio.simulate: the whole-recording calls of the
+// public API (rvlio/api.h), with the GIL released and Ctrl-C as
+// KeyboardInterrupt.
+#include "run_py.h"
+
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "config_py.h"
+#include "odometry_py.h"
+#include "rvlio/api.h"
+
+namespace rvlio::python {
+namespace {
+
+constexpr const char* kStopReason = "KeyboardInterrupt";
+// rvlio.run calls its `progress` function after each new scan result, and
+// while reading without new results at most this often.
+constexpr std::chrono::milliseconds kProgressPeriod{200};
+
+// The per-scan table: the columns of scans.csv as numpy arrays (one row per scan).
+py::dict ScanTable(const std::vector<ScanResult>& scans) {
+  const auto n = static_cast<py::ssize_t>(scans.size());
+  py::dict table;
+  auto column = [&](const char* name, auto value_of) {
+    using T = decltype(value_of(scans.front()));
+    py::array_t<T> a(n);
+    auto w = a.template mutable_unchecked<1>();
+    for (py::ssize_t i = 0; i < n; ++i) w(i) = value_of(scans[static_cast<size_t>(i)]);
+    table[name] = a;
+  };
+  if (scans.empty()) return table;
+  column("t", [](const ScanResult& r) { return NsToSeconds(r.t_ns); });
+  py::list status;
+  for (const ScanResult& r : scans) status.append(ScanStatusName(r.status));
+  table["status"] = py::module_::import("numpy").attr("array")(status);
+  column("raw_points", [](const ScanResult& r) { return r.raw_points; });
+  column("points", [](const ScanResult& r) { return r.downsampled_points; });
+  column("constraints", [](const ScanResult& r) { return r.constraints; });
+  column("iterations", [](const ScanResult& r) { return r.iterations; });
+  column("rv_active", [](const ScanResult& r) { return r.rv.active; });
+  column("n_alpha_x", [](const ScanResult& r) { return r.rv.n_alpha.x(); });
+  column("n_alpha_y", [](const ScanResult& r) { return r.rv.n_alpha.y(); });
+  column("n_alpha_z", [](const ScanResult& r) { return r.rv.n_alpha.z(); });
+  column("scv", [](const ScanResult& r) { return r.rv.num_scv; });
+  column("coplanar", [](const ScanResult& r) { return r.rv.num_coplanar; });
+  column("repaired", [](const ScanResult& r) { return r.rv.num_repaired; });
+  column("K", [](const ScanResult& r) { return r.rv.K; });
+  column("rv_iterations", [](const ScanResult& r) { return r.rv.iterations; });
+  column("coplanar_fraction", [](const ScanResult& r) { return r.rv.coplanar_fraction; });
+  column("localizability", [](const ScanResult& r) { return r.rv.localizability; });
+  column("ms", [](const ScanResult& r) { return r.ms; });
+  column("x", [](const ScanResult& r) { return r.T_world_imu.t.x(); });
+  column("y", [](const ScanResult& r) { return r.T_world_imu.t.y(); });
+  column("z", [](const ScanResult& r) { return r.T_world_imu.t.z(); });
+  column("vx", [](const ScanResult& r) { return r.v_world_imu.x(); });
+  column("vy", [](const ScanResult& r) { return r.v_world_imu.y(); });
+  column("vz", [](const ScanResult& r) { return r.v_world_imu.z(); });
+  column("acc_x", [](const ScanResult& r) { return r.mean_acc_imu.x(); });
+  column("acc_y", [](const ScanResult& r) { return r.mean_acc_imu.y(); });
+  column("acc_z", [](const ScanResult& r) { return r.mean_acc_imu.z(); });
+  column("reinforced", [](const ScanResult& r) { return r.rv.num_reinforced; });
+  column("nis", [](const ScanResult& r) { return r.health.nis_per_dof; });
+  column("residual_median_m", [](const ScanResult& r) { return r.health.residual_median_m; });
+  column("residual_rms_m", [](const ScanResult& r) { return r.health.residual_rms_m; });
+  column("diverged", [](const ScanResult& r) { return r.health.divergence_mask != 0; });
+  return table;
+}
+
+py::dict RoundDict(const RefineRound& r) {
+  py::dict d;
+  d["round"] = r.round;
+  d["cost_before"] = r.cost_before;
+  d["cost_after"] = r.cost_after;
+  d["iterations"] = r.iterations;
+  d["max_translation_change_m"] = r.max_translation_change_m;
+  d["max_rotation_change_deg"] = r.max_rotation_change_deg;
+  d["constraints"] = r.constraints;
+  d["rv_active_scans"] = r.rv_active_scans;
+  d["total_s"] = r.total_s;
+  return d;
+}
+
+// The stop callback of a long call: Ctrl-C (Python's signal handlers, run
+// every 50 ms with the GIL taken back) stops it.
+StopFn StopOn(SignalCheck* signals) {
+  return [signals] { return signals->Stop() ? std::string(kStopReason) : std::string(); };
+}
+
+ReadWindow Window(double start, double duration) {
+  ReadWindow w;
+  w.start_s = start;
+  w.duration_s = duration;
+  return w;
+}
+
+std::string OutDir(const py::handle& out) { return out.is_none() ? "" : PathText(out); }
+
+struct RunOutput {
+  py::array_t<double> trajectory;
+  py::dict scans;
+  py::object summary;
+  std::vector<ScanResult> results;
+  Trajectory poses;  // the trajectory as the library has it (exact stamps), for refine
+  std::vector<std::string> warnings;
+  bool diverged = false;
+  bool written = false;
+  std::string out;
+};
+
+RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::handle& out,
+              double start, double duration, const py::object& progress) {
+  const std::string bag = PathText(bag_obj);
+  RequireExisting(bag, "recording");
+  Config defaults;
+  RunArgs args;
+  args.bag = bag;
+  args.options = ConfigArg(config, &defaults).options;
+  args.out_dir = OutDir(out);
+  args.window = Window(start, duration);
+  SignalCheck signals;
+  args.stop = StopOn(&signals);
+  auto last_progress = std::chrono::steady_clock::now();
+  int last_scans = 0;
+  if (!progress.is_none())
+    args.progress = [&](const RunProgress& p) {
+      const auto now = std::chrono::steady_clock::now();
+      if (p.scans == last_scans && now - last_progress < kProgressPeriod) return;
+      last_progress = now;
+      last_scans = p.scans;
+      signals.CallPython([&] { progress(p.scans, p.fraction); });
+    };
+  StatusOr<RunResult> result = Status::Internal("not run");
+  {
+    py::gil_scoped_release release;
+    result = RunRecording(args);
+  }
+  signals.Rethrow();  // KeyboardInterrupt (the outputs of the scans done are written)
+  RunResult r = Take(std::move(result));
+  if (!r.read_error.ok()) Raise(r.read_error);
+  RunOutput o;
+  o.trajectory = TrajectoryArray(r.trajectory);
+  o.scans = ScanTable(r.scans);
+  o.summary = ToPython(r.summary);
+  o.results = std::move(r.scans);
+  o.poses = std::move(r.trajectory);
+  o.warnings = std::move(r.warnings);
+  o.diverged = r.divergence.detected;
+  o.written = r.written;
+  o.out = args.out_dir;
+  return o;
+}
+
+struct RefineOutput {
+  py::array_t<double> trajectory;
+  py::object summary;
+  py::list rounds;
+  bool converged = false;
+  std::vector<std::string> warnings;
+  bool written = false;
+};
+
+RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py::handle& config,
+                    const py::handle& out, double start, double duration) {
+  const std::string bag = PathText(bag_obj);
+  RequireExisting(bag, "recording");
+  Config defaults;
+  RefineArgs args;
+  args.bag = bag;
+  args.options = ConfigArg(config, &defaults).options;
+  args.out_dir = OutDir(out);
+  args.window = Window(start, duration);
+  if (py::isinstance<RunOutput>(init)) {
+    args.init = init.cast<const RunOutput&>().poses;
+  } else if (py::isinstance<py::str>(init) || py::hasattr(init, "__fspath__")) {
+    args.init_path = PathText(init);
+    RequireExisting(args.init_path, "initial trajectory");
+  } else {
+    throw py::type_error("init must be a TUM file path or the result of rvlio.run");
+  }
+  SignalCheck signals;
+  args.stop = StopOn(&signals);
+  StatusOr<RefineRunResult> result = Status::Internal("not refined");
+  {
+    py::gil_scoped_release release;
+    result = RefineRecording(args);
+  }
+  signals.Rethrow();
+  RefineRunResult r = Take(std::move(result));
+  RefineOutput o;
+  o.trajectory = TrajectoryArray(r.refine.trajectory);
+  o.summary = ToPython(r.summary);
+  for (const RefineRound& round : r.refine.rounds) o.rounds.append(RoundDict(round));
+  o.converged = r.refine.converged;
+  o.warnings = r.refine.warnings;
+  o.written = r.written;
+  return o;
+}
+
+py::dict Simulate(const std::string& preset, const py::handle& seed, const py::handle& duration,
+                  const py::handle& out, const std::string& name, const std::string& format,
+                  const std::string& lidar_msg, const py::handle& set) {
+  SimulateArgs args;
+  args.preset = preset;
+  if (!seed.is_none()) args.seed = seed.cast<int64_t>();
+  if (!duration.is_none()) args.duration_s = duration.cast<double>();
+  args.overrides = Overrides(set);
+  args.lidar_msg = lidar_msg;
+  args.out_dir = PathText(out);
+  args.name = name;
+  args.format = format;
+  SignalCheck signals;
+  args.stop = StopOn(&signals);
+  StatusOr<SimulateResult> result = Status::Internal("not simulated");
+  {
+    py::gil_scoped_release release;
+    result = SimulateRecording(args);
+  }
+  signals.Rethrow();  // nothing written
+  const SimulateResult r = Take(std::move(result));
+  py::dict d;
+  d["bag"] = r.bag_path;
+  d["ground_truth"] = r.gt_path;
+  d["config"] = r.config_path;
+  d["scans"] = r.scans;
+  d["imu_samples"] = r.imu_samples;
+  d["duration_s"] = r.duration_s;
+  return d;
+}
+
+}  // namespace
+
+void BindRun(py::module_& m) {
+  py::class_<RunOutput>(m, "RunResult", "What rvlio.run returns.")
+      .def_readonly("trajectory", &RunOutput::trajectory,
+                    "(N, 8) [t_s, x, y, z, qx, qy, qz, qw]: trajectory.tum")
+      .def_readonly("scans", &RunOutput::scans,
+                    "per-scan table: column name -> (N,) array (the columns of scans.csv, plus "
+                    "the velocity vx vy vz)")
+      .def_readonly("summary", &RunOutput::summary, "summary.json as a dict")
+      .def_readonly("results", &RunOutput::results, "one rvlio.ScanResult per scan")
+      .def_readonly("warnings", &RunOutput::warnings)
+      .def_readonly("diverged", &RunOutput::diverged, "the divergence monitor fired")
+      .def_readonly("written", &RunOutput::written, "the outputs are in `out`")
+      .def("__len__", [](const RunOutput& o) { return o.results.size(); })
+      .def("__repr__", [](const RunOutput& o) {
+        return "<rvlio.RunResult " + std::to_string(o.results.size()) + " scans" +
+               (o.written ? " -> " + o.out : std::string()) + ">";
+      });
+  py::class_<RefineOutput>(m, "RefineResult", "What rvlio.refine returns.")
+      .def_readonly("trajectory", &RefineOutput::trajectory,
+                    "(N, 8) [t_s, x, y, z, qx, qy, qz, qw]: the refined trajectory.tum")
+      .def_readonly("summary", &RefineOutput::summary, "summary.json as a dict")
+      .def_readonly("rounds", &RefineOutput::rounds, "one dict per round")
+      .def_readonly("converged", &RefineOutput::converged)
+      .def_readonly("warnings", &RefineOutput::warnings)
+      .def_readonly("written", &RefineOutput::written);
+
+  m.def("run", &Run, py::arg("bag"), py::arg("config") = py::none(), py::arg("out") = py::none(),
+        py::kw_only(), py::arg("start") = 0.0, py::arg("duration") = 0.0,
+        py::arg("progress") = py::none(),
+        "`rvlio run`: the odometry over a recording. With `out`, writes trajectory.tum, map.pcd, "
+        "scans.csv and summary.json there, as the command does. progress(scans, fraction) is "
+        "called after each new scan result (and every 0.2 s while reading without one); an "
+        "exception it raises stops the run and is raised. Ctrl-C "
+        "raises KeyboardInterrupt (with `out`, the outputs of the scans done are written first).");
+  m.def("refine", &Refine, py::arg("bag"), py::arg("init"), py::arg("config") = py::none(),
+        py::arg("out") = py::none(), py::kw_only(), py::arg("start") = 0.0,
+        py::arg("duration") = 0.0,
+        "`rvlio refine`: offline batch refinement from `init` (a TUM path or an rvlio.run "
+        "result). With `out`, writes trajectory.tum, map.pcd and summary.json there.");
+  m.def("simulate", &Simulate, py::arg("preset") = "tunnel", py::kw_only(),
+        py::arg("seed") = py::none(), py::arg("duration") = py::none(), py::arg("out"),
+        py::arg("name") = "", py::arg("format") = "bag", py::arg("lidar_msg") = "pointcloud2",
+        py::arg("set") = py::none(),
+        "`rvlio simulate`: writes OUT/NAME.bag (or .mcap / .db3), OUT/NAME_gt.tum and "
+        "OUT/NAME.yaml (the config for rvlio.Config.load); returns their paths and counts. "
+        "Ctrl-C raises KeyboardInterrupt and leaves no recording.");
+}
+
+}  // namespace rvlio::python
