@@ -230,8 +230,12 @@ int CmdRefine(int argc, char** argv) {
   req.bag = args.Get("bag");
   req.init = args.Get("init");
   req.out_dir = args.Get("out");
-  StatusOr<OdometryOptions> options = LoadConfig(args.GetAll("config"), args.GetAll("set"));
+  std::vector<std::string> config_warnings;
+  StatusOr<OdometryOptions> options =
+      LoadConfig(args.GetAll("config"), args.GetAll("set"), &config_warnings);
   if (!options.ok()) return Fail("refine", options.status().message());
+  for (const auto& w : config_warnings)
+    std::fprintf(stderr, "rvlio refine: warning: %s\n", w.c_str());
   StatusOr<Trajectory> init = ReadTum(req.init);
   if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
   if (int rc = ReadCheckpointArgs(args, &req); rc != 0) return rc;

@@ -119,7 +119,7 @@ Status WriteOutputs(const RunRequest& req, const OdometryOptions& options, const
   j["command"] = "run";
   j["bag"] = req.bag;
   j["lidar_layout"] = layout;
-  j["backend"] = options.backend;
+  j["backend"] = EnumName(options.backend);
   j["config"] = ToJson(options);
   j["scan_count"] = data.results.size();
   j["sequence_duration_s"] = duration_s;
@@ -346,8 +346,11 @@ bool PrepareOutputDir(const std::string& command, const std::string& dir) {
 }
 
 int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
-  StatusOr<OdometryOptions> options = LoadConfig(req.config_files, req.overrides);
+  std::vector<std::string> config_warnings;
+  StatusOr<OdometryOptions> options =
+      LoadConfig(req.config_files, req.overrides, &config_warnings);
   if (!options.ok()) return Fail("run", options.status().message());
+  for (const auto& w : config_warnings) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
   StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(*options);
   if (!odo.ok()) return Fail("run", odo.status().message());
   StatusOr<std::unique_ptr<SensorBagReader>> reader =

@@ -18,6 +18,7 @@
 #include <ceres/types.h>
 
 #include "rvlio/common/check.h"
+#include "rvlio/constraints/robust_kernel.h"
 #include "rvlio/imu/noise.h"
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/imu/static_init.h"
@@ -348,11 +349,8 @@ ScanFactors BatchRefiner::AssociateOne(int k, int begin, int end, AssociationWor
   *rv_active = false;
   if (w->list.empty()) return ScanFactors();
   *rv_active = ApplyRv(config_.rv, T_world_lidar, &w->list, &w->rv).active;
-  // Huber IRLS weight at the association estimate, min(1, delta / |r|): a
-  // ceres::LossFunction would act on the whole scan's squared norm.
-  const double delta = config_.smoother.huber_delta;
-  for (Constraint& c : w->list)
-    if (std::abs(c.residual) > delta) c.weight *= delta / std::abs(c.residual);
+  // Huber weights at the association estimate (constraints/robust_kernel.h).
+  ApplyHuberWeights(config_.smoother.refine_huber_delta, &w->list);
   return SplitFactors(k, begin, end, w);
 }
 
