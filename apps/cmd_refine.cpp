@@ -78,8 +78,12 @@ int CmdRefine(int argc, char** argv) {
   req.bag = args.Get("bag");
   req.init_path = args.Get("init");
   req.out_dir = args.Get("out");
-  StatusOr<OdometryOptions> options = LoadConfig(args.GetAll("config"), args.GetAll("set"));
+  std::vector<std::string> config_warnings;
+  StatusOr<OdometryOptions> options =
+      LoadConfig(args.GetAll("config"), args.GetAll("set"), &config_warnings);
   if (!options.ok()) return Fail("refine", options.status().message());
+  for (const auto& w : config_warnings)
+    std::fprintf(stderr, "rvlio refine: warning: %s\n", w.c_str());
   req.options = std::move(*options);
   StatusOr<Trajectory> init = ReadTum(req.init_path);
   if (!init.ok()) return Fail("refine", "--init: " + init.status().message());

@@ -64,8 +64,11 @@ bool PrepareOutputDir(const std::string& command, const std::string& dir) {
 }
 
 int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
-  StatusOr<OdometryOptions> options = LoadConfig(req.config_files, req.overrides);
+  std::vector<std::string> config_warnings;
+  StatusOr<OdometryOptions> options =
+      LoadConfig(req.config_files, req.overrides, &config_warnings);
   if (!options.ok()) return Fail("run", options.status().message());
+  for (const auto& w : config_warnings) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
   RunArgs args;
   args.bag = req.bag;
   args.options = *options;

@@ -65,7 +65,11 @@ class Driver {
   }
   static WindowOptions Options() {
     WindowOptions o;
-    o.imu_noise = Noise();
+    const ImuNoise n = Noise();
+    o.imu.gyro_noise_density = n.gyro_noise_density;
+    o.imu.accel_noise_density = n.accel_noise_density;
+    o.imu.gyro_bias_random_walk = n.gyro_bias_random_walk;
+    o.imu.accel_bias_random_walk = n.accel_bias_random_walk;
     return o;
   }
   static SpeedBiasBlock Speed() {

@@ -45,7 +45,12 @@ Config Load(const py::args& files, const py::object& set) {
     RequireExisting(c.files.back(), "configuration file");
   }
   c.overrides = Overrides(set);
-  c.options = Take(LoadConfig(c.files, c.overrides));
+  std::vector<std::string> warnings;
+  c.options = Take(LoadConfig(c.files, c.overrides, &warnings));
+  // Deprecated option names (config.h): one FutureWarning each, as the CLI
+  // prints one warning line each.
+  for (const std::string& w : warnings)
+    if (PyErr_WarnEx(PyExc_FutureWarning, w.c_str(), 1) != 0) throw py::error_already_set();
   return c;
 }
 
@@ -67,9 +72,9 @@ void BindConfig(py::module_& m) {
            "The resolved configuration as YAML with units and help (rvlio config --dump).")
       .def_readonly("files", &Config::files)
       .def_readonly("overrides", &Config::overrides, "the `set` entries as 'key=value' texts")
-      .def_property_readonly("backend", [](const Config& c) { return c.options.backend; })
+      .def_property_readonly("backend", [](const Config& c) { return std::string(EnumName(c.options.backend)); })
       .def("__repr__", [](const Config& c) {
-        return "rvlio.Config(backend='" + c.options.backend + "', files=" +
+        return "rvlio.Config(backend='" + std::string(EnumName(c.options.backend)) + "', files=" +
                py::repr(py::cast(c.files)).cast<std::string>() + ", overrides=" +
                py::repr(py::cast(c.overrides)).cast<std::string>() + ")";
       });

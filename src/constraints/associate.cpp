@@ -1,14 +1,8 @@
 #include "rvlio/constraints/associate.h"
 
-#include <algorithm>
-#include <cmath>
-
-#include "rvlio/common/check.h"
-#include "rvlio/constraints/plane_fit.h"
-
 namespace rvlio {
 
-namespace {
+namespace association_detail {
 
 AssociationOutcome FromPlaneStatus(PlaneStatus status) {
   switch (status) {
@@ -30,7 +24,20 @@ AssociationOutcome FromPlaneStatus(PlaneStatus status) {
   return AssociationOutcome::kDegenerate;
 }
 
-}  // namespace
+std::vector<AssociationCache::Entry>* PrepareCache(AssociationCache* cache, size_t n,
+                                                   double* reuse2) {
+  *reuse2 = -1.0;
+  if (cache == nullptr) return nullptr;
+  std::vector<AssociationCache::Entry>* entries = &cache->entries();
+  if (entries->size() != n) {
+    entries->assign(n, AssociationCache::Entry());
+  } else {
+    *reuse2 = cache->reuse_distance() * cache->reuse_distance();
+  }
+  return entries;
+}
+
+}  // namespace association_detail
 
 const char* ToString(AssociationOutcome outcome) {
   switch (outcome) {
@@ -84,99 +91,21 @@ void AssociationStats::Count(AssociationOutcome outcome) {
   }
 }
 
-namespace {
-
-// Residual test and record of one accepted plane (paper Eq. 3).
-AssociationOutcome Accept(const Eigen::Vector3d& p_lidar, const Eigen::Vector3d& p_world,
-                          const Eigen::Vector3d& u, const Eigen::Vector3d& q,
-                          const ConstraintOptions& options, Constraint* out) {
-  const double r = u.dot(p_world - q);
-  if (!(std::abs(r) <= options.max_residual)) return AssociationOutcome::kLargeResidual;
-  out->p_lidar = p_lidar;
-  out->normal_world = u;
-  out->q_world = q;
-  out->residual = r;
-  out->weight = 1.0;
-  out->role = RvRole::kPlain;
-  return AssociationOutcome::kAccepted;
-}
-
-// k-NN and plane fit: the outcome of the search (kAccepted: a valid plane,
-// with its normal oriented towards the sensor).
-AssociationOutcome SearchPlane(const Eigen::Vector3d& p_world, const Eigen::Vector3d& sensor_world,
-                               const VoxelMap& map, const ConstraintOptions& options,
-                               NeighborBuffer* neighbors, Eigen::Vector3d* u, Eigen::Vector3d* q) {
-  const int k = std::min(options.num_neighbors, kMaxNeighbors);
-  if (map.KNearest(p_world, k, options.max_neighbor_distance, neighbors) < k)
-    return AssociationOutcome::kTooFewNeighbors;
-  const LocalPlane plane = FitLocalPlane(*neighbors, PlaneThresholds::From(options));
-  if (!plane.valid()) return FromPlaneStatus(plane.status);
-  // The normal's sign is arbitrary; orient it towards the sensor so that
-  // records are reproducible and readable (RV only uses |u . n_alpha|).
-  *u = plane.normal;
-  if (u->dot(sensor_world - plane.centroid) < 0.0) *u = -*u;
-  *q = plane.centroid;
-  return AssociationOutcome::kAccepted;
-}
-
-}  // namespace
-
 AssociationOutcome AssociatePoint(const Eigen::Vector3d& p_lidar, const Pose3& T_world_lidar,
                                   const VoxelMap& map, const ConstraintOptions& options,
                                   NeighborBuffer* neighbors, Constraint* out) {
   const Eigen::Vector3d p_world = T_world_lidar * p_lidar;
   Eigen::Vector3d u = Eigen::Vector3d::UnitZ(), q = Eigen::Vector3d::Zero();
-  const AssociationOutcome found =
-      SearchPlane(p_world, T_world_lidar.t, map, options, neighbors, &u, &q);
+  const AssociationOutcome found = association_detail::SearchPlane(
+      p_world, T_world_lidar.t, map, options, PlaneThresholds::From(options), neighbors, &u, &q);
   if (found != AssociationOutcome::kAccepted) return found;
-  return Accept(p_lidar, p_world, u, q, options, out);
+  return association_detail::Accept(p_lidar, p_world, u, q, options, out);
 }
 
 void Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
                const Pose3& T_imu_lidar, const VoxelMap& map, const ConstraintOptions& options,
                ConstraintList* out, AssociationStats* stats, AssociationCache* cache) {
-  RVLIO_CHECK(out != nullptr);
-  out->clear();
-  out->reserve(p_lidar.size());
-  const Pose3 T_world_lidar = T_world_imu * T_imu_lidar;
-  std::vector<AssociationCache::Entry>* entries = nullptr;
-  double reuse2 = -1.0;  // squared reuse distance; < 0: never reuse
-  if (cache != nullptr) {
-    entries = &cache->entries();
-    if (entries->size() != p_lidar.size()) {
-      entries->assign(p_lidar.size(), AssociationCache::Entry());
-    } else {
-      reuse2 = cache->reuse_distance() * cache->reuse_distance();
-    }
-  }
-  AssociationStats local;
-  double sum_abs_residual = 0.0;
-  NeighborBuffer neighbors;
-  Constraint c;
-  Eigen::Vector3d u = Eigen::Vector3d::UnitZ(), q = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < p_lidar.size(); ++i) {
-    const Eigen::Vector3d p_world = T_world_lidar * p_lidar[i];
-    AssociationOutcome found;
-    AssociationCache::Entry* e = entries != nullptr ? &(*entries)[i] : nullptr;
-    if (e != nullptr && (p_world - e->p_world).squaredNorm() < reuse2) {
-      found = e->outcome;
-      u = e->normal_world;
-      q = e->q_world;
-      ++local.num_reused;
-    } else {
-      found = SearchPlane(p_world, T_world_lidar.t, map, options, &neighbors, &u, &q);
-      if (e != nullptr) *e = AssociationCache::Entry{p_world, u, q, found};
-    }
-    const AssociationOutcome outcome = found == AssociationOutcome::kAccepted
-                                           ? Accept(p_lidar[i], p_world, u, q, options, &c)
-                                           : found;
-    local.Count(outcome);
-    if (outcome != AssociationOutcome::kAccepted) continue;
-    sum_abs_residual += std::abs(c.residual);
-    out->push_back(c);
-  }
-  if (local.num_accepted > 0) local.mean_abs_residual = sum_abs_residual / local.num_accepted;
-  if (stats != nullptr) *stats = local;
+  AssociateWith(p_lidar, T_world_imu * T_imu_lidar, map, options, out, stats, cache);
 }
 
 }  // namespace rvlio

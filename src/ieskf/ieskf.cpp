@@ -211,7 +211,6 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
   const bool with_ext = options_.estimate_extrinsics;
   const double inv_sigma2 = 1.0 / (constraints_.lidar_noise * constraints_.lidar_noise);
   const int cols = with_ext ? 12 : 6;
-  const int kMinConstraints = 6;
   std::array<bool, 6> free{};
   for (int i = 0; i < 6; ++i) free[i] = with_ext && excitation_.excited(i);
   const Matrix24x12d E = ErrorStateColumns(free);
@@ -228,7 +227,7 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
     // (the report still carries the localizability figure).
     result.rv = ApplyRv(rv_, x.T_world_lidar(), &constraints, &rv_workspace_);
     result.num_constraints = static_cast<int>(constraints.size());
-    if (result.num_constraints < kMinConstraints) break;
+    if (result.num_constraints < kMinPoseConstraints) break;
     double zRinvz = 0.0;
     AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
 

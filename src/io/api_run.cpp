@@ -67,7 +67,7 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   j["command"] = "run";
   j["bag"] = args.bag;
   j["lidar_layout"] = result.lidar_layout;
-  j["backend"] = args.options.backend;
+  j["backend"] = EnumName(args.options.backend);
   j["config"] = ToJson(args.options);
   j["scan_count"] = result.scans.size();
   j["sequence_duration_s"] = duration_s;

@@ -388,6 +388,25 @@ Status NotASection(const Node& n, const std::string& key, const std::string& whe
   return Expected(n, key, where, "a section of keys");
 }
 
+Status NotOneOf(const std::string& key, const std::string& where, const std::string& value,
+                const std::vector<std::string>& choices) {
+  std::string list;
+  for (const auto& c : choices) list += (list.empty() ? "" : "|") + c;
+  return Status::InvalidInput(where + ": " + key + " = '" + value + "' is not one of " + list);
+}
+
+Status BothNames(const std::string& old_key, const std::string& new_key,
+                 const std::string& where) {
+  return Status::InvalidInput(old_key + ": given together with its new name " + new_key + " in " +
+                              where + "; keep only " + new_key);
+}
+
+std::string DeprecationWarning(const std::string& old_key, const std::string& new_key,
+                               const std::string& where) {
+  return where + ": " + old_key + " is deprecated, renamed " + new_key +
+         " (the old name is read until the next release)";
+}
+
 Status UnknownKey(const std::string& key, const std::string& where,
                   const std::vector<std::string>& known_keys) {
   std::string msg = key + ": unknown key in " + where;
@@ -506,8 +525,9 @@ Status AttributeToSources(const Status& status, const std::vector<std::string>& 
 }
 
 StatusOr<OdometryOptions> LoadConfig(const std::vector<std::string>& config_files,
-                                     const std::vector<std::string>& set_overrides) {
-  return LoadOptions<OdometryOptions>(config_files, set_overrides);
+                                     const std::vector<std::string>& set_overrides,
+                                     std::vector<std::string>* warnings) {
+  return LoadOptions<OdometryOptions>(config_files, set_overrides, nullptr, warnings);
 }
 
 }  // namespace rvlio

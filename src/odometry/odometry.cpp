@@ -44,12 +44,14 @@ ExtrinsicReport MakeExtrinsicReport(const ExtrinsicExcitation& excitation,
 StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& options) {
   OdometryOptions checked = options;
   if (Status s = checked.Validate(); !s.ok()) return s;
-  if (options.backend == "ieskf") return std::unique_ptr<Odometry>(new IeskfOdometry(options));
-  if (options.backend == "smoother")
-    return std::unique_ptr<Odometry>(new SmootherOdometry(options));
-  return Status::InvalidInput("backend '" + options.backend +
-                              "' is not in this build; use backend=ieskf or "
-                              "backend=smoother");
+  switch (options.backend) {
+    case Backend::kIeskf:
+      return std::unique_ptr<Odometry>(new IeskfOdometry(options));
+    case Backend::kSmoother:
+      return std::unique_ptr<Odometry>(new SmootherOdometry(options));
+  }
+  return Status::InvalidInput("backend " + std::to_string(static_cast<int>(options.backend)) +
+                              " is not a backend");
 }
 
 }  // namespace rvlio

@@ -9,13 +9,6 @@ constexpr int kRemoveFarEveryScans = 10;  // working-map trimming period
 
 }  // namespace
 
-Pose3 ImuTLidar(const ExtrinsicsSection& extrinsics) {
-  const auto& e = extrinsics.imu_T_lidar;
-  return Pose3(Eigen::Quaterniond(e.rotation_xyzw[3], e.rotation_xyzw[0], e.rotation_xyzw[1],
-                                  e.rotation_xyzw[2]),
-               Eigen::Vector3d(e.translation[0], e.translation[1], e.translation[2]));
-}
-
 std::optional<StaticAlignment> StaticInitializer::Add(const ImuSample& imu) {
   samples_.push_back(imu);
   if (imu.t_ns - samples_.front().t_ns < duration_ns_) return std::nullopt;

@@ -13,24 +13,10 @@
 namespace rvlio {
 namespace {
 
-constexpr int kMinConstraints = 6;  // as the IESKF: fewer, the scan adds no plane factor
-
-// The window's configuration: smoother.*, rv.*, the IMU noise densities, the
-// point-to-plane sigma, the extrinsics, and the first state's prior from the
-// IESKF's initial standard deviations (the same static initialization).
+// The window's sections of the configuration, through the options reflection.
 WindowOptions MakeWindowOptions(const OdometryOptions& o) {
   WindowOptions w;
-  w.smoother = o.smoother;
-  w.rv = o.rv;
-  w.imu_noise = ImuNoise::FromOptions(o.imu);
-  w.lidar_noise = o.constraints.lidar_noise;
-  w.min_constraints = kMinConstraints;
-  w.T_imu_lidar = ImuTLidar(o.extrinsics);
-  w.first_prior.rot = o.ieskf.init_rot_std;
-  w.first_prior.pos = o.ieskf.init_pos_std;
-  w.first_prior.vel = o.ieskf.init_vel_std;
-  w.first_prior.bg = o.ieskf.init_bias_gyro_std;
-  w.first_prior.ba = o.ieskf.init_bias_acc_std;
+  CopySections(o, &w);
   return w;
 }
 
@@ -185,8 +171,8 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
                                           const std::vector<ImuSample>& samples, ScanResult* r) {
   std::optional<ImuPreintegration> imu;
   if (t_ns > newest_.t_ns && !HasImuGap(samples, newest_.t_ns, t_ns))
-    imu = ImuPreintegration::FromSamples(samples, newest_.t_ns, t_ns, window_options_.imu_noise,
-                                         bg_, ba_);
+    imu = ImuPreintegration::FromSamples(samples, newest_.t_ns, t_ns,
+                                         ImuNoise::FromOptions(options_.imu), bg_, ba_);
   window_->Add(t_ns, PoseBlock(Eigen::Quaterniond(predicted.R_world_imu), predicted.p_world_imu),
                SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, std::move(imu), p_lidar_end_);
   const ScanAssociateFn associate = [this](const std::vector<Eigen::Vector3d>& p_lidar,
@@ -212,7 +198,7 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
     r->health.residual_median_m = residuals.median_abs_m;
     r->health.residual_rms_m = residuals.rms_m;
   }
-  if (report.newest_constraints < kMinConstraints) {
+  if (report.newest_constraints < kMinPoseConstraints) {
     ++stats_.predict_only;
     return ScanStatus::kPredictOnly;
   }

@@ -1,3 +1,4 @@
+#include "rvlio/constraints/robust_kernel.h"
 #include "rvlio/smoother/refine_association.h"
 
 #include <algorithm>
@@ -92,11 +93,8 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
   *rv_active = false;
   if (w->list.empty()) return ScanFactors();
   *rv_active = ApplyRv(config.rv, T_world_lidar, &w->list, &w->rv).active;
-  // Huber IRLS weight at the association estimate, min(1, delta / |r|): a
-  // ceres::LossFunction would act on the whole scan's squared norm.
-  const double delta = config.smoother.huber_delta;
-  for (Constraint& c : w->list)
-    if (std::abs(c.residual) > delta) c.weight *= delta / std::abs(c.residual);
+  // Huber weights at the association estimate (constraints/robust_kernel.h).
+  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->list);
   SplitScanConstraints(k, chunk, config.smoother.refine_plane_window, w->list, w->sources, states,
                        round.map_poses, &w->fixed, &w->attached);
   return MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise);

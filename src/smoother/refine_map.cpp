@@ -5,7 +5,6 @@
 #include <cstdlib>
 
 #include "rvlio/common/check.h"
-#include "rvlio/constraints/plane_fit.h"
 
 namespace rvlio {
 
@@ -171,44 +170,6 @@ void RefineMap::VisiblePoints(int32_t exclude_scan, std::vector<Eigen::Vector3d>
 
 namespace {
 
-AssociationOutcome FromPlaneStatus(PlaneStatus status) {
-  switch (status) {
-    case PlaneStatus::kValid: return AssociationOutcome::kAccepted;
-    case PlaneStatus::kTooFewPoints: return AssociationOutcome::kTooFewNeighbors;
-    case PlaneStatus::kDegenerate: return AssociationOutcome::kDegenerate;
-    case PlaneStatus::kLineLike: return AssociationOutcome::kLineLike;
-    case PlaneStatus::kNotFlat: return AssociationOutcome::kNotFlat;
-    case PlaneStatus::kFarFromPlane: return AssociationOutcome::kFarFromPlane;
-    case PlaneStatus::kUncertain: return AssociationOutcome::kUncertain;
-  }
-  return AssociationOutcome::kDegenerate;
-}
-
-// k-NN among the other scans' points, plane fit and residual gate of paper
-// Eq. (3): r = u^T (p_world - q).
-AssociationOutcome AssociateOne(const Eigen::Vector3d& p_lidar, const Pose3& T_world_lidar,
-                                int32_t scan_id, const RefineMap& map,
-                                const ConstraintOptions& options, const PlaneThresholds& planes,
-                                ScanNeighbors* nb, Constraint* c) {
-  const Eigen::Vector3d p_world = T_world_lidar * p_lidar;
-  const int k = std::min(options.num_neighbors, kMaxNeighbors);
-  if (map.KNearest(p_world, k, options.max_neighbor_distance, scan_id, nb) < k)
-    return AssociationOutcome::kTooFewNeighbors;
-  const LocalPlane plane = FitLocalPlane(nb->points.data(), nb->size, planes);
-  if (!plane.valid()) return FromPlaneStatus(plane.status);
-  Eigen::Vector3d u = plane.normal;  // sign arbitrary: orient towards the sensor
-  if (u.dot(T_world_lidar.t - plane.centroid) < 0.0) u = -u;
-  const double r = u.dot(p_world - plane.centroid);
-  if (!(std::abs(r) <= options.max_residual)) return AssociationOutcome::kLargeResidual;
-  c->p_lidar = p_lidar;
-  c->normal_world = u;
-  c->q_world = plane.centroid;
-  c->residual = r;
-  c->weight = 1.0;
-  c->role = RvRole::kPlain;
-  return AssociationOutcome::kAccepted;
-}
-
 // The scan contributing most neighbours; ties go to the nearer one (the
 // neighbours are sorted by distance).
 int32_t MajorityScan(const ScanNeighbors& nb) {
@@ -230,26 +191,14 @@ int32_t MajorityScan(const ScanNeighbors& nb) {
 void AssociateScan(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_lidar,
                    int32_t scan_id, const RefineMap& map, const ConstraintOptions& options,
                    ConstraintList* out, AssociationStats* stats, std::vector<int32_t>* sources) {
-  RVLIO_CHECK(out != nullptr);
-  out->clear();
-  out->reserve(p_lidar.size());
-  if (sources != nullptr) sources->clear();
-  const PlaneThresholds planes = PlaneThresholds::From(options);
-  AssociationStats local;
-  double sum_abs = 0.0;
-  ScanNeighbors nb;
-  Constraint c;
-  for (const Eigen::Vector3d& p : p_lidar) {
-    const AssociationOutcome o =
-        AssociateOne(p, T_world_lidar, scan_id, map, options, planes, &nb, &c);
-    local.Count(o);
-    if (o != AssociationOutcome::kAccepted) continue;
-    sum_abs += std::abs(c.residual);
-    out->push_back(c);
-    if (sources != nullptr) sources->push_back(MajorityScan(nb));
+  const LeaveOneOutSearch search{&map, scan_id};
+  if (sources == nullptr) {
+    AssociateWith(p_lidar, T_world_lidar, search, options, out, stats);
+    return;
   }
-  if (local.num_accepted > 0) local.mean_abs_residual = sum_abs / local.num_accepted;
-  if (stats != nullptr) *stats = local;
+  sources->clear();
+  AssociateWith(p_lidar, T_world_lidar, search, options, out, stats, nullptr,
+                [sources](const ScanNeighbors& nb) { sources->push_back(MajorityScan(nb)); });
 }
 
 }  // namespace rvlio

@@ -12,6 +12,7 @@
 #include "rvlio/common/check.h"
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/constraints/point_to_plane.h"
+#include "rvlio/constraints/robust_kernel.h"
 #include "rvlio/math/so3.h"
 #include "rvlio/smoother/imu_factor.h"
 #include "rvlio/smoother/plane_extrinsic_factor.h"
@@ -42,6 +43,31 @@ constexpr int kBlockSize = PoseBlock::kNumParams + SpeedBiasBlock::kNumParams;
 // Lever arm that turns a rotation into a point displacement for the
 // re-association test: a point 10 m away moves by about 10 m x angle.
 constexpr double kReassociationLeverArm = 10.0;  // m
+// Weak continuity across an IMU gap (SpeedBiasContinuityFactor): loose
+// enough not to fight the LiDAR, tight enough to keep the speed and biases
+// of a state without an IMU factor observable.
+constexpr double kGapVelStd = 1.0;  // m/s
+constexpr double kGapBgStd = 1e-3;  // rad/s
+constexpr double kGapBaStd = 1e-2;  // m/s^2
+// A preintegration is integrated again when the bias estimate moved this far
+// from its linearization biases (the first-order bias correction degrades).
+constexpr double kRepropagateBg = 2e-3;  // rad/s
+constexpr double kRepropagateBa = 2e-2;  // m/s^2
+// A solution with a speed above this is treated as diverged (a multirotor or
+// a car stays far below; the divergence monitor's own limit is configurable).
+constexpr double kMaxSpeed = 100.0;  // m/s
+
+// The first state's prior: the filter's initial standard deviations (both
+// backends start from the same static initialization).
+StatePriorStd FirstPriorStd(const IeskfOptions& o) {
+  StatePriorStd s;
+  s.rot = o.init_rot_std;
+  s.pos = o.init_pos_std;
+  s.vel = o.init_vel_std;
+  s.bg = o.init_bias_gyro_std;
+  s.ba = o.init_bias_acc_std;
+  return s;
+}
 
 ceres::Problem::Options ProblemOptions() {
   ceres::Problem::Options o;
@@ -71,17 +97,12 @@ void RemoveNonFinite(ConstraintList* constraints) {
                      constraints->end());
 }
 
-// Iteratively reweighted Huber kernel: the gradient of the Huber cost of the
-// residual r equals that of the weighted square w r^2 / 2 with
-// w = min(1, delta / |r|) (r at the current pose, with the possibly repaired
-// normal). The weight multiplies the RV weight already in the record.
-void ApplyHuberWeights(double delta, const Pose3& T_world_imu, const Pose3& T_imu_lidar,
-                       ConstraintList* constraints) {
-  for (Constraint& c : *constraints) {
-    const double r = std::abs(PointToPlaneResidual(c, T_world_imu, T_imu_lidar));
-    c.residual = r;
-    if (r > delta) c.weight *= delta / r;
-  }
+// |r| at the current pose, with the possibly repaired normal: where the
+// Huber weight (constraints/robust_kernel.h) is taken.
+void RefreshResiduals(const Pose3& T_world_imu, const Pose3& T_imu_lidar,
+                      ConstraintList* constraints) {
+  for (Constraint& c : *constraints)
+    c.residual = std::abs(PointToPlaneResidual(c, T_world_imu, T_imu_lidar));
 }
 
 }  // namespace
@@ -94,10 +115,14 @@ ceres::LinearSolverType WindowLinearSolver(const std::string& name) {
   return ceres::DENSE_SCHUR;
 }
 
-SlidingWindow::SlidingWindow(const WindowOptions& options) : options_(options) {
+SlidingWindow::SlidingWindow(const WindowOptions& options)
+    : options_(options),
+      T_imu_lidar_config_(ImuTLidar(options.extrinsics)),
+      first_prior_(FirstPriorStd(options.ieskf)) {
   RVLIO_CHECK(options_.smoother.window_size >= 2);
-  RVLIO_CHECK(options_.lidar_noise > 0.0 && options_.smoother.online_huber_delta > 0.0);
-  PoseBlock(options_.T_imu_lidar.quaternion(), options_.T_imu_lidar.t).ToArray(extrinsic_);
+  RVLIO_CHECK(options_.constraints.lidar_noise > 0.0 &&
+              options_.smoother.sliding_window_huber_delta > 0.0);
+  PoseBlock(T_imu_lidar_config_.quaternion(), T_imu_lidar_config_.t).ToArray(extrinsic_);
   Vector6d prior_std;
   prior_std << Eigen::Vector3d::Constant(options_.smoother.extrinsic_rot_std),
       Eigen::Vector3d::Constant(options_.smoother.extrinsic_pos_std);
@@ -105,7 +130,7 @@ SlidingWindow::SlidingWindow(const WindowOptions& options) : options_(options) {
 }
 
 Pose3 SlidingWindow::T_imu_lidar() const {
-  return estimate_extrinsics() ? PoseBlock::FromArray(extrinsic_).ToPose3() : options_.T_imu_lidar;
+  return estimate_extrinsics() ? PoseBlock::FromArray(extrinsic_).ToPose3() : T_imu_lidar_config_;
 }
 
 SlidingWindow::~SlidingWindow() = default;
@@ -125,7 +150,7 @@ void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlo
                           std::vector<Eigen::Vector3d> p_lidar) {
   nodes_.clear();
   marginal_prior_.reset();
-  state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, options_.first_prior);
+  state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, first_prior_);
   if (estimate_extrinsics())
     extrinsic_prior_ = std::make_unique<PosePriorFactor>(
         PoseBlock::FromArray(extrinsic_), options_.smoother.extrinsic_rot_std,
@@ -144,7 +169,7 @@ void SlidingWindow::Add(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock
   } else {
     ++stats_.imu_factors_skipped;
     node->gap = std::make_unique<SpeedBiasContinuityFactor>(
-        options_.gap_vel_std, options_.gap_bg_std, options_.gap_ba_std);
+        kGapVelStd, kGapBgStd, kGapBaStd);
   }
   nodes_.push_back(std::move(node));
 }
@@ -205,8 +230,7 @@ bool SlidingWindow::DropNewestImuFactor() {
   Node& n = *nodes_.back();
   if (nodes_.size() < 2 || !n.imu) return false;
   n.imu.reset();
-  n.gap = std::make_unique<SpeedBiasContinuityFactor>(options_.gap_vel_std, options_.gap_bg_std,
-                                                      options_.gap_ba_std);
+  n.gap = std::make_unique<SpeedBiasContinuityFactor>(kGapVelStd, kGapBgStd, kGapBaStd);
   ++stats_.imu_factors_skipped;
   return true;
 }
@@ -230,19 +254,19 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   associate(node->p_lidar, T_world_imu, &node->constraints);
   RemoveNonFinite(&node->constraints);
   node->rv = ApplyRv(options_.rv, T_world_imu * T_imu_lidar, &node->constraints, &rv_workspace_);
-  ApplyHuberWeights(options_.smoother.online_huber_delta, T_world_imu, T_imu_lidar,
-                    &node->constraints);
+  RefreshResiduals(T_world_imu, T_imu_lidar, &node->constraints);
+  ApplyHuberWeights(options_.smoother.sliding_window_huber_delta, &node->constraints);
   node->associated_at = T_world_imu;
   node->associated = true;
   node->plane.reset();
   node->plane_ext.reset();
-  if (static_cast<int>(node->constraints.size()) < options_.min_constraints) return;
+  if (static_cast<int>(node->constraints.size()) < kMinPoseConstraints) return;
   if (estimate_extrinsics()) {
-    node->plane_ext = std::make_unique<PlaneExtrinsicFactor>(node->constraints, options_.lidar_noise);
+    node->plane_ext = std::make_unique<PlaneExtrinsicFactor>(node->constraints, options_.constraints.lidar_noise);
     return;
   }
-  node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, options_.T_imu_lidar,
-                                                     options_.lidar_noise, T_world_imu.t);
+  node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, T_imu_lidar_config_,
+                                                     options_.constraints.lidar_noise, T_world_imu.t);
   // Finite but absurd records (a plane 1e300 m away) overflow the summary:
   // such a scan contributes nothing (and is associated again next round)
   // rather than a cost Ceres cannot evaluate.
@@ -263,8 +287,8 @@ void SlidingWindow::RefreshImuFactors() {
     if (!n.imu) continue;
     const SpeedBiasBlock sb = SpeedBiasBlock::FromArray(nodes_[k - 1]->sb);
     const ImuPreintegration& pre = n.imu->preintegration();
-    if ((sb.bg - pre.bg_lin()).norm() <= options_.repropagate_bg &&
-        (sb.ba - pre.ba_lin()).norm() <= options_.repropagate_ba)
+    if ((sb.bg - pre.bg_lin()).norm() <= kRepropagateBg &&
+        (sb.ba - pre.ba_lin()).norm() <= kRepropagateBa)
       continue;
     ImuPreintegration again = pre;
     again.Repropagate(sb.bg, sb.ba);
@@ -357,7 +381,7 @@ bool SlidingWindow::Healthy() const {
     const Eigen::Map<const Eigen::Matrix<double, 9, 1>> sb(n->sb);
     if (!pose.allFinite() || !sb.allFinite()) return false;
     if (std::abs(pose.head<4>().norm() - 1.0) > 1e-3) return false;
-    if (sb.head<3>().norm() > options_.max_speed) return false;
+    if (sb.head<3>().norm() > kMaxSpeed) return false;
   }
   return true;
 }
@@ -429,7 +453,7 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
     ++stats_.marginalization_failures;
     state_prior_ = std::make_unique<StatePriorFactor>(PoseBlock::FromArray(next.pose),
                                                       SpeedBiasBlock::FromArray(next.sb),
-                                                      options_.first_prior);
+                                                      first_prior_);
     // The extrinsic's information went with the failed prior: its prior again.
     if (estimate_extrinsics())
       extrinsic_prior_ = std::make_unique<PosePriorFactor>(

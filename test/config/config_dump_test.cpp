@@ -66,6 +66,12 @@ class Randomizer {
     for (int i = 0; i < n; ++i)
       v += kPieces[std::uniform_int_distribution<size_t>(0, kPieces.size() - 1)(rng_)];
   }
+  template <class E, std::enable_if_t<std::is_enum_v<E>, int> = 0>
+  void Field(const char*, E& v, const Spec& spec) {
+    const std::string name =
+        spec.choices[std::uniform_int_distribution<size_t>(0, spec.choices.size() - 1)(rng_)];
+    ASSERT_TRUE(ParseEnum(name, &v)) << name;
+  }
   template <class Sub>
   void Section(const char*, Sub& sub) {
     sub.Visit(*this);

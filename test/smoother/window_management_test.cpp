@@ -81,17 +81,19 @@ WindowOptions TestOptions(int window_size, const Pose3& T_imu_lidar) {
   o.smoother.window_size = window_size;
   o.smoother.association_rounds = 1;
   o.smoother.max_solver_iterations = 30;
-  o.smoother.online_huber_delta = 1e3;  // no robust reweighting: the cost is one fixed function
+  o.smoother.sliding_window_huber_delta = 1e3;  // no robust reweighting: the cost is one fixed function
   o.smoother.reassociate_min_motion = 0.0;
   o.smoother.linear_solver = "dense_schur";
   o.rv.enabled = false;
-  o.imu_noise.gyro_noise_density = 2e-3 / std::sqrt(400.0);
-  o.imu_noise.accel_noise_density = 2e-2 / std::sqrt(400.0);
-  o.imu_noise.gyro_bias_random_walk = 1e-4;
-  o.imu_noise.accel_bias_random_walk = 1e-3;
-  o.lidar_noise = 0.02;
+  o.imu.gyro_noise_density = 2e-3 / std::sqrt(400.0);
+  o.imu.accel_noise_density = 2e-2 / std::sqrt(400.0);
+  o.imu.gyro_bias_random_walk = 1e-4;
+  o.imu.accel_bias_random_walk = 1e-3;
+  o.constraints.lidar_noise = 0.02;
   o.g_world = test::Gravity();
-  o.T_imu_lidar = T_imu_lidar;
+  const Eigen::Quaterniond q = T_imu_lidar.quaternion();
+  o.extrinsics.imu_T_lidar.translation = {T_imu_lidar.t.x(), T_imu_lidar.t.y(), T_imu_lidar.t.z()};
+  o.extrinsics.imu_T_lidar.rotation_xyzw = {q.x(), q.y(), q.z(), q.w()};
   return o;
 }
 
@@ -103,7 +105,7 @@ class Driver {
  public:
   Driver(const WindowOptions& options, const Sequence& seq) : window_(options), seq_(seq) {
     associate_ = [this](const std::vector<Vector3d>& p, const Pose3& T, ConstraintList* out) {
-      BoxAssociate(window_.options().T_imu_lidar, p, T, out);
+      BoxAssociate(ImuTLidar(window_.options().extrinsics), p, T, out);
     };
   }
 
@@ -128,8 +130,8 @@ class Driver {
     const ImuKinematics pred = Integrate(x, seq_.imu, t, bg, ba, test::Gravity());
     std::optional<ImuPreintegration> pre;
     if (with_imu)
-      pre = ImuPreintegration::FromSamples(seq_.imu, last.t_ns, t, window_.options().imu_noise,
-                                           bg, ba);
+      pre = ImuPreintegration::FromSamples(seq_.imu, last.t_ns, t,
+                                           ImuNoise::FromOptions(window_.options().imu), bg, ba);
     SpeedBiasBlock sb;
     sb.v_world_imu = pred.v_world_imu;
     sb.bg = bg;
@@ -279,7 +281,7 @@ TEST(SlidingWindowFailure, AbsurdAssociationsNeverReachTheSolution) {
   constexpr int kStates = 8;
   const Sequence seq = MakeSequence(kStates, 9, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
   WindowOptions options = TestOptions(5, kImuLidar);
-  options.smoother.online_huber_delta = 1e300;  // let an absurd residual through unweighted
+  options.smoother.sliding_window_huber_delta = 1e300;  // let an absurd residual through unweighted
   Driver d(options, seq);
   d.Start();
   for (int k = 1; k < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);
@@ -322,7 +324,8 @@ void AddState(Driver* d, const Sequence& seq, const std::vector<ImuSample>& imu,
                                        test::Gravity());
   d->window().Add(t, PoseBlock(Eigen::Quaterniond(pred.R_world_imu), pred.p_world_imu),
                   SpeedBiasBlock{pred.v_world_imu, last.speed_bias.bg, last.speed_bias.ba},
-                  ImuPreintegration::FromSamples(imu, last.t_ns, t, d->window().options().imu_noise,
+                  ImuPreintegration::FromSamples(imu, last.t_ns, t,
+                                                 ImuNoise::FromOptions(d->window().options().imu),
                                                  last.speed_bias.bg, last.speed_bias.ba),
                   scan);
 }
@@ -393,8 +396,8 @@ TEST(SlidingWindowImu, BiasesAreEstimatedAndPreintegrationsReintegrated) {
   const Vector3d bg(0.02, -0.015, 0.01), ba(0.3, -0.2, 0.15);  // large: first order is not enough
   const Sequence seq = MakeSequence(kStates, 31, kImuLidar, 0.005, bg, ba);
   WindowOptions options = TestOptions(8, kImuLidar);
-  options.first_prior.bg = 0.1;  // the estimate starts at zero bias
-  options.first_prior.ba = 1.0;
+  options.ieskf.init_bias_gyro_std = 0.1;  // the estimate starts at zero bias
+  options.ieskf.init_bias_acc_std = 1.0;
   Driver d(options, seq);
   d.Start();
   for (int k = 1; k < kStates; ++k) ASSERT_TRUE(d.Step(k).ok);

@@ -8,15 +8,27 @@
 // io/ walks the same list to load YAML, apply `--set a.b=value`, reject
 // unknown keys and print the resolved configuration; ValidateFields() below
 // checks ranges and choices. Supported field types: bool, int, int64_t,
-// double, std::string, std::array<double, N>.
+// double, std::string, std::array<double, N>, and enums that list their
+// configuration names in EnumNames (below).
+//
+// A renamed key stays readable for one release: the struct that holds it
+// lists the old and new names of its own fields in
+//
+//   static constexpr DeprecatedName kDeprecatedNames[] = {{"huber_delta", "refine_huber_delta"}};
+//
+// and the config layer (io/config.h) then accepts the old name for the new
+// field, with one warning line naming both.
 #include <array>
 #include <cstdint>
+#include <iterator>
 #include <limits>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
 
+#include "rvlio/common/check.h"
 #include "rvlio/common/status.h"
 
 namespace rvlio {
@@ -36,6 +48,90 @@ struct Spec {
   Spec& Positive() { min = 0.0; min_exclusive = true; return *this; }
   Spec& Choices(std::vector<std::string> c) { choices = std::move(c); return *this; }
 };
+
+// An enum is a field type when EnumNames<E> lists its values with the names
+// the configuration uses (YAML, --set, the dump, summary.json):
+//
+//   template <> struct EnumNames<Backend> {
+//     static constexpr std::pair<Backend, const char*> kNames[] = {
+//         {Backend::kIeskf, "ieskf"}, {Backend::kSmoother, "smoother"}};
+//   };
+//
+// The name is parsed once, when the configuration is read; the code then
+// compares enum values. Give the field Spec().Choices(EnumChoices<E>()).
+template <class E>
+struct EnumNames {};
+
+namespace options_detail {
+template <class E, class = void>
+struct IsNamedEnum : std::false_type {};
+template <class E>
+struct IsNamedEnum<E, std::void_t<decltype(EnumNames<E>::kNames)>> : std::is_enum<E> {};
+}  // namespace options_detail
+
+template <class E>
+constexpr bool kIsNamedEnum = options_detail::IsNamedEnum<E>::value;
+
+template <class E>
+const char* EnumName(E value) {
+  for (const auto& [v, name] : EnumNames<E>::kNames)
+    if (v == value) return name;
+  return "?";
+}
+
+// False (and *out untouched) when `name` is none of E's names.
+template <class E>
+bool ParseEnum(const std::string& name, E* out) {
+  for (const auto& [v, n] : EnumNames<E>::kNames)
+    if (name == n) {
+      *out = v;
+      return true;
+    }
+  return false;
+}
+
+template <class E>
+std::vector<std::string> EnumChoices() {
+  std::vector<std::string> names;
+  for (const auto& [v, n] : EnumNames<E>::kNames) names.emplace_back(n);
+  return names;
+}
+
+// A named enum compares with and prints as its configuration name (tests,
+// messages).
+template <class E, std::enable_if_t<kIsNamedEnum<E>, int> = 0>
+bool operator==(E value, const std::string& name) {
+  return name == EnumName(value);
+}
+template <class E, std::enable_if_t<kIsNamedEnum<E>, int> = 0>
+std::ostream& operator<<(std::ostream& os, E value) {
+  return os << EnumName(value);
+}
+
+struct DeprecatedName {
+  const char* old_name;  // accepted with a warning
+  const char* new_name;  // the field it sets
+};
+
+namespace options_detail {
+
+template <class T, class = void>
+struct HasDeprecatedNames : std::false_type {};
+template <class T>
+struct HasDeprecatedNames<T, std::void_t<decltype(T::kDeprecatedNames)>> : std::true_type {};
+
+}  // namespace options_detail
+
+// The renamed keys of one Options struct (empty for most).
+template <class T>
+std::vector<DeprecatedName> DeprecatedNamesOf() {
+  if constexpr (options_detail::HasDeprecatedNames<T>::value) {
+    return std::vector<DeprecatedName>(std::begin(T::kDeprecatedNames),
+                                       std::end(T::kDeprecatedNames));
+  } else {
+    return {};
+  }
+}
 
 namespace options_detail {
 
@@ -80,8 +176,8 @@ class ValidateVisitor {
   }
   template <typename T>
   void Check(const std::string& key, const T& value, const Spec& s) {
-    if constexpr (std::is_same_v<T, bool>) {
-      (void)key; (void)value; (void)s;
+    if constexpr (std::is_same_v<T, bool> || std::is_enum_v<T>) {
+      (void)key; (void)value; (void)s;  // enums: checked when parsed (io/config.h)
     } else if constexpr (std::is_arithmetic_v<T>) {
       CheckNumber(key, static_cast<double>(value), s);
     } else if constexpr (std::is_same_v<T, std::string>) {
@@ -100,6 +196,64 @@ class ValidateVisitor {
 };
 
 }  // namespace options_detail
+
+namespace options_detail {
+
+// Visits a source struct; copies its section `name` into *target when the
+// section has Target's type.
+template <class Target>
+class SectionFinder {
+ public:
+  SectionFinder(const char* name, Target* target) : name_(name), target_(target) {}
+  template <typename T>
+  void Field(const char*, T&, const Spec&) {}
+  template <typename Sub>
+  void Section(const char* name, Sub& sub) {
+    if constexpr (std::is_same_v<Sub, Target>) {
+      if (name_ != name) return;
+      *target_ = sub;
+      found = true;
+    }
+  }
+  bool found = false;
+
+ private:
+  std::string name_;
+  Target* target_;
+};
+
+// Visits a target struct; fills each of its sections from `source`.
+template <class Source>
+class SectionCopier {
+ public:
+  explicit SectionCopier(const Source& source) : source_(source) {}
+  template <typename T>
+  void Field(const char*, T&, const Spec&) {}
+  template <typename Sub>
+  void Section(const char* name, Sub& sub) {
+    Source copy = source_;  // Visit is not const
+    SectionFinder<Sub> finder(name, &sub);
+    copy.Visit(finder);
+    RVLIO_CHECK_MSG(finder.found, "CopySections: the source has no such section");
+  }
+
+ private:
+  const Source& source_;
+};
+
+}  // namespace options_detail
+
+// Fills every top-level section of *target with the section of the same name
+// and type of `source`, through the reflection: a module whose options are a
+// selection of the configuration's sections (e.g. the sliding window's, from
+// OdometryOptions) gets them without a hand-written copy per field. Each
+// section of the target must exist in the source (checked); the target's own
+// top-level fields are left as they are.
+template <class Source, class Target>
+void CopySections(const Source& source, Target* target) {
+  options_detail::SectionCopier<Source> copier(source);
+  target->Visit(copier);
+}
 
 // Range and choice validation of every field of `options`, with key names
 // prefixed by `prefix` (e.g. "rv").

@@ -1,16 +1,29 @@
 #pragma once
-// Point-to-plane association of one scan against the working map
-// (DESIGN.md section 3): for each point, transform it to the world with the
-// current estimate, take its k nearest map points, fit and validate a local
-// plane (plane_fit.h) and keep the constraint when |r| <= max_residual.
+// Point-to-plane association of one scan against a map (DESIGN.md section 3):
+// for each point, transform it to the world with the current estimate, take
+// its k nearest map points, fit and validate a local plane (plane_fit.h) and
+// keep the constraint when |r| <= max_residual.
+//
+// One routine serves every map: AssociateWith<Search> below, where Search is
+// any type with a NeighborSearchTraits specialization (neighbor_search.h):
+// the odometry's working map (VoxelMap: IESKF and sliding window) and the
+// leave-one-out map of batch refinement (smoother/refine_map.h). The plane
+// status mapping, normal orientation, residual gate, record filling and the
+// scan loop with its statistics live only here.
 // Single-threaded, no per-point heap allocation, output in point order.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "rvlio/common/check.h"
 #include "rvlio/constraints/constraint.h"
+#include "rvlio/constraints/neighbor_search.h"
 #include "rvlio/constraints/options.h"
+#include "rvlio/constraints/plane_fit.h"
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
 
@@ -80,11 +93,117 @@ class AssociationCache {
   std::vector<Entry> entries_;  // one per scan point, or empty
 };
 
-// Associates every point of a scan (LiDAR frame, deskewed). *out is cleared
-// and refilled in point order (its capacity is reused); stats may be null.
-// With a cache (may be null), points that moved less than its reuse_distance
-// since their last search reuse that search; a cache of another scan size is
-// reset first.
+namespace association_detail {
+
+AssociationOutcome FromPlaneStatus(PlaneStatus status);
+
+// Residual test and record of one accepted plane (paper Eq. 3).
+inline AssociationOutcome Accept(const Eigen::Vector3d& p_lidar, const Eigen::Vector3d& p_world,
+                                 const Eigen::Vector3d& u, const Eigen::Vector3d& q,
+                                 const ConstraintOptions& options, Constraint* out) {
+  const double r = u.dot(p_world - q);
+  if (!(std::abs(r) <= options.max_residual)) return AssociationOutcome::kLargeResidual;
+  out->p_lidar = p_lidar;
+  out->normal_world = u;
+  out->q_world = q;
+  out->residual = r;
+  out->weight = 1.0;
+  out->role = RvRole::kPlain;
+  return AssociationOutcome::kAccepted;
+}
+
+// k-NN and plane fit: the outcome of the search (kAccepted: a valid plane,
+// with its normal u oriented towards the sensor and q its centroid).
+template <class Search>
+AssociationOutcome SearchPlane(const Eigen::Vector3d& p_world, const Eigen::Vector3d& sensor_world,
+                               const Search& search, const ConstraintOptions& options,
+                               const PlaneThresholds& planes,
+                               typename NeighborSearchTraits<Search>::Neighbors* neighbors,
+                               Eigen::Vector3d* u, Eigen::Vector3d* q) {
+  const int k = std::min(options.num_neighbors, kMaxNeighbors);
+  if (NeighborSearchTraits<Search>::KNearest(search, p_world, k, options.max_neighbor_distance,
+                                             neighbors) < k)
+    return AssociationOutcome::kTooFewNeighbors;
+  const LocalPlane plane = FitLocalPlane(*neighbors, planes);
+  if (!plane.valid()) return FromPlaneStatus(plane.status);
+  // The normal's sign is arbitrary; orient it towards the sensor so that
+  // records are reproducible and readable (RV only uses |u . n_alpha|).
+  *u = plane.normal;
+  if (u->dot(sensor_world - plane.centroid) < 0.0) *u = -*u;
+  *q = plane.centroid;
+  return AssociationOutcome::kAccepted;
+}
+
+// The cache entries of a scan of n points, or null without a cache; *reuse2
+// is the squared reuse distance (< 0: never reuse, as for a fresh cache).
+std::vector<AssociationCache::Entry>* PrepareCache(AssociationCache* cache, size_t n,
+                                                   double* reuse2);
+
+// No per-constraint hook.
+struct NoHook {
+  template <class Neighbors>
+  void operator()(const Neighbors&) const {}
+};
+
+}  // namespace association_detail
+
+// The one association routine. Associates every point of a scan (LiDAR
+// frame, deskewed) at T_world_lidar against `search` (any type with a
+// NeighborSearchTraits specialization). *out is cleared and refilled in point
+// order (its capacity is reused); stats may be null. With a cache (may be
+// null), points that moved less than its reuse_distance since their last
+// search reuse that search; a cache of another scan size is reset first.
+// on_accepted(neighbors) runs after each accepted constraint is appended, with
+// the neighbours its plane was fitted to; it needs a fresh search per point,
+// so it cannot be combined with a cache.
+template <class Search, class OnAccepted = association_detail::NoHook>
+void AssociateWith(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_lidar,
+                   const Search& search, const ConstraintOptions& options, ConstraintList* out,
+                   AssociationStats* stats, AssociationCache* cache = nullptr,
+                   OnAccepted&& on_accepted = OnAccepted()) {
+  using association_detail::Accept;
+  using association_detail::SearchPlane;
+  constexpr bool kHook = !std::is_same_v<std::decay_t<OnAccepted>, association_detail::NoHook>;
+  RVLIO_CHECK(out != nullptr);
+  RVLIO_CHECK(!kHook || cache == nullptr);
+  out->clear();
+  out->reserve(p_lidar.size());
+  double reuse2 = -1.0;
+  std::vector<AssociationCache::Entry>* entries =
+      association_detail::PrepareCache(cache, p_lidar.size(), &reuse2);
+  const PlaneThresholds planes = PlaneThresholds::From(options);
+  AssociationStats local;
+  double sum_abs_residual = 0.0;
+  typename NeighborSearchTraits<Search>::Neighbors neighbors;
+  Constraint c;
+  Eigen::Vector3d u = Eigen::Vector3d::UnitZ(), q = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < p_lidar.size(); ++i) {
+    const Eigen::Vector3d p_world = T_world_lidar * p_lidar[i];
+    AssociationOutcome found;
+    AssociationCache::Entry* e = entries != nullptr ? &(*entries)[i] : nullptr;
+    if (e != nullptr && (p_world - e->p_world).squaredNorm() < reuse2) {
+      found = e->outcome;
+      u = e->normal_world;
+      q = e->q_world;
+      ++local.num_reused;
+    } else {
+      found = SearchPlane(p_world, T_world_lidar.t, search, options, planes, &neighbors, &u, &q);
+      if (e != nullptr) *e = AssociationCache::Entry{p_world, u, q, found};
+    }
+    const AssociationOutcome outcome = found == AssociationOutcome::kAccepted
+                                           ? Accept(p_lidar[i], p_world, u, q, options, &c)
+                                           : found;
+    local.Count(outcome);
+    if (outcome != AssociationOutcome::kAccepted) continue;
+    sum_abs_residual += std::abs(c.residual);
+    out->push_back(c);
+    if constexpr (kHook) on_accepted(neighbors);
+  }
+  if (local.num_accepted > 0) local.mean_abs_residual = sum_abs_residual / local.num_accepted;
+  if (stats != nullptr) *stats = local;
+}
+
+// AssociateWith on the working map at T_world_imu * T_imu_lidar.
 void Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
                const Pose3& T_imu_lidar, const VoxelMap& map, const ConstraintOptions& options,
                ConstraintList* out, AssociationStats* stats, AssociationCache* cache = nullptr);

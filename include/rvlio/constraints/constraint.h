@@ -25,4 +25,9 @@ struct Constraint {
 
 using ConstraintList = std::vector<Constraint>;
 
+// A pose has six degrees of freedom: fewer point-to-plane constraints cannot
+// determine it, so a scan with fewer is not used for its pose (the IESKF
+// keeps the prediction, the sliding window adds no plane factor for it).
+constexpr int kMinPoseConstraints = 6;
+
 }  // namespace rvlio

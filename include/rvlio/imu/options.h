@@ -3,6 +3,7 @@
 #include <string>
 
 #include "rvlio/common/options.h"
+#include "rvlio/math/pose.h"
 
 namespace rvlio {
 
@@ -59,5 +60,13 @@ struct ExtrinsicsSection {
     return s;
   }
 };
+
+// T_imu_lidar of the configuration (LiDAR pose in the IMU frame).
+inline Pose3 ImuTLidar(const ExtrinsicsSection& extrinsics) {
+  const auto& e = extrinsics.imu_T_lidar;
+  return Pose3(Eigen::Quaterniond(e.rotation_xyzw[3], e.rotation_xyzw[0], e.rotation_xyzw[1],
+                                  e.rotation_xyzw[2]),
+               Eigen::Vector3d(e.translation[0], e.translation[1], e.translation[2]));
+}
 
 }  // namespace rvlio

@@ -63,6 +63,14 @@ Status ReadNumbers(const Node& n, const std::string& key, const std::string& whe
                    double* out);
 
 Status NotASection(const Node& n, const std::string& key, const std::string& where);
+// "WHERE: KEY = 'VALUE' is not one of A|B" (the message of a bad choice).
+Status NotOneOf(const std::string& key, const std::string& where, const std::string& value,
+                const std::vector<std::string>& choices);
+// A mapping that gives a key under both its deprecated and its new name.
+Status BothNames(const std::string& old_key, const std::string& new_key, const std::string& where);
+// "WHERE: OLD is deprecated, use NEW (the old name goes in the next release)".
+std::string DeprecationWarning(const std::string& old_key, const std::string& new_key,
+                               const std::string& where);
 Status UnknownKey(const std::string& key, const std::string& where,
                   const std::vector<std::string>& known_keys);
 
@@ -75,6 +83,12 @@ Status ReadField(const Node& n, const std::string& key, const std::string& where
     double x = 0.0;
     Status s = Read(n, key, where, &x);
     if (s.ok()) *out = static_cast<T>(x);
+    return s;
+  } else if constexpr (std::is_enum_v<T>) {
+    static_assert(kIsNamedEnum<T>, "enum fields need EnumNames (common/options.h)");
+    std::string name;
+    Status s = Read(n, key, where, &name);
+    if (s.ok() && !ParseEnum(name, out)) s = NotOneOf(key, where, name, EnumChoices<T>());
     return s;
   } else if constexpr (std::is_integral_v<T>) {
     using Limits = std::numeric_limits<T>;
@@ -119,13 +133,19 @@ class KeyCollector {
 // the mapping that no field or section consumed is an error.
 class ApplyVisitor {
  public:
+  // renamed: the deprecated names of the struct this mapping fills;
+  // deprecations (may be null) receives one warning per old name used.
   ApplyVisitor(const Node& map, std::string prefix, const std::string& source,
-               const std::vector<std::string>& known_keys, ConfigSources* sources)
+               const std::vector<std::string>& known_keys, ConfigSources* sources,
+               std::vector<DeprecatedName> renamed = {},
+               std::vector<std::string>* deprecations = nullptr)
       : map_(map),
         prefix_(std::move(prefix)),
         source_(source),
         known_keys_(known_keys),
         sources_(sources),
+        renamed_(std::move(renamed)),
+        deprecations_(deprecations),
         used_(map.keys.size(), false) {}
 
   template <typename T>
@@ -146,7 +166,8 @@ class ApplyVisitor {
       status_ = NotASection(map_.items[i], key, Where(source_, map_.key_lines[i]));
       return;
     }
-    ApplyVisitor inner(map_.items[i], key, source_, known_keys_, sources_);
+    ApplyVisitor inner(map_.items[i], key, source_, known_keys_, sources_,
+                       DeprecatedNamesOf<Sub>(), deprecations_);
     sub.Visit(inner);
     status_ = inner.Finish();
   }
@@ -162,21 +183,41 @@ class ApplyVisitor {
 
  private:
   static constexpr size_t kAbsent = static_cast<size_t>(-1);
-  // Index of key `name` in the mapping (marked as consumed), or kAbsent.
+  size_t Find(const char* name) const {
+    for (size_t i = 0; i < map_.keys.size(); ++i)
+      if (map_.keys[i] == name) return i;
+    return kAbsent;
+  }
+  // Index of key `name`, or of a deprecated name of it, in the mapping
+  // (marked as consumed), or kAbsent.
   size_t Take(const char* name) {
     if (!status_.ok()) return kAbsent;
-    for (size_t i = 0; i < map_.keys.size(); ++i)
-      if (map_.keys[i] == name) {
-        used_[i] = true;
-        return i;
+    size_t i = Find(name);
+    for (const DeprecatedName& d : renamed_) {
+      if (std::string(d.new_name) != name) continue;
+      const size_t old = Find(d.old_name);
+      if (old == kAbsent) continue;
+      if (i != kAbsent) {
+        status_ = BothNames(options_detail::Join(prefix_, d.old_name),
+                            options_detail::Join(prefix_, name), Where(source_, map_.key_lines[old]));
+        return kAbsent;
       }
-    return kAbsent;
+      i = old;
+      if (deprecations_ != nullptr)
+        deprecations_->push_back(DeprecationWarning(options_detail::Join(prefix_, d.old_name),
+                                                    options_detail::Join(prefix_, name),
+                                                    Where(source_, map_.key_lines[old])));
+    }
+    if (i != kAbsent) used_[i] = true;
+    return i;
   }
   const Node& map_;
   std::string prefix_;
   const std::string& source_;
   const std::vector<std::string>& known_keys_;
   ConfigSources* sources_;
+  std::vector<DeprecatedName> renamed_;
+  std::vector<std::string>* deprecations_;
   std::vector<bool> used_;
   Status status_;
 };
@@ -204,7 +245,9 @@ class DumpVisitor {
   static std::string FormatValue(const std::string& s) { return FormatString(s); }
   template <typename T>
   static std::string FormatValue(const T& v) {
-    if constexpr (std::is_floating_point_v<T>) {
+    if constexpr (std::is_enum_v<T>) {
+      return FormatString(EnumName(v));
+    } else if constexpr (std::is_floating_point_v<T>) {
       return FormatDouble(static_cast<double>(v));
     } else if constexpr (std::is_integral_v<T>) {
       return std::to_string(v);
@@ -229,6 +272,8 @@ class JsonVisitor {
   void Field(const char* name, T& value, const Spec&) {
     if constexpr (std::is_floating_point_v<T>) {
       json[name] = std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+    } else if constexpr (std::is_enum_v<T>) {
+      json[name] = EnumName(value);
     } else {
       json[name] = value;
     }
@@ -256,21 +301,27 @@ std::vector<std::string> KnownKeys(const Opts& options) {
 
 // Applies the mapping `root` to a copy of `options`; on success the copy
 // replaces `options` (a failed file leaves the options untouched).
+// Deprecated names used are appended to *deprecations (may be null), one
+// warning each.
 template <class Opts>
 Status ApplyNode(Opts& options, const Node& root, const std::string& source,
-                 ConfigSources* sources) {
+                 ConfigSources* sources, std::vector<std::string>* deprecations = nullptr) {
   if (root.kind == Node::Kind::kNull) return Status::Ok();
   RVLIO_CHECK(root.kind == Node::Kind::kMap);
   const std::vector<std::string> known = KnownKeys(options);
   Opts copy = options;
   ConfigSources new_sources;
-  ApplyVisitor v(root, "", source, known, &new_sources);
+  std::vector<std::string> new_deprecations;
+  ApplyVisitor v(root, "", source, known, &new_sources, DeprecatedNamesOf<Opts>(),
+                 &new_deprecations);
   copy.Visit(v);
   Status s = v.Finish();
   if (!s.ok()) return s;
   options = std::move(copy);
   if (sources != nullptr)
     for (auto& kv : new_sources) (*sources)[kv.first] = std::move(kv.second);
+  if (deprecations != nullptr)
+    for (auto& w : new_deprecations) deprecations->push_back(std::move(w));
   return Status::Ok();
 }
 
@@ -289,11 +340,13 @@ std::vector<std::string> ListKeys(const Opts& options) {
 
 // Overlays one YAML file onto `options` (only the keys it contains). Records
 // in `sources` (if given) where each key came from.
+// Deprecated names used add a warning each to *deprecations (may be null).
 template <class Opts>
-Status ApplyYamlFile(Opts& options, const std::string& path, ConfigSources* sources = nullptr) {
+Status ApplyYamlFile(Opts& options, const std::string& path, ConfigSources* sources = nullptr,
+                     std::vector<std::string>* deprecations = nullptr) {
   StatusOr<config_detail::Node> root = config_detail::ParseYamlFile(path);
   if (!root.ok()) return root.status();
-  return config_detail::ApplyNode(options, *root, path, sources);
+  return config_detail::ApplyNode(options, *root, path, sources, deprecations);
 }
 
 // Same for YAML text; `source` names it in messages.
@@ -309,10 +362,11 @@ Status ApplyYamlText(Opts& options, const std::string& text, const std::string& 
 // sequence ("extrinsics.imu_T_lidar.translation=[0.1,0,0.05]").
 template <class Opts>
 Status ApplyOverride(Opts& options, const std::string& assignment,
-                     ConfigSources* sources = nullptr) {
+                     ConfigSources* sources = nullptr,
+                     std::vector<std::string>* deprecations = nullptr) {
   StatusOr<config_detail::Node> root = config_detail::ParseOverride(assignment);
   if (!root.ok()) return root.status();
-  return config_detail::ApplyNode(options, *root, "--set", sources);
+  return config_detail::ApplyNode(options, *root, "--set", sources, deprecations);
 }
 
 // Prefixes a validation message with the source of the key it names, e.g.
@@ -322,29 +376,37 @@ Status AttributeToSources(const Status& status, const std::vector<std::string>& 
                           const ConfigSources& sources);
 
 // Defaults, then files in order, then overrides in order, then Opts::Validate().
+// warnings (may be null) receives one line per deprecated key name used
+// (the caller prints them; the library does not).
 template <class Opts>
 StatusOr<Opts> LoadOptions(const std::vector<std::string>& config_files,
                            const std::vector<std::string>& set_overrides,
-                           ConfigSources* sources_out = nullptr) {
+                           ConfigSources* sources_out = nullptr,
+                           std::vector<std::string>* warnings = nullptr) {
   Opts options;
   ConfigSources sources;
+  std::vector<std::string> deprecations;
   for (const auto& f : config_files) {
-    Status s = ApplyYamlFile(options, f, &sources);
+    Status s = ApplyYamlFile(options, f, &sources, &deprecations);
     if (!s.ok()) return s;
   }
   for (const auto& o : set_overrides) {
-    Status s = ApplyOverride(options, o, &sources);
+    Status s = ApplyOverride(options, o, &sources, &deprecations);
     if (!s.ok()) return s;
   }
   Status s = options.Validate();
   if (!s.ok()) return AttributeToSources(s, ListKeys(options), sources);
   if (sources_out != nullptr) *sources_out = std::move(sources);
+  if (warnings != nullptr)
+    for (auto& w : deprecations) warnings->push_back(std::move(w));
   return options;
 }
 
 // The odometry configuration of `rvlio run`, `refine`, `compare`, `ablate`.
+// warnings (may be null): one line per deprecated key name used.
 StatusOr<OdometryOptions> LoadConfig(const std::vector<std::string>& config_files,
-                                     const std::vector<std::string>& set_overrides);
+                                     const std::vector<std::string>& set_overrides,
+                                     std::vector<std::string>* warnings = nullptr);
 
 // The resolved configuration as YAML: every key, nested like the struct, with
 // units and help as comments. ApplyYamlText of the result restores `options`

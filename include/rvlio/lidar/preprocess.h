@@ -17,6 +17,14 @@
 
 namespace rvlio {
 
+// A scan with fewer points after preprocessing is skipped whole (odometry and
+// refine): such a scan is near-empty (sensor blocked, start-up), most of its
+// points fail the plane tests, and the few constraints left would let noise
+// steer the pose. A safety floor far below a real scan (a simulated OS1-32
+// tunnel scan keeps ~1600 points after the 0.5 m grid: scans.csv of
+// `rvlio run`), not a tuned value.
+constexpr int kMinScanPoints = 50;
+
 struct PreprocessStats {
   int num_input = 0;         // raw points
   int num_strided_out = 0;   // dropped by point_stride

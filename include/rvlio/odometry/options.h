@@ -2,6 +2,7 @@
 // The whole configuration of a run: one section per module. This is what
 // `--config` files and `--set key=value` fill (io/config.h).
 #include <string>
+#include <utility>
 
 #include "rvlio/common/options.h"
 #include "rvlio/constraints/options.h"
@@ -16,8 +17,17 @@
 
 namespace rvlio {
 
+// The estimator of a run; written ieskf | smoother in the configuration.
+enum class Backend { kIeskf, kSmoother };
+
+template <>
+struct EnumNames<Backend> {
+  static constexpr std::pair<Backend, const char*> kNames[] = {{Backend::kIeskf, "ieskf"},
+                                                               {Backend::kSmoother, "smoother"}};
+};
+
 struct OdometryOptions {
-  std::string backend = "ieskf";  // ieskf | smoother
+  Backend backend = Backend::kIeskf;
   LidarOptions lidar;
   ImuOptions imu;
   ExtrinsicsSection extrinsics;
@@ -31,7 +41,7 @@ struct OdometryOptions {
 
   template <class V>
   void Visit(V& v) {
-    v.Field("backend", backend, Spec().Choices({"ieskf", "smoother"}).Help("estimator"));
+    v.Field("backend", backend, Spec().Choices(EnumChoices<Backend>()).Help("estimator"));
     v.Section("lidar", lidar);
     v.Section("imu", imu);
     v.Section("extrinsics", extrinsics);

@@ -14,6 +14,7 @@
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/static_init.h"
 #include "rvlio/lidar/deskew.h"
+#include "rvlio/lidar/preprocess.h"
 #include "rvlio/map/options.h"
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
@@ -21,11 +22,8 @@
 
 namespace rvlio {
 
-constexpr int kMinScanPoints = 50;                  // fewer after preprocessing: scan skipped
 constexpr TimeNs kNominalScanPeriodNs = 100000000;  // 10 Hz, for the IMU-gap warning
 
-// T_imu_lidar of the configuration (LiDAR pose in the IMU frame).
-Pose3 ImuTLidar(const ExtrinsicsSection& extrinsics);
 
 // Collects IMU samples until they span init_duration_s, then aligns them
 // (imu/static_init.h).

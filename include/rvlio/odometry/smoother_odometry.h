@@ -26,7 +26,7 @@
 // Defaults, measured on simulated OS1-32 (32 x 1024, 10 Hz) tunnel, corridor
 // and hall sequences, 30 s, seeds 1-3, mean ATE over the 9 runs:
 //   map_update marginalized 1.04 cm vs newest 1.31 cm (Huber 0.1 m; self-matching);
-//   online_huber_delta 0.02 / 0.03 / 0.04 / 0.05 / 0.1 / 0.3 m:
+//   sliding_window_huber_delta 0.02 / 0.03 / 0.04 / 0.05 / 0.1 / 0.3 m:
 //     0.83 / 0.82 / 0.84 / 0.88 / 1.04 / 1.62 cm;
 //   window_size 5 / 8 / 10 / 12 / 15 / 20 (Huber 0.03 m):
 //     0.89 / 0.84 / 0.82 / 0.81 / 0.84 / 0.86 cm, median CPU per scan

@@ -10,7 +10,7 @@ struct SmootherOptions {
   int window_size = 10;              // scans in the window
   int association_rounds = 2;        // re-association rounds per new scan
   int max_solver_iterations = 6;     // Ceres iterations per round
-  double huber_delta = 0.1;          // m, robust kernel on point-to-plane residuals
+  double refine_huber_delta = 0.1;   // m, Huber width on the point-to-plane residuals of refine
   int refine_rounds = 4;             // outer rounds of `rvlio refine`
   int refine_chunk_scans = 2000;     // scans per refine chunk (long sequences)
   int refine_solver_iterations = 10; // Ceres iterations per refine round (and chunk)
@@ -20,17 +20,24 @@ struct SmootherOptions {
   std::string linear_solver = "dense_schur";  // Ceres linear solver of the window solve
   std::string map_update = "marginalized";    // when a window scan enters the working map
   double reassociate_min_motion = 0.01;       // m, re-associate a window scan that moved more
-  double online_huber_delta = 0.03;           // m, Huber width of the window (huber_delta: refine)
+  double sliding_window_huber_delta = 0.03;   // m, Huber width on the residuals of the window
   bool estimate_extrinsics = false;           // T_imu_lidar as a window parameter block
   double extrinsic_rot_std = 0.05;            // rad, prior std of the configured extrinsic rotation
   double extrinsic_pos_std = 0.1;             // m, prior std of the configured extrinsic translation
+
+  // The names before the scope was spelled out (read with a warning until
+  // the next release): huber_delta was refine's width, online_huber_delta
+  // the window's.
+  static constexpr DeprecatedName kDeprecatedNames[] = {
+      {"huber_delta", "refine_huber_delta"}, {"online_huber_delta", "sliding_window_huber_delta"}};
 
   template <class V>
   void Visit(V& v) {
     v.Field("window_size", window_size, Spec().Range(2, 200));
     v.Field("association_rounds", association_rounds, Spec().Range(1, 20));
     v.Field("max_solver_iterations", max_solver_iterations, Spec().Range(1, 200));
-    v.Field("huber_delta", huber_delta, Spec().Unit("m").Positive());
+    v.Field("refine_huber_delta", refine_huber_delta, Spec().Unit("m").Positive()
+                .Help("Huber width on the point-to-plane residuals of `rvlio refine`"));
     v.Field("refine_rounds", refine_rounds, Spec().Range(1, 50));
     v.Field("refine_chunk_scans", refine_chunk_scans, Spec().Range(10, 1000000));
     v.Field("refine_solver_iterations", refine_solver_iterations, Spec().Range(1, 200));
@@ -43,7 +50,7 @@ struct SmootherOptions {
                 .Help("a scan enters the working map when marginalized (final estimate) or right after its first solve"));
     v.Field("reassociate_min_motion", reassociate_min_motion, Spec().Unit("m").Range(0.0, 10.0)
                 .Help("re-associate a window scan when it moved more than this (translation + 10 m x rotation in rad)"));
-    v.Field("online_huber_delta", online_huber_delta, Spec().Unit("m").Positive()
+    v.Field("sliding_window_huber_delta", sliding_window_huber_delta, Spec().Unit("m").Positive()
                 .Help("Huber width on the point-to-plane residuals of the sliding window (backend: smoother)"));
     v.Field("estimate_extrinsics", estimate_extrinsics, Spec().Help(
         "estimate T_imu_lidar in the sliding window (backend: smoother); an axis the motion does "

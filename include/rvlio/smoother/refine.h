@@ -28,7 +28,7 @@
 //            estimates (refine_map.h): a scan never matches its own points;
 //   Associate every scan against the others' points (threads over scans);
 //   RV       per scan when rv.enabled (rv/rv.h: 1/K on SCVs, normal repair),
-//            then Huber IRLS weights (smoother.huber_delta) folded into the
+//            then Huber IRLS weights (smoother.refine_huber_delta) folded into the
 //            constraint weights;
 //   Solve    one Ceres problem per chunk: PoseBlock + SpeedBiasBlock per
 //            scan, ImuFactor between consecutive scans (preintegrated at the
@@ -72,6 +72,7 @@
 #include "rvlio/common/types.h"
 #include "rvlio/constraints/options.h"
 #include "rvlio/imu/options.h"
+#include "rvlio/lidar/preprocess.h"
 #include "rvlio/map/options.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/options.h"
@@ -141,7 +142,7 @@ struct RefineResult {
   std::vector<std::string> warnings;
 };
 
-constexpr int kRefineMinScanPoints = 50;
+constexpr int kRefineMinScanPoints = kMinScanPoints;  // the odometry's floor (lidar/preprocess.h)
 
 // Called after each round (e.g. to print the convergence line).
 using RefineRoundCallback = std::function<void(const RefineRound&)>;

@@ -31,6 +31,7 @@
 
 #include "rvlio/constraints/associate.h"
 #include "rvlio/constraints/constraint.h"
+#include "rvlio/constraints/neighbor_search.h"
 #include "rvlio/constraints/options.h"
 #include "rvlio/map/options.h"
 #include "rvlio/map/voxel_key.h"
@@ -39,13 +40,11 @@
 
 namespace rvlio {
 
-// The result of one query, reused across queries: the first `size` entries,
-// sorted by increasing distance.
-struct ScanNeighbors {
-  int size = 0;
-  std::array<Eigen::Vector3d, kMaxNeighbors> points;  // world, m
-  std::array<double, kMaxNeighbors> dist2;            // m^2
-  std::array<int32_t, kMaxNeighbors> scan_ids;        // scan each point came from
+// The result of one query, reused across queries: the first `size` entries
+// (points, world, m; dist2, m^2), sorted by increasing distance, and the scan
+// each point came from.
+struct ScanNeighbors : NeighborBuffer {
+  std::array<int32_t, kMaxNeighbors> scan_ids;
 };
 
 struct RefineMapStats {
@@ -107,11 +106,26 @@ class RefineMap {
   RefineMapStats stats_;
 };
 
+// The leave-one-out map as seen by scan `scan_id` (RefineMap::kNoScan: every
+// entry's point), for the association (constraints/neighbor_search.h).
+struct LeaveOneOutSearch {
+  const RefineMap* map = nullptr;
+  int32_t scan_id = RefineMap::kNoScan;
+};
+
+template <>
+struct NeighborSearchTraits<LeaveOneOutSearch> {
+  using Neighbors = ScanNeighbors;
+  static int KNearest(const LeaveOneOutSearch& search, const Eigen::Vector3d& q_world, int k,
+                      double max_dist, Neighbors* out) {
+    return search.map->KNearest(q_world, k, max_dist, search.scan_id, out);
+  }
+};
+
 // Point-to-plane association of one deskewed scan (LiDAR frame at its end)
-// against the leave-one-out map on behalf of scan `scan_id`: the same plane
-// fit, validity test, normal orientation and residual gate as
-// constraints/associate.h (DESIGN.md section 3), with the k nearest points
-// drawn only from other scans. *out is cleared and refilled in point order.
+// against the leave-one-out map on behalf of scan `scan_id`: the one
+// association routine (constraints/associate.h, AssociateWith), with the k
+// nearest points drawn only from other scans. *out is cleared and refilled in point order.
 // sources (may be null) receives, per constraint, the scan that contributed
 // most of the plane's neighbours (ties: the nearest neighbour's scan).
 void AssociateScan(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_lidar,

@@ -12,7 +12,7 @@
 //     (PlaneSummaryFactor: PlaneFactor's cost in 13 exact residuals,
 //     plane_summary_factor.h). Per-point information = Constraint::weight / sigma^2
 //     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
-//     min(1, online_huber_delta / |r|) at the pose of association);
+//     min(1, sliding_window_huber_delta / |r|) at the pose of association);
 //   - the prior on the oldest state: a StatePriorFactor on the first state of
 //     the run, then the marginalization prior (marginalization.h), whose
 //     Jacobian stays at its linearization point (first-estimate Jacobians).
@@ -34,7 +34,7 @@
 // With smoother.estimate_extrinsics the extrinsic T_imu_lidar is one more
 // parameter block (PoseBlock, PoseManifold) shared by every scan's plane
 // factor (PlaneExtrinsicFactor instead of the summary). Its prior
-// (PosePriorFactor at options.T_imu_lidar, smoother.extrinsic_*_std) enters
+// (PosePriorFactor at the configured extrinsics, smoother.extrinsic_*_std) enters
 // the first marginalization; from then on the extrinsic is a kept block of
 // the marginalization prior, which carries the information of every scan that
 // left the window (the same Schur complement, no double counting). Its
@@ -54,8 +54,12 @@
 #include <Eigen/Core>
 #include <ceres/types.h>
 
+#include "rvlio/common/options.h"
 #include "rvlio/common/time.h"
 #include "rvlio/constraints/constraint.h"
+#include "rvlio/constraints/options.h"
+#include "rvlio/ieskf/options.h"
+#include "rvlio/imu/options.h"
 #include "rvlio/imu/noise.h"
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/math/extrinsic_excitation.h"
@@ -78,24 +82,31 @@ class ImuFactor;
 class PlaneExtrinsicFactor;
 class PlaneSummaryFactor;
 
+// The window's configuration: the option sections it reads, with the names
+// and types they have in the whole configuration (OdometryOptions), listed in
+// Visit so that the odometry fills them through the options reflection
+// (CopySections, common/options.h) and validation names their keys; plus the
+// gravity of the static initialization, which is not configuration.
 struct WindowOptions {
-  SmootherOptions smoother;          // window_size, rounds, iterations, online_huber_delta, ...
-  RvOptions rv;                      // the same switches and parameters as the filter
-  ImuNoise imu_noise;                // preintegration noise (for re-integration)
-  double lidar_noise = 0.03;         // m, sigma of one point-to-plane residual
-  int min_constraints = 6;           // fewer: the scan gets no plane factor
-  Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);  // m/s^2
-  Pose3 T_imu_lidar;                 // extrinsics: fixed, or the prior (smoother.estimate_extrinsics)
-  StatePriorStd first_prior;         // prior of the first state of the run
-  // Weak continuity across an IMU gap (SpeedBiasContinuityFactor).
-  double gap_vel_std = 1.0;          // m/s
-  double gap_bg_std = 1e-3;          // rad/s
-  double gap_ba_std = 1e-2;          // m/s^2
-  // Re-integration thresholds of the preintegration's linearization biases.
-  double repropagate_bg = 2e-3;      // rad/s
-  double repropagate_ba = 2e-2;      // m/s^2
-  // A solution with a speed above this is treated as diverged.
-  double max_speed = 100.0;          // m/s
+  SmootherOptions smoother;       // window_size, rounds, iterations, sliding_window_huber_delta, ...
+  RvOptions rv;                   // the same switches and parameters as the filter
+  ImuOptions imu;                 // noise densities of the preintegration (re-integration)
+  ConstraintOptions constraints;  // lidar_noise: sigma of one point-to-plane residual
+  IeskfOptions ieskf;             // init_*_std: prior of the run's first state (the same static
+                                  // initialization as the filter)
+  ExtrinsicsSection extrinsics;   // T_imu_lidar: fixed, or the prior (smoother.estimate_extrinsics)
+  Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);  // m/s^2, static initialization
+
+  template <class V>
+  void Visit(V& v) {
+    v.Section("smoother", smoother);
+    v.Section("rv", rv);
+    v.Section("imu", imu);
+    v.Section("constraints", constraints);
+    v.Section("ieskf", ieskf);
+    v.Section("extrinsics", extrinsics);
+  }
+  Status Validate() { return ValidateFields(*this); }
 };
 
 // Ceres' solver type for smoother.linear_solver (a validated choice).
@@ -150,7 +161,7 @@ class SlidingWindow {
   SlidingWindow& operator=(const SlidingWindow&) = delete;
 
   // Clears the window and starts it with the first state of a run, held by
-  // a StatePriorFactor at the given values (options.first_prior).
+  // a StatePriorFactor at the given values (std: ieskf.init_*_std).
   void Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
              std::vector<Eigen::Vector3d> p_lidar);
 
@@ -175,7 +186,7 @@ class SlidingWindow {
   const ConstraintList& constraints(int k) const;
   bool has_imu_factor(int k) const;  // between states k - 1 and k
   const WindowStats& stats() const { return stats_; }
-  // The extrinsic in use: the estimate (estimate_extrinsics) or options.T_imu_lidar.
+  // The extrinsic in use: the estimate (estimate_extrinsics) or the configured one.
   Pose3 T_imu_lidar() const;
   const ExtrinsicExcitation& extrinsic_excitation() const { return excitation_; }
   // One processed scan: the newest state's attitude feeds the rotational excitation.
@@ -201,6 +212,8 @@ class SlidingWindow {
   void Restore();
 
   WindowOptions options_;
+  Pose3 T_imu_lidar_config_;    // options_.extrinsics
+  StatePriorStd first_prior_;   // options_.ieskf.init_*_std
   PoseManifold pose_manifold_;
   std::deque<std::unique_ptr<Node>> nodes_;
   std::unique_ptr<StatePriorFactor> state_prior_;        // on nodes_[0], or null
