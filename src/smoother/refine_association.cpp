@@ -67,10 +67,17 @@ ScanFactors MakeScanFactors(const RefineAssociationWorkspace& w,
                             double sigma) {
   ScanFactors f;
   if (!w.fixed.empty()) f.fixed = std::make_unique<PlaneFactor>(w.fixed, T_imu_lidar, sigma);
+  size_t sources = 0;
+  for (size_t a = 0; a < w.attached.size(); ++a)
+    sources += a == 0 || w.attached[a - 1].first != w.attached[a].first ? 1 : 0;
+  f.pairs.reserve(sources);
   for (size_t a = 0; a < w.attached.size(); ++a) {
     const int j = w.attached[a].first;
-    if (a == 0 || w.attached[a - 1].first != j)
-      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>());
+    if (a == 0 || w.attached[a - 1].first != j) {
+      size_t end = a + 1;  // attached is sorted by source: count j's planes
+      while (end < w.attached.size() && w.attached[end].first == j) ++end;
+      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>(static_cast<int>(end - a)));
+    }
     const Constraint& c = w.list[w.attached[a].second];
     const Pose3& T_j = map_poses[j];
     f.pairs.back().second->Add(T_imu_lidar * c.p_lidar, T_j.R.transpose() * c.normal_world,
