@@ -12,7 +12,7 @@
 # Recordings and initial trajectories are cached in --work (default
 # /tmp/rvlio_refine_scaling) and reused by later calls with the same lengths,
 # so a before/after comparison only reruns refine. --keep leaves the refine
-# outputs there (refine_<scans>/).
+# outputs there (tunnel_<scans>/refine_<binary name>/, e.g. to cmp them).
 set -euo pipefail
 
 bin=build/bin/rvlio
@@ -58,7 +58,7 @@ printf '%-8s %-10s %-10s %-8s %s\n' scans s/round peak_MB MB/scan rounds
 for n in $scans_list; do
   prepare "$n"
   dir=$work/tunnel_$n
-  out=$dir/refine
+  out=$dir/refine_$(basename "$bin")
   rm -rf "$out"
   /usr/bin/time -f %M -o "$dir.maxrss_kb" "$bin" refine --bag "$dir/tunnel.bag" \
     --init "$dir/init/trajectory.tum" --config "$dir/tunnel.yaml" \

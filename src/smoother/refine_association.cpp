@@ -33,6 +33,13 @@ void BuildRefineMap(const std::vector<RefineState>& states, const Pose3& T_imu_l
   }
 }
 
+void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundMap* round) {
+  std::vector<std::vector<Eigen::Vector3d>>& p = round->p_lidar_end;
+  const int end = std::min(next_begin, static_cast<int>(p.size()));
+  for (int k = chunk.begin; k < end; ++k) std::vector<Eigen::Vector3d>().swap(p[k]);
+  if (next_begin >= static_cast<int>(p.size())) round->map.Release();
+}
+
 void SplitScanConstraints(int k, const ScanRange& chunk, int plane_window,
                           const ConstraintList& list, const std::vector<int32_t>& sources,
                           const std::vector<RefineState>& states,
