@@ -75,6 +75,7 @@ Status BatchRefiner::Initialize() {
   StatusOr<RefineSequence> sequence = SelectRefineScans(input_, &result_.stats);
   if (!sequence.ok()) return sequence.status();
   sequence_ = std::move(sequence).value();
+  ReleaseInputPoints(&input_);  // sequence_ holds the refined scans' points
   const RefineGravity g = InitRefineGravity(input_.imu, input_.init, config_.imu);
   result_.g_world = g.g_world;
   result_.stats.started_moving = g.started_moving;

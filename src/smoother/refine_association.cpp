@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "rvlio/common/parallel.h"
 
@@ -13,8 +16,9 @@ void DeskewRefineScans(const RefineSequence& sequence, const std::vector<RefineS
   p_lidar_end->resize(states.size());
   ParallelFor(0, static_cast<int>(states.size()), threads, [&](int k, int) {
     const Scan& scan = sequence.scan(k);
+    const RefineScanPoints& points = sequence.points[k];
     DeskewWithImu(SliceImu(sequence.imu(), scan.t_start_ns, scan.t_end_ns), states[k], g_world,
-                  T_imu_lidar, scan.points, scan.t_start_ns, &(*p_lidar_end)[k]);
+                  T_imu_lidar, points.p_lidar, points.t_ns, scan.t_start_ns, &(*p_lidar_end)[k]);
   });
 }
 
@@ -38,6 +42,11 @@ void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundM
   const int end = std::min(next_begin, static_cast<int>(p.size()));
   for (int k = chunk.begin; k < end; ++k) std::vector<Eigen::Vector3d>().swap(p[k]);
   if (next_begin >= static_cast<int>(p.size())) round->map.Release();
+#if defined(__GLIBC__)
+  // The points are freed in blocks below glibc's mmap threshold: without a
+  // trim their pages stay resident while the solve allocates anew.
+  malloc_trim(0);
+#endif
 }
 
 void SplitScanConstraints(int k, const ScanRange& chunk, int plane_window,

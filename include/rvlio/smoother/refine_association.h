@@ -56,6 +56,7 @@ void BuildRefineMap(const std::vector<RefineState>& states, const Pose3& T_imu_l
 // chunk, the map. So a chunk's solve does not hold the points of the scans
 // already associated, and the last one holds neither points nor map. The
 // round's results do not change (the next round deskews and builds anew).
+// With glibc, the freed pages are returned to the system (malloc_trim).
 void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundMap* round);
 
 // The plane factors of one scan: world-fixed planes, and planes attached to
