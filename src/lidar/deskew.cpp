@@ -43,8 +43,7 @@ void DeskewToScanEnd(const std::vector<ImuPoseSample>& samples, const Pose3& T_i
                      std::vector<Eigen::Vector3d>* p_lidar_end) {
   DeskewPoints(
       samples, T_imu_lidar, points.size(), [&](size_t i) { return points[i].t_ns; },
-      [&](size_t i) -> const Eigen::Vector3f& { return points[i].p_lidar; }, t_end_ns,
-      p_lidar_end);
+      [&](size_t i) -> const Eigen::Vector3f& { return points[i].p_lidar; }, t_end_ns, p_lidar_end);
 }
 
 void DeskewToScanEnd(const std::vector<ImuPoseSample>& samples, const Pose3& T_imu_lidar,

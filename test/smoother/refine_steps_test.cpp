@@ -265,7 +265,7 @@ TEST(RefineAssociation, ReleaseFreesTheAssociatedScansThenTheMap) {
   ASSERT_GT(entries, 0);
   ReleaseAssociatedScans(ScanRange{0, 5}, 4, &round);  // the next chunk starts at 4
   for (int k = 0; k < 8; ++k) EXPECT_EQ(round.p_lidar_end[k].empty(), k < 4) << k;
-  EXPECT_EQ(round.map.stats().entries, entries);  // later chunks still read it
+  EXPECT_EQ(round.map.stats().entries, entries);       // later chunks still read it
   ReleaseAssociatedScans(ScanRange{4, 8}, 8, &round);  // the last chunk
   for (int k = 0; k < 8; ++k) EXPECT_TRUE(round.p_lidar_end[k].empty()) << k;
   EXPECT_EQ(round.map.stats().entries, 0);
