@@ -53,7 +53,7 @@ class BatchRefiner {
   RefineRoundState State() const;
   bool StopRequested() const { return stop_ && stop_(); }
   bool RunRound(int round, RefineRound* report);
-  void SolveChunk(const ScanRange& chunk, RefineRound* report);
+  void SolveChunk(const ScanRange& chunk, int next_begin, RefineRound* report);
   void Finish();
 
   const RefineConfig& config_;
@@ -75,6 +75,7 @@ Status BatchRefiner::Initialize() {
   StatusOr<RefineSequence> sequence = SelectRefineScans(input_, &result_.stats);
   if (!sequence.ok()) return sequence.status();
   sequence_ = std::move(sequence).value();
+  ReleaseInputPoints(&input_);  // sequence_ holds the refined scans' points
   const RefineGravity g = InitRefineGravity(input_.imu, input_.init, config_.imu);
   result_.g_world = g.g_world;
   result_.stats.started_moving = g.started_moving;
@@ -84,7 +85,8 @@ Status BatchRefiner::Initialize() {
   return Status::Ok();
 }
 
-void BatchRefiner::SolveChunk(const ScanRange& chunk, RefineRound* report) {
+// next_begin: the next chunk's first scan (the scan count after the last).
+void BatchRefiner::SolveChunk(const ScanRange& chunk, int next_begin, RefineRound* report) {
   auto t0 = Clock::now();
   ChunkAssociation a =
       AssociateRefineChunk(config_, round_map_, states_, chunk, solver_.threads, stop_);
@@ -93,6 +95,7 @@ void BatchRefiner::SolveChunk(const ScanRange& chunk, RefineRound* report) {
   report->rv_active_scans += a.rv_active_scans;
   report->associate_s += SecondsSince(t0);
   if (StopRequested()) return;
+  ReleaseAssociatedScans(chunk, next_begin, &round_map_);
 
   t0 = Clock::now();
   ceres::Problem problem(RefineProblemOptions());
@@ -142,8 +145,8 @@ bool BatchRefiner::RunRound(int round, RefineRound* out) {
       MakeRefineChunks(sequence_.size(), config_.smoother.refine_chunk_scans);
   report.chunks = static_cast<int>(chunks.size());
   result_.stats.chunks = report.chunks;
-  for (const ScanRange& chunk : chunks) {
-    SolveChunk(chunk, &report);
+  for (size_t c = 0; c < chunks.size(); ++c) {
+    SolveChunk(chunks[c], c + 1 < chunks.size() ? chunks[c + 1].begin : sequence_.size(), &report);
     if (stopped()) return false;
   }
   for (size_t k = 0; k < states_.size(); ++k) {

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "rvlio/common/parallel.h"
 
@@ -14,8 +17,9 @@ void DeskewRefineScans(const RefineSequence& sequence, const std::vector<RefineS
   p_lidar_end->resize(states.size());
   ParallelFor(0, static_cast<int>(states.size()), threads, [&](int k, int) {
     const Scan& scan = sequence.scan(k);
+    const RefineScanPoints& points = sequence.points[k];
     DeskewWithImu(SliceImu(sequence.imu(), scan.t_start_ns, scan.t_end_ns), states[k], g_world,
-                  T_imu_lidar, scan.points, scan.t_start_ns, &(*p_lidar_end)[k]);
+                  T_imu_lidar, points.p_lidar, points.t_ns, scan.t_start_ns, &(*p_lidar_end)[k]);
   });
 }
 
@@ -32,6 +36,18 @@ void BuildRefineMap(const std::vector<RefineState>& states, const Pose3& T_imu_l
     for (size_t i = 0; i < p_world.size(); ++i) p_world[i] = T_world_lidar * p_lidar[i];
     round->map.Insert(static_cast<int32_t>(k), p_world);
   }
+}
+
+void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundMap* round) {
+  std::vector<std::vector<Eigen::Vector3d>>& p = round->p_lidar_end;
+  const int end = std::min(next_begin, static_cast<int>(p.size()));
+  for (int k = chunk.begin; k < end; ++k) std::vector<Eigen::Vector3d>().swap(p[k]);
+  if (next_begin >= static_cast<int>(p.size())) round->map.Release();
+#if defined(__GLIBC__)
+  // The points are freed in blocks below glibc's mmap threshold: without a
+  // trim their pages stay resident while the solve allocates anew.
+  malloc_trim(0);
+#endif
 }
 
 void SplitScanConstraints(int k, const ScanRange& chunk, int plane_window,
@@ -68,10 +84,17 @@ ScanFactors MakeScanFactors(const RefineAssociationWorkspace& w,
                             double sigma) {
   ScanFactors f;
   if (!w.fixed.empty()) f.fixed = std::make_unique<PlaneFactor>(w.fixed, T_imu_lidar, sigma);
+  size_t sources = 0;
+  for (size_t a = 0; a < w.attached.size(); ++a)
+    sources += a == 0 || w.attached[a - 1].first != w.attached[a].first ? 1 : 0;
+  f.pairs.reserve(sources);
   for (size_t a = 0; a < w.attached.size(); ++a) {
     const int j = w.attached[a].first;
-    if (a == 0 || w.attached[a - 1].first != j)
-      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>());
+    if (a == 0 || w.attached[a - 1].first != j) {
+      size_t end = a + 1;  // attached is sorted by source: count j's planes
+      while (end < w.attached.size() && w.attached[end].first == j) ++end;
+      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>(static_cast<int>(end - a)));
+    }
     const Constraint& c = w.list[w.attached[a].second];
     const Pose3& T_j = map_poses[j];
     f.pairs.back().second->Add(T_imu_lidar * c.p_lidar, T_j.R.transpose() * c.normal_world,

@@ -67,7 +67,22 @@ StatusOr<RefineSequence> SelectRefineScans(const RefineInput& input, RefineStats
   }
   st.scans_refined = static_cast<int64_t>(seq.kept.size());
   if (seq.kept.size() < 2) return TooFewScans(input, st, seq.kept.size());
+  seq.points.resize(seq.kept.size());
+  for (int k = 0; k < seq.size(); ++k) {
+    const std::vector<LidarPoint>& from = seq.scan(k).points;
+    RefineScanPoints& to = seq.points[k];
+    to.p_lidar.resize(from.size());
+    to.t_ns.resize(from.size());
+    for (size_t i = 0; i < from.size(); ++i) {
+      to.p_lidar[i] = from[i].p_lidar;
+      to.t_ns[i] = from[i].t_ns;
+    }
+  }
   return seq;
+}
+
+void ReleaseInputPoints(RefineInput* input) {
+  for (Scan& scan : input->scans) std::vector<LidarPoint>().swap(scan.points);
 }
 
 RefineGravity InitRefineGravity(const std::vector<ImuSample>& imu, const Trajectory& init,

@@ -71,6 +71,12 @@ void RefineMap::Clear() {
   stats_ = RefineMapStats();
 }
 
+void RefineMap::Release() {
+  Clear();
+  std::vector<Voxel>().swap(voxels_);
+  decltype(index_)().swap(index_);
+}
+
 void RefineMap::Insert(int32_t scan_id, const std::vector<Eigen::Vector3d>& p_world) {
   RVLIO_CHECK(scan_id >= 0);
   for (const Eigen::Vector3d& p : p_world) {

@@ -1,5 +1,6 @@
 #include "rvlio/smoother/refine_pair_factor.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rvlio/common/check.h"
@@ -9,6 +10,14 @@
 namespace rvlio {
 
 using RowMajorX6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
+
+ScanPairPlaneFactor::ScanPairPlaneFactor(int constraints) {
+  const size_t n = static_cast<size_t>(std::max(constraints, 0));
+  p_imu_.reserve(n);
+  u_j_.reserve(n);
+  u_dot_q_.reserve(n);
+  scale_.reserve(n);
+}
 
 void ScanPairPlaneFactor::Add(const Eigen::Vector3d& p_imu_k, const Eigen::Vector3d& u_j,
                               const Eigen::Vector3d& q_j, double weight, double sigma_m) {

@@ -65,11 +65,11 @@ std::vector<ImuSample> SliceImu(const std::vector<ImuSample>& samples, TimeNs t0
   return std::vector<ImuSample>(first, last);
 }
 
+namespace {
+
 // The IMU integrated backwards from the scan-end state (imu/pose_history.h).
-void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_state,
-                   const Eigen::Vector3d& g_world, const Pose3& T_imu_lidar,
-                   const std::vector<LidarPoint>& points, TimeNs t_start_ns,
-                   std::vector<Eigen::Vector3d>* p_lidar_end) {
+ImuPoseHistory BackwardHistory(const std::vector<ImuSample>& imu, const RefineState& end_state,
+                               const Eigen::Vector3d& g_world, TimeNs t_start_ns) {
   RVLIO_CHECK(!imu.empty());
   const SpeedBiasBlock sb = end_state.SpeedBias();
   const Pose3 T_end = end_state.T_world_imu();
@@ -78,9 +78,26 @@ void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_sta
   end.R_world_imu = T_end.R;
   end.p_world_imu = T_end.t;
   end.v_world_imu = sb.v_world_imu;
-  const ImuPoseHistory history = ImuPoseHistory::Integrate(
-      end, imu, std::min(t_start_ns, end_state.t_ns), sb.bg, sb.ba, g_world);
+  return ImuPoseHistory::Integrate(end, imu, std::min(t_start_ns, end_state.t_ns), sb.bg, sb.ba,
+                                   g_world);
+}
+
+}  // namespace
+
+void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_state,
+                   const Eigen::Vector3d& g_world, const Pose3& T_imu_lidar,
+                   const std::vector<LidarPoint>& points, TimeNs t_start_ns,
+                   std::vector<Eigen::Vector3d>* p_lidar_end) {
+  const ImuPoseHistory history = BackwardHistory(imu, end_state, g_world, t_start_ns);
   DeskewToScanEnd(history.samples(), T_imu_lidar, points, end_state.t_ns, p_lidar_end);
+}
+
+void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_state,
+                   const Eigen::Vector3d& g_world, const Pose3& T_imu_lidar,
+                   const std::vector<Eigen::Vector3f>& p_lidar, const std::vector<TimeNs>& t_ns,
+                   TimeNs t_start_ns, std::vector<Eigen::Vector3d>* p_lidar_end) {
+  const ImuPoseHistory history = BackwardHistory(imu, end_state, g_world, t_start_ns);
+  DeskewToScanEnd(history.samples(), T_imu_lidar, p_lidar, t_ns, end_state.t_ns, p_lidar_end);
 }
 
 double RotationDifferenceDeg(const Pose3& a, const Pose3& b) {

@@ -254,6 +254,25 @@ TEST(RefineAssociation, DeskewMapAndAssociationAreTheSameOnOneOrTwoThreads) {
   EXPECT_EQ(stopped.constraints, 0);
 }
 
+TEST(RefineAssociation, ReleaseFreesTheAssociatedScansThenTheMap) {
+  const Round r = MakeRound(8);
+  const RefineConfig config = Config();
+  RefineRoundMap round(config.map);
+  DeskewRefineScans(r.sequence, r.states, test::Gravity(), config.T_imu_lidar, 1,
+                    &round.p_lidar_end);
+  BuildRefineMap(r.states, config.T_imu_lidar, &round);
+  const int64_t entries = round.map.stats().entries;
+  ASSERT_GT(entries, 0);
+  ReleaseAssociatedScans(ScanRange{0, 5}, 4, &round);  // the next chunk starts at 4
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(round.p_lidar_end[k].empty(), k < 4) << k;
+  EXPECT_EQ(round.map.stats().entries, entries);       // later chunks still read it
+  ReleaseAssociatedScans(ScanRange{4, 8}, 8, &round);  // the last chunk
+  for (int k = 0; k < 8; ++k) EXPECT_TRUE(round.p_lidar_end[k].empty()) << k;
+  EXPECT_EQ(round.map.stats().entries, 0);
+  ScanNeighbors nb;
+  EXPECT_EQ(round.map.KNearest(r.states[0].T_world_imu().t, 1, 100.0, 0, &nb), 0);
+}
+
 // ---- problem build and solve ----
 
 TEST(RefineProblem, ChunkProblemHoldsItsFirstPoseAndLinksEveryScan) {

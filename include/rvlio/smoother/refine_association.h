@@ -50,6 +50,15 @@ void DeskewRefineScans(const RefineSequence& sequence, const std::vector<RefineS
 void BuildRefineMap(const std::vector<RefineState>& states, const Pose3& T_imu_lidar,
                     RefineRoundMap* round);
 
+// Frees what no later chunk of the round reads once `chunk` is associated:
+// the deskewed points of its scans before next_begin (the next chunk's first
+// scan; round->p_lidar_end.size() after the last chunk) and, after the last
+// chunk, the map. So a chunk's solve does not hold the points of the scans
+// already associated, and the last one holds neither points nor map. The
+// round's results do not change (the next round deskews and builds anew).
+// With glibc, the freed pages are returned to the system (malloc_trim).
+void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundMap* round);
+
 // The plane factors of one scan: world-fixed planes, and planes attached to
 // their source scans (refine_pair_factor.h), one factor per source.
 struct ScanFactors {

@@ -20,11 +20,22 @@ namespace rvlio {
 // Half width of the central differences that start the velocities.
 constexpr TimeNs kRefineVelocityHalfWindowNs = 50000000;  // 50 ms
 
+// The points of a refined scan as refinement reads them (LiDAR frame, m;
+// absolute times): 20 bytes a point instead of a LidarPoint's 32, the same
+// coordinates and times.
+struct RefineScanPoints {
+  std::vector<Eigen::Vector3f> p_lidar;
+  std::vector<TimeNs> t_ns;
+};
+
 // The refined scans of an input: refined scan k is input scan kept[k]. Holds
-// a pointer to the input, which must outlive it.
+// a pointer to the input, which must outlive it, and its own copy of the
+// refined scans' points, so that the driver can free the input's
+// (ReleaseInputPoints): scan(k) is then read for its times only.
 struct RefineSequence {
   const RefineInput* input = nullptr;
-  std::vector<int> kept;  // input scan index per refined scan, increasing end times
+  std::vector<int> kept;                 // input scan index per refined scan, increasing end times
+  std::vector<RefineScanPoints> points;  // per refined scan
 
   int size() const { return static_cast<int>(kept.size()); }
   const Scan& scan(int k) const { return input->scans[kept[k]]; }
@@ -38,7 +49,12 @@ Status CheckRefineInput(const RefineInput& input);
 // the initial trajectory's span, covered by IMU data and with increasing end
 // times; fills the scan counts of *stats. InvalidInput (with both time spans)
 // when fewer than 2 scans remain. `input` passes CheckRefineInput.
+// Copies the kept scans' points into RefineSequence::points.
 StatusOr<RefineSequence> SelectRefineScans(const RefineInput& input, RefineStats* stats);
+
+// Frees the points of every input scan (the sequence holds its own copy);
+// the scans' times stay.
+void ReleaseInputPoints(RefineInput* input);
 
 // Gravity and the starting gyro bias (refine.h): the static alignment of the
 // first imu.init_duration of samples, carried into the initial trajectory's

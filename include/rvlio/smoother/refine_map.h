@@ -76,7 +76,8 @@ class RefineMap {
   void VisiblePoints(int32_t exclude_scan, std::vector<Eigen::Vector3d>* points,
                      std::vector<int32_t>* scan_ids) const;
 
-  void Clear();  // keeps the allocated memory
+  void Clear();    // keeps the allocated memory
+  void Release();  // Clear() and frees the memory
   const RefineMapStats& stats() const { return stats_; }
 
  private:

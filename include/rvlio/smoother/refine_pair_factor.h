@@ -34,7 +34,9 @@ namespace rvlio {
 class ScanPairPlaneFactor final : public ceres::CostFunction {
  public:
   // Accumulate constraints with Add(), then Finalize() before use.
-  ScanPairPlaneFactor() = default;
+  // `constraints`: how many Add() calls follow, so that the storage is
+  // allocated once at its final size (a refine round holds millions of them).
+  explicit ScanPairPlaneFactor(int constraints = 0);
 
   // p_imu_k: the point in scan k's IMU frame (m); u_j: unit normal and q_j: a
   // plane point, both in scan j's IMU frame; weight >= 0; sigma_m > 0.

@@ -51,6 +51,12 @@ void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_sta
                    const std::vector<LidarPoint>& points, TimeNs t_start_ns,
                    std::vector<Eigen::Vector3d>* p_lidar_end);
 
+// The same for points kept apart from their times (lidar/deskew.h).
+void DeskewWithImu(const std::vector<ImuSample>& imu, const RefineState& end_state,
+                   const Eigen::Vector3d& g_world, const Pose3& T_imu_lidar,
+                   const std::vector<Eigen::Vector3f>& p_lidar, const std::vector<TimeNs>& t_ns,
+                   TimeNs t_start_ns, std::vector<Eigen::Vector3d>* p_lidar_end);
+
 // Rotation angle (deg) and translation (m) between two poses.
 double RotationDifferenceDeg(const Pose3& a, const Pose3& b);
 double TranslationDifference(const Pose3& a, const Pose3& b);
