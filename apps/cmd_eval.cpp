@@ -1,5 +1,5 @@
 // rvlio eval: ATE/RPE of an estimated trajectory against ground truth with the
-// definitions of evo (DESIGN.md section 7). Argument parsing and output only;
+// definitions of evo (docs/design.md section 8). Argument parsing and output only;
 // the metrics live in eval/, the file formats in io/trajectory_io.h.
 #include <cmath>
 #include <cstdio>

@@ -1,6 +1,6 @@
 #pragma once
 // Point-to-plane association of one scan against the working map
-// (DESIGN.md section 3): for each point, transform it to the world with the
+// (docs/design.md section 4): for each point, transform it to the world with the
 // current estimate, take its k nearest map points, fit and validate a local
 // plane (plane_fit.h) and keep the constraint when |r| <= max_residual.
 // Single-threaded, no per-point heap allocation, output in point order.

@@ -1,5 +1,5 @@
 #pragma once
-// The leave-one-out map of batch refinement (DESIGN.md section 5, "refine":
+// The leave-one-out map of batch refinement (docs/design.md section 6, "refine":
 // a scan never matches its own points).
 //
 // It holds every scan's points in the world frame, each tagged with its scan
@@ -110,7 +110,7 @@ class RefineMap {
 // Point-to-plane association of one deskewed scan (LiDAR frame at its end)
 // against the leave-one-out map on behalf of scan `scan_id`: the same plane
 // fit, validity test, normal orientation and residual gate as
-// constraints/associate.h (DESIGN.md section 3), with the k nearest points
+// constraints/associate.h (docs/design.md section 4), with the k nearest points
 // drawn only from other scans. *out is cleared and refilled in point order.
 // sources (may be null) receives, per constraint, the scan that contributed
 // most of the plane's neighbours (ties: the nearest neighbour's scan).
