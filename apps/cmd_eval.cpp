@@ -1,5 +1,5 @@
 // rvlio eval: ATE/RPE of an estimated trajectory against ground truth with the
-// definitions of evo (DESIGN.md section 7). Argument parsing and output only;
+// definitions of evo (docs/design.md section 8). Argument parsing and output only;
 // EvaluateFiles and EvalJson (rvlio/api.h) do the work.
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,5 @@
-# Debian's ROS1 bag storage library ships no usable CMake package (DESIGN.md
-# section 9). Build an imported target by hand. Its headers pull the ROS 2
+# Debian's ROS1 bag storage library ships no usable CMake package (docs/design.md
+# section 10). Build an imported target by hand. Its headers pull the ROS 2
 # flavour of pluginlib, hence the extra include folders. rosbag_storage itself
 # links roslz4 and bz2, so compressed bags read without more libraries here.
 #

@@ -1,7 +1,24 @@
 #!/usr/bin/env bash
-# Configures and builds rvlio in ./build (Release). Extra arguments go to cmake.
+# Configures and builds rvlio in ./build (Release).
+#
+#   bash scripts/build.sh [--target NAME ...] [cmake configure arguments ...]
+#
+# --target NAME (repeatable) builds only those targets (default: all); every
+# other argument goes to the cmake configure step (e.g. -DRVLIO_WERROR=ON).
+# The configuration does not depend on --target, so a later call that builds
+# more reuses what an earlier one built (scripts/demo.sh builds `rvlio` only,
+# scripts/test.sh then builds the rest in the same folder).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
-cmake --build build -j "$jobs"
+targets=()
+configure_args=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --target) targets+=(--target "$2"); shift 2 ;;
+    --target=*) targets+=(--target "${1#*=}"); shift ;;
+    *) configure_args+=("$1"); shift ;;
+  esac
+done
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${configure_args[@]}" >/dev/null
+cmake --build build -j "$jobs" "${targets[@]}"

@@ -54,7 +54,7 @@ done
 build=$root/build-fuzz
 cxx=$(command -v clang++ || command -v clang++-14 || true)
 [[ -n "$cxx" ]] || { echo "fuzz.sh: clang++ not found (bash scripts/install_deps.sh --with-test-tools)" >&2; exit 1; }
-cmake -S fuzz -B "$build" -DCMAKE_CXX_COMPILER="$cxx" >/dev/null
+cmake -S fuzz -B "$build" -DCMAKE_CXX_COMPILER="$cxx" -DRVLIO_WERROR=ON >/dev/null
 cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target "${targets[@]/#/fuzz_}"
 
 symbolizer=$(command -v llvm-symbolizer || command -v llvm-symbolizer-14 || true)

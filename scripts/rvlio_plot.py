@@ -10,7 +10,7 @@ Usage:
   rvlio_plot.py compare-bars --table CSV --out PREFIX [--metric NAME ...]
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
 
-Inputs follow the run-directory contract of `rvlio run` (DESIGN.md section 6):
+Inputs follow the run-directory contract of `rvlio run` (docs/design.md section 7):
 DIR/trajectory.tum (t x y z qx qy qz qw, seconds), DIR/scans.csv (one row per
 scan) and DIR/summary.json. Every plot is written as PREFIX_<kind>.png (150 dpi)
 and PREFIX_<kind>.pdf, atomically (temp file, then rename); a PREFIX ending in

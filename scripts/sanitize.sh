@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the test suite with AddressSanitizer + UndefinedBehaviorSanitizer
-# (gcc, -O1 -g1: line tables for stack traces, assertions on, no benchmarks)
+# (gcc, -O1 -g1: line tables for stack traces, assertions on, no benchmarks,
+# warnings are errors: RVLIO_WERROR)
 # in ./build-asan and runs ctest there. Any finding aborts the test that
 # triggered it (halt_on_error=1, -fno-sanitize-recover=all), so ctest fails.
 #
@@ -72,7 +73,7 @@ ex=(
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}
 
-cmake -S . -B "$build_dir" -DRVLIO_SANITIZE=ON -DRVLIO_BUILD_BENCH=OFF \
+cmake -S . -B "$build_dir" -DRVLIO_SANITIZE=ON -DRVLIO_BUILD_BENCH=OFF -DRVLIO_WERROR=ON \
   -DCMAKE_C_COMPILER=gcc -DCMAKE_CXX_COMPILER=g++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1" >/dev/null

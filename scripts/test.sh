@@ -2,16 +2,18 @@
 # The README's test command (CI runs it through .ci/run): installs what is
 # missing, then runs the stages in order and stops at the first failure:
 #
-#   release   Release build in build/ + ctest (every test)
+#   release   Release build in build/ (warnings are errors: RVLIO_WERROR)
+#             + ctest (every test)
 #   python    scripts/python_test.sh: pytest of the Python module against
 #             the Release build tree, examples/compare_backends.py on a 6 s
 #             tunnel, and `import rvlio` from a temporary install prefix
 #             (about 2 minutes)
 #   sanitize  scripts/sanitize.sh: the test suite built with gcc
-#             ASan + UBSan (-O1 -g) in build-asan/ + ctest there
-#   fuzz      scripts/fuzz.sh --ci: the libFuzzer targets of fuzz/ (clang) in
-#             build-fuzz/, seed 1, a fixed number of inputs (about 60 s) per
-#             target, at most $RVLIO_FUZZ_SECONDS (default 60) s each
+#             ASan + UBSan (-O1 -g, RVLIO_WERROR) in build-asan/ + ctest there
+#   fuzz      scripts/fuzz.sh --ci: the libFuzzer targets of fuzz/ (clang,
+#             RVLIO_WERROR) in build-fuzz/, seed 1, a fixed number of
+#             inputs (about 60 s) per target, at most $RVLIO_FUZZ_SECONDS
+#             (default 60) s each
 #   slurm     scripts/slurm_test.sh: a single-node Slurm cluster started
 #             here (scripts/slurm_local.sh), config/grids/tiny.yaml through
 #             the Snakemake workflow on it, the table compared with the one
@@ -50,7 +52,7 @@ bash scripts/install_deps.sh --with-test-tools
 finish_stage deps
 
 if want release; then
-  bash scripts/build.sh
+  bash scripts/build.sh -DRVLIO_WERROR=ON
   (cd build && ctest --output-on-failure -j "$jobs") 2>&1 | tee "$log"
   count_tests
   finish_stage release

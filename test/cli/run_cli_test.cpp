@@ -1,6 +1,6 @@
 // End to end: `rvlio simulate` -> `rvlio run` (IESKF) -> `rvlio eval`, with
 // explicit accuracy bounds on deterministic simulated data, the output
-// contract of DESIGN.md section 6, determinism and bad input.
+// contract of docs/design.md section 7, determinism and bad input.
 #include <filesystem>
 
 #include <gtest/gtest.h>

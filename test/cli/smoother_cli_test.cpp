@@ -1,7 +1,7 @@
 // End to end for the sliding-window smoother: `rvlio simulate` ->
 // `rvlio run --set backend=smoother` -> `rvlio eval` on the seeded
 // 512-column tunnel of run_cli_test.cpp, with explicit accuracy bounds, the
-// output contract of DESIGN.md section 6 and no NaN anywhere; a sequence
+// output contract of docs/design.md section 7 and no NaN anywhere; a sequence
 // shorter than the window; and, in process, an IMU gap inside the window.
 #include <cmath>
 #include <filesystem>

@@ -1,4 +1,4 @@
-// Plane validity on the ring pattern of a 32-beam LiDAR (DESIGN.md section 3):
+// Plane validity on the ring pattern of a 32-beam LiDAR (docs/design.md section 4):
 // a wall seen by an OS1-32-like sensor leaves points on ring lines a few
 // degrees apart, and a line admits any plane through it. Association must
 // only produce normals that are the wall's normal, never ones tilted towards

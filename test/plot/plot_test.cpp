@@ -13,7 +13,6 @@
 #include <fstream>
 #include <iterator>
 #include <random>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -262,17 +261,24 @@ class PlotScriptTest : public ::testing::Test {
 
 bool PlotScriptTest::available_ = false;
 
+// The script's line "run 'LABEL': M/N poses matched, along-axis error max X m,
+// final Y m". Parsed with sscanf, not <regex>: gcc 12's std::regex trips
+// -Wmaybe-uninitialized inside libstdc++ at -O1 (the sanitizer build), which
+// RVLIO_WERROR turns into an error.
 RunFigures ParseRun(const std::string& out, const std::string& label) {
-  const std::regex re("run '" + label +
-                      "': (\\d+)/(\\d+) poses matched, along-axis error max ([-0-9.eE+]+) m, "
-                      "final ([-0-9.eE+]+) m");
-  std::smatch m;
   RunFigures f;
-  if (std::regex_search(out, m, re)) {
-    f.matched = std::stoi(m[1]);
-    f.total = std::stoi(m[2]);
-    f.max_error = std::stod(m[3]);
-    f.final_error = std::stod(m[4]);
+  const std::string prefix = "run '" + label + "': ";
+  const size_t at = out.find(prefix);
+  if (at == std::string::npos) return f;
+  int matched = 0, total = 0;
+  double max_error = 0.0, final_error = 0.0;
+  if (std::sscanf(out.c_str() + at + prefix.size(),
+                  "%d/%d poses matched, along-axis error max %lf m, final %lf m", &matched,
+                  &total, &max_error, &final_error) == 4) {
+    f.matched = matched;
+    f.total = total;
+    f.max_error = max_error;
+    f.final_error = final_error;
   }
   return f;
 }

@@ -1,5 +1,5 @@
 // Oracle: the noise-free simulated IMU, integrated from the true initial
-// state, reproduces the true trajectory (DESIGN.md section 8). The integrator
+// state, reproduces the true trajectory (docs/design.md section 9). The integrator
 // is written here (midpoint rotation, trapezoidal acceleration) so the test
 // depends on nothing but the simulator.
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// Point-to-plane association of one scan against a map (DESIGN.md section 3):
+// Point-to-plane association of one scan against a map (docs/design.md section 4):
 // for each point, transform it to the world with the current estimate, take
 // its k nearest map points, fit and validate a local plane (plane_fit.h) and
 // keep the constraint when |r| <= max_residual.

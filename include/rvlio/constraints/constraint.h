@@ -1,6 +1,6 @@
 #pragma once
 // The constraint record both estimators consume and the RV module edits
-// (DESIGN.md section 3): one point-to-plane correspondence of one scan point.
+// (docs/design.md section 4): one point-to-plane correspondence of one scan point.
 #include <cstdint>
 #include <vector>
 

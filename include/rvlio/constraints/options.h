@@ -1,5 +1,5 @@
 #pragma once
-// Point-to-plane association (DESIGN.md section 3).
+// Point-to-plane association (docs/design.md section 4).
 #include "rvlio/common/options.h"
 
 namespace rvlio {

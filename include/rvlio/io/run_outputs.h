@@ -1,5 +1,5 @@
 #pragma once
-// The files `rvlio run` writes (DESIGN.md section 6), each atomically.
+// The files `rvlio run` writes (docs/design.md section 7), each atomically.
 #include <string>
 #include <vector>
 

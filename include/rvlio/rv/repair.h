@@ -4,8 +4,8 @@
 // Eq. (20) as printed, u' = (u . n_alpha) n_alpha, is the component of u
 // ALONG n_alpha (out of plane alpha); it contradicts the text ("pull the
 // deviated vector back toward the correct direction": wall normals are
-// coplanar). We implement the in-plane projection instead (DESIGN.md
-// section 4):  u' = normalize(u - (u . n_alpha) n_alpha).
+// coplanar). We implement the in-plane projection instead (docs/design.md
+// section 5):  u' = normalize(u - (u . n_alpha) n_alpha).
 #include <Eigen/Core>
 
 #include "rvlio/constraints/constraint.h"

@@ -1,7 +1,7 @@
 #pragma once
 // The RV pass of one scan (one filter iteration): Alg. 1 criterion ->
 // Alg. 2 reinforcement -> Alg. 3 repair, applied in place to the constraint
-// list before the estimator uses it (DESIGN.md sections 3-4).
+// list before the estimator uses it (docs/design.md sections 4-5).
 #include <Eigen/Core>
 
 #include "rvlio/constraints/constraint.h"

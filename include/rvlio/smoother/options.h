@@ -1,5 +1,5 @@
 #pragma once
-// Sliding-window smoother and batch refinement (DESIGN.md section 5).
+// Sliding-window smoother and batch refinement (docs/design.md section 6).
 #include <string>
 
 #include "rvlio/common/options.h"

@@ -1,6 +1,6 @@
 #pragma once
 // All point-to-plane constraints of one scan as one Ceres cost function
-// (DESIGN.md sections 3 and 5). One parameter block: the scan's pose
+// (docs/design.md sections 4 and 6). One parameter block: the scan's pose
 // (PoseBlock, 7). Extrinsics are fixed (constructor argument).
 //
 // For constraint i (paper Eq. 3, constraints/point_to_plane.h):
