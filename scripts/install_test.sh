@@ -32,19 +32,8 @@ passed=0
 failed=0
 trap 'rm -rf "$work"' EXIT
 
-check() {  # check NAME COMMAND...: one test
-  local name=$1; shift
-  if "$@"; then
-    echo "ok - $name"; passed=$((passed + 1))
-  else
-    echo "FAIL - $name"; failed=$((failed + 1))
-  fi
-}
-fatal() {
-  echo "install: error: $*" >&2
-  echo "install: $passed passed, $((failed + 1)) failed"
-  exit 1
-}
+stage=install
+source scripts/stage_checks.sh
 
 if [[ ! -f build/CMakeCache.txt ]]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null

@@ -39,17 +39,8 @@ passed=$((passed + $(count passed)))
 failed=$((failed + $(count failed) + $(count error)))
 [[ $(count passed) -gt 0 ]] || failed=$((failed + 1))  # no test ran at all
 
-check() {  # check NAME COMMAND...: one pass or fail
-  local name=$1
-  shift
-  if "$@"; then
-    echo "python: ok: $name"
-    passed=$((passed + 1))
-  else
-    echo "python: FAILED: $name" >&2
-    failed=$((failed + 1))
-  fi
-}
+stage=python
+source scripts/stage_checks.sh
 
 # 2. The example on a short sequence.
 example() {

@@ -48,19 +48,8 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 
-check() {  # check NAME COMMAND...: one test
-  local name=$1; shift
-  if "$@"; then
-    echo "ok - $name"; passed=$((passed + 1))
-  else
-    echo "FAIL - $name"; failed=$((failed + 1))
-  fi
-}
-fatal() {
-  echo "slurm: error: $*" >&2
-  echo "slurm: $passed passed, $((failed + 1)) failed"
-  exit 1
-}
+stage=slurm
+source scripts/stage_checks.sh
 
 if [[ ! -x $rvlio ]]; then
   echo "slurm: building $rvlio"
