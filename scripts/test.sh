@@ -51,37 +51,24 @@ count_tests() {
 bash scripts/install_deps.sh --with-test-tools
 finish_stage deps
 
-if want release; then
-  bash scripts/build.sh -DRVLIO_WERROR=ON
-  (cd build && ctest --output-on-failure -j "$jobs") 2>&1 | tee "$log"
+# run_stage NAME COMMAND...: one stage whose output names its count of tests.
+run_stage() {
+  local name=$1
+  shift
+  want "$name" || return 0
+  "$@" 2>&1 | tee "$log"
   count_tests
-  finish_stage release
-fi
-if want install; then
-  bash scripts/install_test.sh 2>&1 | tee "$log"
-  count_tests
-  finish_stage install
-fi
-if want python; then
-  bash scripts/python_test.sh 2>&1 | tee "$log"
-  count_tests
-  finish_stage python
-fi
-if want sanitize; then
-  bash scripts/sanitize.sh 2>&1 | tee "$log"
-  count_tests
-  finish_stage sanitize
-fi
-if want fuzz; then
-  bash scripts/fuzz.sh --ci 2>&1 | tee "$log"
-  count_tests
-  finish_stage fuzz
-fi
-if want slurm; then
-  bash scripts/slurm_test.sh 2>&1 | tee "$log"
-  count_tests
-  finish_stage slurm
-fi
+  finish_stage "$name"
+}
+release() {
+  bash scripts/build.sh -DRVLIO_WERROR=ON && (cd build && ctest --output-on-failure -j "$jobs")
+}
+run_stage release release
+run_stage install bash scripts/install_test.sh
+run_stage python bash scripts/python_test.sh
+run_stage sanitize bash scripts/sanitize.sh
+run_stage fuzz bash scripts/fuzz.sh --ci
+run_stage slurm bash scripts/slurm_test.sh
 
 echo "test.sh: stages $stages passed; wall time per stage: $(IFS=,; echo "${times[*]}" | sed 's/,/, /g')"
 echo "test.sh: $passed passed, 0 failed"

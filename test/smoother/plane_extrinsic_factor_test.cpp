@@ -16,17 +16,7 @@
 namespace rvlio {
 namespace {
 
-ConstraintList RandomConstraints(std::mt19937& rng, int n) {
-  std::uniform_real_distribution<double> w(0.0, 2.0);
-  ConstraintList list(n);
-  for (Constraint& c : list) {
-    c.p_lidar = test::RandomVector(rng, 10.0);
-    c.normal_world = test::RandomVector(rng, 1.0).normalized();
-    c.q_world = test::RandomVector(rng, 10.0);
-    c.weight = w(rng);
-  }
-  return list;
-}
+using test::RandomConstraints;
 
 TEST(PlaneExtrinsicFactor, ResidualsAreTheSharedModelScaledByWeight) {
   std::mt19937 rng(41);

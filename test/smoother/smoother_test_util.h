@@ -92,6 +92,20 @@ inline Vector3d RandomVector(std::mt19937& rng, double sigma) {
   return Vector3d(n(rng), n(rng), n(rng));
 }
 
+// n point-to-plane constraints with random points, normals, plane points
+// and weights in [0, 2).
+inline ConstraintList RandomConstraints(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> w(0.0, 2.0);
+  ConstraintList list(n);
+  for (Constraint& c : list) {
+    c.p_lidar = RandomVector(rng, 10.0);
+    c.normal_world = RandomVector(rng, 1.0).normalized();
+    c.q_world = RandomVector(rng, 10.0);
+    c.weight = w(rng);
+  }
+  return list;
+}
+
 inline PoseBlock RandomPose(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::Quaterniond q(u(rng), u(rng), u(rng), u(rng));
