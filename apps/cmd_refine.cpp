@@ -2,8 +2,11 @@
 // signals and lines: reads the whole bag into memory (downsampled scans and
 // all IMU samples), batch-refines the initial trajectory (smoother/refine.h)
 // and writes trajectory.tum, map.pcd and summary.json atomically.
+#include <cerrno>
 #include <chrono>
+#include <climits>
 #include <cstdio>
+#include <cstdlib>
 #include <utility>
 
 #include "cli.h"
@@ -48,6 +51,32 @@ int ReadCheckpointArgs(const Args& args, RefineArgs* req) {
   return 0;
 }
 
+// A whole number from an option's text; false for anything else.
+bool ParseInt(const std::string& text, int* value) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno != 0 || v < INT_MIN || v > INT_MAX) return false;
+  *value = static_cast<int>(v);
+  return true;
+}
+
+// --chunk K --of N: both or neither, whole numbers (their range is checked
+// against the initial trajectory by RefineRecording).
+int ReadChunkArgs(const Args& args, RefineArgs* req) {
+  if (args.Has("chunk") != args.Has("of"))
+    return Fail("refine", args.Has("chunk") ? "--chunk needs --of N (the number of chunks)"
+                                            : "--of needs --chunk K (which chunk, 1..N)");
+  if (!args.Has("chunk")) return 0;
+  if (!ParseInt(args.Get("chunk"), &req->chunk))
+    return Fail("refine", "--chunk " + args.Get("chunk") + ": not a whole number");
+  if (!ParseInt(args.Get("of"), &req->chunk_count))
+    return Fail("refine", "--of " + args.Get("of") + ": not a whole number");
+  if (req->chunk_count < 1)
+    return Fail("refine", "--of " + args.Get("of") + ": needs at least 1 chunk");
+  return 0;
+}
+
 }  // namespace
 
 int CmdRefine(int argc, char** argv) {
@@ -66,6 +95,11 @@ int CmdRefine(int argc, char** argv) {
                     {"resume", "DIR",
                      "continue from DIR/refine.checkpoint (same --bag, --init, --config and --set; "
                      "smoother.refine_rounds may differ) and go on checkpointing there"},
+                    {"chunk", "K",
+                     "refine only chunk K (1-based) of --of N overlapping chunks of the initial "
+                     "trajectory's span (smoother.refine_job_overlap_s); writes chunk.json too, "
+                     "for `rvlio merge`"},
+                    {"of", "N", "the number of chunks (with --chunk)"},
                     AllowDivergenceOption(),
                     StartOption(),
                     DurationOption()}};
@@ -89,6 +123,7 @@ int CmdRefine(int argc, char** argv) {
   if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
   req.init = std::move(*init);
   if (int rc = ReadCheckpointArgs(args, &req); rc != 0) return rc;
+  if (int rc = ReadChunkArgs(args, &req); rc != 0) return rc;
   const int rounds = req.options.smoother.refine_rounds;
   req.on_round = [rounds](const RefineRound& r) { PrintRound(r, rounds); };
   req.on_resume = [&req](int rounds_done) {
@@ -114,6 +149,12 @@ int CmdRefine(int argc, char** argv) {
                  req.out_dir.c_str());
     return InterruptExitCode();
   }
+  if (!result->chunk.is_null())
+    std::printf("rvlio refine: chunk %d of %d: scans ending %.3f .. %.3f s (its own %.3f .. %.3f s)\n",
+                req.chunk, req.chunk_count, result->chunk["begin_ns"].get<int64_t>() * 1e-9,
+                result->chunk["end_ns"].get<int64_t>() * 1e-9,
+                result->chunk["core_begin_ns"].get<int64_t>() * 1e-9,
+                result->chunk["core_end_ns"].get<int64_t>() * 1e-9);
   std::printf("rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
               refined.trajectory.size(), refined.rounds.size(),
               refined.converged ? " (converged)" : "", refined.linear_solver.c_str(),

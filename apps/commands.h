@@ -5,6 +5,7 @@ namespace rvlio::cli {
 
 int CmdRun(int argc, char** argv);
 int CmdRefine(int argc, char** argv);
+int CmdMerge(int argc, char** argv);
 int CmdSimulate(int argc, char** argv);
 int CmdEval(int argc, char** argv);
 int CmdCompare(int argc, char** argv);

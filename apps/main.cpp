@@ -19,6 +19,8 @@ constexpr Subcommand kSubcommands[] = {
     {"run", "run the odometry (IESKF or smoother) on a ROS1 or ROS 2 bag", rvlio::cli::CmdRun},
     {"refine", "offline batch refinement of a whole sequence from an initial trajectory",
      rvlio::cli::CmdRefine},
+    {"merge", "merge the chunk jobs of `refine --chunk K --of N` into one trajectory and map",
+     rvlio::cli::CmdMerge},
     {"simulate", "simulate a tunnel flight: ROS1/ROS 2 bag, ground truth and sensor config",
      rvlio::cli::CmdSimulate},
     {"eval", "ATE/RPE of an estimated trajectory against ground truth (evo definitions)",

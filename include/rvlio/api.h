@@ -105,6 +105,14 @@ struct RefineArgs {
   StopFn stop;  // polled while reading and between rounds: the last completed round is the result
   std::function<void(const RefineRound&)> on_round;  // after each round
   std::function<void(int rounds_done)> on_resume;    // a checkpoint was loaded
+  // Chunk job (`rvlio refine --chunk K --of N`, smoother/refine_jobs.h): when
+  // chunk_count > 0, refines only chunk `chunk` (1-based) of chunk_count
+  // chunks of the initial trajectory's span, overlapping by
+  // smoother.refine_job_overlap_s; only that chunk's scans (and the IMU
+  // samples around them) are kept while reading. out_dir then also receives
+  // chunk.json, which MergeRefineChunks reads.
+  int chunk = 0;
+  int chunk_count = 0;
 };
 
 struct RefineRunResult {
@@ -115,11 +123,35 @@ struct RefineRunResult {
   std::string stop_reason;
   bool read_complete = true;    // false: stopped while reading; nothing refined or written
   bool written = false;
+  nlohmann::json chunk;         // chunk.json of a chunk job (null otherwise)
 };
 
 // Errors: unreadable inputs, a checkpoint that is missing or belongs to other
 // inputs, a failed refinement (the message names the bag and init).
 StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args);
+
+// ---------------------------------------------------------------------------
+// merge: the chunk jobs of one recording into one trajectory and map
+// ---------------------------------------------------------------------------
+
+struct MergeArgs {
+  std::vector<std::string> chunk_dirs;  // the output folders of `refine --chunk K --of N`, any order
+  std::string out_dir;  // empty: nothing written; else trajectory.tum, map.pcd, summary.json
+};
+
+struct MergeResult {
+  Trajectory trajectory;                    // T_world_imu, the merged frame is chunk 1's
+  std::vector<Eigen::Vector3d> map_points;  // the chunks' maps carried into that frame, re-voxelized
+  nlohmann::json summary;                   // summary.json
+  std::vector<std::string> warnings;        // the chunks' warnings, each once
+  bool written = false;
+};
+
+// InvalidInput (one line naming the folder or the chunk) for a folder without
+// a readable chunk.json, trajectory.tum or map.pcd, chunks of different N,
+// options, initial trajectory or overlap, a chunk given twice, a missing
+// chunk K, or neighbours that share too few poses (smoother/refine_jobs.h).
+StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args);
 
 // ---------------------------------------------------------------------------
 // simulate: a simulated recording with its ground truth and sensor config

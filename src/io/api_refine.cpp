@@ -4,7 +4,10 @@
 // trajectory.tum, map.pcd and summary.json atomically. `rvlio refine` is this
 // call plus argument parsing, signals and the terminal lines.
 #include <chrono>
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 #include "rvlio/api.h"
@@ -15,6 +18,7 @@
 #include "rvlio/io/summary_json.h"
 #include "rvlio/io/trajectory_io.h"
 #include "rvlio/lidar/preprocess.h"
+#include "rvlio/smoother/refine_jobs.h"
 
 namespace rvlio {
 namespace {
@@ -42,28 +46,145 @@ RefineConfig ToRefineConfig(const OdometryOptions& o) {
 // What `stop` says now ("" goes on).
 std::string StopReason(const RefineArgs& args) { return args.stop ? args.stop() : std::string(); }
 
+// IMU samples kept around a chunk job's scans (before its first scan's
+// start, after its last scan's end).
+constexpr TimeNs kChunkImuMarginNs = 1000000000;  // 1 s
+
+// What the reader saw of the recording's scans (all of them, also those a
+// chunk job does not keep): the coverage of the initial trajectory.
+struct ScansSeen {
+  int64_t scans = 0;
+  TimeNs first_end_ns = 0, last_end_ns = 0;
+  int64_t outside_init = 0;  // end stamp outside the initial trajectory's span
+  int64_t chunk_first = -1, chunk_last = -1;  // recording index (0-based) of a chunk's kept scans
+};
+
+// A chunk job keeps the IMU samples around its scans and, as the whole
+// refinement, those of the recording's first imu.init_duration (from
+// `static_end_ns` on: the static alignment that gives gravity and the gyro
+// bias, refine_init.h), so every chunk starts from the same gravity vector.
+bool KeepImu(const RefineJobSpan* job, TimeNs static_end_ns, TimeNs t_ns) {
+  if (job == nullptr || t_ns <= static_end_ns) return true;
+  return (job->chunk == 1 || t_ns >= job->begin_ns - kChunkImuMarginNs) &&
+         (job->chunk == job->count || t_ns <= job->end_ns + kChunkImuMarginNs);
+}
+
+void CountScan(const Scan& scan, const Trajectory& init, ScansSeen* seen) {
+  if (seen->scans == 0) seen->first_end_ns = scan.t_end_ns;
+  seen->first_end_ns = std::min(seen->first_end_ns, scan.t_end_ns);
+  seen->last_end_ns = std::max(seen->last_end_ns, scan.t_end_ns);
+  if (scan.t_end_ns < init.front().t_ns || scan.t_end_ns > init.back().t_ns) ++seen->outside_init;
+  ++seen->scans;
+}
+
 // Every IMU sample and every scan, downsampled as the odometry does
-// (lidar/preprocess.h), so that a 100 s sequence stays small in memory.
+// (lidar/preprocess.h), so that a 100 s sequence stays small in memory; a
+// chunk job (`job`) keeps only its scans and the IMU samples around them.
 // Stops early (Ok, *stop_reason set) when `stop` says so.
-Status ReadBag(const RefineArgs& args, SensorBagReader* reader, RefineInput* input,
-               int64_t* raw_points, std::string* stop_reason) {
+Status ReadBag(const RefineArgs& args, const RefineJobSpan* job, SensorBagReader* reader,
+               RefineInput* input, int64_t* raw_points, ScansSeen* seen,
+               std::string* stop_reason) {
   ScanPreprocessor preprocessor(args.options.lidar);
   ImuSample imu;
   Scan scan;
+  TimeNs static_end_ns = 0;
   while ((*stop_reason = StopReason(args)).empty()) {
     StatusOr<SensorMessage> m = reader->Next(&imu, &scan);
     if (!m.ok()) return m.status();
     if (*m == SensorMessage::kEnd) return Status::Ok();
     if (*m == SensorMessage::kImu) {
-      input->imu.push_back(imu);
+      if (input->imu.empty()) static_end_ns = imu.t_ns + SecondsToNs(args.options.imu.init_duration);
+      if (KeepImu(job, static_end_ns, imu.t_ns)) input->imu.push_back(imu);
       continue;
     }
+    CountScan(scan, input->init, seen);
+    if (job != nullptr && !job->Contains(scan.t_end_ns)) continue;
+    if (seen->chunk_first < 0) seen->chunk_first = seen->scans - 1;
+    seen->chunk_last = seen->scans - 1;
     *raw_points += static_cast<int64_t>(scan.points.size());
     Scan small;
     preprocessor.Downsample(scan, &small);
     input->scans.push_back(std::move(small));
   }
   return Status::Ok();
+}
+
+std::string SecondsText(TimeNs t_ns) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3f", NsToSeconds(t_ns));
+  return buf;
+}
+
+// Scans the initial trajectory may leave out at the recording's start beyond
+// imu.init_duration (the odometry's static initialization has no poses) and
+// at its end, before refine says it covers only part of the recording.
+constexpr double kCoverageSlackS = 0.5;
+
+bool CoversRecording(const ScansSeen& seen, const Trajectory& init, double init_duration_s) {
+  if (seen.outside_init == 0) return true;
+  const double lead_s = NsToSeconds(init.front().t_ns - seen.first_end_ns);
+  const double tail_s = NsToSeconds(seen.last_end_ns - init.back().t_ns);
+  return lead_s <= init_duration_s + kCoverageSlackS && tail_s <= kCoverageSlackS;
+}
+
+// The warning when the initial trajectory leaves a part of the recording out
+// (empty when it covers it, CoversRecording).
+std::string CoverageWarning(const ScansSeen& seen, const Trajectory& init,
+                            double init_duration_s) {
+  if (CoversRecording(seen, init, init_duration_s)) return "";
+  return "the initial trajectory (" + SecondsText(init.front().t_ns) + " .. " +
+         SecondsText(init.back().t_ns) + " s) covers only part of the recording's scans (" +
+         SecondsText(seen.first_end_ns) + " .. " + SecondsText(seen.last_end_ns) + " s): " +
+         std::to_string(seen.outside_init) + " of " + std::to_string(seen.scans) +
+         " scans outside it are not refined";
+}
+
+nlohmann::json CoverageJson(const ScansSeen& seen, const Trajectory& init,
+                            double init_duration_s) {
+  return {{"init_begin_s", NsToSeconds(init.front().t_ns)},
+          {"init_end_s", NsToSeconds(init.back().t_ns)},
+          {"scans_begin_s", NsToSeconds(seen.first_end_ns)},
+          {"scans_end_s", NsToSeconds(seen.last_end_ns)},
+          {"recording_scans", seen.scans},
+          {"scans_outside_init", seen.outside_init},
+          {"complete", CoversRecording(seen, init, init_duration_s)}};
+}
+
+std::string HashText(uint64_t h) {
+  char buf[17];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+// chunk.json of a chunk job: what `rvlio merge` needs to check and merge it.
+nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const ScansSeen& seen,
+                         uint64_t init_hash, const RefineResult& res) {
+  return {{"format", 1},
+          {"chunk", job.chunk},
+          {"of", job.count},
+          {"overlap_s", args.options.smoother.refine_job_overlap_s},
+          {"core_begin_ns", job.core_begin_ns},
+          {"core_end_ns", job.core_end_ns},
+          {"begin_ns", job.begin_ns},
+          {"end_ns", job.end_ns},
+          {"recording_scan_first", seen.chunk_first},
+          {"recording_scan_last", seen.chunk_last},
+          {"scans_refined", res.trajectory.size()},
+          {"t_first_ns", res.trajectory.front().t_ns},
+          {"t_last_ns", res.trajectory.back().t_ns},
+          {"map_output_resolution", args.options.map.output_resolution},
+          {"options_hash", HashText(ConfigHash(args.options))},
+          {"init_hash", HashText(init_hash)},
+          {"interrupted", res.stopped},
+          {"bag", args.bag},
+          {"init", args.init_path}};
+}
+
+std::string ShortChunk(const RefineJobSpan& job, size_t scans) {
+  return "--chunk " + std::to_string(job.chunk) + " --of " + std::to_string(job.count) +
+         ": the chunk (" + SecondsText(job.begin_ns) + " .. " + SecondsText(job.end_ns) +
+         " s) holds " + std::to_string(scans) + " scans, fewer than " +
+         std::to_string(kRefineJobMinScans) + "; use fewer chunks";
 }
 
 nlohmann::json StatsJson(const RefineStats& s, const SensorReaderStats& r, int64_t raw_points) {
@@ -123,6 +244,9 @@ nlohmann::json Summary(const RefineArgs& args, const RefineRunResult& r,
 Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r) {
   OutputStage stage(out_dir);  // all outputs or none
   if (Status s = stage.Open(); !s.ok()) return s;
+  if (!r.chunk.is_null())
+    if (Status s = WriteFileAtomically(stage.Path("chunk.json"), JsonText(r.chunk) + "\n"); !s.ok())
+      return stage.Explain(s);
   if (Status s = WriteTum(stage.Path("trajectory.tum"), r.refine.trajectory); !s.ok())
     return stage.Explain(s);
   if (Status s = WriteMapPcd(stage.Path("map.pcd"), r.refine.map_points); !s.ok())
@@ -182,6 +306,16 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args) {
     if (!init.ok()) return init.status();
     input.init = std::move(*init);
   }
+  std::optional<RefineJobSpan> job;
+  if (args.chunk_count > 0) {
+    StatusOr<RefineJobSpan> span =
+        MakeRefineJobSpan(input.init.front().t_ns, input.init.back().t_ns, args.chunk,
+                          args.chunk_count, args.options.smoother.refine_job_overlap_s);
+    if (!span.ok()) return span.status();
+    job = *span;
+  }
+  const uint64_t init_hash = job ? TrajectoryHash(input.init) : 0;
+  const Trajectory init_span = {input.init.front(), input.init.back()};
   if (Status s = PrepareCheckpointDir(args); !s.ok()) return s;
   StatusOr<std::unique_ptr<SensorBagReader>> reader = OpenSensorStream(
       args.bag, args.options.lidar, args.options.imu, args.window, args.options.io);
@@ -192,13 +326,18 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args) {
 
   RefineRunResult r;
   int64_t raw_points = 0;
-  if (Status s = ReadBag(args, reader->get(), &input, &raw_points, &r.stop_reason); !s.ok())
+  ScansSeen seen;
+  if (Status s = ReadBag(args, job ? &*job : nullptr, reader->get(), &input, &raw_points, &seen,
+                         &r.stop_reason);
+      !s.ok())
     return s;
   if (!r.stop_reason.empty()) {  // stopped while reading: nothing refined or written
     r.stopped = true;
     r.read_complete = false;
     return r;
   }
+  if (job && static_cast<int64_t>(input.scans.size()) < kRefineJobMinScans)
+    return Status::InvalidInput(ShortChunk(*job, input.scans.size()));
   Times times;
   times.read_s = SecondsSince(t0);
   StatusOr<RefineResult> refined =
@@ -210,12 +349,16 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args) {
                                                             : Status::InvalidInput(what);
   }
   r.refine = std::move(*refined);
+  if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
+  if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, r.refine);
   r.stopped = r.refine.stopped;
   if (!r.stopped) r.stop_reason.clear();
   r.divergence = CheckRefineResult(r.refine, args.options.divergence,
                                    args.options.constraints.lidar_noise, args.options.imu.gravity);
   times.wall_s = SecondsSince(t0);
   r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
+  r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
+  if (job) r.summary["chunk"] = r.chunk;
   if (!write) return r;
   if (Status s = WriteOutputs(args.out_dir, r); !s.ok()) return s;
   r.written = true;

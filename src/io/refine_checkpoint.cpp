@@ -128,6 +128,23 @@ json RoundJson(const RefineRound& r) {
             {"total", r.total_s}}}};
 }
 
+uint64_t ConfigHash(const OdometryOptions& options) {
+  Fnv1a h;
+  h.AddText(ToJson(options).dump());
+  return h.value();
+}
+
+uint64_t TrajectoryHash(const Trajectory& trajectory) {
+  Fnv1a h;
+  for (const StampedPose& p : trajectory) {
+    h.Add(p.t_ns);
+    for (int i = 0; i < 3; ++i) h.Add(p.p_world_imu[i]);
+    for (double q : {p.q_world_imu.x(), p.q_world_imu.y(), p.q_world_imu.z(), p.q_world_imu.w()})
+      h.Add(q);
+  }
+  return h.value();
+}
+
 uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input) {
   OdometryOptions config = options;
   config.smoother.refine_rounds = 0;  // resuming may go on for more rounds

@@ -13,6 +13,9 @@ namespace rvlio {
 
 // Binary PCD (x y z float32; header made by PCL), written atomically.
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
+// Reads a map WriteMapPcd wrote (binary, fields x y z float32, one row per
+// point). InvalidInput naming the file for anything else, or a short file.
+StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
 
 // One row per scan: time, status, point and constraint counts, the RV report,
 // the processing time and `rss_mb[i]`, the process's resident memory (MB) when
