@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include <Eigen/Core>
 #include <gtest/gtest.h>
 
 #include "cli_util.h"
@@ -116,28 +117,33 @@ TEST_F(RefineChunksCliTest, MergedChunksAgreeWithTheWholeRefineAndBeatTheInit) {
                ate_merged = Ate(out + "/trajectory.tum");
   std::printf("ATE init %.4f whole %.4f merged %.4f m; merged - whole RMS %.4f m\n", ate_init,
               ate_whole, ate_merged, rms_m);
-  // Measured (docs/refine_chunks.md): init ~12 mm, whole ~5 mm, merged ~6 mm, RMS ~3 mm.
+  // Measured (docs/refine_chunks.md): init 15.0 mm, whole 6.2 mm, merged 6.4 mm, RMS 3.8 mm.
   EXPECT_LT(rms_m, 0.01);
   EXPECT_LT(ate_merged, ate_whole + 0.005);
   EXPECT_LT(ate_merged, 0.8 * ate_init);
 
-  // No step at a border: the change of the pose-to-pose step (second
-  // difference) inside the shared intervals stays within what it is away
-  // from them (the refined trajectory's own noise), with a 50% margin.
+  // No step at a border. The flight itself accelerates (its positions' second
+  // differences reach ~4 cm), so the steps are those of the difference to
+  // the whole refine, e_i = merged_i - whole_i: a jump at a border would be
+  // one large |e_i - e_(i-1)|. Inside the shared intervals the step stays
+  // within twice its largest value elsewhere (slowly varying drift
+  // differences), or 1 mm.
   std::vector<double> borders_s;
   for (int k = 1; k < 3; ++k)
     borders_s.push_back(
         nlohmann::json::parse(ReadFile(ChunkDir(k) + "/chunk.json"))["core_end_ns"].get<int64_t>() * 1e-9);
   double at_borders_m = 0.0, elsewhere_m = 0.0;
-  for (size_t i = 1; i + 1 < merged.p.size(); ++i) {
-    const double d2 = (merged.p[i + 1] - 2.0 * merged.p[i] + merged.p[i - 1]).norm();
+  for (size_t i = 1; i < merged.p.size(); ++i) {
+    const double step =
+        ((merged.p[i] - whole.p[i]) - (merged.p[i - 1] - whole.p[i - 1])).norm();
     const bool shared = std::any_of(borders_s.begin(), borders_s.end(),
                                     [&](double b) { return std::abs(merged.t_s[i] - b) <= 1.5; });
-    (shared ? at_borders_m : elsewhere_m) = std::max(shared ? at_borders_m : elsewhere_m, d2);
+    double& worst = shared ? at_borders_m : elsewhere_m;
+    worst = std::max(worst, step);
   }
-  std::printf("largest second difference: %.5f m at the borders, %.5f m elsewhere\n", at_borders_m,
-              elsewhere_m);
-  EXPECT_LT(at_borders_m, 1.5 * elsewhere_m);
+  std::printf("largest step of merged - whole: %.5f m at the borders, %.5f m elsewhere\n",
+              at_borders_m, elsewhere_m);
+  EXPECT_LT(at_borders_m, std::max(2.0 * elsewhere_m, 0.001));
 }
 
 TEST_F(RefineChunksCliTest, ChunkJsonRecordsTheSpanAndTheHashes) {
