@@ -17,7 +17,11 @@
 #      cell alone fails and its log is named; a job cancelled while it runs is
 #      submitted again (the profile's restart-times) and the grid finishes
 #
-#   5. no process of any job is left
+#   5. refine chunk jobs (workflow/refine_chunks.smk): a short simulated
+#      tunnel refined in 3 chunks + merge through Slurm (each chunk and the
+#      merge one Slurm job, COMPLETED) gives the same merged trajectory.tum
+#      and map.pcd, byte for byte, as the same workflow run locally
+#   6. no process of any job is left
 #
 # Prints "ok - ..." / "FAIL - ..." per check and ends with
 # "slurm: N passed, M failed"; exit 1 when a check failed or the cluster did
@@ -249,6 +253,55 @@ retried_ok() {
 }
 check "a job cancelled while running ($retried_job, cell $retried_cell) was submitted again and finished" retried_ok
 
+# 5. Refine chunk jobs: the same 3 chunks + merge locally and through Slurm.
+chunks_cfg() {  # the --config of workflow/refine_chunks.smk for output folder $1
+  echo bag="$work/chunks_data/tunnel.bag" init="$work/chunks_init/trajectory.tum" chunks=3 \
+    out="$1" config="[$work/chunks_data/tunnel.yaml]" rvlio="$rvlio" \
+    "set=[smoother.refine_rounds=2,smoother.refine_job_overlap_s=3]" cpus="$cpus" mem_mb="$mem_mb" \
+    runtime="$minutes"
+}
+chunks_ready() {
+  "$rvlio" simulate --preset tunnel --seed 3 --duration 12 --set lidar.columns=512 \
+    --out "$work/chunks_data" >"$work/chunks_sim.log" 2>&1 &&
+    "$rvlio" run --bag "$work/chunks_data/tunnel.bag" --config "$work/chunks_data/tunnel.yaml" \
+      --set backend=ieskf --out "$work/chunks_init" >"$work/chunks_run.log" 2>&1
+}
+check "a 12 s tunnel simulated and run (IESKF) for the chunk jobs" chunks_ready
+# shellcheck disable=SC2046  # chunks_cfg prints one word per key=value
+chunks_local() {
+  (cd "$work" && timeout 300 snakemake -s "$repo/workflow/refine_chunks.smk" -j 2 \
+    --config $(chunks_cfg "$work/chunks_local") >"$work/run_chunks_local.log" 2>&1)
+}
+check "workflow/refine_chunks.smk runs 3 chunks + merge locally" chunks_local
+sm=$work/sm_chunks
+mkdir -p "$sm"
+# shellcheck disable=SC2046
+chunks_slurm() {
+  (cd "$sm" && timeout 300 snakemake -s "$repo/workflow/refine_chunks.smk" \
+    --profile "$repo/workflow/profiles/slurm" --default-resources slurm_partition=rvlio \
+    --max-status-checks-per-second 1 --latency-wait 5 \
+    --config $(chunks_cfg "$work/chunks_slurm") >"$work/run_chunks_slurm.log" 2>&1)
+}
+check "workflow/refine_chunks.smk runs 3 chunks + merge through Slurm" chunks_slurm
+chunk_jobs_completed() {  # every chunk and the merge: one Slurm job, COMPLETED
+  local rule f n
+  for rule in chunk:3 merge:1; do
+    n=0
+    for f in "$sm/.snakemake/slurm_logs/rule_${rule%%:*}"/*.log; do
+      [[ -f $f ]] || continue
+      [[ $(job_state "$(basename "$f" .log)") == COMPLETED ]] || { echo "  $f: not COMPLETED" >&2; return 1; }
+      n=$((n + 1))
+    done
+    [[ $n -eq ${rule##*:} ]] || { echo "  rule ${rule%%:*}: $n Slurm jobs, expected ${rule##*:}" >&2; return 1; }
+  done
+}
+check "each chunk and the merge ran as one Slurm job (sacct: COMPLETED)" chunk_jobs_completed
+same_merge() {
+  cmp "$work/chunks_local/merged/trajectory.tum" "$work/chunks_slurm/merged/trajectory.tum" &&
+    cmp "$work/chunks_local/merged/map.pcd" "$work/chunks_slurm/merged/map.pcd"
+}
+check "Slurm's merged trajectory.tum and map.pcd equal the local ones (cmp)" same_merge
+
 # Nothing of any job is still running (a cancelled job's processes included;
 # Slurm kills them KillWait = 5 s after the SIGTERM).
 leftovers() {
@@ -268,7 +321,9 @@ leftovers() {
 check "no process of any job (cancelled ones included) is left running" leftovers
 
 if [[ $failed -gt 0 ]]; then
-  for f in "$work"/run*.log; do echo "---- $f (last 30 lines)"; tail -n 30 "$f"; done
+  for f in "$work"/run*.log "$work"/chunks_*.log; do
+    [[ -f $f ]] && { echo "---- $f (last 30 lines)"; tail -n 30 "$f"; }
+  done
 fi
 echo "slurm: $passed passed, $failed failed"
 [[ $failed -eq 0 ]]

@@ -173,7 +173,7 @@ nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const
           {"t_first_ns", res.trajectory.front().t_ns},
           {"t_last_ns", res.trajectory.back().t_ns},
           {"map_output_resolution", args.options.map.output_resolution},
-          {"options_hash", HashText(ConfigHash(args.options))},
+          {"options_hash", HashText(RefineOptionsHash(args.options))},
           {"init_hash", HashText(init_hash)},
           {"interrupted", res.stopped},
           {"bag", args.bag},

@@ -128,9 +128,11 @@ json RoundJson(const RefineRound& r) {
             {"total", r.total_s}}}};
 }
 
-uint64_t ConfigHash(const OdometryOptions& options) {
+uint64_t RefineOptionsHash(const OdometryOptions& options) {
+  OdometryOptions config = options;
+  config.smoother.refine_threads = 0;
   Fnv1a h;
-  h.AddText(ToJson(options).dump());
+  h.AddText(ToJson(config).dump());
   return h.value();
 }
 

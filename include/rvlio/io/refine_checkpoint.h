@@ -20,10 +20,11 @@ namespace rvlio {
 constexpr const char* kCheckpointFile = "refine.checkpoint";
 
 uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input);
-// The same hash (FNV-1a 64) over the configuration alone (its JSON) and over
-// a trajectory's stamps and poses: what chunk.json records so that `rvlio
-// merge` only merges chunks of one refinement (refine_jobs.h).
-uint64_t ConfigHash(const OdometryOptions& options);
+// The same hash (FNV-1a 64) over the configuration alone (its JSON, except
+// smoother.refine_threads: refine's result is bit-identical on any thread
+// count) and over a trajectory's stamps and poses: what chunk.json records so
+// that `rvlio merge` only merges chunks of one refinement (refine_jobs.h).
+uint64_t RefineOptionsHash(const OdometryOptions& options);
 uint64_t TrajectoryHash(const Trajectory& trajectory);
 
 Status WriteRefineCheckpoint(const std::string& dir, uint64_t fingerprint,
