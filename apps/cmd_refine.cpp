@@ -1,7 +1,9 @@
 // `rvlio refine`: RefineRecording (rvlio/api.h) with the command's arguments,
 // signals and lines: reads the whole bag into memory (downsampled scans and
-// all IMU samples), batch-refines the initial trajectory (smoother/refine.h)
-// and writes trajectory.tum, map.pcd and summary.json atomically.
+// all IMU samples; with --chunk K --of N only chunk K's scans and the IMU
+// samples around them), batch-refines the initial trajectory
+// (smoother/refine.h) and writes trajectory.tum, map.pcd and summary.json
+// (and chunk.json) atomically.
 #include <cerrno>
 #include <chrono>
 #include <climits>

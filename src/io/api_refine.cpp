@@ -1,10 +1,11 @@
 // RefineRecording (rvlio/api.h): reads the whole recording into memory
-// (downsampled scans and all IMU samples), batch-refines the initial
+// (downsampled scans and all IMU samples; a chunk job, RefineArgs::chunk,
+// only its chunk's scans and the IMU samples around them), batch-refines the initial
 // trajectory (smoother/refine.h) and, given an output folder, writes
 // trajectory.tum, map.pcd and summary.json atomically. `rvlio refine` is this
 // call plus argument parsing, signals and the terminal lines.
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
