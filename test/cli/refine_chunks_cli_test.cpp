@@ -37,6 +37,10 @@ class RefineChunksCliTest : public ::testing::Test {
     const ToolRun run = RunTool("run --bag " + Bag() + " --config " + Sensors() +
                                     " --set backend=ieskf --out " + dir_ + "/ieskf", dir_);
     ASSERT_EQ(run.exit_code, 0) << run.err;
+  }
+  // The whole refine and chunks 1..3 of 3, which the merge checks work on.
+  // Not in SetUpTestSuite: ctest runs each test case in its own process.
+  static void RefineWholeAndChunks() {
     const ToolRun whole = RunTool(Refine("--out " + dir_ + "/whole"), dir_);
     ASSERT_EQ(whole.exit_code, 0) << whole.err;
     for (int k = 1; k <= 3; ++k) {
@@ -44,6 +48,9 @@ class RefineChunksCliTest : public ::testing::Test {
       ASSERT_EQ(chunk.exit_code, 0) << chunk.err;
     }
   }
+  static void CheckMergeAgreesWithWhole();
+  static void CheckChunkJson();
+  static void CheckBadMerges();
   static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
 
   static std::string Bag() { return dir_ + "/data/tunnel.bag"; }
@@ -91,7 +98,7 @@ Tum ReadPositions(const std::string& path) {
   return out;
 }
 
-TEST_F(RefineChunksCliTest, MergedChunksAgreeWithTheWholeRefineAndBeatTheInit) {
+void RefineChunksCliTest::CheckMergeAgreesWithWhole() {
   const std::string out = dir_ + "/merged";
   const ToolRun merge = RunTool(MergeArgs({3, 1, 2}, out), dir_);  // any order
   ASSERT_EQ(merge.exit_code, 0) << merge.err;
@@ -146,7 +153,7 @@ TEST_F(RefineChunksCliTest, MergedChunksAgreeWithTheWholeRefineAndBeatTheInit) {
   EXPECT_LT(at_borders_m, std::max(2.0 * elsewhere_m, 0.001));
 }
 
-TEST_F(RefineChunksCliTest, ChunkJsonRecordsTheSpanAndTheHashes) {
+void RefineChunksCliTest::CheckChunkJson() {
   const auto c1 = nlohmann::json::parse(ReadFile(ChunkDir(1) + "/chunk.json"));
   const auto c2 = nlohmann::json::parse(ReadFile(ChunkDir(2) + "/chunk.json"));
   EXPECT_EQ(c2["chunk"], 2);
@@ -161,6 +168,15 @@ TEST_F(RefineChunksCliTest, ChunkJsonRecordsTheSpanAndTheHashes) {
   const auto summary = nlohmann::json::parse(ReadFile(ChunkDir(2) + "/summary.json"));
   EXPECT_EQ(summary["chunk"]["chunk"], 2);
   EXPECT_TRUE(summary["init_coverage"]["complete"].get<bool>());
+}
+
+// One case for the chunked refine and everything that needs its chunks.
+TEST_F(RefineChunksCliTest, MergedChunksAgreeWithTheWholeRefineHaveNoBorderStepsAndRefuseBadSets) {
+  RefineWholeAndChunks();
+  if (HasFatalFailure()) return;
+  CheckMergeAgreesWithWhole();
+  CheckChunkJson();
+  CheckBadMerges();
 }
 
 TEST_F(RefineChunksCliTest, BadChunkParametersAreExit2WithOneLine) {
@@ -185,7 +201,8 @@ TEST_F(RefineChunksCliTest, BadChunkParametersAreExit2WithOneLine) {
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/bad/trajectory.tum"));
 }
 
-TEST_F(RefineChunksCliTest, MergeOfAMissingOrForeignChunkIsExit2AndWritesNothing) {
+// A missing, repeated or foreign chunk: exit 2, one line, nothing written.
+void RefineChunksCliTest::CheckBadMerges() {
   const std::string out = dir_ + "/merge_bad";
   ToolRun r = RunTool(MergeArgs({1, 3}, out), dir_);
   EXPECT_EQ(r.exit_code, 2) << r.err;
