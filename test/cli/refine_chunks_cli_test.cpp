@@ -177,6 +177,12 @@ TEST_F(RefineChunksCliTest, MergedChunksAgreeWithTheWholeRefineHaveNoBorderSteps
   CheckMergeAgreesWithWhole();
   CheckChunkJson();
   CheckBadMerges();
+  // Chunk 1 of 1 is the whole refine, byte for byte: the same scans, the
+  // same IMU samples.
+  const ToolRun one = RunTool(Refine("--chunk 1 --of 1 --out " + dir_ + "/one"), dir_);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  for (const char* f : {"/trajectory.tum", "/map.pcd"})
+    EXPECT_EQ(ReadFile(dir_ + "/one" + f), ReadFile(dir_ + "/whole" + f)) << f;
 }
 
 TEST_F(RefineChunksCliTest, BadChunkParametersAreExit2WithOneLine) {
