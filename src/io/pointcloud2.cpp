@@ -317,12 +317,21 @@ TimeMapping AbsoluteMapping(const PointCloud2View& cloud, const Layout& layout,
   return m;
 }
 
+// std::llround(v) without a libm call for |v| < 2^52, where the truncation
+// and the fraction v - trunc(v) are exact (relative times are < 3.6e12 ns).
+int64_t RoundHalfAwayFromZero(double v) {
+  if (!(std::abs(v) < 4.5e15)) return std::llround(v);
+  const int64_t i = static_cast<int64_t>(v);
+  const double frac = v - static_cast<double>(i);
+  return i + (frac >= 0.5 ? 1 : 0) - (frac <= -0.5 ? 1 : 0);
+}
+
 // Absolute ns of a raw time, or false when it is unusable. Absolute seconds
 // are split into whole and fractional seconds to keep the double's precision.
 bool ToAbsoluteNs(double raw, const TimeMapping& m, TimeNs* t_ns) {
   if (std::isnan(raw)) return false;
   if (m.relative) {
-    *t_ns = m.stamp_ns + static_cast<TimeNs>(std::llround(raw + m.shift_ns));
+    *t_ns = m.stamp_ns + static_cast<TimeNs>(RoundHalfAwayFromZero(raw + m.shift_ns));
     return true;
   }
   const double ns = m.seconds ? raw * 1e9 : raw;
@@ -356,6 +365,26 @@ uint16_t ToRing(double v) {
   return static_cast<uint16_t>(v);
 }
 
+// FilterPoint (pointcloud2.h), inlined into the decoding loops.
+inline bool KeepPoint(double x, double y, double z, bool time_ok, const LidarOptions& lidar,
+                      DecodeStats* stats, Eigen::Vector3f* p_lidar) {
+  const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z) &&
+                      std::abs(x) < 1e9 && std::abs(y) < 1e9 && std::abs(z) < 1e9;
+  // The zero and range tests use the stored float coordinates: a float64
+  // coordinate of 1e-50 becomes 0 and must not slip through as a point.
+  if (finite) *p_lidar = Eigen::Vector3f(float(x), float(y), float(z));
+  if (!finite || p_lidar->isZero(0.0f) || !time_ok) {
+    ++stats->invalid_points;
+    return false;
+  }
+  const double r2 = p_lidar->cast<double>().squaredNorm();
+  if (r2 < lidar.min_range * lidar.min_range || r2 > lidar.max_range * lidar.max_range) {
+    ++stats->out_of_range_points;
+    return false;
+  }
+  return true;
+}
+
 template <typename Reader>
 void DecodePoints(const PointCloud2View& cloud, const Reader& reader, const TimeMapping& mapping,
                   const LidarOptions& lidar, Scan* scan, DecodeStats* stats) {
@@ -363,8 +392,8 @@ void DecodePoints(const PointCloud2View& cloud, const Reader& reader, const Time
   ForEachPoint(cloud, [&](const uint8_t* point) {
     LidarPoint p;
     const bool time_ok = ToAbsoluteNs(reader.Time(point), mapping, &p.t_ns);
-    if (!FilterPoint(reader.X(point), reader.Y(point), reader.Z(point), time_ok, lidar, stats,
-                     &p.p_lidar))
+    if (!KeepPoint(reader.X(point), reader.Y(point), reader.Z(point), time_ok, lidar, stats,
+                   &p.p_lidar))
       return;
     if (reader.has_intensity()) {
       const double v = reader.Intensity(point);
@@ -460,21 +489,7 @@ StatusOr<Scan> Decode(const PointCloud2View& cloud, const LidarOptions& lidar,
 
 bool FilterPoint(double x, double y, double z, bool time_ok, const LidarOptions& lidar,
                  DecodeStats* stats, Eigen::Vector3f* p_lidar) {
-  const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z) &&
-                      std::abs(x) < 1e9 && std::abs(y) < 1e9 && std::abs(z) < 1e9;
-  // The zero and range tests use the stored float coordinates: a float64
-  // coordinate of 1e-50 becomes 0 and must not slip through as a point.
-  if (finite) *p_lidar = Eigen::Vector3f(float(x), float(y), float(z));
-  if (!finite || p_lidar->isZero(0.0f) || !time_ok) {
-    ++stats->invalid_points;
-    return false;
-  }
-  const double r2 = p_lidar->cast<double>().squaredNorm();
-  if (r2 < lidar.min_range * lidar.min_range || r2 > lidar.max_range * lidar.max_range) {
-    ++stats->out_of_range_points;
-    return false;
-  }
-  return true;
+  return KeepPoint(x, y, z, time_ok, lidar, stats, p_lidar);
 }
 
 void SetScanTimeBounds(TimeNs fallback_ns, Scan* scan) {
