@@ -170,6 +170,7 @@ StatusOr<Layout> SelectLayout(const PointCloud2View& cloud, const std::string& t
 // Calls fn(point) for every point, row by row; the geometry has been validated.
 template <typename Fn>
 void ForEachPoint(const PointCloud2View& cloud, Fn&& fn) {
+  if (cloud.width == 0) return;  // no points, however many (empty) rows
   for (uint32_t row = 0; row < cloud.height; ++row) {
     const uint8_t* point = cloud.data + uint64_t{row} * cloud.row_step;
     for (uint32_t col = 0; col < cloud.width; ++col, point += cloud.point_step) fn(point);

@@ -162,5 +162,26 @@ TEST(PointCloud2FastPath, ErrorsAreTheGenericReadersErrors) {
   EXPECT_EQ(fast.status().message(), generic.status().message());
 }
 
+// Rows are walked one by one: a cloud of zero-width rows must not visit its
+// (up to 2^32) empty rows. Found by the fuzzer.
+TEST(PointCloud2FastPath, ZeroWidthCloudWithHugeHeightIsEmpty) {
+  RawCloud cloud = test::OusterCloud();
+  cloud.stamp_ns = kStamp;
+  PointCloud2View view = cloud.View();
+  view.height = std::numeric_limits<uint32_t>::max();
+  view.width = 0;
+  view.row_step = 0;
+  LidarOptions lidar;
+  for (const bool fast : {true, false}) {
+    DecodeStats stats;
+    const StatusOr<Scan> scan =
+        fast ? DecodePointCloud2(view, lidar, &stats) : DecodePointCloud2Generic(view, lidar, &stats);
+    ASSERT_TRUE(scan.ok()) << scan.status().message();
+    EXPECT_TRUE(scan->points.empty());
+    EXPECT_EQ(stats.raw_points, 0);
+    EXPECT_EQ(scan->t_start_ns, kStamp);
+  }
+}
+
 }  // namespace
 }  // namespace rvlio
