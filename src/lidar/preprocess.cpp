@@ -45,7 +45,7 @@ void ScanPreprocessor::BeginScan() {
   used_.clear();
 }
 
-size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) const {
+inline size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) const {
   const size_t mask = table_.size() - 1;
   size_t slot = HashVoxelKey(key) & mask;
   while (table_[slot].stamp == stamp_ && table_[slot].key != key) slot = (slot + 1) & mask;
@@ -66,7 +66,7 @@ void ScanPreprocessor::Grow() {
 
 // The table slot of key for the current scan, creating the entry (for point
 // i at squared centre distance d2) when the voxel is new; *created tells.
-size_t ScanPreprocessor::SlotOf(const VoxelKey& key, int i, float d2, bool* created) {
+inline size_t ScanPreprocessor::SlotOf(const VoxelKey& key, int i, float d2, bool* created) {
   size_t slot = FindOrAdd(key);
   *created = table_[slot].stamp != stamp_;
   if (!*created) return slot;
