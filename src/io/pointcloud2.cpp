@@ -225,9 +225,9 @@ double LoadHost(const uint8_t* p) {
   return static_cast<double>(value);
 }
 
-// The common Ouster and Velodyne layouts in host byte order: x, y, z float32,
-// time TimeT (uint32 ns or float32 s), intensity float32 or absent, ring
-// RingT (uint8, uint16 or Absent). Every value is the double GenericReader
+// The common relative-time layouts (Ouster, Velodyne, Livox offset_time) in
+// host byte order: x, y, z float32, time TimeT (uint32 ns or float32 s),
+// intensity float32 or absent, ring RingT (uint8, uint16 or Absent). Every value is the double GenericReader
 // reads, so both decode the same points.
 template <typename TimeT, bool kIntensity, typename RingT>
 class FastReader {
