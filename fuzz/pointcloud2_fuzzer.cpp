@@ -1,6 +1,7 @@
 // libFuzzer target: sensor_msgs/PointCloud2 decoding (io/pointcloud2.h), the
 // entry points the bag reader calls (DetectPointCloud2Layout at open,
-// DecodePointCloud2 per message), on a message built from the fuzz bytes.
+// DecodePointCloud2 per message), on a message built from the fuzz bytes;
+// every decoded scan is also compared with DecodePointCloud2Generic's.
 //
 // Input layout (FuzzedDataProvider; fuzz/make_seeds.py writes the same):
 // integers are taken from the END of the input in this order
@@ -21,6 +22,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -100,6 +102,21 @@ void CheckScan(const PointCloud2View& cloud, const rvlio::LidarOptions& lidar, c
   }
 }
 
+bool SameScan(const Scan& a, const Scan& b) {
+  if (a.points.size() != b.points.size() || a.t_start_ns != b.t_start_ns ||
+      a.t_end_ns != b.t_end_ns)
+    return false;
+  for (size_t i = 0; i < a.points.size(); ++i) {
+    const rvlio::LidarPoint& p = a.points[i];
+    const rvlio::LidarPoint& q = b.points[i];
+    if (std::memcmp(p.p_lidar.data(), q.p_lidar.data(), 3 * sizeof(float)) != 0 ||
+        std::memcmp(&p.intensity, &q.intensity, sizeof(float)) != 0 || p.t_ns != q.t_ns ||
+        p.ring != q.ring)
+      return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -168,5 +185,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   Require(again.ok() && again->points.size() == scan->points.size() &&
               again->t_start_ns == scan->t_start_ns && again->t_end_ns == scan->t_end_ns,
           "explicit layout decodes differently from auto");
+  // The fast path of the common layouts and the generic reader agree bit for bit.
+  DecodeStats generic_stats;
+  const rvlio::StatusOr<Scan> generic = rvlio::DecodePointCloud2Generic(cloud, lidar, &generic_stats);
+  Require(generic.ok(), "generic reader rejects what the fast path decodes");
+  Require(SameScan(*scan, *generic), "fast path and generic reader decode different scans");
+  Require(stats.invalid_points == generic_stats.invalid_points &&
+              stats.out_of_range_points == generic_stats.out_of_range_points &&
+              stats.stamp_is_end == generic_stats.stamp_is_end,
+          "fast path and generic reader count differently");
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 namespace rvlio {
 namespace {
@@ -166,52 +167,107 @@ StatusOr<Layout> SelectLayout(const PointCloud2View& cloud, const std::string& t
   return layout;
 }
 
-// Iterates the points row by row; the geometry has been validated.
-class PointCursor {
- public:
-  explicit PointCursor(const PointCloud2View& cloud)
-      : cloud_(cloud), swap_(cloud.is_bigendian != HostIsBigEndian()) {}
-  uint64_t size() const { return uint64_t{cloud_.height} * cloud_.width; }
-  const uint8_t* Point(uint64_t i) const {
-    const uint64_t row = i / cloud_.width, col = i % cloud_.width;
-    return cloud_.data + row * cloud_.row_step + col * cloud_.point_step;
+// Calls fn(point) for every point, row by row; the geometry has been validated.
+template <typename Fn>
+void ForEachPoint(const PointCloud2View& cloud, Fn&& fn) {
+  if (cloud.width == 0) return;  // no points, however many (empty) rows
+  for (uint32_t row = 0; row < cloud.height; ++row) {
+    const uint8_t* point = cloud.data + uint64_t{row} * cloud.row_step;
+    for (uint32_t col = 0; col < cloud.width; ++col, point += cloud.point_step) fn(point);
   }
-  double Read(uint64_t i, const FieldRef& f) const {
-    return ReadScalar(Point(i) + f.offset, f.datatype, swap_);
-  }
+}
 
- private:
-  const PointCloud2View& cloud_;
-  bool swap_;
-};
-
-// Time field of point i in its native scale: ns for relative layouts, the
-// raw value for absolute ones. NaN when unusable.
-double RawTime(const PointCursor& cursor, uint64_t i, const Layout& layout) {
-  double v = cursor.Read(i, layout.time);
+// Time field value in its native scale: ns for relative layouts, the raw
+// value for absolute ones. NaN when unusable.
+double NormalizeTime(double v, TimeKind kind) {
   if (!std::isfinite(v)) return std::numeric_limits<double>::quiet_NaN();
-  if (layout.kind == TimeKind::kRelativeS) v *= 1e9;
-  const bool relative =
-      layout.kind == TimeKind::kRelativeNs || layout.kind == TimeKind::kRelativeS;
+  if (kind == TimeKind::kRelativeS) v *= 1e9;
+  const bool relative = kind == TimeKind::kRelativeNs || kind == TimeKind::kRelativeS;
   if (relative && std::abs(v) > kMaxRelativeNs) return std::numeric_limits<double>::quiet_NaN();
   return v;
 }
+
+struct PointFields {
+  FieldRef x, y, z, intensity, ring;
+};
+
+// Reads the fields of a point of any layout: each element through its
+// datatype code, byte-swapped when the cloud's byte order is not the host's.
+class GenericReader {
+ public:
+  GenericReader(const PointCloud2View& cloud, const Layout& layout, const PointFields& f)
+      : layout_(layout), f_(f), swap_(cloud.is_bigendian != HostIsBigEndian()) {}
+  double Time(const uint8_t* p) const { return NormalizeTime(Read(p, layout_.time), layout_.kind); }
+  double X(const uint8_t* p) const { return Read(p, f_.x); }
+  double Y(const uint8_t* p) const { return Read(p, f_.y); }
+  double Z(const uint8_t* p) const { return Read(p, f_.z); }
+  bool has_intensity() const { return f_.intensity.present; }
+  double Intensity(const uint8_t* p) const { return Read(p, f_.intensity); }
+  bool has_ring() const { return f_.ring.present; }
+  double Ring(const uint8_t* p) const { return Read(p, f_.ring); }
+
+ private:
+  double Read(const uint8_t* p, const FieldRef& f) const {
+    return ReadScalar(p + f.offset, f.datatype, swap_);
+  }
+  const Layout& layout_;
+  const PointFields& f_;
+  bool swap_;
+};
+
+// No field of this kind (fast path template argument).
+struct Absent {};
+
+template <typename T>
+double LoadHost(const uint8_t* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return static_cast<double>(value);
+}
+
+// The common relative-time layouts (Ouster, Velodyne, Livox offset_time) in
+// host byte order: x, y, z float32, time TimeT (uint32 ns or float32 s),
+// intensity float32 or absent, ring RingT (uint8, uint16 or Absent). Every value is the double GenericReader
+// reads, so both decode the same points.
+template <typename TimeT, bool kIntensity, typename RingT>
+class FastReader {
+ public:
+  FastReader(const Layout& layout, const PointFields& f)
+      : kind_(layout.kind), t_(layout.time.offset), x_(f.x.offset), y_(f.y.offset),
+        z_(f.z.offset), i_(f.intensity.offset), r_(f.ring.offset) {}
+  double Time(const uint8_t* p) const { return NormalizeTime(LoadHost<TimeT>(p + t_), kind_); }
+  double X(const uint8_t* p) const { return LoadHost<float>(p + x_); }
+  double Y(const uint8_t* p) const { return LoadHost<float>(p + y_); }
+  double Z(const uint8_t* p) const { return LoadHost<float>(p + z_); }
+  static constexpr bool has_intensity() { return kIntensity; }
+  double Intensity(const uint8_t* p) const { return LoadHost<float>(p + i_); }
+  static constexpr bool has_ring() { return !std::is_same<RingT, Absent>::value; }
+  double Ring(const uint8_t* p) const {
+    if constexpr (has_ring()) return LoadHost<RingT>(p + r_);
+    return 0.0;
+  }
+
+ private:
+  TimeKind kind_;
+  uint32_t t_, x_, y_, z_, i_, r_;
+};
 
 struct TimeRange {
   int64_t valid = 0, negative = 0;
   double min = 0.0, max = 0.0;
 };
 
-TimeRange ScanTimes(const PointCursor& cursor, const Layout& layout) {
+template <typename Reader>
+TimeRange ScanTimes(const PointCloud2View& cloud, const Reader& reader) {
   TimeRange r;
-  for (uint64_t i = 0; i < cursor.size(); ++i) {
-    const double v = RawTime(cursor, i, layout);
-    if (std::isnan(v)) continue;
+  ForEachPoint(cloud, [&](const uint8_t* point) {
+    const double v = reader.Time(point);
+    if (std::isnan(v)) return;
     r.min = r.valid == 0 ? v : std::min(r.min, v);
     r.max = r.valid == 0 ? v : std::max(r.max, v);
     r.negative += v < 0.0;
     ++r.valid;
-  }
+  });
   return r;
 }
 
@@ -262,12 +318,21 @@ TimeMapping AbsoluteMapping(const PointCloud2View& cloud, const Layout& layout,
   return m;
 }
 
+// std::llround(v) without a libm call for |v| < 2^52, where the truncation
+// and the fraction v - trunc(v) are exact (relative times are < 3.6e12 ns).
+int64_t RoundHalfAwayFromZero(double v) {
+  if (!(std::abs(v) < 4.5e15)) return std::llround(v);
+  const int64_t i = static_cast<int64_t>(v);
+  const double frac = v - static_cast<double>(i);
+  return i + (frac >= 0.5 ? 1 : 0) - (frac <= -0.5 ? 1 : 0);
+}
+
 // Absolute ns of a raw time, or false when it is unusable. Absolute seconds
 // are split into whole and fractional seconds to keep the double's precision.
 bool ToAbsoluteNs(double raw, const TimeMapping& m, TimeNs* t_ns) {
   if (std::isnan(raw)) return false;
   if (m.relative) {
-    *t_ns = m.stamp_ns + static_cast<TimeNs>(std::llround(raw + m.shift_ns));
+    *t_ns = m.stamp_ns + static_cast<TimeNs>(RoundHalfAwayFromZero(raw + m.shift_ns));
     return true;
   }
   const double ns = m.seconds ? raw * 1e9 : raw;
@@ -281,10 +346,6 @@ bool ToAbsoluteNs(double raw, const TimeMapping& m, TimeNs* t_ns) {
           static_cast<TimeNs>(std::llround((raw - whole_s) * 1e9));
   return true;
 }
-
-struct PointFields {
-  FieldRef x, y, z, intensity, ring;
-};
 
 Status FindPointFields(const PointCloud2View& cloud, const Layout& layout, PointFields* f) {
   f->x = Find(cloud, "x");
@@ -305,29 +366,9 @@ uint16_t ToRing(double v) {
   return static_cast<uint16_t>(v);
 }
 
-void DecodePoints(const PointCursor& cursor, const Layout& layout, const PointFields& f,
-                  const TimeMapping& mapping, const LidarOptions& lidar, Scan* scan,
-                  DecodeStats* stats) {
-  scan->points.reserve(cursor.size());
-  for (uint64_t i = 0; i < cursor.size(); ++i) {
-    LidarPoint p;
-    const bool time_ok = ToAbsoluteNs(RawTime(cursor, i, layout), mapping, &p.t_ns);
-    if (!FilterPoint(cursor.Read(i, f.x), cursor.Read(i, f.y), cursor.Read(i, f.z), time_ok,
-                     lidar, stats, &p.p_lidar))
-      continue;
-    if (f.intensity.present) {
-      const double v = cursor.Read(i, f.intensity);
-      p.intensity = std::isfinite(v) && std::abs(v) < 1e30 ? float(v) : 0.0f;
-    }
-    if (f.ring.present) p.ring = ToRing(cursor.Read(i, f.ring));
-    scan->points.push_back(p);
-  }
-}
-
-}  // namespace
-
-bool FilterPoint(double x, double y, double z, bool time_ok, const LidarOptions& lidar,
-                 DecodeStats* stats, Eigen::Vector3f* p_lidar) {
+// FilterPoint (pointcloud2.h), inlined into the decoding loops.
+inline bool KeepPoint(double x, double y, double z, bool time_ok, const LidarOptions& lidar,
+                      DecodeStats* stats, Eigen::Vector3f* p_lidar) {
   const bool finite = std::isfinite(x) && std::isfinite(y) && std::isfinite(z) &&
                       std::abs(x) < 1e9 && std::abs(y) < 1e9 && std::abs(z) < 1e9;
   // The zero and range tests use the stored float coordinates: a float64
@@ -343,6 +384,113 @@ bool FilterPoint(double x, double y, double z, bool time_ok, const LidarOptions&
     return false;
   }
   return true;
+}
+
+template <typename Reader>
+void DecodePoints(const PointCloud2View& cloud, const Reader& reader, const TimeMapping& mapping,
+                  const LidarOptions& lidar, Scan* scan, DecodeStats* stats) {
+  scan->points.reserve(uint64_t{cloud.height} * cloud.width);
+  ForEachPoint(cloud, [&](const uint8_t* point) {
+    LidarPoint p;
+    const bool time_ok = ToAbsoluteNs(reader.Time(point), mapping, &p.t_ns);
+    if (!KeepPoint(reader.X(point), reader.Y(point), reader.Z(point), time_ok, lidar, stats,
+                   &p.p_lidar))
+      return;
+    if (reader.has_intensity()) {
+      const double v = reader.Intensity(point);
+      p.intensity = std::isfinite(v) && std::abs(v) < 1e30 ? float(v) : 0.0f;
+    }
+    if (reader.has_ring()) p.ring = ToRing(reader.Ring(point));
+    scan->points.push_back(p);
+  });
+}
+
+// Both passes (time range, then points) through one reader.
+template <typename Reader>
+Scan DecodeWith(const PointCloud2View& cloud, const Reader& reader, const Layout& layout,
+                const LidarOptions& lidar, DecodeStats* stats) {
+  const TimeRange range = ScanTimes(cloud, reader);
+  const bool relative =
+      layout.kind == TimeKind::kRelativeNs || layout.kind == TimeKind::kRelativeS;
+  const TimeMapping mapping = relative
+                                  ? RelativeMapping(cloud, range, lidar.header_stamp, stats)
+                                  : AbsoluteMapping(cloud, layout, range, stats);
+  Scan scan;
+  DecodePoints(cloud, reader, mapping, lidar, &scan, stats);
+  SetScanTimeBounds(cloud.header_stamp_ns, &scan);
+  return scan;
+}
+
+bool Is(const FieldRef& f, uint8_t datatype) { return f.present && f.datatype == datatype; }
+
+template <typename TimeT, bool kIntensity>
+bool TryFastRing(const PointCloud2View& cloud, const Layout& layout, const PointFields& f,
+                 const LidarOptions& lidar, DecodeStats* stats, Scan* scan) {
+  if (!f.ring.present) {
+    *scan = DecodeWith(cloud, FastReader<TimeT, kIntensity, Absent>(layout, f), layout, lidar, stats);
+  } else if (f.ring.datatype == kPointUint16) {
+    *scan = DecodeWith(cloud, FastReader<TimeT, kIntensity, uint16_t>(layout, f), layout, lidar, stats);
+  } else if (f.ring.datatype == kPointUint8) {
+    *scan = DecodeWith(cloud, FastReader<TimeT, kIntensity, uint8_t>(layout, f), layout, lidar, stats);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+template <typename TimeT>
+bool TryFastIntensity(const PointCloud2View& cloud, const Layout& layout, const PointFields& f,
+                      const LidarOptions& lidar, DecodeStats* stats, Scan* scan) {
+  if (!f.intensity.present) return TryFastRing<TimeT, false>(cloud, layout, f, lidar, stats, scan);
+  if (f.intensity.datatype == kPointFloat32)
+    return TryFastRing<TimeT, true>(cloud, layout, f, lidar, stats, scan);
+  return false;
+}
+
+// The fast path: relative times in uint32 ns (Ouster `t`, Livox
+// `offset_time`) or float32 s (Velodyne `time`), host byte order, float32
+// x, y, z. False (nothing decoded)
+// for any other layout, which then takes the generic reader.
+bool TryFastDecode(const PointCloud2View& cloud, const Layout& layout, const PointFields& f,
+                   const LidarOptions& lidar, DecodeStats* stats, Scan* scan) {
+  if (cloud.is_bigendian != HostIsBigEndian()) return false;
+  if (!Is(f.x, kPointFloat32) || !Is(f.y, kPointFloat32) || !Is(f.z, kPointFloat32)) return false;
+  if (layout.kind == TimeKind::kRelativeNs && Is(layout.time, kPointUint32))
+    return TryFastIntensity<uint32_t>(cloud, layout, f, lidar, stats, scan);
+  if (layout.kind == TimeKind::kRelativeS && Is(layout.time, kPointFloat32))
+    return TryFastIntensity<float>(cloud, layout, f, lidar, stats, scan);
+  return false;
+}
+
+StatusOr<Scan> Decode(const PointCloud2View& cloud, const LidarOptions& lidar,
+                      DecodeStats* stats_out, bool allow_fast) {
+  DecodeStats local;
+  DecodeStats* stats = stats_out ? stats_out : &local;
+  *stats = DecodeStats();
+  if (Status s = ValidateGeometry(cloud); !s.ok()) return s;
+  if (std::abs(static_cast<double>(cloud.header_stamp_ns)) > kMaxAbsoluteNs / 2) {
+    return Status::InvalidInput(Where(cloud) + ": header stamp out of range");
+  }
+  StatusOr<Layout> layout = SelectLayout(cloud, lidar.type);
+  if (!layout.ok()) return layout.status();
+  PointFields fields;
+  if (Status s = FindPointFields(cloud, *layout, &fields); !s.ok()) return s;
+
+  stats->layout = layout->name;
+  stats->raw_points = static_cast<int64_t>(uint64_t{cloud.height} * cloud.width);
+  Scan scan;
+  stats->fast_path = allow_fast && TryFastDecode(cloud, *layout, fields, lidar, stats, &scan);
+  if (!stats->fast_path) {
+    scan = DecodeWith(cloud, GenericReader(cloud, *layout, fields), *layout, lidar, stats);
+  }
+  return scan;
+}
+
+}  // namespace
+
+bool FilterPoint(double x, double y, double z, bool time_ok, const LidarOptions& lidar,
+                 DecodeStats* stats, Eigen::Vector3f* p_lidar) {
+  return KeepPoint(x, y, z, time_ok, lidar, stats, p_lidar);
 }
 
 void SetScanTimeBounds(TimeNs fallback_ns, Scan* scan) {
@@ -379,32 +527,13 @@ StatusOr<std::string> DetectPointCloud2Layout(const PointCloud2View& cloud,
 }
 
 StatusOr<Scan> DecodePointCloud2(const PointCloud2View& cloud, const LidarOptions& lidar,
-                                 DecodeStats* stats_out) {
-  DecodeStats local;
-  DecodeStats* stats = stats_out ? stats_out : &local;
-  *stats = DecodeStats();
-  if (Status s = ValidateGeometry(cloud); !s.ok()) return s;
-  if (std::abs(static_cast<double>(cloud.header_stamp_ns)) > kMaxAbsoluteNs / 2) {
-    return Status::InvalidInput(Where(cloud) + ": header stamp out of range");
-  }
-  StatusOr<Layout> layout = SelectLayout(cloud, lidar.type);
-  if (!layout.ok()) return layout.status();
-  PointFields fields;
-  if (Status s = FindPointFields(cloud, *layout, &fields); !s.ok()) return s;
+                                 DecodeStats* stats) {
+  return Decode(cloud, lidar, stats, /*allow_fast=*/true);
+}
 
-  const PointCursor cursor(cloud);
-  stats->layout = layout->name;
-  stats->raw_points = static_cast<int64_t>(cursor.size());
-  const TimeRange range = ScanTimes(cursor, *layout);
-  const bool relative =
-      layout->kind == TimeKind::kRelativeNs || layout->kind == TimeKind::kRelativeS;
-  const TimeMapping mapping = relative
-                                  ? RelativeMapping(cloud, range, lidar.header_stamp, stats)
-                                  : AbsoluteMapping(cloud, *layout, range, stats);
-  Scan scan;
-  DecodePoints(cursor, *layout, fields, mapping, lidar, &scan, stats);
-  SetScanTimeBounds(cloud.header_stamp_ns, &scan);
-  return scan;
+StatusOr<Scan> DecodePointCloud2Generic(const PointCloud2View& cloud, const LidarOptions& lidar,
+                                        DecodeStats* stats) {
+  return Decode(cloud, lidar, stats, /*allow_fast=*/false);
 }
 
 }  // namespace rvlio

@@ -2,10 +2,24 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "rvlio/common/check.h"
 
 namespace rvlio {
+namespace {
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+int CountTrailingZeros(uint64_t bits) {  // bits != 0
+#if defined(__GNUC__) || defined(__clang__)
+  return __builtin_ctzll(bits);
+#else
+  int n = 0;
+  while ((bits & 1) == 0) bits >>= 1, ++n;
+  return n;
+#endif
+}
+}  // namespace
 
 ScanPreprocessor::ScanPreprocessor(const LidarOptions& options)
     : min_range2_(options.min_range * options.min_range),
@@ -31,7 +45,7 @@ void ScanPreprocessor::BeginScan() {
   used_.clear();
 }
 
-size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) const {
+inline size_t ScanPreprocessor::FindOrAdd(const VoxelKey& key) const {
   const size_t mask = table_.size() - 1;
   size_t slot = HashVoxelKey(key) & mask;
   while (table_[slot].stamp == stamp_ && table_[slot].key != key) slot = (slot + 1) & mask;
@@ -52,7 +66,7 @@ void ScanPreprocessor::Grow() {
 
 // The table slot of key for the current scan, creating the entry (for point
 // i at squared centre distance d2) when the voxel is new; *created tells.
-size_t ScanPreprocessor::SlotOf(const VoxelKey& key, int i, float d2, bool* created) {
+inline size_t ScanPreprocessor::SlotOf(const VoxelKey& key, int i, float d2, bool* created) {
   size_t slot = FindOrAdd(key);
   *created = table_[slot].stamp != stamp_;
   if (!*created) return slot;
@@ -78,15 +92,12 @@ void ScanPreprocessor::FilterPoints(const Scan& scan, std::vector<int>* indices)
   size_t last_slot = 0;
   bool have_last = false;
   for (int i = 0; i < n; i += stride_) {
-    const Eigen::Vector3f& p_f = scan.points[i].p_lidar;
-    if (!std::isfinite(p_f.x()) || !std::isfinite(p_f.y()) || !std::isfinite(p_f.z())) {
-      ++stats_.num_invalid;
-      continue;
-    }
-    const Eigen::Vector3d p = p_f.cast<double>();
+    const Eigen::Vector3d p = scan.points[i].p_lidar.cast<double>();
+    // r2 is finite iff the point is (float squares cannot overflow a double),
+    // so one test passes the in-range points; the rare rest are sorted out.
     const double r2 = p.squaredNorm();
-    if (r2 < min_range2_ || r2 > max_range2_) {
-      ++stats_.num_out_of_range;
+    if (!(r2 >= min_range2_ && r2 <= max_range2_ && r2 < kInfinity)) {
+      ++(std::isfinite(r2) ? stats_.num_out_of_range : stats_.num_invalid);
       continue;
     }
     if (!grid) {
@@ -111,9 +122,23 @@ void ScanPreprocessor::FilterPoints(const Scan& scan, std::vector<int>* indices)
       e.d2 = d2;
     }
   }
-  if (!grid) return;
-  for (const int32_t slot : used_) indices->push_back(table_[slot].best);
-  std::sort(indices->begin(), indices->end());
+  if (grid) CollectAscending(n, indices);
+}
+
+// The kept point of every voxel, in ascending index order: a bitmap over
+// the scan's points instead of sorting the indices.
+void ScanPreprocessor::CollectAscending(int n, std::vector<int>* indices) {
+  kept_bits_.assign((static_cast<size_t>(n) + 63) / 64, 0);
+  for (const int32_t slot : used_) {
+    const uint32_t i = static_cast<uint32_t>(table_[slot].best);
+    kept_bits_[i / 64] |= uint64_t{1} << (i % 64);
+  }
+  indices->reserve(used_.size());
+  for (size_t w = 0; w < kept_bits_.size(); ++w) {
+    for (uint64_t bits = kept_bits_[w]; bits != 0; bits &= bits - 1) {
+      indices->push_back(static_cast<int>(64 * w + static_cast<size_t>(CountTrailingZeros(bits))));
+    }
+  }
 }
 
 void ScanPreprocessor::SelectIndices(const Scan& scan, std::vector<int>* indices) {

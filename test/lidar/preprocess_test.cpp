@@ -171,6 +171,56 @@ TEST(Preprocess, SweepMatchesExactReferenceIncludingTies) {
   }
 }
 
+// Clouds in random order (no sweep structure, so consecutive points rarely
+// share a voxel) with NaN, +-Inf, no-return, near and far points: the kept
+// indices match the reference and the drop counts match a direct count,
+// also with a max_range whose square overflows to +Inf.
+TEST(Preprocess, RandomCloudsMatchReferenceAndCountDrops) {
+  std::mt19937 rng(18);
+  std::uniform_real_distribution<float> coord(-40.0f, 40.0f);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int trial = 0; trial < 60; ++trial) {
+    LidarOptions options;
+    options.voxel_size = 0.2 + 0.1 * (trial % 7);
+    options.min_range = 0.5 * (trial % 3);
+    options.max_range = trial % 5 == 0 ? 1e200 : 30.0 + 5.0 * (trial % 4);
+    options.point_stride = 1 + trial % 2;
+    // Far points: beyond max_range, or (huge max_range) still keyable voxels.
+    const float far_scale = trial % 5 == 0 ? 1e3f : 1e30f;
+    Scan scan;
+    const int n = 500 + static_cast<int>(rng() % 3000);
+    for (int i = 0; i < n; ++i) {
+      LidarPoint pt;
+      pt.p_lidar = Eigen::Vector3f(coord(rng), coord(rng), 0.2f * coord(rng));
+      const double roll = u(rng);
+      if (roll < 0.02) pt.p_lidar.y() = std::numeric_limits<float>::quiet_NaN();
+      else if (roll < 0.04) pt.p_lidar.z() = (roll < 0.03 ? inf : -inf);
+      else if (roll < 0.06) pt.p_lidar.setZero();
+      else if (roll < 0.08) pt.p_lidar *= far_scale;
+      pt.t_ns = i;
+      scan.points.push_back(pt);
+    }
+    int invalid = 0, out_of_range = 0;
+    for (int i = 0; i < n; i += options.point_stride) {
+      const Eigen::Vector3d p = scan.points[i].p_lidar.cast<double>();
+      const double r2 = p.squaredNorm();
+      if (!p.allFinite()) ++invalid;
+      else if (r2 < options.min_range * options.min_range ||
+               r2 > options.max_range * options.max_range) ++out_of_range;
+    }
+    ScanPreprocessor pre(options);
+    std::vector<int> indices;
+    pre.SelectIndices(scan, &indices);
+    const std::vector<int> expected = ReferenceIndices(scan, options);
+    ASSERT_GT(expected.size(), 50u);
+    ASSERT_EQ(indices, expected) << "trial " << trial;
+    EXPECT_EQ(pre.stats().num_invalid, invalid) << "trial " << trial;
+    EXPECT_EQ(pre.stats().num_out_of_range, out_of_range) << "trial " << trial;
+    EXPECT_EQ(pre.stats().num_output, static_cast<int>(expected.size())) << "trial " << trial;
+  }
+}
+
 TEST(Preprocess, VoxelSizeZeroKeepsEveryPointInRange) {
   std::mt19937 rng(2);
   LidarOptions options;

@@ -63,6 +63,7 @@ struct DecodeStats {
   int64_t raw_points = 0;      // height * width
   int64_t invalid_points = 0;  // NaN/Inf coordinates or time, all-zero (no-return)
   int64_t out_of_range_points = 0;  // outside [lidar.min_range, lidar.max_range]
+  bool fast_path = false;  // decoded by the typed loop of the common layouts (below)
 };
 
 // Returns the layout lidar.type selects for these fields ("auto" detects it),
@@ -82,8 +83,20 @@ StatusOr<std::string> DetectPointCloud2Layout(const PointCloud2View& cloud,
 //          the rel are mostly negative, else t = stamp + rel
 //   end    the stamp is the scan end: shifted so the latest rel is 0 when the
 //          rel are mostly non-negative, else t = stamp + rel
+//
+// The common layouts take a fast path with the same result: host byte order,
+// x, y, z float32, a relative time field in uint32 ns (Ouster `t`, Livox
+// `offset_time`) or float32 s (Velodyne `time`), intensity float32 or absent,
+// ring (or Livox line) uint8, uint16 or absent. The
+// layout is checked once per message (a few field-name compares); the points
+// are then read at fixed offsets with fixed types. Any other layout (another
+// byte order or datatype, absolute times) goes through the generic reader.
 StatusOr<Scan> DecodePointCloud2(const PointCloud2View& cloud, const LidarOptions& lidar,
                                  DecodeStats* stats = nullptr);
+// DecodePointCloud2 with the fast path off: every layout through the generic
+// reader (the reference the fast path is tested and benchmarked against).
+StatusOr<Scan> DecodePointCloud2Generic(const PointCloud2View& cloud, const LidarOptions& lidar,
+                                        DecodeStats* stats = nullptr);
 
 // The point filter of DecodePointCloud2, shared with the other decoders
 // (io/livox): false, counted in stats->invalid_points, for a non-finite, huge

@@ -57,6 +57,7 @@ class ScanPreprocessor {
   size_t FindOrAdd(const VoxelKey& key) const;  // the key's slot, or the free slot for it
   size_t SlotOf(const VoxelKey& key, int i, float d2, bool* created);
   void Grow();
+  void CollectAscending(int n, std::vector<int>* indices);
 
   double min_range2_;
   double max_range2_;
@@ -69,6 +70,7 @@ class ScanPreprocessor {
   std::vector<Entry> table_;     // open addressing, power-of-two size
   std::vector<int32_t> used_;    // table slots used by the current scan
   std::vector<int> indices_;     // scratch for Downsample
+  std::vector<uint64_t> kept_bits_;  // one bit per input point, the kept ones set
   uint32_t stamp_ = 0;
 };
 
