@@ -351,6 +351,7 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   ceres::Solver::Options so;
   so.linear_solver_type = WindowLinearSolver(options_.smoother.linear_solver);
   so.max_num_iterations = options_.smoother.max_solver_iterations;
+  so.function_tolerance = options_.smoother.function_tolerance;
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
