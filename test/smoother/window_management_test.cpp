@@ -435,6 +435,25 @@ TEST(SlidingWindowRounds, ARoundWithoutNewAssociationsEndsOptimize) {
   for (const WindowSolveReport& r : moving) EXPECT_EQ(r.rounds, 3);
 }
 
+// smoother.function_tolerance reaches Ceres: a loose tolerance stops the
+// solves earlier (fewer iterations) than the default 1e-6.
+TEST(SlidingWindowRounds, FunctionToleranceStopsTheSolvesEarlier) {
+  constexpr int kStates = 6;
+  const Sequence seq = MakeSequence(kStates, 43, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
+  const auto iterations = [&seq](double tolerance) {
+    WindowOptions o = TestOptions(5, kImuLidar);
+    o.smoother.function_tolerance = tolerance;
+    Driver d(o, seq);
+    d.Start();
+    int total = 0;
+    for (int k = 1; k < kStates; ++k) total += d.Step(k).iterations;
+    return total;
+  };
+  const int tight = iterations(1e-6), loose = iterations(1e-2);
+  EXPECT_GT(loose, 0);
+  EXPECT_LT(loose, tight);
+}
+
 TEST(SlidingWindowImu, BiasesAreEstimatedAndPreintegrationsReintegrated) {
   constexpr int kStates = 16;
   const Vector3d bg(0.02, -0.015, 0.01), ba(0.3, -0.2, 0.15);  // large: first order is not enough
