@@ -33,9 +33,11 @@ PlaneSummaryFactor::PlaneSummaryFactor(const ConstraintList& constraints,
     for (int k = 0; k < 3; ++k) a.segment<3>(3 * k) = s * p_imu(k) * u;
     a.segment<3>(9) = s * u;
     a(12) = -s * u.dot(c.q_world - center_);
-    M_.selfadjointView<Eigen::Lower>().rankUpdate(a);
+    // The full outer product in fixed size: each entry gets a_r a_c in the
+    // same order as a lower-triangle rank update (and the product commutes,
+    // so M_ is exactly symmetric), at a fraction of its cost.
+    M_.noalias() += a * a.transpose();
   }
-  M_ = M_.selfadjointView<Eigen::Lower>();
   const Eigen::SelfAdjointEigenSolver<Matrix13d> eig(M_);
   const double floor = kRelativeEigenvalueFloor * std::max(eig.eigenvalues().maxCoeff(), 0.0);
   const Vector13d sqrt_lambda =

@@ -201,9 +201,13 @@ WindowSolveReport SlidingWindow::Optimize(const ScanAssociateFn& associate) {
   bool retried = false;
   for (int round = 0; round < options_.smoother.association_rounds; ++round) {
     const double t0 = ThreadCpuMs();
-    AssociateRound(associate, &report);
+    const int associated = AssociateRound(associate, &report);
     const double t1 = ThreadCpuMs();
     report.association_ms += t1 - t0;
+    // A later round whose association changed nothing would solve the
+    // problem the previous round has just solved (and so would every round
+    // after it).
+    if (round > 0 && associated == 0 && !options_.smoother.solve_unchanged_rounds) break;
     const bool ok = SolveRound(&report);
     report.solve_ms += ThreadCpuMs() - t1;
     if (ok) {
@@ -237,14 +241,18 @@ bool SlidingWindow::DropNewestImuFactor() {
 
 // Every state never associated, or moved by more than reassociate_min_motion
 // since its last association (its constraints would be stale).
-void SlidingWindow::AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report) {
+// Returns how many were (re-)associated.
+int SlidingWindow::AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report) {
+  int associated = 0;
   for (auto& node : nodes_) {
     if (node->associated &&
         Motion(node->associated_at, node->T_world_imu()) <= options_.smoother.reassociate_min_motion)
       continue;
     AssociateNode(associate, node.get());
-    ++report->associations;
+    ++associated;
   }
+  report->associations += associated;
+  return associated;
 }
 
 // Associate -> RV (Alg. 1-3 on this scan's list) -> Huber weights -> factor.
@@ -343,6 +351,7 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   ceres::Solver::Options so;
   so.linear_solver_type = WindowLinearSolver(options_.smoother.linear_solver);
   so.max_num_iterations = options_.smoother.max_solver_iterations;
+  so.function_tolerance = options_.smoother.function_tolerance;
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;

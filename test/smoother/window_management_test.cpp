@@ -8,6 +8,7 @@
 //   - sequences shorter than the window; bias re-integration; RV plumbing.
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -389,6 +390,68 @@ TEST(SlidingWindowShortSequence, FewerStatesThanTheWindowNeverMarginalize) {
   EXPECT_EQ(d.marginalized(), 0);
   EXPECT_FALSE(d.window().MarginalizeIfFull().has_value());
   EXPECT_LT(Difference(d.newest(), {0, test::TruePose(d.newest().t_ns), {}}).pos, 0.01);
+}
+
+// Rounds after the first: with smoother.solve_unchanged_rounds = false a round
+// that re-associates no scan ends Optimize, so the window equals one that
+// runs a single round; a round that does re-associate is solved either way.
+TEST(SlidingWindowRounds, ARoundWithoutNewAssociationsEndsOptimize) {
+  constexpr int kStates = 8;
+  const Sequence seq = MakeSequence(kStates, 41, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
+  const auto run = [&seq](int rounds, double min_motion, bool solve_unchanged,
+                          std::vector<WindowSolveReport>* reports) {
+    WindowOptions o = TestOptions(5, kImuLidar);
+    o.smoother.association_rounds = rounds;
+    o.smoother.max_solver_iterations = 3;  // not converged in one round: another solve moves it
+    o.smoother.reassociate_min_motion = min_motion;
+    o.smoother.solve_unchanged_rounds = solve_unchanged;
+    auto d = std::make_unique<Driver>(o, seq);
+    d->Start();
+    for (int k = 1; k < kStates; ++k) reports->push_back(d->Step(k));
+    return d;
+  };
+  std::vector<WindowSolveReport> one, skip, solve_all, moving;
+  // min_motion 10 m: nothing is associated again after its first round.
+  const auto single = run(1, 10.0, false, &one);
+  const auto skipped = run(3, 10.0, false, &skip);
+  const auto repeated = run(3, 10.0, true, &solve_all);
+  for (int k = 0; k < kStates - 1; ++k) {
+    EXPECT_EQ(skip[k].rounds, 1) << k;
+    EXPECT_EQ(solve_all[k].rounds, 3) << k;
+    EXPECT_EQ(skip[k].associations, one[k].associations) << k;
+    EXPECT_EQ(skip[k].iterations, one[k].iterations) << k;
+    EXPECT_GT(solve_all[k].iterations, one[k].iterations) << k;
+  }
+  for (int i = 0; i < single->window().size(); ++i) {
+    const StateError same = Difference(skipped->window().state(i), single->window().state(i));
+    EXPECT_EQ(same.rot, 0.0) << i;
+    EXPECT_EQ(same.pos, 0.0) << i;
+    EXPECT_EQ(same.vel, 0.0) << i;
+  }
+  // The extra solves of the repeated rounds do move the states.
+  EXPECT_GT(Difference(repeated->newest(), single->newest()).pos, 0.0);
+  // min_motion 0: every round re-associates every scan, so every round is solved.
+  run(3, 0.0, false, &moving);
+  for (const WindowSolveReport& r : moving) EXPECT_EQ(r.rounds, 3);
+}
+
+// smoother.function_tolerance reaches Ceres: a loose tolerance stops the
+// solves earlier (fewer iterations) than the default 1e-6.
+TEST(SlidingWindowRounds, FunctionToleranceStopsTheSolvesEarlier) {
+  constexpr int kStates = 6;
+  const Sequence seq = MakeSequence(kStates, 43, kImuLidar, 0.01, Vector3d::Zero(), Vector3d::Zero());
+  const auto iterations = [&seq](double tolerance) {
+    WindowOptions o = TestOptions(5, kImuLidar);
+    o.smoother.function_tolerance = tolerance;
+    Driver d(o, seq);
+    d.Start();
+    int total = 0;
+    for (int k = 1; k < kStates; ++k) total += d.Step(k).iterations;
+    return total;
+  };
+  const int tight = iterations(1e-6), loose = iterations(1e-2);
+  EXPECT_GT(loose, 0);
+  EXPECT_LT(loose, tight);
 }
 
 TEST(SlidingWindowImu, BiasesAreEstimatedAndPreintegrationsReintegrated) {

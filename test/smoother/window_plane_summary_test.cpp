@@ -1,6 +1,7 @@
 // PlaneSummaryFactor: the 13-residual summary of a scan's point-to-plane
 // constraints has PlaneFactor's cost, gradient and Gauss-Newton Hessian at
 // every pose (not only at the pose of construction), and an exact Jacobian.
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -80,6 +81,35 @@ TEST(PlaneSummaryFactor, JacobianMatchesNumericDifferences) {
     EXPECT_LT(test::TangentJacobianError(summary, {test::ToVector(Plus(truth, d))}, {&manifold}),
               1e-6)
         << trial;
+  }
+}
+
+TEST(PlaneSummaryFactor, InformationIsTheSumOfOuterProductsAndExactlySymmetric) {
+  // The reference: M accumulated as a lower-triangle rank update per
+  // constraint, then mirrored (the construction before the fixed-size outer
+  // product). Same summation order per entry: equal to rounding (bitwise
+  // without fused multiply-add), and the mirror image of itself exactly.
+  std::mt19937 rng(19);
+  const Pose3 T_imu_lidar(test::Rz(-0.3), Vector3d(0.05, 0.0, 0.1));
+  for (int trial = 0; trial < 20; ++trial) {
+    const PoseBlock truth = test::RandomPose(rng);
+    const ConstraintList list = RandomConstraints(rng, truth, T_imu_lidar, 300);
+    const Vector3d center = truth.p_world_imu;
+    const PlaneSummaryFactor summary(list, T_imu_lidar, 0.03, center);
+    PlaneSummaryFactor::Matrix13d ref = PlaneSummaryFactor::Matrix13d::Zero();
+    for (const Constraint& c : list) {
+      const double s = std::sqrt(c.weight) / 0.03;
+      const Vector3d p_imu = T_imu_lidar * c.p_lidar;
+      PlaneSummaryFactor::Vector13d a;
+      for (int k = 0; k < 3; ++k) a.segment<3>(3 * k) = s * p_imu(k) * c.normal_world;
+      a.segment<3>(9) = s * c.normal_world;
+      a(12) = -s * c.normal_world.dot(c.q_world - center);
+      ref.selfadjointView<Eigen::Lower>().rankUpdate(a);
+    }
+    ref = ref.selfadjointView<Eigen::Lower>();
+    const PlaneSummaryFactor::Matrix13d& M = summary.information();
+    EXPECT_TRUE(M == M.transpose()) << trial;
+    EXPECT_LE((M - ref).cwiseAbs().maxCoeff(), 1e-14 * ref.cwiseAbs().maxCoeff()) << trial;
   }
 }
 

@@ -10,6 +10,8 @@ struct SmootherOptions {
   int window_size = 10;              // scans in the window
   int association_rounds = 2;        // re-association rounds per new scan
   int max_solver_iterations = 6;     // Ceres iterations per round
+  bool solve_unchanged_rounds = false;  // solve a round even when its association changed no scan
+  double function_tolerance = 1e-6;     // Ceres: stop when the relative cost change is below this
   double refine_huber_delta = 0.1;   // m, Huber width on the point-to-plane residuals of refine
   int refine_rounds = 4;             // outer rounds of `rvlio refine`
   int refine_chunk_scans = 2000;     // scans per refine chunk (long sequences)
@@ -37,6 +39,12 @@ struct SmootherOptions {
     v.Field("window_size", window_size, Spec().Range(2, 200));
     v.Field("association_rounds", association_rounds, Spec().Range(1, 20));
     v.Field("max_solver_iterations", max_solver_iterations, Spec().Range(1, 200));
+    v.Field("function_tolerance", function_tolerance, Spec().Range(1e-12, 1e-1).Help(
+        "Ceres function tolerance of the sliding-window solve: a solve stops when an iteration "
+        "changes the cost by less than this fraction"));
+    v.Field("solve_unchanged_rounds", solve_unchanged_rounds, Spec().Help(
+        "solve an association round after the first even when it re-associated no scan (the "
+        "same problem again: more Ceres iterations, no new constraints); false ends Optimize there"));
     v.Field("refine_huber_delta", refine_huber_delta, Spec().Unit("m").Positive()
                 .Help("Huber width on the point-to-plane residuals of `rvlio refine`"));
     v.Field("refine_rounds", refine_rounds, Spec().Range(1, 50));

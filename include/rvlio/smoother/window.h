@@ -21,6 +21,9 @@
 //   associate (every state that moved more than reassociate_min_motion since
 //   its last association, and every state never associated) -> RV -> Huber
 //   weights -> Ceres solve (max_solver_iterations).
+// A round after the first that associates no scan ends Optimize (its solve
+// would repeat the previous round's problem), unless
+// smoother.solve_unchanged_rounds.
 // A round whose solve fails or yields non-finite (or absurd: speed above
 // max_speed) values restores the states from before that round (counted) and
 // invalidates the associations. The round is then redone once without the
@@ -199,7 +202,7 @@ class SlidingWindow {
   static std::unique_ptr<Node> MakeNode(TimeNs t_ns, const PoseBlock& pose,
                                         const SpeedBiasBlock& speed_bias,
                                         std::vector<Eigen::Vector3d> p_lidar);
-  void AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
+  int AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
   void AssociateNode(const ScanAssociateFn& associate, Node* node);
   void RefreshImuFactors();
   bool DropNewestImuFactor();
