@@ -38,10 +38,11 @@ long PeakKib(const std::string& args, const std::string& scratch) {
   return usage.ru_maxrss;  // KiB on Linux
 }
 
-// Main at f8c4f0c (one residual per constraint): ~0.76 MB per scan at 1020
-// scans; with summarized pair factors ~0.38 MB (docs/refine_scaling.md).
-// The bound sits between them with room for allocator and library changes.
-constexpr double kMaxPeakMbPerScan = 0.6;
+// This refine (420 scans, 1 round, 2 threads) peaked at 332 MB (0.79 MB per
+// scan) with one residual per constraint (f8c4f0c) and at 214 MB (0.51 MB)
+// with summarized pair factors (docs/refine_scaling.md). The bound sits
+// between them, ~25 % above the latter for allocator and library changes.
+constexpr double kMaxPeakMbPerScan = 0.65;
 
 TEST(RefineMemory, PeakPerScanOfA400ScanRefineStaysBounded) {
   const std::string dir = testing_cli::MakeTempDir("rvlio_refine_memory");
