@@ -76,31 +76,52 @@ void SplitScanConstraints(int k, const ScanRange& chunk, int plane_window,
 
 namespace {
 
-// The factors of the split: one PlaneFactor for the fixed planes, one
-// ScanPairPlaneFactor per source scan of attached planes (expressed in the
-// source's IMU frame at the map's pose).
+// Scan j's attached planes w.attached[begin, end) (expressed in the source's
+// IMU frame at the map's pose) into a new factor of type Factor.
+template <class Factor>
+std::unique_ptr<ceres::CostFunction> MakePairFactor(const RefineAssociationWorkspace& w,
+                                                    size_t begin, size_t end, const Pose3& T_j,
+                                                    const Pose3& T_imu_lidar, double sigma,
+                                                    std::unique_ptr<Factor> f) {
+  const Pose3 T_j_inv = T_j.Inverse();
+  for (size_t a = begin; a < end; ++a) {
+    const Constraint& c = w.list[w.attached[a].second];
+    f->Add(T_imu_lidar * c.p_lidar, T_j.R.transpose() * c.normal_world, T_j_inv * c.q_world,
+           c.weight, sigma);
+  }
+  f->Finalize();
+  return f;
+}
+
+// The factors of the split: one for the fixed planes, one per source scan of
+// attached planes; summaries for groups of kRefineSummaryMinConstraints or
+// more when `summarize`. center_world: scan k's position (the fixed summary's
+// centre).
 ScanFactors MakeScanFactors(const RefineAssociationWorkspace& w,
                             const std::vector<Pose3>& map_poses, const Pose3& T_imu_lidar,
-                            double sigma) {
+                            double sigma, bool summarize, const Eigen::Vector3d& center_world) {
+  auto summary = [&](size_t n) { return summarize && n >= kRefineSummaryMinConstraints; };
   ScanFactors f;
-  if (!w.fixed.empty()) f.fixed = std::make_unique<PlaneFactor>(w.fixed, T_imu_lidar, sigma);
+  if (summary(w.fixed.size()))
+    f.fixed = std::make_unique<PlaneSummaryFactor>(w.fixed, T_imu_lidar, sigma, center_world);
+  else if (!w.fixed.empty())
+    f.fixed = std::make_unique<PlaneFactor>(w.fixed, T_imu_lidar, sigma);
   size_t sources = 0;
   for (size_t a = 0; a < w.attached.size(); ++a)
     sources += a == 0 || w.attached[a - 1].first != w.attached[a].first ? 1 : 0;
   f.pairs.reserve(sources);
-  for (size_t a = 0; a < w.attached.size(); ++a) {
+  for (size_t a = 0; a < w.attached.size();) {
     const int j = w.attached[a].first;
-    if (a == 0 || w.attached[a - 1].first != j) {
-      size_t end = a + 1;  // attached is sorted by source: count j's planes
-      while (end < w.attached.size() && w.attached[end].first == j) ++end;
-      f.pairs.emplace_back(j, std::make_unique<ScanPairPlaneFactor>(static_cast<int>(end - a)));
-    }
-    const Constraint& c = w.list[w.attached[a].second];
-    const Pose3& T_j = map_poses[j];
-    f.pairs.back().second->Add(T_imu_lidar * c.p_lidar, T_j.R.transpose() * c.normal_world,
-                               T_j.Inverse() * c.q_world, c.weight, sigma);
+    size_t end = a + 1;  // attached is sorted by source: j's planes
+    while (end < w.attached.size() && w.attached[end].first == j) ++end;
+    const size_t n = end - a;
+    f.pairs.emplace_back(
+        j, summary(n) ? MakePairFactor(w, a, end, map_poses[j], T_imu_lidar, sigma,
+                                       std::make_unique<ScanPairSummaryFactor>())
+                      : MakePairFactor(w, a, end, map_poses[j], T_imu_lidar, sigma,
+                                       std::make_unique<ScanPairPlaneFactor>(static_cast<int>(n))));
+    a = end;
   }
-  for (auto& [j, pair] : f.pairs) pair->Finalize();
   return f;
 }
 
@@ -120,7 +141,8 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
   ApplyHuberWeights(config.smoother.refine_huber_delta, &w->list);
   SplitScanConstraints(k, chunk, config.smoother.refine_plane_window, w->list, w->sources, states,
                        round.map_poses, &w->fixed, &w->attached);
-  return MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise);
+  return MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise,
+                         config.smoother.refine_summarize_pairs, states[k].T_world_imu().t);
 }
 
 ChunkAssociation AssociateRefineChunk(const RefineConfig& config, const RefineRoundMap& round,

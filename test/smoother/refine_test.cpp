@@ -5,6 +5,7 @@
 // refined one recovers the truth far better than where it started, with and
 // without chunking; bad input is InvalidInput.
 #include <atomic>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -103,6 +104,33 @@ TEST(Refine, PlanesMovingWithTheirScansConvergeFasterThanAWorldFixedMap) {
   const double e_fixed = Compare(ra->trajectory, a.truth).position_rmse;
   const double e_joint = Compare(rb->trajectory, b.truth).position_rmse;
   EXPECT_LT(e_joint, 0.25 * e_fixed) << "fixed map " << e_fixed << ", joint " << e_joint;
+}
+
+// Summarized pair and world-plane factors (smoother.refine_summarize_pairs,
+// refine_pair_factor.h) have the exact factors' cost, gradient and
+// Gauss-Newton Hessian: the refined trajectories agree to rounding, far
+// below the error left.
+TEST(Refine, SummarizedFactorsAgreeWithExactFactors) {
+  RefineConfig exact = Config(), summarized = Config();
+  exact.smoother.refine_summarize_pairs = false;
+  summarized.smoother.refine_summarize_pairs = true;
+  summarized.smoother.refine_chunk_scans = exact.smoother.refine_chunk_scans = 12;  // fixed planes too
+  Scene a = MakeScene(30, 5), b = MakeScene(30, 5);
+  StatusOr<RefineResult> ra = Refine(exact, std::move(a.input));
+  StatusOr<RefineResult> rb = Refine(summarized, std::move(b.input));
+  ASSERT_TRUE(ra.ok() && rb.ok());
+  ASSERT_EQ(ra->trajectory.size(), rb->trajectory.size());
+  double max_dp = 0.0, max_dq = 0.0;
+  for (size_t k = 0; k < ra->trajectory.size(); ++k) {
+    max_dp = std::max(max_dp, (ra->trajectory[k].p_world_imu - rb->trajectory[k].p_world_imu).norm());
+    max_dq = std::max(max_dq, ra->trajectory[k].q_world_imu.angularDistance(rb->trajectory[k].q_world_imu));
+  }
+  EXPECT_LT(max_dp, 1e-6);  // m
+  EXPECT_LT(max_dq, 1e-6);  // rad
+  ASSERT_EQ(ra->rounds.size(), rb->rounds.size());
+  EXPECT_NEAR(rb->rounds.front().cost_before, ra->rounds.front().cost_before,
+              1e-8 * ra->rounds.front().cost_before);
+  EXPECT_EQ(rb->rounds.front().constraints, ra->rounds.front().constraints);
 }
 
 TEST(Refine, BadInputIsInvalidInputWithAClearMessage) {

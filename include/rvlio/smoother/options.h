@@ -19,6 +19,7 @@ struct SmootherOptions {
   int refine_threads = 0;            // threads of `rvlio refine` (association, Ceres); 0: all cores
   int refine_plane_window = 100;     // scans: a plane moves with its source scan within this distance
   double refine_job_overlap_s = 10.0; // s shared by neighbouring chunk jobs (refine --chunk K --of N)
+  bool refine_summarize_pairs = true;  // refine: 13-residual summaries of scan pairs (and world planes)
   // Sliding-window backend (backend: smoother).
   std::string linear_solver = "dense_schur";  // Ceres linear solver of the window solve
   std::string map_update = "marginalized";    // when a window scan enters the working map
@@ -56,6 +57,10 @@ struct SmootherOptions {
                 .Help("seconds of scans shared by neighbouring chunks of `rvlio refine --chunk K "
                       "--of N` (half on each side of a border); `rvlio merge` aligns and blends "
                       "the chunks over them"));
+    v.Field("refine_summarize_pairs", refine_summarize_pairs, Spec().Help(
+        "`rvlio refine`: a scan's constraints against one source scan (and its world-fixed ones) "
+        "as one exact 13-residual summary when they are many (same cost, less memory); false: "
+        "one residual per constraint"));
     v.Field("linear_solver", linear_solver,
             Spec().Choices({"dense_schur", "dense_normal_cholesky", "sparse_normal_cholesky", "dense_qr"})
                 .Help("Ceres linear solver of the sliding-window solve"));

@@ -18,6 +18,10 @@
 //   d r / d d_rot,k = L^1/2 V^T [vec(R Hat(e_k)); 0; 0],   d r / d d_pos = L^1/2 V^T [0; I; 0],
 // reported in the ambient form of smoother/manifolds.h. Then J^T J and J^T r
 // equal those of PlaneFactor, so Ceres takes the same steps.
+//
+// The rows a_i and the square root are shared with the scan-pair summary of
+// batch refinement (ScanPairSummaryFactor, refine_pair_factor.h), whose z is
+// the relative pose of two scans instead of one world pose.
 #include <Eigen/Core>
 #include <ceres/sized_cost_function.h>
 
@@ -25,6 +29,25 @@
 #include "rvlio/math/pose.h"
 
 namespace rvlio {
+
+namespace plane_summary {
+
+using Matrix13d = Eigen::Matrix<double, 13, 13>;
+using Vector13d = Eigen::Matrix<double, 13, 1>;
+
+// Adds a a^T to *M (all of it; exactly symmetric) for the row
+// a = s [p (x) u; u; -d] (a[j + 3k] = s u_j p_k), whose product with
+// z = [vec(R); t; 1] is s (u^T (R p + t) - d).
+void AddRow(const Eigen::Vector3d& p, const Eigen::Vector3d& u, double d, double s, Matrix13d* M);
+
+// L^1/2 V^T for M = V L V^T given by its lower triangle (eigenvalues below a
+// relative floor of 1e-15 count as zero): (L^1/2 V^T)^T (L^1/2 V^T) = M.
+Matrix13d SqrtInformation(const Matrix13d& M_lower);
+
+// Column k (0..2) of d vec(R Exp(d_rot)) / d d_rot at d_rot = 0: vec(R Hat(e_k)).
+Eigen::Matrix<double, 9, 1> RightRotationColumn(const Eigen::Matrix3d& R, int k);
+
+}  // namespace plane_summary
 
 class PlaneSummaryFactor final : public ceres::SizedCostFunction<13, 7> {
  public:

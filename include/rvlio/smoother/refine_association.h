@@ -15,11 +15,13 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <ceres/cost_function.h>
 
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/rv.h"
 #include "rvlio/smoother/plane_factor.h"
+#include "rvlio/smoother/plane_summary_factor.h"
 #include "rvlio/smoother/refine.h"
 #include "rvlio/smoother/refine_chunks.h"
 #include "rvlio/smoother/refine_init.h"
@@ -59,11 +61,18 @@ void BuildRefineMap(const std::vector<RefineState>& states, const Pose3& T_imu_l
 // With glibc, the freed pages are returned to the system (malloc_trim).
 void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundMap* round);
 
-// The plane factors of one scan: world-fixed planes, and planes attached to
-// their source scans (refine_pair_factor.h), one factor per source.
+// The plane factors of one scan: world-fixed planes (PlaneFactor, or
+// PlaneSummaryFactor), and planes attached to their source scans
+// (refine_pair_factor.h: ScanPairPlaneFactor, or ScanPairSummaryFactor), one
+// factor per source. With smoother.refine_summarize_pairs a group of at
+// least kRefineSummaryMinConstraints constraints becomes a summary: below,
+// the summary's fixed size (~3 KB with Ceres' Jacobian) exceeds the ~190 B
+// per constraint of the exact factor.
+constexpr int kRefineSummaryMinConstraints = 16;
+
 struct ScanFactors {
-  std::unique_ptr<PlaneFactor> fixed;
-  std::vector<std::pair<int, std::unique_ptr<ScanPairPlaneFactor>>> pairs;  // source scan, factor
+  std::unique_ptr<ceres::CostFunction> fixed;                                // pose_k
+  std::vector<std::pair<int, std::unique_ptr<ceres::CostFunction>>> pairs;  // source j; pose_k, pose_j
 };
 
 // Where the planes of scan k's constraints live. A plane whose source scan j

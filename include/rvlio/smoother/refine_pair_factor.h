@@ -26,6 +26,7 @@
 
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include "rvlio/math/pose.h"
 
@@ -52,6 +53,43 @@ class ScanPairPlaneFactor final : public ceres::CostFunction {
  private:
   std::vector<Eigen::Vector3d> p_imu_, u_j_;
   std::vector<double> u_dot_q_, scale_;
+};
+
+// The constraints of ScanPairPlaneFactor summarized exactly in 13 residuals
+// (the construction of PlaneSummaryFactor, plane_summary_factor.h): the
+// residual above is linear in the relative pose
+//   z = [vec(R_j^T R_k) (9, column-major); R_j^T (t_k - t_j); 1],
+//   r_i = a_i^T z,  a_i = s_i [p_i (x) u_j,i; u_j,i; -u_j,i^T q_j,i],
+// so the pair's cost sum_i r_i^2 = z^T M z, M = sum_i a_i a_i^T, and the
+// residual is r = L^1/2 V^T z (M = V L V^T). Its tangent Jacobians, with
+// R_jk = R_j^T R_k and t_kj = R_j^T (t_k - t_j):
+//   d z / d rot_k,m = [vec(R_jk Hat(e_m)); 0; 0],   d z / d pos_k = [0; R_j^T; 0],
+//   d z / d rot_j,m = [vec(-Hat(e_m) R_jk); -Hat(e_m) t_kj; 0],
+//   d z / d pos_j = [0; -R_j^T; 0].
+// Same cost, gradient and Gauss-Newton Hessian as the exact factor at every
+// pose pair (up to rounding); fixed memory (one 13 x 13 matrix) instead of
+// 64 B per constraint in the factor and a 14-double Jacobian row in Ceres.
+// Parameter blocks: pose_k (7), pose_j (7).
+class ScanPairSummaryFactor final : public ceres::SizedCostFunction<13, 7, 7> {
+ public:
+  using Matrix13d = Eigen::Matrix<double, 13, 13>;
+
+  ScanPairSummaryFactor();
+
+  // As ScanPairPlaneFactor::Add; Finalize() once after the last.
+  void Add(const Eigen::Vector3d& p_imu_k, const Eigen::Vector3d& u_j, const Eigen::Vector3d& q_j,
+           double weight, double sigma_m);
+  void Finalize();
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+  int num_constraints() const { return num_constraints_; }
+
+ private:
+  Matrix13d m_;  // M's lower triangle while adding, L^1/2 V^T once finalized
+  int num_constraints_ = 0;
+  bool finalized_ = false;
 };
 
 }  // namespace rvlio
