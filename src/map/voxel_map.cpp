@@ -102,7 +102,8 @@ inline double AxisGap(int d, double q_local, double s) {
 inline double ShellGap(int r, const double q_local[3], double s) {
   if (r == 0) return 0.0;
   double g = AxisGap(r, q_local[0], s);
-  for (int a = 0; a < 3; ++a) g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
+  for (int a = 0; a < 3; ++a)
+    g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
   return g * g;
 }
 
@@ -159,9 +160,9 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
       const int sx = (octant & 1) ? -1 : 1, sy = (octant & 2) ? -1 : 1, sz = (octant & 4) ? -1 : 1;
       for (const Offset& o : shell) {
         const int dx = sx * o.dx, dy = sy * o.dy, dz = sz * o.dz;
-        shells_[r][octant].push_back(OctantOffset{
-            o.lower_bound2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
-            static_cast<uint8_t>(dz + r), OffsetKey(0, dx, dy, dz)});
+        shells_[r][octant].push_back(
+            OctantOffset{o.lower_bound2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
+                         static_cast<uint8_t>(dz + r), OffsetKey(0, dx, dy, dz)});
       }
     }
   }
@@ -186,6 +187,43 @@ int VoxelMap::FindSlot(uint64_t key) const {
   return -1;
 }
 
+namespace {
+// The lookup cache entry of a packed key: the low 4 bits of each biased
+// coordinate (the bias is a multiple of 16, so neighbours map to neighbours).
+size_t LookupIndex(uint64_t key) {
+  constexpr int b = 4;
+  constexpr uint64_t m = (uint64_t{1} << b) - 1;
+  return static_cast<size_t>((((key >> (2 * kKeyBits)) & m) << (2 * b)) |
+                             (((key >> kKeyBits) & m) << b) | (key & m));
+}
+}  // namespace
+
+void VoxelMap::BindLookups(VoxelLookupCache* lookups) const {
+  static_assert(VoxelLookupCache::kAxisBits == 4, "LookupIndex assumes 4 bits per axis");
+  if (lookups->entries_.empty()) {
+    lookups->entries_.resize(size_t{1} << (3 * VoxelLookupCache::kAxisBits));
+    lookups->epoch_ = 0;
+    lookups->map_ = nullptr;
+  }
+  if (lookups->map_ == this && lookups->map_version_ == version_) return;
+  lookups->map_ = this;
+  lookups->map_version_ = version_;
+  if (++lookups->epoch_ == 0) {  // wrapped: forget entries explicitly
+    for (VoxelLookupCache::Entry& e : lookups->entries_) e.epoch = 0;
+    lookups->epoch_ = 1;
+  }
+}
+
+int VoxelMap::FindSlot(uint64_t key, VoxelLookupCache* lookups) const {
+  if (lookups == nullptr) return FindSlot(key);
+  VoxelLookupCache::Entry& e = lookups->entries_[LookupIndex(key)];
+  if (e.epoch == lookups->epoch_ && e.key == key) return e.slot;
+  e.key = key;
+  e.slot = FindSlot(key);
+  e.epoch = lookups->epoch_;
+  return e.slot;
+}
+
 void VoxelMap::InsertSlot(const Slot& s) {
   size_t i = HashKey(s.key) & mask_;
   while (slots_[i].offset >= 0) i = (i + 1) & mask_;
@@ -195,6 +233,7 @@ void VoxelMap::InsertSlot(const Slot& s) {
 void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
   slots_.assign(capacity, Slot());
   mask_ = capacity - 1;
+  ++version_;
   num_voxels_ = slots.size();
   for (const Slot& s : slots) InsertSlot(s);
 }
@@ -212,6 +251,7 @@ int VoxelMap::CreateSlot(uint64_t key) {
   s.offset = AllocateBlock(s.capacity);
   InsertSlot(s);
   ++num_voxels_;
+  ++version_;
   return FindSlot(key);
 }
 
@@ -360,7 +400,7 @@ void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
 // Visits the voxel home + (dx, dy, dz) unless its box is already farther than
 // the current limit (exact box distance from the query).
 void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
-                           const float q[3], Candidates* c) const {
+                           const float q[3], VoxelLookupCache* lookups, Candidates* c) const {
   const double s = options_.voxel_size;
   const double gx = AxisGap(dx, q_local[0], s);
   const double gy = AxisGap(dy, q_local[1], s);
@@ -368,12 +408,12 @@ void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const d
   if (gx * gx + gy * gy + gz * gz > c->limit()) return;
   const int64_t x = int64_t{home.x} + dx, y = int64_t{home.y} + dy, z = int64_t{home.z} + dz;
   if (std::max({std::abs(x), std::abs(y), std::abs(z)}) >= kKeyBias) return;  // never stored
-  const int slot = FindSlot(PackKey(x, y, z));
+  const int slot = FindSlot(PackKey(x, y, z), lookups);
   if (slot >= 0) ScanBlock(slots_[slot], q, c);
 }
 
 void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
-                          Candidates* c) const {
+                          VoxelLookupCache* lookups, Candidates* c) const {
   if (r > kPrecomputedShells) {
     // Whole planes and rows of the shell are skipped when their gap alone
     // exceeds the limit (the limit only shrinks, so exactly the voxels a
@@ -387,7 +427,8 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
         if (gx * gx + gy * gy > c->limit()) continue;
         const bool side = std::abs(dx) == r || std::abs(dy) == r;
         const int dz_step = side ? 1 : 2 * r;  // interior columns: only the two caps
-        for (int dz = -r; dz <= r; dz += dz_step) VisitOffset(home, dx, dy, dz, q_local, q, c);
+        for (int dz = -r; dz <= r; dz += dz_step)
+          VisitOffset(home, dx, dy, dz, q_local, q, lookups, c);
       }
     }
     return;
@@ -409,7 +450,8 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
   for (const OctantOffset& o : shells_[r][octant]) {
     if (o.lower_bound2 * s2 > c->limit()) break;  // sorted: the rest are no closer
     if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > c->limit()) continue;
-    const int slot = FindSlot(home_key + o.key_delta);  // == OffsetKey(home_key, dx, dy, dz)
+    const int slot =
+        FindSlot(home_key + o.key_delta, lookups);  // key: OffsetKey(home_key, dx, dy, dz)
     if (slot >= 0) ScanBlock(slots_[slot], q, c);
   }
 }
@@ -432,6 +474,11 @@ void VoxelMap::ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3],
 
 int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
                        NeighborBuffer* out) const {
+  return KNearest(q_world, k, max_dist, out, nullptr);
+}
+
+int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist, NeighborBuffer* out,
+                       VoxelLookupCache* lookups) const {
   RVLIO_CHECK(k >= 1 && k <= kMaxNeighbors);
   RVLIO_CHECK(out != nullptr);
   out->size = 0;
@@ -454,9 +501,10 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
   if (width * width * width > static_cast<double>(slots_.size())) {
     ScanAllVoxels(q_world, q, &c);
   } else {
+    if (lookups != nullptr) BindLookups(lookups);
     for (int r = 0; r <= max_shell; ++r) {
       if (ShellGap(r, q_local, s) > c.limit()) break;  // nothing closer remains
-      VisitShell(r, home, q_local, q, &c);
+      VisitShell(r, home, q_local, q, lookups, &c);
     }
   }
 

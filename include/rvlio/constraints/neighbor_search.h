@@ -23,13 +23,15 @@ namespace rvlio {
 template <class Search>
 struct NeighborSearchTraits;
 
-// The odometry's working map (IESKF and sliding window).
+// The odometry's working map (IESKF and sliding window). The record carries
+// the lookup cache of the caller's queries (consecutive scan points share
+// most neighbour voxels).
 template <>
 struct NeighborSearchTraits<VoxelMap> {
-  using Neighbors = NeighborBuffer;
-  static int KNearest(const VoxelMap& map, const Eigen::Vector3d& q_world, int k,
-                      double max_dist, Neighbors* out) {
-    return map.KNearest(q_world, k, max_dist, out);
+  using Neighbors = VoxelNeighbors;
+  static int KNearest(const VoxelMap& map, const Eigen::Vector3d& q_world, int k, double max_dist,
+                      Neighbors* out) {
+    return map.KNearest(q_world, k, max_dist, out, &out->lookups);
   }
 };
 
