@@ -205,9 +205,9 @@ void VoxelMap::BindLookups(VoxelLookupCache* lookups) const {
     lookups->epoch_ = 0;
     lookups->map_ = nullptr;
   }
-  if (lookups->map_ == this && lookups->map_version_ == version_) return;
+  if (lookups->map_ == this && lookups->map_version_ == version_.value) return;
   lookups->map_ = this;
-  lookups->map_version_ = version_;
+  lookups->map_version_ = version_.value;
   if (++lookups->epoch_ == 0) {  // wrapped: forget entries explicitly
     for (VoxelLookupCache::Entry& e : lookups->entries_) e.epoch = 0;
     lookups->epoch_ = 1;
@@ -233,7 +233,7 @@ void VoxelMap::InsertSlot(const Slot& s) {
 void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
   slots_.assign(capacity, Slot());
   mask_ = capacity - 1;
-  ++version_;
+  ++version_.value;
   num_voxels_ = slots.size();
   for (const Slot& s : slots) InsertSlot(s);
 }
@@ -251,7 +251,7 @@ int VoxelMap::CreateSlot(uint64_t key) {
   s.offset = AllocateBlock(s.capacity);
   InsertSlot(s);
   ++num_voxels_;
-  ++version_;
+  ++version_.value;
   return FindSlot(key);
 }
 

@@ -12,6 +12,7 @@
 // of a query vectorizes); block capacities c grow 4, 8, 16, ... up to
 // max_points_per_voxel, so sparse voxels stay small. Memory is reused: freed
 // blocks go to per-capacity free lists, and queries allocate nothing.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -170,7 +171,19 @@ class VoxelMap {
   std::vector<Slot> scratch_slots_;                // reused by RemoveFar / growth
   size_t num_voxels_ = 0;
   size_t num_points_ = 0;
-  uint64_t version_ = 0;  // bumped whenever a voxel moves, appears or goes (lookup caches)
+  // Bumped whenever a voxel moves, appears or goes, so a lookup cache bound
+  // to (this, version) notices; assigning another map moves it past both
+  // maps' values, so one object never shows the same version twice.
+  struct TableVersion {
+    uint64_t value = 0;
+    TableVersion() = default;
+    TableVersion(const TableVersion&) = default;
+    TableVersion& operator=(const TableVersion& other) {
+      value = std::max(value, other.value) + 1;
+      return *this;
+    }
+  };
+  TableVersion version_;
 
   // shells_[r]: voxel offsets with Chebyshev norm r in visiting order (see
   // MakeShell), for r <= kPrecomputedShells.
