@@ -93,7 +93,7 @@ void AssociationStats::Count(AssociationOutcome outcome) {
 
 AssociationOutcome AssociatePoint(const Eigen::Vector3d& p_lidar, const Pose3& T_world_lidar,
                                   const VoxelMap& map, const ConstraintOptions& options,
-                                  VoxelNeighbors* neighbors, Constraint* out) {
+                                  NeighborBuffer* neighbors, Constraint* out) {
   const Eigen::Vector3d p_world = T_world_lidar * p_lidar;
   Eigen::Vector3d u = Eigen::Vector3d::UnitZ(), q = Eigen::Vector3d::Zero();
   const AssociationOutcome found = association_detail::SearchPlane(

@@ -61,11 +61,10 @@ struct AssociationStats {
 // Associates one point. T_world_lidar = T_world_imu * T_imu_lidar. On
 // acceptance fills *out (p_lidar, normal_world oriented towards the sensor
 // origin, q_world = plane centroid, residual, weight 1, role kPlain);
-// otherwise *out is unspecified. `neighbors` is scratch space (its lookup
-// cache speeds up calls for nearby points).
+// otherwise *out is unspecified. `neighbors` is scratch space.
 AssociationOutcome AssociatePoint(const Eigen::Vector3d& p_lidar, const Pose3& T_world_lidar,
                                   const VoxelMap& map, const ConstraintOptions& options,
-                                  VoxelNeighbors* neighbors, Constraint* out);
+                                  NeighborBuffer* neighbors, Constraint* out);
 
 // The local plane (or the rejection) found for each point of one scan, so
 // that the later iterations of one update search the map again only for the

@@ -23,15 +23,13 @@ namespace rvlio {
 template <class Search>
 struct NeighborSearchTraits;
 
-// The odometry's working map (IESKF and sliding window). The record carries
-// the lookup cache of the caller's queries (consecutive scan points share
-// most neighbour voxels).
+// The odometry's working map (IESKF and sliding window).
 template <>
 struct NeighborSearchTraits<VoxelMap> {
-  using Neighbors = VoxelNeighbors;
-  static int KNearest(const VoxelMap& map, const Eigen::Vector3d& q_world, int k, double max_dist,
-                      Neighbors* out) {
-    return map.KNearest(q_world, k, max_dist, out, &out->lookups);
+  using Neighbors = NeighborBuffer;
+  static int KNearest(const VoxelMap& map, const Eigen::Vector3d& q_world, int k,
+                      double max_dist, Neighbors* out) {
+    return map.KNearest(q_world, k, max_dist, out);
   }
 };
 

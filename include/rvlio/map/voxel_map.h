@@ -7,12 +7,16 @@
 // A voxel keeps at most max_points_per_voxel points; a new point closer than
 // min_point_distance to a point already in its voxel is skipped. Voxels are
 // found through an open-addressing hash table (linear probing, power-of-two
-// capacity, load <= 1/2) whose slots hold the voxel records. Each voxel owns a
+// capacity, load <= 1/2) whose slots hold keys and indices of voxel records.
+// A record keeps, besides its points, the records of its 26 face-, edge- and
+// corner-neighbours (-1: empty), linked when a voxel is created and unlinked
+// when it is removed (as iVox keeps neighbour lists), so a query whose own
+// voxel is occupied looks up one key instead of up to 27. Records do not
+// move when the table grows or is rebuilt. Each voxel owns a
 // block of float storage laid out as x[c], y[c], z[c] (so the distance loop
 // of a query vectorizes); block capacities c grow 4, 8, 16, ... up to
 // max_points_per_voxel, so sparse voxels stay small. Memory is reused: freed
 // blocks go to per-capacity free lists, and queries allocate nothing.
-#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -36,44 +40,6 @@ struct NeighborBuffer {
   std::array<double, kMaxNeighbors> dist2;            // squared distance to the query, m^2
 };
 
-class VoxelMap;
-
-// Remembers where the voxels that recent queries looked up sit in a map's
-// hash table, or that they are empty, so that queries near the previous ones
-// skip the hash probes: consecutive points of a scan share most of their
-// neighbour voxels (and ~85% of the voxels a query visits are empty). It is
-// direct-mapped by the low 4 bits of each voxel coordinate (a 16^3 voxel
-// window, 64 KiB, allocated at the first query) and follows the map it was
-// last used with: any change of that map's voxel table (a new voxel,
-// RemoveFar, Clear) or a query on another map object forgets every entry.
-// Results are identical with or without it. One per thread: queries sharing
-// a cache must not run at the same time. Reset() before using it with a map
-// built where another map it served was destroyed.
-class VoxelLookupCache {
- public:
-  void Reset() { map_ = nullptr; }
-
- private:
-  friend class VoxelMap;
-  struct Entry {
-    uint64_t key = 0;
-    int32_t slot = -1;   // table slot of the voxel, -1: empty
-    uint32_t epoch = 0;  // valid when equal to epoch_
-  };
-  static constexpr int kAxisBits = 4;
-  std::vector<Entry> entries_;
-  const VoxelMap* map_ = nullptr;
-  uint64_t map_version_ = 0;
-  uint32_t epoch_ = 0;
-};
-
-// The neighbour record of the association's VoxelMap searches
-// (neighbor_search.h): the result plus the lookup cache of the caller's
-// queries.
-struct VoxelNeighbors : NeighborBuffer {
-  VoxelLookupCache lookups;
-};
-
 class VoxelMap {
  public:
   explicit VoxelMap(const MapOptions& options = MapOptions());
@@ -88,11 +54,6 @@ class VoxelMap {
   // sorted by distance into *out. Returns out->size (< k when fewer points are
   // within max_dist). 1 <= k <= kMaxNeighbors. No heap allocation.
   int KNearest(const Eigen::Vector3d& q_world, int k, double max_dist, NeighborBuffer* out) const;
-  // The same query, with the hash lookups answered from (and recorded in)
-  // *lookups when not null: identical results, fewer probes for queries
-  // near the previous ones.
-  int KNearest(const Eigen::Vector3d& q_world, int k, double max_dist, NeighborBuffer* out,
-               VoxelLookupCache* lookups) const;
 
   // Removes every voxel whose centre is farther than radius (m) from
   // center_world (the sensor position: keeps a working window).
@@ -110,53 +71,61 @@ class VoxelMap {
   template <class F>
   void ForEachPoint(F&& f) const {
     for (const Slot& s : slots_) {
-      if (s.offset < 0) continue;
-      const float* x = pool_.data() + s.offset;
-      for (int i = 0; i < s.count; ++i)
-        f(Eigen::Vector3d(x[i], x[i + s.capacity], x[i + 2 * s.capacity]));
+      if (s.voxel < 0) continue;
+      const Voxel& v = voxels_[s.voxel];
+      const float* x = pool_.data() + v.offset;
+      for (int i = 0; i < v.count; ++i)
+        f(Eigen::Vector3d(x[i], x[i + v.capacity], x[i + 2 * v.capacity]));
     }
   }
   std::vector<Eigen::Vector3d> Points() const;
 
  private:
-  // One voxel: its key and its block x[capacity], y[capacity], z[capacity]
-  // at pool_[offset].
+  // One entry of the hash table: a voxel's key and record.
   struct Slot {
-    uint64_t key = 0;     // packed voxel coordinates (voxel_map.cpp)
-    int32_t offset = -1;  // -1: empty slot
+    uint64_t key = 0;    // packed voxel coordinates (voxel_map.cpp)
+    int32_t voxel = -1;  // index into voxels_; -1: empty slot
+  };
+  // One voxel: its block x[capacity], y[capacity], z[capacity] at
+  // pool_[offset] and its neighbours.
+  struct Voxel {
+    int32_t offset = -1;  // -1: a free record
     uint16_t count = 0;
     uint16_t capacity = 0;
+    // near[NearIndex(dx, dy, dz)]: the record of the voxel at that offset in
+    // {-1, 0, 1}^3 (-1: empty); near[13] is the voxel itself.
+    std::array<int32_t, 27> near;
   };
   struct Offset {
     int8_t dx, dy, dz;
     float lower_bound2;  // squared box distance bound, in voxel edges^2 (see MakeShell)
   };
   // An offset mirrored into one query octant: its per-axis gap-table
-  // indices (offset + r) and the packed-key difference it adds.
+  // indices (offset + r), the packed-key difference it adds and, in shell 1,
+  // its Voxel::near index.
   struct OctantOffset {
     float lower_bound2;
     uint8_t ix, iy, iz;
+    uint8_t near;
     uint64_t key_delta;
   };
   class Candidates;
 
-  int FindSlot(uint64_t key) const;  // slot index, or -1
-  // FindSlot through a lookup cache bound to this map (BindLookups), if any.
-  int FindSlot(uint64_t key, VoxelLookupCache* lookups) const;
-  void BindLookups(VoxelLookupCache* lookups) const;
-  int CreateSlot(uint64_t key);    // key must be absent; returns its slot
-  void InsertSlot(const Slot& s);  // key must be absent; no growth check
+  int FindVoxel(uint64_t key) const;  // record index, or -1
+  int CreateVoxel(uint64_t key);      // key must be absent; returns its record
+  void InsertSlot(const Slot& s);     // key must be absent; no growth check
+  void FreeVoxel(int v);              // unlinks the record and frees it and its block
   void Rebuild(size_t capacity, const std::vector<Slot>& slots);
   int CapacityClass(int capacity) const;
   int32_t AllocateBlock(int capacity);
   void FreeBlock(int32_t offset, int capacity);
-  void GrowBlock(Slot* s);
+  void GrowBlock(Voxel* v);
 
-  void ScanBlock(const Slot& s, const float q[3], Candidates* c) const;
+  void ScanBlock(const Voxel& v, const float q[3], Candidates* c) const;
   void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
-                   const float q[3], VoxelLookupCache* lookups, Candidates* c) const;
-  void VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
-                  VoxelLookupCache* lookups, Candidates* c) const;
+                   const float q[3], Candidates* c) const;
+  void VisitShell(int r, const VoxelKey& home, const Voxel* home_voxel, const double q_local[3],
+                  const float q[3], Candidates* c) const;
   void ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3], Candidates* c) const;
 
   MapOptions options_;
@@ -166,24 +135,13 @@ class VoxelMap {
 
   std::vector<Slot> slots_;
   size_t mask_ = 0;
+  std::vector<Voxel> voxels_;                      // records, indexed by Slot::voxel
+  std::vector<int32_t> free_voxels_;               // free record indices
   std::vector<float> pool_;                        // blocks of x[c], y[c], z[c]
   std::vector<std::vector<int32_t>> free_blocks_;  // freed offsets per capacity class
   std::vector<Slot> scratch_slots_;                // reused by RemoveFar / growth
   size_t num_voxels_ = 0;
   size_t num_points_ = 0;
-  // Bumped whenever a voxel moves, appears or goes, so a lookup cache bound
-  // to (this, version) notices; assigning another map moves it past both
-  // maps' values, so one object never shows the same version twice.
-  struct TableVersion {
-    uint64_t value = 0;
-    TableVersion() = default;
-    TableVersion(const TableVersion&) = default;
-    TableVersion& operator=(const TableVersion& other) {
-      value = std::max(value, other.value) + 1;
-      return *this;
-    }
-  };
-  TableVersion version_;
 
   // shells_[r]: voxel offsets with Chebyshev norm r in visiting order (see
   // MakeShell), for r <= kPrecomputedShells.
