@@ -102,15 +102,9 @@ inline double AxisGap(int d, double q_local, double s) {
 inline double ShellGap(int r, const double q_local[3], double s) {
   if (r == 0) return 0.0;
   double g = AxisGap(r, q_local[0], s);
-  for (int a = 0; a < 3; ++a)
-    g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
+  for (int a = 0; a < 3; ++a) g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
   return g * g;
 }
-
-// Voxel::near index of the offset (dx, dy, dz) in {-1, 0, 1}^3; the opposite
-// offset has index 26 - NearIndex(dx, dy, dz).
-constexpr int NearIndex(int dx, int dy, int dz) { return (dx + 1) * 9 + (dy + 1) * 3 + (dz + 1); }
-constexpr int kNearSelf = NearIndex(0, 0, 0);
 
 }  // namespace
 
@@ -165,10 +159,9 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
       const int sx = (octant & 1) ? -1 : 1, sy = (octant & 2) ? -1 : 1, sz = (octant & 4) ? -1 : 1;
       for (const Offset& o : shell) {
         const int dx = sx * o.dx, dy = sy * o.dy, dz = sz * o.dz;
-        const int near = r <= 1 ? NearIndex(dx, dy, dz) : kNearSelf;
         shells_[r][octant].push_back(OctantOffset{
             o.lower_bound2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
-            static_cast<uint8_t>(dz + r), static_cast<uint8_t>(near), OffsetKey(0, dx, dy, dz)});
+            static_cast<uint8_t>(dz + r), OffsetKey(0, dx, dy, dz)});
       }
     }
   }
@@ -177,8 +170,6 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
 
 void VoxelMap::Clear() {
   pool_.clear();
-  voxels_.clear();
-  free_voxels_.clear();
   for (auto& list : free_blocks_) list.clear();
   num_points_ = 0;
   Rebuild(kInitialCapacity, {});
@@ -186,10 +177,10 @@ void VoxelMap::Clear() {
 
 // ---------------------------------------------------------------- hash table
 
-int VoxelMap::FindVoxel(uint64_t key) const {
+int VoxelMap::FindSlot(uint64_t key) const {
   size_t i = HashKey(key) & mask_;
-  while (slots_[i].voxel >= 0) {
-    if (slots_[i].key == key) return slots_[i].voxel;
+  while (slots_[i].offset >= 0) {
+    if (slots_[i].key == key) return static_cast<int>(i);
     i = (i + 1) & mask_;
   }
   return -1;
@@ -197,7 +188,7 @@ int VoxelMap::FindVoxel(uint64_t key) const {
 
 void VoxelMap::InsertSlot(const Slot& s) {
   size_t i = HashKey(s.key) & mask_;
-  while (slots_[i].voxel >= 0) i = (i + 1) & mask_;
+  while (slots_[i].offset >= 0) i = (i + 1) & mask_;
   slots_[i] = s;
 }
 
@@ -208,53 +199,20 @@ void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
   for (const Slot& s : slots) InsertSlot(s);
 }
 
-// A new record linked with its occupied neighbours both ways.
-int VoxelMap::CreateVoxel(uint64_t key) {
+int VoxelMap::CreateSlot(uint64_t key) {
   if (2 * (num_voxels_ + 1) > slots_.size()) {  // keep the load <= 1/2
     scratch_slots_.clear();
     for (const Slot& s : slots_)
-      if (s.voxel >= 0) scratch_slots_.push_back(s);
+      if (s.offset >= 0) scratch_slots_.push_back(s);
     Rebuild(2 * slots_.size(), scratch_slots_);
   }
-  int v;
-  if (!free_voxels_.empty()) {
-    v = free_voxels_.back();
-    free_voxels_.pop_back();
-  } else {
-    RVLIO_CHECK(voxels_.size() < static_cast<size_t>(std::numeric_limits<int32_t>::max()));
-    v = static_cast<int>(voxels_.size());
-    voxels_.emplace_back();
-  }
-  const uint16_t capacity = static_cast<uint16_t>(std::min(kFirstBlockCapacity, max_points_));
-  const int32_t offset = AllocateBlock(capacity);
-  Voxel& voxel = voxels_[v];
-  voxel.offset = offset;
-  voxel.count = 0;
-  voxel.capacity = capacity;
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz) {
-        const int i = NearIndex(dx, dy, dz);
-        if (i == kNearSelf) continue;
-        const int n = FindVoxel(OffsetKey(key, dx, dy, dz));  // |key| < kKeyLimit: no carries
-        voxel.near[i] = n;
-        if (n >= 0) voxels_[n].near[26 - i] = v;
-      }
-  voxel.near[kNearSelf] = v;
-  InsertSlot(Slot{key, v});
+  Slot s;
+  s.key = key;
+  s.capacity = static_cast<uint16_t>(std::min(kFirstBlockCapacity, max_points_));
+  s.offset = AllocateBlock(s.capacity);
+  InsertSlot(s);
   ++num_voxels_;
-  return v;
-}
-
-void VoxelMap::FreeVoxel(int v) {
-  Voxel& voxel = voxels_[v];
-  for (int i = 0; i < 27; ++i)
-    if (i != kNearSelf && voxel.near[i] >= 0) voxels_[voxel.near[i]].near[26 - i] = -1;
-  num_points_ -= voxel.count;
-  FreeBlock(voxel.offset, voxel.capacity);
-  voxel.offset = -1;
-  voxel.count = 0;
-  free_voxels_.push_back(v);
+  return FindSlot(key);
 }
 
 // ------------------------------------------------------------ block storage
@@ -284,7 +242,7 @@ void VoxelMap::FreeBlock(int32_t offset, int capacity) {
 }
 
 // Moves a full voxel to a block of the next capacity class.
-void VoxelMap::GrowBlock(Voxel* s) {
+void VoxelMap::GrowBlock(Slot* s) {
   const int new_capacity = std::min(2 * s->capacity, max_points_);
   const int32_t new_offset = AllocateBlock(new_capacity);  // may reallocate pool_
   for (int axis = 0; axis < 3; ++axis)
@@ -304,9 +262,9 @@ bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
   const float px = static_cast<float>(p_world.x());
   const float py = static_cast<float>(p_world.y());
   const float pz = static_cast<float>(p_world.z());
-  int v = FindVoxel(key);
-  if (v >= 0) {
-    const Voxel& s = voxels_[v];
+  int slot = FindSlot(key);
+  if (slot >= 0) {
+    const Slot& s = slots_[slot];
     if (s.count >= max_points_) return false;
     const float* x = pool_.data() + s.offset;
     for (int i = 0; i < s.count; ++i) {
@@ -314,9 +272,9 @@ bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
       if (dx * dx + dy * dy + dz * dz < min_d2_) return false;
     }
   } else {
-    v = CreateVoxel(key);
+    slot = CreateSlot(key);
   }
-  Voxel& s = voxels_[v];
+  Slot& s = slots_[slot];
   if (s.count == s.capacity) GrowBlock(&s);
   float* x = pool_.data() + s.offset;
   x[s.count] = px;
@@ -337,11 +295,12 @@ void VoxelMap::RemoveFar(const Eigen::Vector3d& center_world, double radius) {
   scratch_slots_.clear();
   bool removed = false;
   for (const Slot& s : slots_) {
-    if (s.voxel < 0) continue;
+    if (s.offset < 0) continue;
     const VoxelKey k = UnpackKey(s.key);
     const Eigen::Vector3d c((k.x + 0.5) * vs, (k.y + 0.5) * vs, (k.z + 0.5) * vs);
     if ((c - center_world).squaredNorm() > r2) {
-      FreeVoxel(s.voxel);
+      num_points_ -= s.count;
+      FreeBlock(s.offset, s.capacity);
       removed = true;
     } else {
       scratch_slots_.push_back(s);
@@ -364,7 +323,7 @@ std::vector<Eigen::Vector3d> VoxelMap::Points() const {
 // and a movemask, so a group whose points are all too far costs a few
 // instructions; the points that beat the limit are offered in index order,
 // each re-checked against the limit as it tightens.
-void VoxelMap::ScanBlock(const Voxel& s, const float q[3], Candidates* c) const {
+void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
   const float* x = pool_.data() + s.offset;
   const float* y = x + s.capacity;
   const float* z = y + s.capacity;
@@ -409,14 +368,12 @@ void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const d
   if (gx * gx + gy * gy + gz * gz > c->limit()) return;
   const int64_t x = int64_t{home.x} + dx, y = int64_t{home.y} + dy, z = int64_t{home.z} + dz;
   if (std::max({std::abs(x), std::abs(y), std::abs(z)}) >= kKeyBias) return;  // never stored
-  const int v = FindVoxel(PackKey(x, y, z));
-  if (v >= 0) ScanBlock(voxels_[v], q, c);
+  const int slot = FindSlot(PackKey(x, y, z));
+  if (slot >= 0) ScanBlock(slots_[slot], q, c);
 }
 
-// home_voxel: the query's own voxel, or null when it is empty; its links
-// answer the lookups of shells 0 and 1.
-void VoxelMap::VisitShell(int r, const VoxelKey& home, const Voxel* home_voxel,
-                          const double q_local[3], const float q[3], Candidates* c) const {
+void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
+                          Candidates* c) const {
   if (r > kPrecomputedShells) {
     // Whole planes and rows of the shell are skipped when their gap alone
     // exceeds the limit (the limit only shrinks, so exactly the voxels a
@@ -449,13 +406,11 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const Voxel* home_voxel,
   }
   const double s2 = s * s;
   const uint64_t home_key = PackKey(home.x, home.y, home.z);  // |home| < kKeyLimit: no carries
-  const bool linked = r <= 1 && home_voxel != nullptr;
   for (const OctantOffset& o : shells_[r][octant]) {
     if (o.lower_bound2 * s2 > c->limit()) break;  // sorted: the rest are no closer
     if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > c->limit()) continue;
-    const int v = linked ? home_voxel->near[o.near]
-                         : FindVoxel(home_key + o.key_delta);  // == OffsetKey(home_key, dx, dy, dz)
-    if (v >= 0) ScanBlock(voxels_[v], q, c);
+    const int slot = FindSlot(home_key + o.key_delta);  // == OffsetKey(home_key, dx, dy, dz)
+    if (slot >= 0) ScanBlock(slots_[slot], q, c);
   }
 }
 
@@ -465,13 +420,13 @@ void VoxelMap::ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3],
                              Candidates* c) const {
   const double s = options_.voxel_size;
   for (const Slot& slot : slots_) {
-    if (slot.voxel < 0) continue;
+    if (slot.offset < 0) continue;
     const VoxelKey k = UnpackKey(slot.key);
     const Eigen::Vector3d lo(k.x * s, k.y * s, k.z * s);
     const Eigen::Vector3d gap =
         (lo - q_world).cwiseMax(q_world - lo - Eigen::Vector3d::Constant(s)).cwiseMax(0.0);
     if (gap.squaredNorm() > c->limit()) continue;
-    ScanBlock(voxels_[slot.voxel], q, c);
+    ScanBlock(slot, q, c);
   }
 }
 
@@ -499,11 +454,9 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
   if (width * width * width > static_cast<double>(slots_.size())) {
     ScanAllVoxels(q_world, q, &c);
   } else {
-    const int home_v = FindVoxel(PackKey(home.x, home.y, home.z));
-    const Voxel* home_voxel = home_v >= 0 ? &voxels_[home_v] : nullptr;
     for (int r = 0; r <= max_shell; ++r) {
       if (ShellGap(r, q_local, s) > c.limit()) break;  // nothing closer remains
-      VisitShell(r, home, home_voxel, q_local, q, &c);
+      VisitShell(r, home, q_local, q, &c);
     }
   }
 

@@ -240,12 +240,12 @@ void ExpectSameAnswer(const NeighborBuffer& a, const NeighborBuffer& b) {
 
 // Queries walking through random maps (consecutive queries close together,
 // as the points of a scan) while the map changes between them: inserts that
-// add voxels or only points, RemoveFar (which unlinks voxels from their
-// neighbours and reuses their records), Clear and assignment of another map.
-// Every answer must agree with brute force over the stored points and equal,
-// bit for bit and in order, the answer of a map freshly built from those
-// points (whose neighbour links never saw a removal).
-TEST(VoxelMap, LinkedNeighboursMatchBruteForceWhileTheMapChanges) {
+// add voxels or only points, RemoveFar (which rebuilds the table and reuses
+// freed blocks), Clear and assignment of another map. Every answer must agree
+// with brute force over the stored points and equal, bit for bit and in
+// order, the answer of a map freshly built from those points (which never
+// saw a removal).
+TEST(VoxelMap, KNearestMatchesBruteForceAndAFreshMapWhileTheMapChanges) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> step(0.0, 0.15);
