@@ -102,7 +102,8 @@ inline double AxisGap(int d, double q_local, double s) {
 inline double ShellGap(int r, const double q_local[3], double s) {
   if (r == 0) return 0.0;
   double g = AxisGap(r, q_local[0], s);
-  for (int a = 0; a < 3; ++a) g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
+  for (int a = 0; a < 3; ++a)
+    g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
   return g * g;
 }
 
@@ -153,6 +154,7 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
   min_d2_ = static_cast<float>(options.min_point_distance * options.min_point_distance);
   max_points_ = options.max_points_per_voxel;
   free_blocks_.resize(CapacityClass(max_points_) + 1);
+  const double s2 = options.voxel_size * options.voxel_size;  // as VisitShell's bound test had it
   for (int r = 0; r <= kPrecomputedShells; ++r) {
     const std::vector<Offset> shell = MakeShell<Offset>(r);
     for (int octant = 0; octant < 8; ++octant) {
@@ -160,7 +162,7 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
       for (const Offset& o : shell) {
         const int dx = sx * o.dx, dy = sy * o.dy, dz = sz * o.dz;
         shells_[r][octant].push_back(OctantOffset{
-            o.lower_bound2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
+            o.lower_bound2 * s2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
             static_cast<uint8_t>(dz + r), OffsetKey(0, dx, dy, dz)});
       }
     }
@@ -177,7 +179,7 @@ void VoxelMap::Clear() {
 
 // ---------------------------------------------------------------- hash table
 
-int VoxelMap::FindSlot(uint64_t key) const {
+inline int VoxelMap::FindSlot(uint64_t key) const {
   size_t i = HashKey(key) & mask_;
   while (slots_[i].offset >= 0) {
     if (slots_[i].key == key) return static_cast<int>(i);
@@ -404,10 +406,9 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
       gap2[a][d + r] = g * g;
     }
   }
-  const double s2 = s * s;
   const uint64_t home_key = PackKey(home.x, home.y, home.z);  // |home| < kKeyLimit: no carries
   for (const OctantOffset& o : shells_[r][octant]) {
-    if (o.lower_bound2 * s2 > c->limit()) break;  // sorted: the rest are no closer
+    if (o.lower_bound_m2 > c->limit()) break;  // sorted: the rest are no closer
     if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > c->limit()) continue;
     const int slot = FindSlot(home_key + o.key_delta);  // == OffsetKey(home_key, dx, dy, dz)
     if (slot >= 0) ScanBlock(slots_[slot], q, c);
