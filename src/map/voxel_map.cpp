@@ -361,13 +361,11 @@ void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
 
 // Visits the voxel home + (dx, dy, dz) unless its box is already farther than
 // the current limit (exact box distance from the query).
-void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
-                           const float q[3], Candidates* c) const {
-  const double s = options_.voxel_size;
-  const double gx = AxisGap(dx, q_local[0], s);
-  const double gy = AxisGap(dy, q_local[1], s);
-  const double gz = AxisGap(dz, q_local[2], s);
-  if (gx * gx + gy * gy + gz * gz > c->limit()) return;
+// gxy2 = gx * gx + gy * gy, the squared gaps along x and y.
+inline void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, double gxy2,
+                                  const double q_local[3], const float q[3], Candidates* c) const {
+  const double gz = AxisGap(dz, q_local[2], options_.voxel_size);
+  if (gxy2 + gz * gz > c->limit()) return;
   const int64_t x = int64_t{home.x} + dx, y = int64_t{home.y} + dy, z = int64_t{home.z} + dz;
   if (std::max({std::abs(x), std::abs(y), std::abs(z)}) >= kKeyBias) return;  // never stored
   const int slot = FindSlot(PackKey(x, y, z));
@@ -386,10 +384,12 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
       if (gx * gx > c->limit()) continue;
       for (int dy = -r; dy <= r; ++dy) {
         const double gy = AxisGap(dy, q_local[1], s);
-        if (gx * gx + gy * gy > c->limit()) continue;
+        const double gxy2 = gx * gx + gy * gy;
+        if (gxy2 > c->limit()) continue;
         const bool side = std::abs(dx) == r || std::abs(dy) == r;
         const int dz_step = side ? 1 : 2 * r;  // interior columns: only the two caps
-        for (int dz = -r; dz <= r; dz += dz_step) VisitOffset(home, dx, dy, dz, q_local, q, c);
+        for (int dz = -r; dz <= r; dz += dz_step)
+          VisitOffset(home, dx, dy, dz, gxy2, q_local, q, c);
       }
     }
     return;
@@ -407,11 +407,14 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
     }
   }
   const uint64_t home_key = PackKey(home.x, home.y, home.z);  // |home| < kKeyLimit: no carries
+  double limit = c->limit();                                  // changes only in ScanBlock
   for (const OctantOffset& o : shells_[r][octant]) {
-    if (o.lower_bound_m2 > c->limit()) break;  // sorted: the rest are no closer
-    if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > c->limit()) continue;
+    if (o.lower_bound_m2 > limit) break;  // sorted: the rest are no closer
+    if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > limit) continue;
     const int slot = FindSlot(home_key + o.key_delta);  // == OffsetKey(home_key, dx, dy, dz)
-    if (slot >= 0) ScanBlock(slots_[slot], q, c);
+    if (slot < 0) continue;
+    ScanBlock(slots_[slot], q, c);
+    limit = c->limit();
   }
 }
 

@@ -107,8 +107,8 @@ class VoxelMap {
   void GrowBlock(Slot* s);
 
   void ScanBlock(const Slot& s, const float q[3], Candidates* c) const;
-  void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
-                   const float q[3], Candidates* c) const;
+  void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, double gxy2,
+                   const double q_local[3], const float q[3], Candidates* c) const;
   void VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
                   Candidates* c) const;
   void ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3], Candidates* c) const;
