@@ -136,6 +136,22 @@ void BM_AssociateScan(benchmark::State& state) {
 }
 BENCHMARK(BM_AssociateScan)->Unit(benchmark::kMillisecond);
 
+// The same association on 1 or 2 threads (constraints.threads): wall time,
+// since the second thread's CPU time is not the benchmark thread's.
+void BM_AssociateScanThreads(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  ConstraintList constraints;
+  AssociationStats stats;
+  const int threads = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    Associate(f.scan, f.T_world_imu, Pose3(), f.map, ConstraintOptions(), &constraints, &stats,
+              nullptr, threads);
+    benchmark::DoNotOptimize(constraints.data());
+  }
+  state.counters["accepted"] = stats.num_accepted;
+}
+BENCHMARK(BM_AssociateScanThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
 // A later iteration of the same update: the pose moved by ~1 cm, every point
 // reuses its plane from the AssociationCache.
 void BM_AssociateScanCached(benchmark::State& state) {

@@ -104,8 +104,9 @@ AssociationOutcome AssociatePoint(const Eigen::Vector3d& p_lidar, const Pose3& T
 
 void Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
                const Pose3& T_imu_lidar, const VoxelMap& map, const ConstraintOptions& options,
-               ConstraintList* out, AssociationStats* stats, AssociationCache* cache) {
-  AssociateWith(p_lidar, T_world_imu * T_imu_lidar, map, options, out, stats, cache);
+               ConstraintList* out, AssociationStats* stats, AssociationCache* cache, int threads) {
+  AssociateWith(p_lidar, T_world_imu * T_imu_lidar, map, options, out, stats, cache,
+                association_detail::NoHook(), threads);
 }
 
 }  // namespace rvlio

@@ -102,7 +102,8 @@ inline double AxisGap(int d, double q_local, double s) {
 inline double ShellGap(int r, const double q_local[3], double s) {
   if (r == 0) return 0.0;
   double g = AxisGap(r, q_local[0], s);
-  for (int a = 0; a < 3; ++a) g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
+  for (int a = 0; a < 3; ++a)
+    g = std::min({g, AxisGap(r, q_local[a], s), AxisGap(-r, q_local[a], s)});
   return g * g;
 }
 
@@ -153,6 +154,7 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
   min_d2_ = static_cast<float>(options.min_point_distance * options.min_point_distance);
   max_points_ = options.max_points_per_voxel;
   free_blocks_.resize(CapacityClass(max_points_) + 1);
+  const double s2 = options.voxel_size * options.voxel_size;  // as VisitShell's bound test had it
   for (int r = 0; r <= kPrecomputedShells; ++r) {
     const std::vector<Offset> shell = MakeShell<Offset>(r);
     for (int octant = 0; octant < 8; ++octant) {
@@ -160,7 +162,7 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
       for (const Offset& o : shell) {
         const int dx = sx * o.dx, dy = sy * o.dy, dz = sz * o.dz;
         shells_[r][octant].push_back(OctantOffset{
-            o.lower_bound2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
+            o.lower_bound2 * s2, static_cast<uint8_t>(dx + r), static_cast<uint8_t>(dy + r),
             static_cast<uint8_t>(dz + r), OffsetKey(0, dx, dy, dz)});
       }
     }
@@ -177,7 +179,7 @@ void VoxelMap::Clear() {
 
 // ---------------------------------------------------------------- hash table
 
-int VoxelMap::FindSlot(uint64_t key) const {
+inline int VoxelMap::FindSlot(uint64_t key) const {
   size_t i = HashKey(key) & mask_;
   while (slots_[i].offset >= 0) {
     if (slots_[i].key == key) return static_cast<int>(i);
@@ -359,13 +361,11 @@ void VoxelMap::ScanBlock(const Slot& s, const float q[3], Candidates* c) const {
 
 // Visits the voxel home + (dx, dy, dz) unless its box is already farther than
 // the current limit (exact box distance from the query).
-void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
-                           const float q[3], Candidates* c) const {
-  const double s = options_.voxel_size;
-  const double gx = AxisGap(dx, q_local[0], s);
-  const double gy = AxisGap(dy, q_local[1], s);
-  const double gz = AxisGap(dz, q_local[2], s);
-  if (gx * gx + gy * gy + gz * gz > c->limit()) return;
+// gxy2 = gx * gx + gy * gy, the squared gaps along x and y.
+inline void VoxelMap::VisitOffset(const VoxelKey& home, int dx, int dy, int dz, double gxy2,
+                                  const double q_local[3], const float q[3], Candidates* c) const {
+  const double gz = AxisGap(dz, q_local[2], options_.voxel_size);
+  if (gxy2 + gz * gz > c->limit()) return;
   const int64_t x = int64_t{home.x} + dx, y = int64_t{home.y} + dy, z = int64_t{home.z} + dz;
   if (std::max({std::abs(x), std::abs(y), std::abs(z)}) >= kKeyBias) return;  // never stored
   const int slot = FindSlot(PackKey(x, y, z));
@@ -384,10 +384,12 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
       if (gx * gx > c->limit()) continue;
       for (int dy = -r; dy <= r; ++dy) {
         const double gy = AxisGap(dy, q_local[1], s);
-        if (gx * gx + gy * gy > c->limit()) continue;
+        const double gxy2 = gx * gx + gy * gy;
+        if (gxy2 > c->limit()) continue;
         const bool side = std::abs(dx) == r || std::abs(dy) == r;
         const int dz_step = side ? 1 : 2 * r;  // interior columns: only the two caps
-        for (int dz = -r; dz <= r; dz += dz_step) VisitOffset(home, dx, dy, dz, q_local, q, c);
+        for (int dz = -r; dz <= r; dz += dz_step)
+          VisitOffset(home, dx, dy, dz, gxy2, q_local, q, c);
       }
     }
     return;
@@ -404,13 +406,15 @@ void VoxelMap::VisitShell(int r, const VoxelKey& home, const double q_local[3], 
       gap2[a][d + r] = g * g;
     }
   }
-  const double s2 = s * s;
   const uint64_t home_key = PackKey(home.x, home.y, home.z);  // |home| < kKeyLimit: no carries
+  double limit = c->limit();                                  // changes only in ScanBlock
   for (const OctantOffset& o : shells_[r][octant]) {
-    if (o.lower_bound2 * s2 > c->limit()) break;  // sorted: the rest are no closer
-    if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > c->limit()) continue;
+    if (o.lower_bound_m2 > limit) break;  // sorted: the rest are no closer
+    if (gap2[0][o.ix] + gap2[1][o.iy] + gap2[2][o.iz] > limit) continue;
     const int slot = FindSlot(home_key + o.key_delta);  // == OffsetKey(home_key, dx, dy, dz)
-    if (slot >= 0) ScanBlock(slots_[slot], q, c);
+    if (slot < 0) continue;
+    ScanBlock(slots_[slot], q, c);
+    limit = c->limit();
   }
 }
 

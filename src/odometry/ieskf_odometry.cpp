@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "rvlio/common/cpu_time.h"
+#include "rvlio/common/parallel.h"
 #include "rvlio/constraints/associate.h"
 #include "rvlio/lidar/deskew.h"
 
@@ -111,7 +112,7 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   const AssociateFn associate = [this, &cache](const FilterState& x, ConstraintList* constraints) {
     AssociationStats stats;
     Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_.map(), options_.constraints,
-              constraints, &stats, &cache);
+              constraints, &stats, &cache, ResolveThreads(options_.constraints.threads));
   };
   const IeskfUpdateResult u = filter_.Update(associate);
   r->constraints = u.num_constraints;

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "rvlio/common/cpu_time.h"
+#include "rvlio/common/parallel.h"
 #include "rvlio/constraints/associate.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/imu/pose_history.h"
@@ -177,7 +178,8 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
                SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, std::move(imu), p_lidar_end_);
   const ScanAssociateFn associate = [this](const std::vector<Eigen::Vector3d>& p_lidar,
                                            const Pose3& T_world_imu, ConstraintList* out) {
-    Associate(p_lidar, T_world_imu, CurrentTImuLidar(), map_.map(), options_.constraints, out, nullptr);
+    Associate(p_lidar, T_world_imu, CurrentTImuLidar(), map_.map(), options_.constraints, out,
+              nullptr, nullptr, ResolveThreads(options_.constraints.threads));
   };
   const WindowSolveReport report = window_->Optimize(associate);
   stats_.association_ms += report.association_ms;

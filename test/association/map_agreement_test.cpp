@@ -3,7 +3,8 @@
 // batch refinement (RefineMap, seen by a scan none of whose points it holds).
 // Filled with the same points, both must give the same constraints, to the
 // bit, and the same statistics: random scenes over several seeds, and a real
-// simulated tunnel scan against the map of earlier scans.
+// simulated tunnel scan against the map of earlier scans. Also: the same
+// constraints for any thread count of the association.
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -180,6 +181,65 @@ TEST(MapAgreement, SimulatedTunnelScanGivesIdenticalConstraintsOnBothMaps) {
   s.T_world_lidar = sim.TruthAt(query.t_end_ns).T_world_imu * off * T_imu_lidar;
   const AssociationStats st = AssociateBoth(s, MapOptions(), ConstraintOptions());
   EXPECT_GT(st.num_accepted, st.num_points / 2);
+}
+
+// Association on several threads (AssociateWith's `threads`): fixed chunks of
+// points merged in point order, so the constraints, the statistics and the
+// AssociationCache are the same, to the bit, for any thread count. Three
+// passes per scene as in one IESKF update: a fresh search, a pose 1 cm off
+// (most planes reused) and one 20 cm off (most searched again).
+TEST(ParallelAssociation, SameConstraintsStatsAndCacheForAnyThreadCount) {
+  int64_t reused = 0, searched_again = 0, accepted = 0;
+  for (uint32_t seed = 1; seed <= 4; ++seed) {
+    SCOPED_TRACE(seed);
+    const Scene scene = RandomScene(seed);
+    ASSERT_GT(scene.query_lidar.size(), 4u * association_detail::kAssociationChunk);
+    MapOptions map_options;
+    map_options.voxel_size = seed % 2 == 0 ? 0.5 : 1.0;
+    VoxelMap map(map_options);
+    for (const auto& scan : scene.map_scans) map.Insert(scan);
+    ConstraintOptions options;
+    options.max_residual = 0.2;
+    const Vector3d shifts[3] = {Vector3d::Zero(), Vector3d(0.01, 0.0, 0.0), Vector3d(0.0, 0.2, 0.0)};
+    std::vector<ConstraintList> reference(3);
+    std::vector<AssociationStats> reference_stats(3);
+    std::vector<AssociationCache::Entry> reference_cache;
+    for (int threads : {1, 2, 3, 8}) {
+      SCOPED_TRACE(threads);
+      AssociationCache cache(0.05);
+      for (int pass = 0; pass < 3; ++pass) {
+        Pose3 T = scene.T_world_lidar;
+        T.t += shifts[pass];
+        ConstraintList out;
+        AssociationStats stats;
+        Associate(scene.query_lidar, T, Pose3(), map, options, &out, &stats, &cache, threads);
+        if (threads == 1) {
+          reference[pass] = out;
+          reference_stats[pass] = stats;
+          accepted += stats.num_accepted;
+          if (pass == 1) reused += stats.num_reused;
+          if (pass == 2) searched_again += stats.num_points - stats.num_reused;
+          continue;
+        }
+        ExpectSameConstraints(reference[pass], out);
+        ExpectSameStats(reference_stats[pass], stats);
+      }
+      if (threads == 1) {
+        reference_cache = cache.entries();
+        continue;
+      }
+      ASSERT_EQ(cache.entries().size(), reference_cache.size());
+      for (size_t i = 0; i < reference_cache.size(); ++i) {
+        EXPECT_EQ(cache.entries()[i].p_world, reference_cache[i].p_world);
+        EXPECT_EQ(cache.entries()[i].normal_world, reference_cache[i].normal_world);
+        EXPECT_EQ(cache.entries()[i].q_world, reference_cache[i].q_world);
+        EXPECT_EQ(cache.entries()[i].outcome, reference_cache[i].outcome);
+      }
+    }
+  }
+  EXPECT_GT(accepted, 10000);
+  EXPECT_GT(reused, 5000);
+  EXPECT_GT(searched_again, 5000);
 }
 
 }  // namespace

@@ -228,6 +228,85 @@ namespace {
 // Points and queries on a lattice aligned with the voxel faces (queries on
 // faces, edges and corners: zero in-voxel offsets, many equal distances),
 // sparse enough that most queries search deep shells with a loose limit.
+// Two answers with the same points in the same order (ties included) and the
+// same distances, bit for bit.
+void ExpectSameAnswer(const NeighborBuffer& a, const NeighborBuffer& b) {
+  ASSERT_EQ(a.size, b.size);
+  for (int i = 0; i < a.size; ++i) {
+    EXPECT_EQ(a.points[i], b.points[i]) << "rank " << i;
+    EXPECT_EQ(a.dist2[i], b.dist2[i]) << "rank " << i;
+  }
+}
+
+// Queries walking through random maps (consecutive queries close together,
+// as the points of a scan) while the map changes between them: inserts that
+// add voxels or only points, RemoveFar (which rebuilds the table and reuses
+// freed blocks), Clear and assignment of another map. Every answer must agree
+// with brute force over the stored points and equal, bit for bit and in
+// order, the answer of a map freshly built from those points (which never
+// saw a removal).
+TEST(VoxelMap, KNearestMatchesBruteForceAndAFreshMapWhileTheMapChanges) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> step(0.0, 0.15);
+  int checked = 0, full = 0, partial = 0, changes = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    MapOptions options;
+    options.voxel_size = 0.2 + 0.8 * unit(rng);
+    options.max_points_per_voxel = 1 + static_cast<int>(30 * unit(rng));
+    options.min_point_distance = (trial % 3 == 0) ? 0.0 : 0.05 * unit(rng);
+    const double half_extent = 2.0 + 8.0 * unit(rng);
+    VoxelMap map(options);
+    const VoxelMap other = [&] {
+      VoxelMap m(options);
+      m.Insert(RandomCloud(&rng, 500, half_extent));
+      return m;
+    }();
+    map.Insert(RandomCloud(&rng, 200 + static_cast<int>(2000 * unit(rng)), half_extent));
+    NeighborBuffer nb, fresh_nb;
+    Eigen::Vector3d q = Eigen::Vector3d::Zero();
+    for (int query = 0; query < 150; ++query) {
+      q += Eigen::Vector3d(step(rng), step(rng), step(rng));
+      if (q.cwiseAbs().maxCoeff() > 1.2 * half_extent) q.setZero();
+      if (query % 25 == 5) {  // new points, most in new voxels
+        map.Insert(RandomCloud(&rng, 100, half_extent));
+        ++changes;
+      } else if (query % 25 == 10 || query % 25 == 18) {
+        map.RemoveFar(q, 0.3 * half_extent + 2.0 * options.voxel_size * unit(rng));
+        ++changes;
+      } else if (query % 25 == 20 && trial % 4 == 0) {
+        map.Clear();
+        map.Insert(RandomCloud(&rng, 300, half_extent));
+        ++changes;
+      } else if (query % 25 == 20 && trial % 4 == 1) {
+        map = other;
+        ++changes;
+      }
+      const int k = 1 + query % 10;
+      const double max_dist = (query % 6 == 0) ? 3.0 * options.voxel_size : 0.1 + 2.0 * unit(rng);
+      const int found = map.KNearest(q, k, max_dist, &nb);
+      const std::vector<Eigen::Vector3d> stored = map.Points();
+      VoxelMap fresh(options);
+      fresh.Insert(stored);
+      ASSERT_EQ(fresh.Size(), map.Size());
+      ASSERT_EQ(fresh.KNearest(q, k, max_dist, &fresh_nb), found) << "trial " << trial;
+      ExpectSameAnswer(fresh_nb, nb);
+      if (NearBoundary(stored, q, max_dist)) continue;
+      const std::vector<double> expected = BruteForce(stored, q, k, max_dist);
+      ASSERT_EQ(found, static_cast<int>(expected.size())) << "trial " << trial;
+      for (int i = 0; i < found; ++i)
+        EXPECT_NEAR(nb.dist2[i], expected[i], 1e-9 + 1e-6 * expected[i]) << "rank " << i;
+      ++checked;
+      if (found == k) ++full;
+      if (found > 0 && found < k) ++partial;
+    }
+  }
+  EXPECT_GT(checked, 8000);
+  EXPECT_GT(full, 3000);
+  EXPECT_GT(partial, 200);
+  EXPECT_GT(changes, 400);
+}
+
 TEST(VoxelMap, LatticeQueriesOnVoxelFacesMatchBruteForce) {
   std::mt19937 rng(9);
   std::uniform_int_distribution<int> cell(-12, 12);
@@ -236,7 +315,8 @@ TEST(VoxelMap, LatticeQueriesOnVoxelFacesMatchBruteForce) {
   options.min_point_distance = 0.0;
   VoxelMap map(options);
   std::vector<Eigen::Vector3d> pts;
-  for (int i = 0; i < 400; ++i) pts.emplace_back(0.25 * cell(rng), 0.25 * cell(rng), 0.25 * cell(rng));
+  for (int i = 0; i < 400; ++i)
+    pts.emplace_back(0.25 * cell(rng), 0.25 * cell(rng), 0.25 * cell(rng));
   map.Insert(pts);
   const std::vector<Eigen::Vector3d> stored = map.Points();
   int checked = 0, deep = 0;

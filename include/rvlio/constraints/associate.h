@@ -10,7 +10,10 @@
 // leave-one-out map of batch refinement (smoother/refine_map.h). The plane
 // status mapping, normal orientation, residual gate, record filling and the
 // scan loop with its statistics live only here.
-// Single-threaded, no per-point heap allocation, output in point order.
+// Output in point order; on several threads (AssociateWith's `threads`) the
+// points are split into fixed chunks whose results are merged in point order,
+// so constraints and statistics are the same for any thread count. No
+// per-point heap allocation.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -20,6 +23,7 @@
 #include <Eigen/Core>
 
 #include "rvlio/common/check.h"
+#include "rvlio/common/parallel.h"
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/constraints/neighbor_search.h"
 #include "rvlio/constraints/options.h"
@@ -115,11 +119,11 @@ inline AssociationOutcome Accept(const Eigen::Vector3d& p_lidar, const Eigen::Ve
 // k-NN and plane fit: the outcome of the search (kAccepted: a valid plane,
 // with its normal u oriented towards the sensor and q its centroid).
 template <class Search>
-AssociationOutcome SearchPlane(const Eigen::Vector3d& p_world, const Eigen::Vector3d& sensor_world,
-                               const Search& search, const ConstraintOptions& options,
-                               const PlaneThresholds& planes,
-                               typename NeighborSearchTraits<Search>::Neighbors* neighbors,
-                               Eigen::Vector3d* u, Eigen::Vector3d* q) {
+[[gnu::always_inline]] inline AssociationOutcome SearchPlane(
+    const Eigen::Vector3d& p_world, const Eigen::Vector3d& sensor_world, const Search& search,
+    const ConstraintOptions& options, const PlaneThresholds& planes,
+    typename NeighborSearchTraits<Search>::Neighbors* neighbors, Eigen::Vector3d* u,
+    Eigen::Vector3d* q) {
   const int k = std::min(options.num_neighbors, kMaxNeighbors);
   if (NeighborSearchTraits<Search>::KNearest(search, p_world, k, options.max_neighbor_distance,
                                              neighbors) < k)
@@ -145,6 +149,38 @@ struct NoHook {
   void operator()(const Neighbors&) const {}
 };
 
+// One point: its plane from the cache entry e (may be null) when the point
+// moved less than sqrt(reuse2) since that search (*reused set), else from a
+// search (e refreshed), then the residual test. On kAccepted *c holds the
+// constraint.
+// Inlined (as SearchPlane) into both loops of AssociateWith: a call per point
+// cost ~5 % of the association's own instructions.
+template <class Search>
+[[gnu::always_inline]] inline AssociationOutcome AssociateOne(
+    const Eigen::Vector3d& p_lidar, const Pose3& T_world_lidar, const Search& search,
+    const ConstraintOptions& options, const PlaneThresholds& planes, AssociationCache::Entry* e,
+    double reuse2, typename NeighborSearchTraits<Search>::Neighbors* neighbors, bool* reused,
+    Constraint* c) {
+  const Eigen::Vector3d p_world = T_world_lidar * p_lidar;
+  Eigen::Vector3d u = Eigen::Vector3d::UnitZ(), q = Eigen::Vector3d::Zero();
+  AssociationOutcome found;
+  *reused = e != nullptr && (p_world - e->p_world).squaredNorm() < reuse2;
+  if (*reused) {
+    found = e->outcome;
+    u = e->normal_world;
+    q = e->q_world;
+  } else {
+    found = SearchPlane(p_world, T_world_lidar.t, search, options, planes, neighbors, &u, &q);
+    if (e != nullptr) *e = AssociationCache::Entry{p_world, u, q, found};
+  }
+  return found == AssociationOutcome::kAccepted ? Accept(p_lidar, p_world, u, q, options, c)
+                                                : found;
+}
+
+// Points per chunk of a parallel association: fixed, so the split (and with
+// it every result) does not depend on the thread count.
+constexpr int kAssociationChunk = 256;
+
 }  // namespace association_detail
 
 // The one association routine. Associates every point of a scan (LiDAR
@@ -155,57 +191,80 @@ struct NoHook {
 // search reuse that search; a cache of another scan size is reset first.
 // on_accepted(neighbors) runs after each accepted constraint is appended, with
 // the neighbours its plane was fitted to; it needs a fresh search per point,
-// so it cannot be combined with a cache.
+// so it cannot be combined with a cache, nor with threads > 1. threads > 1
+// searches chunks of points on up to that many threads (common/parallel.h;
+// `search` is only read) and gives the same *out, *stats and cache as one.
 template <class Search, class OnAccepted = association_detail::NoHook>
 void AssociateWith(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_lidar,
                    const Search& search, const ConstraintOptions& options, ConstraintList* out,
                    AssociationStats* stats, AssociationCache* cache = nullptr,
-                   OnAccepted&& on_accepted = OnAccepted()) {
-  using association_detail::Accept;
-  using association_detail::SearchPlane;
+                   OnAccepted&& on_accepted = OnAccepted(), int threads = 1) {
+  using association_detail::AssociateOne;
+  using Neighbors = typename NeighborSearchTraits<Search>::Neighbors;
   constexpr bool kHook = !std::is_same_v<std::decay_t<OnAccepted>, association_detail::NoHook>;
   RVLIO_CHECK(out != nullptr);
   RVLIO_CHECK(!kHook || cache == nullptr);
+  RVLIO_CHECK(!kHook || threads <= 1);
   out->clear();
   out->reserve(p_lidar.size());
   double reuse2 = -1.0;
   std::vector<AssociationCache::Entry>* entries =
       association_detail::PrepareCache(cache, p_lidar.size(), &reuse2);
+  auto entry = [entries](size_t i) { return entries != nullptr ? &(*entries)[i] : nullptr; };
   const PlaneThresholds planes = PlaneThresholds::From(options);
+  const int n = static_cast<int>(p_lidar.size());
+  const int chunks =
+      (n + association_detail::kAssociationChunk - 1) / association_detail::kAssociationChunk;
   AssociationStats local;
   double sum_abs_residual = 0.0;
-  typename NeighborSearchTraits<Search>::Neighbors neighbors;
-  Constraint c;
-  Eigen::Vector3d u = Eigen::Vector3d::UnitZ(), q = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < p_lidar.size(); ++i) {
-    const Eigen::Vector3d p_world = T_world_lidar * p_lidar[i];
-    AssociationOutcome found;
-    AssociationCache::Entry* e = entries != nullptr ? &(*entries)[i] : nullptr;
-    if (e != nullptr && (p_world - e->p_world).squaredNorm() < reuse2) {
-      found = e->outcome;
-      u = e->normal_world;
-      q = e->q_world;
-      ++local.num_reused;
-    } else {
-      found = SearchPlane(p_world, T_world_lidar.t, search, options, planes, &neighbors, &u, &q);
-      if (e != nullptr) *e = AssociationCache::Entry{p_world, u, q, found};
-    }
-    const AssociationOutcome outcome = found == AssociationOutcome::kAccepted
-                                           ? Accept(p_lidar[i], p_world, u, q, options, &c)
-                                           : found;
+  // Counts and appends one point's result (in point order).
+  auto record = [&](AssociationOutcome outcome, bool reused, const Constraint& c) {
+    local.num_reused += reused ? 1 : 0;
     local.Count(outcome);
-    if (outcome != AssociationOutcome::kAccepted) continue;
+    if (outcome != AssociationOutcome::kAccepted) return false;
     sum_abs_residual += std::abs(c.residual);
     out->push_back(c);
-    if constexpr (kHook) on_accepted(neighbors);
+    return true;
+  };
+  if (kHook || threads <= 1 || chunks <= 1) {
+    Neighbors neighbors;
+    Constraint c;
+    for (int i = 0; i < n; ++i) {
+      bool reused = false;
+      const AssociationOutcome outcome =
+          AssociateOne(p_lidar[i], T_world_lidar, search, options, planes, entry(i), reuse2,
+                       &neighbors, &reused, &c);
+      if (record(outcome, reused, c)) {
+        if constexpr (kHook) on_accepted(neighbors);
+      }
+    }
+  } else {
+    // Each point's result in its own element, merged in point order below.
+    std::vector<AssociationOutcome> outcomes(n);
+    std::vector<uint8_t> reused(n);
+    std::vector<Constraint> constraints(n);
+    std::vector<Neighbors> neighbors(ParallelSlots(threads, chunks));
+    ParallelFor(0, chunks, threads, [&](int chunk, int slot) {
+      const int begin = chunk * association_detail::kAssociationChunk;
+      const int end = std::min(n, begin + association_detail::kAssociationChunk);
+      for (int i = begin; i < end; ++i) {
+        bool r = false;
+        outcomes[i] = AssociateOne(p_lidar[i], T_world_lidar, search, options, planes, entry(i),
+                                   reuse2, &neighbors[slot], &r, &constraints[i]);
+        reused[i] = r ? 1 : 0;
+      }
+    });
+    for (int i = 0; i < n; ++i) record(outcomes[i], reused[i] != 0, constraints[i]);
   }
   if (local.num_accepted > 0) local.mean_abs_residual = sum_abs_residual / local.num_accepted;
   if (stats != nullptr) *stats = local;
 }
 
 // AssociateWith on the working map at T_world_imu * T_imu_lidar.
+// threads as AssociateWith's.
 void Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
                const Pose3& T_imu_lidar, const VoxelMap& map, const ConstraintOptions& options,
-               ConstraintList* out, AssociationStats* stats, AssociationCache* cache = nullptr);
+               ConstraintList* out, AssociationStats* stats, AssociationCache* cache = nullptr,
+               int threads = 1);
 
 }  // namespace rvlio

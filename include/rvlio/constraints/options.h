@@ -14,6 +14,7 @@ struct ConstraintOptions {
   double lidar_noise = 0.03;            // m, std of one point-to-plane residual
   double max_normal_std_deg = 0.0;      // deg, reject planes whose normal is this uncertain (0: off)
   double reuse_distance = 0.05;         // m, IESKF: later iterations of one scan keep a point's plane while it moved less (0: search every iteration)
+  int threads = 1;                      // threads of one scan's association in `rvlio run` (IESKF, smoother); 0: all cores
 
   template <class V>
   void Visit(V& v) {
@@ -30,6 +31,8 @@ struct ConstraintOptions {
         .Help("reject planes whose normal's predicted tilt std (from lidar_noise) exceeds this; 0: off"));
     v.Field("reuse_distance", reuse_distance, Spec().Unit("m").Range(0.0, 1.0)
         .Help("IESKF iterations of one scan reuse a point's plane while it moved less than this; 0: search every iteration"));
+    v.Field("threads", threads, Spec().Range(0, 256)
+        .Help("threads sharing one scan's association in `rvlio run` (IESKF and smoother); the constraints are the same for any count; 0: all cores"));
   }
   Status Validate() { return ValidateFields(*this, "constraints"); }
 };

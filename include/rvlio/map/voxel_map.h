@@ -87,10 +87,11 @@ class VoxelMap {
     int8_t dx, dy, dz;
     float lower_bound2;  // squared box distance bound, in voxel edges^2 (see MakeShell)
   };
-  // An offset mirrored into one query octant: its per-axis gap-table
-  // indices (offset + r) and the packed-key difference it adds.
+  // An offset mirrored into one query octant: its lower bound scaled to this
+  // map's voxels, its per-axis gap-table indices (offset + r) and the
+  // packed-key difference it adds.
   struct OctantOffset {
-    float lower_bound2;
+    double lower_bound_m2;  // Offset::lower_bound2 * voxel_size^2, m^2
     uint8_t ix, iy, iz;
     uint64_t key_delta;
   };
@@ -106,8 +107,8 @@ class VoxelMap {
   void GrowBlock(Slot* s);
 
   void ScanBlock(const Slot& s, const float q[3], Candidates* c) const;
-  void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, const double q_local[3],
-                   const float q[3], Candidates* c) const;
+  void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, double gxy2,
+                   const double q_local[3], const float q[3], Candidates* c) const;
   void VisitShell(int r, const VoxelKey& home, const double q_local[3], const float q[3],
                   Candidates* c) const;
   void ScanAllVoxels(const Eigen::Vector3d& q_world, const float q[3], Candidates* c) const;
