@@ -18,7 +18,7 @@ struct IeskfOptions {
   double init_gravity_std = 1e-4;     // m/s^2
   // Random walk of the estimated extrinsic axes (estimate_extrinsics).
   double extrinsic_rot_random_walk = 1e-4;  // rad/sqrt(s)
-  double extrinsic_pos_random_walk = 3e-4;  // m/sqrt(s)
+  double extrinsic_pos_random_walk = 2e-4;  // m/sqrt(s)
 
   template <class V>
   void Visit(V& v) {
