@@ -193,7 +193,19 @@ void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu
   x_.R_world_imu = x_.R_world_imu * so3::Exp(w_dt);
 
   PropagateCovariance(F, imu_, dt_s, &P_);
-  if (options_.estimate_extrinsics) PropagateCovariance(F, imu_, dt_s, &P_all_extrinsic_);
+  if (options_.estimate_extrinsics) {
+    PropagateCovariance(F, imu_, dt_s, &P_all_extrinsic_);
+    AddExtrinsicRandomWalk(dt_s);
+  }
+}
+
+// Only released axes: a held axis keeps its tiny variance (see ReleaseExcitedAxes).
+void Ieskf::AddExtrinsicRandomWalk(double dt_s) {
+  for (int i = 0; i < 6; ++i) {
+    if (!released_[i]) continue;
+    const double q = i < 3 ? options_.extrinsic_rot_random_walk : options_.extrinsic_pos_random_walk;
+    P_(FilterState::kExtRot + i, FilterState::kExtRot + i) += q * q * dt_s;
+  }
 }
 
 // Iterated update, paper Eq. (1), in information form. With

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "rvlio/common/check.h"
+#include "rvlio/math/so3.h"
 #include "rvlio/sim/random.h"
 
 namespace rvlio::sim {
@@ -14,6 +15,7 @@ namespace {
 constexpr double kYawEnvelope = 2.0;          // s over which the yaw motion fades in
 constexpr double kYawFreq[2] = {0.05, 0.13};  // Hz
 constexpr double kYawWeight[2] = {0.7, 0.3};
+constexpr double kSwayFreqRatio[3] = {1.0, 1.37, 0.71};  // roll, pitch, yaw
 
 // Septic smoothstep and its derivatives / integral on [0, 1].
 double S(double x) { return x * x * x * x * (35.0 + x * (-84.0 + x * (70.0 - 20.0 * x))); }
@@ -91,6 +93,8 @@ FlightTrajectory::FlightTrajectory(std::vector<Eigen::Vector3d> waypoints,
   }
   Rng rng = Rng::Stream(seed, 7);
   for (double& phase : yaw_phase_) phase = rng.Uniform(0.0, 2.0 * M_PI);
+  Rng sway_rng = Rng::Stream(seed, 8);  // own stream: no sway leaves every other draw as it was
+  for (double& phase : sway_phase_) phase = sway_rng.Uniform(0.0, 2.0 * M_PI);
 }
 
 void FlightTrajectory::AlongSegment(const Segment& s, double tau, double* d, double* v, double* a,
@@ -157,6 +161,21 @@ void FlightTrajectory::Yaw(double tau, double* yaw, double* yaw_rate) const {
   *yaw_rate = options_.yaw_amplitude * (env_rate * y + env * y_rate);
 }
 
+void FlightTrajectory::Sway(double tau, Eigen::Vector3d* phi, Eigen::Vector3d* phi_rate) const {
+  const double s = tau - options_.static_duration;
+  phi->setZero();
+  phi_rate->setZero();
+  if (s <= 0.0 || options_.sway_amplitude == 0.0) return;
+  const double x = std::min(1.0, s / kYawEnvelope);
+  const double env = S(x), env_rate = x < 1.0 ? S1(x) / kYawEnvelope : 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double w = 2.0 * M_PI * options_.sway_frequency * kSwayFreqRatio[i];
+    const double y = std::sin(w * s + sway_phase_[i]), y_rate = w * std::cos(w * s + sway_phase_[i]);
+    (*phi)[i] = options_.sway_amplitude * env * y;
+    (*phi_rate)[i] = options_.sway_amplitude * (env_rate * y + env * y_rate);
+  }
+}
+
 // Attitude from the required thrust: z_b = f / |f| with f = a - g_world, y_b
 // = normalize(z_b x x_c) with the heading x_c = (cos yaw, sin yaw, 0), x_b =
 // y_b x z_b. The angular rate is vee(R^T dR/dt) with dR/dt from the exact
@@ -192,6 +211,14 @@ TruthState FlightTrajectory::At(TimeNs t_ns) const {
   s.v_world_imu = v;
   s.a_world_imu = a;
   s.w_imu = 0.5 * Eigen::Vector3d(W(2, 1) - W(1, 2), W(0, 2) - W(2, 0), W(1, 0) - W(0, 1));
+  if (options_.sway_amplitude > 0.0) {
+    // R' = R Exp(phi): w' = Exp(phi)^T w + Jr(phi) phi_dot.
+    Eigen::Vector3d phi, phi_rate;
+    Sway(tau, &phi, &phi_rate);
+    const Eigen::Matrix3d R_sway = so3::Exp(phi);
+    s.T_world_imu = Pose3(R * R_sway, p);
+    s.w_imu = R_sway.transpose() * s.w_imu + so3::Jr(phi) * phi_rate;
+  }
   return s;
 }
 

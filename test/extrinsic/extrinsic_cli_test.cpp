@@ -4,10 +4,14 @@
 //     estimate stays at the configured value;
 //   - a start error of 2 deg / 5 cm (smoother): the axes the flight excites
 //     move toward the truth, the others are reported held;
+//   - a tunnel flight with sway ("normal excitation"), start error 2 deg /
+//     5 cm, both backends: the convergence bounds of issue 15 where met;
 //   - a motionless bag: nothing excited, the extrinsic stays exactly at its
 //     prior and summary.json says so.
 // Longer multi-seed measurements: docs/extrinsics.md.
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -94,6 +98,55 @@ TEST_F(ExtrinsicCliTest, SmootherPerturbedStartMovesTheExcitedAxesTowardTheTruth
     EXPECT_DOUBLE_EQ(t[1].get<double>(), 0.028868);
   }
   EXPECT_LT(Ate(out), 0.03);
+}
+
+// "Normal excitation": the full 52 s tunnel flight with carried-sensor sway
+// (trajectory.sway_amplitude 0.1 rad at 1 Hz, docs/extrinsics.md), seed 1,
+// start error 2 deg / 5 cm. Measured (docs/extrinsics.md): smoother 0.03 deg,
+// t error 0.4 / 1.0 / 0.7 cm; IESKF 0.29 deg (pitch 0.27), t error
+// 0.3 / 0.5 / 0.4 cm. Bounds: the issue's 0.2 deg / 1 cm where met (smoother
+// rotation, IESKF translation), the measured figure plus margin elsewhere.
+double RotationErrorDeg(const nlohmann::json& e) {
+  double sum2 = 0.0;  // true rotation: identity; small angles
+  for (const auto& a : e["T_imu_lidar"]["rpy_deg"]) sum2 += a.get<double>() * a.get<double>();
+  return std::sqrt(sum2);
+}
+double MaxTranslationErrorM(const nlohmann::json& e) {
+  const auto& t = e["T_imu_lidar"]["translation_m"];
+  const double truth[3] = {0.05, 0.0, 0.1};
+  double worst = 0.0;
+  for (int i = 0; i < 3; ++i) worst = std::max(worst, std::abs(t[i].get<double>() - truth[i]));
+  return worst;
+}
+
+TEST(ExtrinsicCliSway, PerturbedStartConvergesOnATunnelFlightWithSway) {
+  const std::string dir = testing_cli::MakeTempDir("rvlio_extrinsic_sway");
+  ASSERT_FALSE(dir.empty());
+  const ToolRun sim = testing_cli::SimulateTunnel(
+      dir + "/data", 1, 52, dir,
+      "--set trajectory.sway_amplitude=0.1 --set trajectory.sway_frequency=1.0");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  nlohmann::json e[2];
+  const char* backends[2] = {"ieskf", "smoother"};
+  for (int b = 0; b < 2; ++b) {
+    const std::string backend = backends[b], out = dir + "/" + backend;
+    const ToolRun r = RunTool("run --bag " + dir + "/data/tunnel.bag --config " + dir +
+                                  "/data/tunnel.yaml --out " + out + " --set backend=" + backend +
+                                  " --set " + backend + ".estimate_extrinsics=true" +
+                                  " --allow-divergence" + kPerturbed,
+                              dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    e[b] = nlohmann::json::parse(ReadFile(out + "/summary.json"))["extrinsic"];
+    ASSERT_TRUE(e[b].is_object()) << backend;
+    EXPECT_TRUE(e[b]["estimated"].get<bool>()) << backend;
+    for (const auto& [axis, excited] : e[b]["axes_excited"].items())
+      EXPECT_TRUE(excited.get<bool>()) << backend << " " << axis;
+  }
+  EXPECT_LT(MaxTranslationErrorM(e[0]), 0.01);  // ieskf, from 2.9 cm per axis
+  EXPECT_LT(RotationErrorDeg(e[0]), 0.45);      // ieskf, from 2 deg
+  EXPECT_LT(RotationErrorDeg(e[1]), 0.2);       // smoother
+  EXPECT_LT(MaxTranslationErrorM(e[1]), 0.015);  // smoother
+  std::filesystem::remove_all(dir);
 }
 
 // A bag in which the vehicle never moves: nothing to calibrate against.

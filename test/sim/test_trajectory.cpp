@@ -110,6 +110,35 @@ TEST(Trajectory, AnalyticDerivativesMatchFiniteDifferences) {
   }
 }
 
+// Sway (trajectory.sway_amplitude): the angular rate still matches the
+// finite differences of the attitude, the sway stays within its amplitude
+// about each body axis, and 0 leaves the attitude exactly as without it.
+TEST(Trajectory, SwayRotatesAboutAllAxesWithConsistentAngularRate) {
+  SimOptions o = *PresetOptions("tunnel");
+  const FlightTrajectory plain = Make(o);
+  o.trajectory.sway_amplitude = 0.05;
+  o.trajectory.sway_frequency = 0.8;
+  const FlightTrajectory traj = Make(o);
+  Rng rng(4);
+  Eigen::Vector3d max_sway = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 300; ++i) {
+    const double tau = rng.Uniform(0.0, traj.MotionEnd() + 1.0);
+    const double h = 1e-4;
+    const TruthState s = traj.At(At(tau)), s0 = plain.At(At(tau));
+    const TruthState sp = traj.At(At(tau + h)), sm = traj.At(At(tau - h));
+    const Eigen::Vector3d w_num = Log(sm.T_world_imu.R.transpose() * sp.T_world_imu.R) / (2 * h);
+    EXPECT_LT((s.w_imu - w_num).norm(), 1e-5) << tau;
+    EXPECT_EQ(s.T_world_imu.t, s0.T_world_imu.t);
+    EXPECT_EQ(s.a_world_imu, s0.a_world_imu);
+    const Eigen::Vector3d sway = Log(s0.T_world_imu.R.transpose() * s.T_world_imu.R);
+    max_sway = max_sway.cwiseMax(sway.cwiseAbs());
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LE(max_sway[k], 0.05 + 1e-9);
+    EXPECT_GT(max_sway[k], 0.03);
+  }
+}
+
 // C^2 acceleration: no jumps anywhere, including the ramp boundaries;
 // shocks reach a few m/s^2 and tilt the vehicle.
 TEST(Trajectory, AccelerationIsContinuousAndShocksAreAFewMetresPerSecondSquared) {

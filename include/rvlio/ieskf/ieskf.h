@@ -84,6 +84,7 @@ class Ieskf {
   void Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s);
   void RecordPose(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu);
   void ReleaseExcitedAxes();
+  void AddExtrinsicRandomWalk(double dt_s);
   void UpdateExcitation(const Eigen::Matrix<double, 12, 12>& HtRinvH, const Matrix24d& J);
 
   IeskfOptions options_;

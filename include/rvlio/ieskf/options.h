@@ -16,6 +16,9 @@ struct IeskfOptions {
   double init_extrinsic_rot_std = 0.05;  // rad, prior std of R_imu_lidar (estimate_extrinsics)
   double init_extrinsic_pos_std = 0.1;   // m, prior std of t_imu_lidar (estimate_extrinsics)
   double init_gravity_std = 1e-4;     // m/s^2
+  // Random walk of the estimated extrinsic axes (estimate_extrinsics).
+  double extrinsic_rot_random_walk = 1e-4;  // rad/sqrt(s)
+  double extrinsic_pos_random_walk = 2e-4;  // m/sqrt(s)
 
   template <class V>
   void Visit(V& v) {
@@ -34,6 +37,12 @@ struct IeskfOptions {
     v.Field("init_extrinsic_pos_std", init_extrinsic_pos_std, Spec().Unit("m").Positive()
         .Help("prior std of the configured extrinsic translation when estimate_extrinsics is on"));
     v.Field("init_gravity_std", init_gravity_std, Spec().Unit("m/s^2").Positive());
+    v.Field("extrinsic_rot_random_walk", extrinsic_rot_random_walk,
+            Spec().Unit("rad/sqrt(s)").Range(0.0, 1.0).Help(
+                "process noise of each estimated extrinsic rotation axis (estimate_extrinsics)"));
+    v.Field("extrinsic_pos_random_walk", extrinsic_pos_random_walk,
+            Spec().Unit("m/sqrt(s)").Range(0.0, 1.0).Help(
+                "process noise of each estimated extrinsic translation axis (estimate_extrinsics)"));
   }
   Status Validate() { return ValidateFields(*this, "ieskf"); }
 };

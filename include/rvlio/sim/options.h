@@ -166,6 +166,12 @@ struct SimTrajectoryOptions {
   double ramp_time = 0.8;        // s of each speed ramp (peak accel = 2.1875 speed / ramp_time)
   double hover_time = 1.5;       // s at rest at each intermediate waypoint
   double yaw_amplitude = 0.05;   // rad, small yaw motion after the static phase
+  // Carried-sensor sway ("normal excitation"): a rotation Exp(phi(t)) applied
+  // in the body frame on top of the thrust attitude, phi_i = sway_amplitude *
+  // sin(2 pi f_i t + random phase) with f = sway_frequency * (1, 1.37, 0.71)
+  // for roll, pitch, yaw, faded in with the yaw motion. 0: off (the presets).
+  double sway_amplitude = 0.0;   // rad per axis
+  double sway_frequency = 0.8;   // Hz of the roll component
 
   template <class V>
   void Visit(V& v) {
@@ -177,6 +183,13 @@ struct SimTrajectoryOptions {
             Spec().Unit("s").Range(0.05, 60.0).Help("duration of each speed ramp"));
     v.Field("hover_time", hover_time, Spec().Unit("s").Range(0.0, 3600.0));
     v.Field("yaw_amplitude", yaw_amplitude, Spec().Unit("rad").Range(0.0, 1.5));
+    v.Field("sway_amplitude", sway_amplitude,
+            Spec().Unit("rad").Range(0.0, 0.5).Help(
+                "handheld/drone sway about all three body axes (0: off); "
+                "0.05 at 0.8 Hz is the 'normal excitation' of docs/extrinsics.md"));
+    v.Field("sway_frequency", sway_frequency,
+            Spec().Unit("Hz").Range(0.01, 20.0).Help("sway frequency of the roll axis; "
+                                                     "pitch x1.37, yaw x0.71"));
   }
 };
 

@@ -46,6 +46,8 @@ class FlightTrajectory {
                    Eigen::Vector3d* jerk) const;
   // Yaw (rad) and its rate at tau.
   void Yaw(double tau, double* yaw, double* yaw_rate) const;
+  // The sway rotation vector phi (body frame) and its time derivative.
+  void Sway(double tau, Eigen::Vector3d* phi, Eigen::Vector3d* phi_rate) const;
 
   const std::vector<Eigen::Vector3d>& waypoints() const { return waypoints_; }
   // Seconds after t0 at which waypoint i is reached (0 for the first).
@@ -76,6 +78,7 @@ class FlightTrajectory {
   double gravity_;
   TimeNs t0_ns_;
   double yaw_phase_[2] = {0.0, 0.0};
+  double sway_phase_[3] = {0.0, 0.0, 0.0};
 };
 
 }  // namespace rvlio::sim
