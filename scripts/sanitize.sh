@@ -50,7 +50,7 @@ ex=(
   SmootherCliTest.AnImuGapInsideTheWindowIsBridged
   CompareTest.FullCompareWritesTablesEqualToEvalAndPlots
   CompareTest.EveryVariantFailedIsExitOne
-  'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*'
+  'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData
   DivergenceCli.LidarTopicOfAnotherRobot
