@@ -159,4 +159,17 @@ class SimulatedTunnelSuite : public ::testing::Test {
   static inline std::string dir_;
 };
 
+// SimulatedTunnelSuite plus an IESKF run of its bag (dir_/ieskf): the
+// initial trajectory of the refine suites.
+class IeskfTunnelSuite : public SimulatedTunnelSuite {
+ protected:
+  static void SetUpTestSuite() {
+    SimulatedTunnelSuite::SetUpTestSuite();
+    if (::testing::Test::HasFatalFailure()) return;
+    const ToolRun run = Run(dir_ + "/ieskf", "--set backend=ieskf");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+  }
+  static std::string Init() { return dir_ + "/ieskf/trajectory.tum"; }
+};
+
 }  // namespace rvlio::testing_cli

@@ -27,17 +27,8 @@ using testing_cli::ToolRun;
 // tunnel (cores of ~4.3 s).
 const char* const kFast = " --set smoother.refine_rounds=2 --set smoother.refine_job_overlap_s=3";
 
-class RefineChunksCliTest : public ::testing::Test {
+class RefineChunksCliTest : public testing_cli::IeskfTunnelSuite {
  protected:
-  static void SetUpTestSuite() {
-    dir_ = testing_cli::MakeTempDir("rvlio_refine_chunks_cli");
-    ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = testing_cli::SimulateTunnel(dir_ + "/data", 3, 14, dir_);
-    ASSERT_EQ(sim.exit_code, 0) << sim.err;
-    const ToolRun run = RunTool("run --bag " + Bag() + " --config " + Sensors() +
-                                    " --set backend=ieskf --out " + dir_ + "/ieskf", dir_);
-    ASSERT_EQ(run.exit_code, 0) << run.err;
-  }
   // The whole refine and chunks 1..3 of 3, which the merge checks work on.
   // Not in SetUpTestSuite: ctest runs each test case in its own process.
   static void RefineWholeAndChunks() {
@@ -51,12 +42,7 @@ class RefineChunksCliTest : public ::testing::Test {
   static void CheckMergeAgreesWithWhole();
   static void CheckChunkJson();
   static void CheckBadMerges();
-  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
 
-  static std::string Bag() { return dir_ + "/data/tunnel.bag"; }
-  static std::string Sensors() { return dir_ + "/data/tunnel.yaml"; }
-  static std::string Truth() { return dir_ + "/data/tunnel_gt.tum"; }
-  static std::string Init() { return dir_ + "/ieskf/trajectory.tum"; }
   static std::string ChunkDir(int k) { return dir_ + "/chunk" + std::to_string(k); }
   static std::string ChunkArgs(int k, int n) {
     return "--chunk " + std::to_string(k) + " --of " + std::to_string(n) + " --out " + ChunkDir(k);
@@ -75,7 +61,6 @@ class RefineChunksCliTest : public ::testing::Test {
     const auto j = EvalJson(Truth(), est, dir_);
     return j.is_object() ? j["ape"]["rmse"].get<double>() : 1e9;
   }
-  static inline std::string dir_;
 };
 
 struct Tum {

@@ -19,26 +19,8 @@ using testing_cli::ReadFile;
 using testing_cli::RunTool;
 using testing_cli::ToolRun;
 
-class RefineCliTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = testing_cli::MakeTempDir("rvlio_refine_cli");
-    ASSERT_FALSE(dir_.empty());
-    const ToolRun sim = testing_cli::SimulateTunnel(dir_ + "/data", 3, 14, dir_);
-    ASSERT_EQ(sim.exit_code, 0) << sim.err;
-    const ToolRun run = RunTool("run --bag " + Bag() + " --config " + Sensors() +
-                                    " --set backend=ieskf --out " + dir_ + "/ieskf", dir_);
-    ASSERT_EQ(run.exit_code, 0) << run.err;
-  }
-  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
-
-  static std::string Bag() { return dir_ + "/data/tunnel.bag"; }
-  static std::string Sensors() { return dir_ + "/data/tunnel.yaml"; }
-  static std::string Truth() { return dir_ + "/data/tunnel_gt.tum"; }
-  static std::string Init() { return dir_ + "/ieskf/trajectory.tum"; }
-  static std::string dir_;
-};
-std::string RefineCliTest::dir_;
+// The suite's bag (14 s tunnel, seed 3) and its IESKF run as the initial trajectory.
+class RefineCliTest : public testing_cli::IeskfTunnelSuite {};
 
 TEST_F(RefineCliTest, RefineFromAnIeskfRunLowersItsAteAndWritesTheOutputs) {
   const std::string out = dir_ + "/refined";
