@@ -9,8 +9,12 @@ import time
 
 import numpy as np
 
+# Each child restores Python's own SIGINT handler: a process started in the
+# background by a non-interactive shell (nohup, CI runners) inherits SIGINT
+# ignored, and Python then keeps it ignored.
 RUN_CHILD = r"""
-import sys, rvlio
+import signal, sys, rvlio
+signal.signal(signal.SIGINT, signal.default_int_handler)
 bag, config, out = sys.argv[1:4]
 told = False
 def progress(scans, fraction):
@@ -27,7 +31,8 @@ print("usable", rvlio.Config().backend, flush=True)
 """
 
 SIMULATE_CHILD = r"""
-import sys, rvlio
+import signal, sys, rvlio
+signal.signal(signal.SIGINT, signal.default_int_handler)
 print("ready", flush=True)
 try:
     rvlio.simulate("tunnel", duration=600, out=sys.argv[1])
