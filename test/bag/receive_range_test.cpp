@@ -1,8 +1,10 @@
 // SensorBagReader::Open with a ReceiveTimeRange: exactly the messages a full
 // read delivers whose receive time lies in the range, for every storage the
-// writer produces (ROS1, MCAP chunked zstd / uncompressed / unchunked, db3),
-// with range edges on exact receive stamps and empty ranges.
+// writer produces (ROS1, MCAP chunked zstd / uncompressed / unchunked, db3, a
+// ROS 2 folder split into two MCAP files), with range edges on exact receive
+// stamps and empty ranges.
 #include <algorithm>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,16 +29,36 @@ struct StorageCase {
 
 class ReceiveRangeTest : public TempDirTest, public ::testing::WithParamInterface<StorageCase> {
  protected:
-  // kScans sweeps of 16 x 128 (100 ms apart) and 200 Hz IMU over their span.
+  // kScans sweeps of 16 x 128 (100 ms apart) and 200 Hz IMU over their span;
+  // the "folder" case: a ROS 2 bag folder split into two MCAP files at scan 12.
   std::string WriteRecording() {
+    const std::string name = GetParam().name;
+    if (name != "folder") {
+      const std::string path = Path("rec." + name);
+      WritePart(path, GetParam().format, 0, kScans);
+      return path;
+    }
+    const std::string folder = Path("split");
+    std::filesystem::create_directory(folder);
+    WritePart(folder + "/split_0.mcap", "mcap", 0, 12);
+    WritePart(folder + "/split_1.mcap", "mcap", 12, kScans);
+    WriteAll(folder + "/metadata.yaml",
+             "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n"
+             "  relative_file_paths:\n    - split_0.mcap\n    - split_1.mcap\n");
+    return folder;
+  }
+
+  // Scans first_scan..end_scan-1 and the IMU samples up to their ends (from
+  // the previous scan's end on).
+  void WritePart(const std::string& path, const std::string& format, int first_scan,
+                 int end_scan) {
     BagWriterOptions options;
-    options.format = GetParam().format;
+    options.format = format;
     options.mcap_compression = GetParam().compression;
-    const std::string path = Path(std::string("rec.") + GetParam().name);
     auto writer = SensorBagWriter::Create(path, options);
     EXPECT_TRUE(writer.ok());
-    int imu_index = 0;
-    for (int k = 0; k < kScans; ++k) {
+    int imu_index = first_scan == 0 ? 0 : (first_scan * 100 - 1) / 5 + 1;
+    for (int k = first_scan; k < end_scan; ++k) {
       const Scan scan = SyntheticScan(kT0 + k * 100 * kMs, 16, 128, k);
       for (; kT0 + imu_index * 5 * kMs <= scan.t_end_ns; ++imu_index) {
         ImuSample s;
@@ -48,7 +70,6 @@ class ReceiveRangeTest : public TempDirTest, public ::testing::WithParamInterfac
       EXPECT_TRUE((*writer)->WriteOusterScan(kCloudTopic, "os_lidar", scan, 16, 128).ok());
     }
     EXPECT_TRUE((*writer)->Close().ok());
-    return path;
   }
 };
 
@@ -114,7 +135,8 @@ INSTANTIATE_TEST_SUITE_P(Storages, ReceiveRangeTest,
                                            StorageCase{"mcap", "mcap", "zstd"},
                                            StorageCase{"mcap_none", "mcap", "none"},
                                            StorageCase{"mcap_unchunked", "mcap", "unchunked"},
-                                           StorageCase{"db3", "db3", "zstd"}),
+                                           StorageCase{"db3", "db3", "zstd"},
+                                           StorageCase{"folder", "mcap", "zstd"}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace
