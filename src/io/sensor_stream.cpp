@@ -75,8 +75,9 @@ class WindowedReader final : public SensorBagReader {
 // decoded. Header stamps may trail or lead receive times; the check below
 // keeps the read exact whatever the margin.
 constexpr TimeNs kSkipMarginNs = 2000000000;  // 2 s
-// Messages a SkipAheadReader holds while it checks its start, at most.
-constexpr size_t kSkipCheckMessages = 100000;
+// Decoded scan memory a SkipAheadReader holds while it checks its start, at
+// most (past it, the recording is read from its start).
+constexpr size_t kSkipCheckBytes = size_t{256} << 20;
 
 // The window's first needed stamps, on the IMU clock: IMU samples from
 // `imu_ns`, scans ending from `scan_ns` (earlier ones WindowedReader drops).
@@ -111,13 +112,15 @@ class SkipAheadReader final : public SensorBagReader {
     if (!ranged.ok()) return ranged.status();
     inner_ = std::move(ranged).value();
     bool imu_checked = false, scan_checked = false;
+    size_t held_bytes = 0;
     while (!(imu_checked && scan_checked)) {
       Held held;
-      held.kind = inner_->Next(&held.imu, &held.scan);
-      if (!held.kind.ok() || *held.kind == SensorMessage::kEnd ||
-          held_.size() >= kSkipCheckMessages)
-        return ReadFromStart();
-      const bool is_imu = *held.kind == SensorMessage::kImu;
+      StatusOr<SensorMessage> kind = inner_->Next(&held.imu, &held.scan);
+      if (!kind.ok() || *kind == SensorMessage::kEnd || held_bytes > kSkipCheckBytes)
+        return ReadFromStart();  // a read from the start meets the same error in its place
+      held.kind = *kind;
+      held_bytes += sizeof(Held) + held.scan.points.size() * sizeof(LidarPoint);
+      const bool is_imu = *kind == SensorMessage::kImu;
       bool& checked = is_imu ? imu_checked : scan_checked;
       if (!checked) {
         const TimeNs t = is_imu ? held.imu.t_ns : held.scan.t_end_ns + offset_ns_;
@@ -126,16 +129,15 @@ class SkipAheadReader final : public SensorBagReader {
       }
       held_.push_back(std::move(held));
     }
-    skipped_ = true;
     return Status::Ok();
   }
 
   StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override {
     if (held_.empty()) return inner_->Next(imu, scan);
     Held& h = held_.front();
-    if (h.kind.ok() && *h.kind == SensorMessage::kImu) *imu = h.imu;
-    if (h.kind.ok() && *h.kind == SensorMessage::kScan) *scan = std::move(h.scan);
-    StatusOr<SensorMessage> kind = std::move(h.kind);
+    const SensorMessage kind = h.kind;
+    if (kind == SensorMessage::kImu) *imu = h.imu;
+    else *scan = std::move(h.scan);
     held_.pop_front();
     return kind;
   }
@@ -143,12 +145,10 @@ class SkipAheadReader final : public SensorBagReader {
   const SensorReaderStats& stats() const override { return inner_->stats(); }
   std::string lidar_layout() const override { return inner_->lidar_layout(); }
   std::vector<std::string> warnings() const override { return inner_->warnings(); }
-  // False when the checks failed and the recording is read from its start.
-  bool skipped() const { return skipped_; }
 
  private:
   struct Held {
-    StatusOr<SensorMessage> kind = SensorMessage::kEnd;
+    SensorMessage kind = SensorMessage::kEnd;  // kImu or kScan
     ImuSample imu;
     Scan scan;
   };
@@ -167,8 +167,7 @@ class SkipAheadReader final : public SensorBagReader {
   TimeNs offset_ns_;
   SkipThresholds thresholds_;
   std::unique_ptr<SensorBagReader> inner_;
-  std::deque<Held> held_;
-  bool skipped_ = false;
+  std::deque<Held> held_;  // read while checking the start, not yet returned
 };
 
 // Runs the wrapped reader on a thread of its own; the consumer sees each
