@@ -356,6 +356,10 @@ class McapReader : public Reader {
     filter_ = std::set<uint16_t>(channel_ids.begin(), channel_ids.end());
     filtering_ = true;
   }
+  void SetTimeRange(uint64_t first_ns, uint64_t last_ns) override {
+    time_first_ns_ = first_ns;
+    time_last_ns_ = last_ns;
+  }
   StatusOr<bool> Next(Message* out) override;
   std::vector<std::string> warnings() const override { return warnings_; }
   uint64_t chunks_loaded() const override { return chunks_loaded_; }
@@ -393,6 +397,12 @@ class McapReader : public Reader {
   Status Decompress(uint64_t offset, const ChunkHeader& chunk, std::string* records);
 
   bool Wanted(uint16_t channel) const { return !filtering_ || filter_.count(channel) > 0; }
+  bool InTimeRange(uint64_t log_time_ns) const {
+    return log_time_ns >= time_first_ns_ && log_time_ns <= time_last_ns_;
+  }
+  bool Wanted(uint16_t channel, uint64_t log_time_ns) const {
+    return Wanted(channel) && InTimeRange(log_time_ns);
+  }
   bool WantSegment(const Segment& s) const;
   Status OpenSegment(size_t index, std::unique_ptr<Cursor>* cursor);
   // Ends a finished cursor; keeps it for reuse.
@@ -416,6 +426,7 @@ class McapReader : public Reader {
   std::priority_queue<Cursor*, std::vector<Cursor*>, CursorAfter> heap_;
   std::set<uint16_t> filter_;
   bool filtering_ = false;
+  uint64_t time_first_ns_ = 0, time_last_ns_ = UINT64_MAX;  // SetTimeRange
   uint64_t chunks_loaded_ = 0;
   Status error_;
 };
@@ -782,6 +793,9 @@ Status McapReader::ScanRecord(uint8_t opcode, uint64_t pos, uint64_t end, ScanSt
 }
 
 bool McapReader::WantSegment(const Segment& s) const {
+  // A segment's span is its messages' log times (start <= end when it holds any).
+  if (s.start_time <= s.end_time && (s.end_time < time_first_ns_ || s.start_time > time_last_ns_))
+    return false;
   if (!filtering_ || s.channels.empty()) return true;
   for (uint16_t channel : s.channels)
     if (filter_.count(channel) > 0) return true;
@@ -816,7 +830,7 @@ Status McapReader::OpenSegment(size_t index, std::unique_ptr<Cursor>* cursor) {
     if (op != detail::kMessage) return true;
     MessageView m;
     if (!ParseMessage(rc, &m)) return !(malformed = true);
-    if (Wanted(m.channel_id)) c.entries.emplace_back(m.log_time, at);
+    if (Wanted(m.channel_id, m.log_time)) c.entries.emplace_back(m.log_time, at);
     return true;
   });
   if (!complete || malformed)
@@ -859,7 +873,7 @@ Status McapReader::Advance(Cursor* c, bool* has_message) {
     if (Status s = ReadBytes(at + kRecordHeaderSize, length, &bytes); !s.ok()) return s;
     MessageView m;
     if (!ParseMessage(bytes, &m)) return AtOffset("message", at, "malformed record");
-    if (!Wanted(m.channel_id)) continue;
+    if (!Wanted(m.channel_id, m.log_time)) continue;
     CopyMessage(m, &c->current);
     *has_message = true;
     return Status::Ok();
@@ -898,7 +912,7 @@ StatusOr<bool> McapReader::Next(Message* out) {
     if (heap_.empty()) return false;
     Cursor* top = heap_.top();
     heap_.pop();
-    const bool wanted = Wanted(top->current.channel_id);
+    const bool wanted = Wanted(top->current.channel_id, top->current.log_time_ns);
     // Swapped, not moved: the cursor gets the caller's previous buffer to
     // copy its next message into.
     if (wanted) std::swap(*out, top->current);

@@ -78,6 +78,13 @@ class SqliteSource final : public RecordingSource {
     return Status::Ok();
   }
 
+  Status SetTimeFilter(TimeNs first_ns, TimeNs last_ns) override {
+    time_first_ns_ = first_ns;
+    time_last_ns_ = last_ns;
+    time_filtered_ = true;
+    return Status::Ok();
+  }
+
   StatusOr<bool> Next(RawMessage* out) override {
     if (!error_.ok()) return error_;
     if (stmt_ == nullptr) {
@@ -158,6 +165,11 @@ class SqliteSource final : public RecordingSource {
       }
       sql += ")";
     }
+    if (time_filtered_) {
+      sql += filtered_ ? " AND" : " WHERE";
+      sql += " timestamp BETWEEN " + std::to_string(time_first_ns_) + " AND " +
+             std::to_string(time_last_ns_);
+    }
     sql += " ORDER BY timestamp, id";
     if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK)
       return Error("has no readable messages table");
@@ -171,6 +183,8 @@ class SqliteSource final : public RecordingSource {
   std::map<int64_t, int> topic_index_;  // topics.id -> index
   std::vector<int> filter_;
   bool filtered_ = false;
+  TimeNs time_first_ns_ = 0, time_last_ns_ = 0;
+  bool time_filtered_ = false;
   Status error_;
 };
 
@@ -211,6 +225,17 @@ class McapSource final : public RecordingSource {
       if (t >= 0 && t < static_cast<int>(channel_ids_.size())) ids.push_back(channel_ids_[t]);
     }
     reader_->SetChannelFilter(ids);
+    return Status::Ok();
+  }
+
+  // Receive times before the epoch hold no MCAP message (log times are unsigned).
+  Status SetTimeFilter(TimeNs first_ns, TimeNs last_ns) override {
+    if (last_ns < 0 || first_ns > last_ns) {
+      reader_->SetTimeRange(1, 0);
+    } else {
+      reader_->SetTimeRange(static_cast<uint64_t>(std::max<TimeNs>(first_ns, 0)),
+                            static_cast<uint64_t>(last_ns));
+    }
     return Status::Ok();
   }
 
@@ -387,6 +412,13 @@ class FolderSource final : public RecordingSource {
           local.push_back(static_cast<int>(t));
       }
       if (Status s = parts_[i]->SetTopicFilter(local); !s.ok()) return s;
+    }
+    return Status::Ok();
+  }
+
+  Status SetTimeFilter(TimeNs first_ns, TimeNs last_ns) override {
+    for (const auto& part : parts_) {
+      if (Status s = part->SetTimeFilter(first_ns, last_ns); !s.ok()) return s;
     }
     return Status::Ok();
   }

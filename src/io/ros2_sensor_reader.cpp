@@ -41,7 +41,8 @@ class Ros2SensorReader final : public SensorBagReader {
   Ros2SensorReader(std::string path, LidarOptions lidar, ImuOptions imu)
       : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_) {}
 
-  Status Init() {
+  // With `range` the layout comes from the first LiDAR message inside it.
+  Status Init(const std::optional<ReceiveTimeRange>& range) {
     StatusOr<std::unique_ptr<RecordingSource>> source = RecordingSource::Open(path_);
     if (!source.ok()) return source.status();
     source_ = std::move(source).value();
@@ -59,6 +60,8 @@ class Ros2SensorReader final : public SensorBagReader {
     if (Status s = RequireCdr(*source_, lidar_index_, "lidar.topic"); !s.ok()) return s;
     if (Status s = RequireCdr(*source_, imu_index_, "imu.topic"); !s.ok()) return s;
     if (Status s = source_->SetTopicFilter({lidar_index_, imu_index_}); !s.ok()) return s;
+    if (range)
+      if (Status s = source_->SetTimeFilter(range->first_ns, range->last_ns); !s.ok()) return s;
     if (livox_) layout_ = "livox_custom";
     else if (Status s = PeekLayout(); !s.ok()) return s;
     return Status::Ok();
@@ -179,11 +182,11 @@ class Ros2SensorReader final : public SensorBagReader {
 
 }  // namespace
 
-StatusOr<std::unique_ptr<SensorBagReader>> OpenRos2SensorReader(const std::string& path,
-                                                                const LidarOptions& lidar,
-                                                                const ImuOptions& imu) {
+StatusOr<std::unique_ptr<SensorBagReader>> OpenRos2SensorReader(
+    const std::string& path, const LidarOptions& lidar, const ImuOptions& imu,
+    const std::optional<ReceiveTimeRange>& range) {
   auto reader = std::make_unique<Ros2SensorReader>(path, lidar, imu);
-  if (Status s = reader->Init(); !s.ok()) return s;
+  if (Status s = reader->Init(range); !s.ok()) return s;
   return std::unique_ptr<SensorBagReader>(std::move(reader));
 }
 

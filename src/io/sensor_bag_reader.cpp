@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -32,12 +33,20 @@ StatusOr<std::string> PeekLayout(const rosbag::Bag& bag, const LidarOptions& lid
   return std::string();
 }
 
+// ros::Time of a receive time, clamped to what ros::Time holds (unsigned
+// seconds): the bag's records are all in that span.
+ros::Time RosTime(TimeNs t_ns) {
+  const TimeNs max_ns = static_cast<TimeNs>(std::numeric_limits<uint32_t>::max()) * 1000000000 +
+                        999999999;
+  return ros::Time().fromNSec(static_cast<uint64_t>(std::clamp<TimeNs>(t_ns, 0, max_ns)));
+}
+
 class RosbagSensorReader final : public SensorBagReader {
  public:
   RosbagSensorReader(std::string path, LidarOptions lidar, ImuOptions imu)
       : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_) {}
 
-  Status Init() {
+  Status Init(const std::optional<ReceiveTimeRange>& range) {
     if (Status s = bag_detail::OpenForRead(path_, &bag_); !s.ok()) return s;
     try {
       const auto topics = bag_detail::TopicTypes(bag_);
@@ -56,9 +65,13 @@ class RosbagSensorReader final : public SensorBagReader {
           livox_ ? StatusOr<std::string>(std::string("livox_custom")) : PeekLayout(bag_, lidar_);
       if (!layout.ok()) return layout.status();
       layout_ = *layout;
-      view_ = std::make_unique<rosbag::View>(
-          bag_, rosbag::TopicQuery(std::vector<std::string>{lidar_.topic, imu_.topic}));
+      const rosbag::TopicQuery query(std::vector<std::string>{lidar_.topic, imu_.topic});
+      view_ = range ? std::make_unique<rosbag::View>(bag_, query, RosTime(range->first_ns),
+                                                     RosTime(range->last_ns))
+                    : std::make_unique<rosbag::View>(bag_, query);
       it_ = view_->begin();
+      // An empty or pre-epoch range: rosbag's clamped View would not be empty.
+      if (range && (range->first_ns > range->last_ns || range->last_ns < 0)) it_ = view_->end();
     } catch (const std::exception& e) {
       return ReadError(e);
     }
@@ -148,14 +161,15 @@ class RosbagSensorReader final : public SensorBagReader {
 
 }  // namespace
 
-StatusOr<std::unique_ptr<SensorBagReader>> SensorBagReader::Open(const std::string& path,
-                                                                 const LidarOptions& lidar,
-                                                                 const ImuOptions& imu) {
+StatusOr<std::unique_ptr<SensorBagReader>> SensorBagReader::Open(
+    const std::string& path, const LidarOptions& lidar, const ImuOptions& imu,
+    const std::optional<ReceiveTimeRange>& range) {
   StatusOr<RecordingKind> kind = DetectRecording(path);
   if (!kind.ok()) return kind.status();
-  if (*kind != RecordingKind::kRos1Bag) return bag_detail::OpenRos2SensorReader(path, lidar, imu);
+  if (*kind != RecordingKind::kRos1Bag)
+    return bag_detail::OpenRos2SensorReader(path, lidar, imu, range);
   auto reader = std::make_unique<RosbagSensorReader>(path, lidar, imu);
-  if (Status s = reader->Init(); !s.ok()) return s;
+  if (Status s = reader->Init(range); !s.ok()) return s;
   return std::unique_ptr<SensorBagReader>(std::move(reader));
 }
 

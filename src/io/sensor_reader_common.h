@@ -5,6 +5,7 @@
 // what was dropped (SensorReaderStats).
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,8 +52,8 @@ class SensorGate {
 
 // The SensorBagReader of a ROS 2 recording (.db3, .mcap or bag folder);
 // src/io/ros2_sensor_reader.cpp.
-StatusOr<std::unique_ptr<SensorBagReader>> OpenRos2SensorReader(const std::string& path,
-                                                                const LidarOptions& lidar,
-                                                                const ImuOptions& imu);
+StatusOr<std::unique_ptr<SensorBagReader>> OpenRos2SensorReader(
+    const std::string& path, const LidarOptions& lidar, const ImuOptions& imu,
+    const std::optional<ReceiveTimeRange>& range);
 
 }  // namespace rvlio::bag_detail

@@ -105,6 +105,54 @@ TEST_P(McapRoundTrip, ReadsBackInLogTimeOrder) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_), {}), 1);
 }
 
+// SetTimeRange returns exactly the messages of the range (the full read,
+// filtered), from the indexes and from a linear scan (no footer), and opens
+// only the chunks whose time span meets the range.
+TEST_P(McapRoundTrip, TimeRangeReturnsExactlyTheMessagesOfTheRange) {
+  const RoundTripCase c = GetParam();
+  const std::string written = Write(Options(c.compression, c.chunked));
+  const std::vector<mcap::Message> all = InLogTimeOrder(messages_);
+  const uint64_t t_a = all[100].log_time_ns, t_b = all[180].log_time_ns;  // exact stamps
+  struct Range {
+    uint64_t first, last;
+  };
+  const std::vector<Range> ranges = {{t_a, t_b},
+                                     {t_a, t_a},
+                                     {t_a + 1, t_a + 2},  // between two stamps: none
+                                     {t_b, t_a},          // first > last: none
+                                     {0, UINT64_MAX},
+                                     {all.back().log_time_ns, UINT64_MAX},
+                                     {0, all.front().log_time_ns}};
+  for (const bool use_summary : {true, false}) {
+    for (const Range& range : ranges) {
+      SCOPED_TRACE(std::string(use_summary ? "indexed" : "linear scan") + " [" +
+                   std::to_string(range.first) + ", " + std::to_string(range.last) + "]");
+      std::string bytes = written;
+      if (!use_summary) bytes.resize(bytes.size() - 30);  // no footer
+      auto reader = mcap::Reader::OpenBuffer(bytes, "t.mcap");
+      ASSERT_TRUE(reader.ok()) << reader.status().message();
+      (*reader)->SetTimeRange(range.first, range.last);
+      std::vector<mcap::Message> want;
+      for (const mcap::Message& m : all)
+        if (m.log_time_ns >= range.first && m.log_time_ns <= range.last) want.push_back(m);
+      const std::vector<mcap::Message> got = ReadAll(reader->get());
+      mcap_test::ExpectSameMessages(want, got);
+      if (!c.chunked) continue;
+      const uint64_t chunks = (*reader)->summary().chunk_count;
+      if (want.empty() && range.first <= range.last && range.first > 0) {
+        EXPECT_LE((*reader)->chunks_loaded(), 2u);  // at most the chunks around the gap
+      }
+      if (range.first == t_a && range.last == t_b) {
+        EXPECT_GT((*reader)->chunks_loaded(), 0u);
+        EXPECT_LT((*reader)->chunks_loaded(), chunks / 2);
+      }
+      if (range.first > range.last) {
+        EXPECT_EQ((*reader)->chunks_loaded(), 0u);
+      }
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Compressions, McapRoundTrip,
                          ::testing::Values(RoundTripCase{"", true}, RoundTripCase{"zstd", true},
                                            RoundTripCase{"lz4", true},

@@ -76,6 +76,11 @@ class Reader {
   // Restricts Next() to these channels (all when never called). Chunks with
   // none of them are not decompressed when the summary's indexes tell so.
   virtual void SetChannelFilter(const std::vector<uint16_t>& channel_ids) = 0;
+  // Restricts Next() to messages with first_ns <= log time <= last_ns (all
+  // when never called; first_ns > last_ns: none). Chunks and runs of loose
+  // messages whose time span (chunk index or chunk header) lies outside are
+  // neither read nor decompressed.
+  virtual void SetTimeRange(uint64_t first_ns, uint64_t last_ns) = 0;
   // The next message in log-time order (ties: file order); false at the end.
   // Messages of a truncated tail record are not returned; a CRC mismatch or a
   // malformed record is an error, and later calls return it again.

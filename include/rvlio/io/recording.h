@@ -66,6 +66,11 @@ class RecordingSource {
   // Restricts Next() to these topic indexes (all when never called); call
   // before the first Next().
   virtual Status SetTopicFilter(const std::vector<int>& topics) = 0;
+  // Restricts Next() to messages received in [first_ns, last_ns] (all when
+  // never called; first_ns > last_ns: none); call before the first Next().
+  // Messages outside are not read: a .db3 selects by its timestamp index, an
+  // MCAP file skips the chunks outside (mcap::Reader::SetTimeRange).
+  virtual Status SetTimeFilter(TimeNs first_ns, TimeNs last_ns) = 0;
   // The next message; false at the end. Errors repeat on later calls.
   virtual StatusOr<bool> Next(RawMessage* out) = 0;
   // One entry per topic (same order as topics()), from a pass that leaves

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,14 @@ struct SensorReaderStats {
 
 enum class SensorMessage { kImu, kScan, kEnd };
 
+// The messages of a recording received (ROS1 record time, ROS 2 receive /
+// MCAP log time) in [first_ns, last_ns], both included; first_ns > last_ns
+// selects none. Receive times, not the header stamps the estimators use.
+struct ReceiveTimeRange {
+  TimeNs first_ns = 0;
+  TimeNs last_ns = 0;
+};
+
 // Streams IMU samples and decoded scans in bag time order without loading the
 // whole bag.
 class SensorBagReader {
@@ -40,9 +49,12 @@ class SensorBagReader {
   virtual ~SensorBagReader() = default;
   // Fails (InvalidInput) for a missing/unreadable/truncated bag, or a topic
   // that is not there (the message lists the topics that are).
-  static StatusOr<std::unique_ptr<SensorBagReader>> Open(const std::string& path,
-                                                         const LidarOptions& lidar,
-                                                         const ImuOptions& imu);
+  // With `range`, messages received outside it are neither read nor decoded
+  // (ROS1: the bag's index; .db3: an SQL time condition; MCAP: chunks outside
+  // are skipped undecompressed; split folders: every file) and count nowhere.
+  static StatusOr<std::unique_ptr<SensorBagReader>> Open(
+      const std::string& path, const LidarOptions& lidar, const ImuOptions& imu,
+      const std::optional<ReceiveTimeRange>& range = std::nullopt);
   // Fills *imu or *scan and says which; kEnd at the end. A scan's points are
   // range-cropped and finite, with absolute per-point times; t_start_ns and
   // t_end_ns are the earliest and latest point times. Messages come in bag
