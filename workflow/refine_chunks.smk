@@ -1,6 +1,6 @@
 # `rvlio refine` of one long recording as N chunk jobs, then `rvlio merge`
 # (docs/refine_chunks.md). One job per chunk (`rvlio refine --chunk K --of N`,
-# each reading only its part of the recording), then one merge job. Runs
+# each keeping only its part of the recording in memory), then one merge job. Runs
 # locally or on Slurm through the same profile as the ablation grid:
 #
 #   snakemake -s workflow/refine_chunks.smk -j 2 \
