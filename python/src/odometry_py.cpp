@@ -170,6 +170,14 @@ std::vector<ScanResult> OdometrySession::Finish() {
   return out;
 }
 
+py::array_t<double> PointsArray(const std::vector<Eigen::Vector3d>& p) {
+  py::array_t<double> a({static_cast<py::ssize_t>(p.size()), py::ssize_t{3}});
+  auto w = a.mutable_unchecked<2>();
+  for (size_t i = 0; i < p.size(); ++i)
+    for (int k = 0; k < 3; ++k) w(static_cast<py::ssize_t>(i), k) = p[i][k];
+  return a;
+}
+
 py::array_t<double> TrajectoryArray(const Trajectory& trajectory) {
   py::array_t<double> a({static_cast<py::ssize_t>(trajectory.size()), py::ssize_t{8}});
   auto w = a.mutable_unchecked<2>();
@@ -310,14 +318,7 @@ void BindOdometry(py::module_& m) {
       .def_property_readonly("warnings", [](const OdometrySession& o) { return o.odometry().warnings(); })
       .def(
           "map_points",
-          [](const OdometrySession& o) {
-            const std::vector<Eigen::Vector3d> p = o.odometry().MapPoints();
-            py::array_t<double> a({static_cast<py::ssize_t>(p.size()), py::ssize_t{3}});
-            auto w = a.mutable_unchecked<2>();
-            for (size_t i = 0; i < p.size(); ++i)
-              for (int k = 0; k < 3; ++k) w(static_cast<py::ssize_t>(i), k) = p[i][k];
-            return a;
-          },
+          [](const OdometrySession& o) { return PointsArray(o.odometry().MapPoints()); },
           "The map (coarse resolution), world frame, (K, 3).");
 }
 

@@ -18,6 +18,8 @@ Scan ScanFromArrays(TimeNs t_ns, const py::handle& points, const py::handle& tim
 // The (N, 8) TUM rows [t_s x y z qx qy qz qw] of a trajectory, of results.
 py::array_t<double> TrajectoryArray(const Trajectory& trajectory);
 py::array_t<double> TumArray(const std::vector<ScanResult>& results);
+// (K, 3) float64 rows of points.
+py::array_t<double> PointsArray(const std::vector<Eigen::Vector3d>& p);
 
 // rvlio.Odometry: the library's Odometry plus the checks of what Python feeds
 // it (finite values, increasing IMU stamps and scan ends).

@@ -162,8 +162,21 @@ struct RefineOutput {
   bool written = false;
 };
 
+// `chunk`/`of` of a chunk job (both None: the whole refine).
+void SetChunk(const py::handle& chunk, const py::handle& of, RefineArgs* args) {
+  if (chunk.is_none() != of.is_none())
+    throw py::value_error("chunk and of go together: chunk=K, of=N (1 <= K <= N)");
+  if (chunk.is_none()) return;
+  args->chunk = chunk.cast<int>();
+  args->chunk_count = of.cast<int>();
+  if (args->chunk_count < 1 || args->chunk < 1 || args->chunk > args->chunk_count)
+    throw py::value_error("chunk=" + std::to_string(args->chunk) + ", of=" +
+                          std::to_string(args->chunk_count) + ": needs 1 <= chunk <= of");
+}
+
 RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py::handle& config,
-                    const py::handle& out, double start, double duration) {
+                    const py::handle& out, double start, double duration, const py::handle& chunk,
+                    const py::handle& of) {
   const std::string bag = PathText(bag_obj);
   RequireExisting(bag, "recording");
   Config defaults;
@@ -172,6 +185,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   args.options = ConfigArg(config, &defaults).options;
   args.out_dir = OutDir(out);
   args.window = Window(start, duration);
+  SetChunk(chunk, of, &args);
   if (py::isinstance<RunOutput>(init)) {
     args.init = init.cast<const RunOutput&>().poses;
   } else if (py::isinstance<py::str>(init) || py::hasattr(init, "__fspath__")) {
@@ -195,6 +209,33 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   for (const RefineRound& round : r.refine.rounds) o.rounds.append(RoundDict(round));
   o.converged = r.refine.converged;
   o.warnings = r.refine.warnings;
+  o.written = r.written;
+  return o;
+}
+
+struct MergeOutput {
+  py::array_t<double> trajectory;
+  py::array_t<double> map_points;
+  py::object summary;
+  std::vector<std::string> warnings;
+  bool written = false;
+};
+
+MergeOutput Merge(const py::iterable& chunks, const py::handle& out) {
+  MergeArgs args;
+  for (const py::handle& c : chunks) args.chunk_dirs.push_back(PathText(c));
+  args.out_dir = OutDir(out);
+  StatusOr<MergeResult> result = Status::Internal("not merged");
+  {
+    py::gil_scoped_release release;
+    result = MergeRefineChunks(args);
+  }
+  MergeResult r = Take(std::move(result));
+  MergeOutput o;
+  o.trajectory = TrajectoryArray(r.trajectory);
+  o.map_points = PointsArray(r.map_points);
+  o.summary = ToPython(r.summary);
+  o.warnings = r.warnings;
   o.written = r.written;
   return o;
 }
@@ -258,6 +299,15 @@ void BindRun(py::module_& m) {
       .def_readonly("warnings", &RefineOutput::warnings)
       .def_readonly("written", &RefineOutput::written);
 
+  py::class_<MergeOutput>(m, "MergeResult", "What rvlio.merge returns.")
+      .def_readonly("trajectory", &MergeOutput::trajectory,
+                    "(N, 8) [t_s, x, y, z, qx, qy, qz, qw]: the merged trajectory.tum")
+      .def_readonly("map_points", &MergeOutput::map_points,
+                    "(K, 3) the chunks' maps in the merged frame (map.pcd)")
+      .def_readonly("summary", &MergeOutput::summary, "summary.json as a dict")
+      .def_readonly("warnings", &MergeOutput::warnings)
+      .def_readonly("written", &MergeOutput::written);
+
   m.def("run", &Run, py::arg("bag"), py::arg("config") = py::none(), py::arg("out") = py::none(),
         py::kw_only(), py::arg("start") = 0.0, py::arg("duration") = 0.0,
         py::arg("progress") = py::none(),
@@ -268,9 +318,15 @@ void BindRun(py::module_& m) {
         "raises KeyboardInterrupt (with `out`, the outputs of the scans done are written first).");
   m.def("refine", &Refine, py::arg("bag"), py::arg("init"), py::arg("config") = py::none(),
         py::arg("out") = py::none(), py::kw_only(), py::arg("start") = 0.0,
-        py::arg("duration") = 0.0,
+        py::arg("duration") = 0.0, py::arg("chunk") = py::none(), py::arg("of") = py::none(),
         "`rvlio refine`: offline batch refinement from `init` (a TUM path or an rvlio.run "
-        "result). With `out`, writes trajectory.tum, map.pcd and summary.json there.");
+        "result). With `out`, writes trajectory.tum, map.pcd and summary.json there. "
+        "chunk=K, of=N: the chunk job `rvlio refine --chunk K --of N` (also writes chunk.json; "
+        "join the N output folders with rvlio.merge).");
+  m.def("merge", &Merge, py::arg("chunks"), py::arg("out") = py::none(),
+        "`rvlio merge`: joins the output folders of the N chunk jobs (any order) into one "
+        "trajectory and map; with `out`, writes trajectory.tum, map.pcd and summary.json there. "
+        "A missing or mismatched chunk raises ValueError naming it.");
   m.def("simulate", &Simulate, py::arg("preset") = "tunnel", py::kw_only(),
         py::arg("seed") = py::none(), py::arg("duration") = py::none(), py::arg("out"),
         py::arg("name") = "", py::arg("format") = "bag", py::arg("lidar_msg") = "pointcloud2",

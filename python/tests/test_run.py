@@ -103,3 +103,38 @@ def test_an_exception_in_progress_stops_the_run(tunnel):
     with pytest.raises(RuntimeError, match="enough"):
         rvlio.run(tunnel["bag"], tunnel["config"], progress=progress)
     assert calls and all(0.0 <= f <= 1.1 for _, f in calls)
+
+
+def test_refine_chunks_and_merge_give_the_cli_files(rvlio_bin, tunnel, cli_run, tmp_path):
+    sets = ["smoother.refine_rounds=1", "smoother.refine_job_overlap_s=1"]
+    config = rvlio.Config.load(tunnel["config"], set={"smoother.refine_rounds": 1,
+                                                      "smoother.refine_job_overlap_s": 1})
+    init = cli_run / "trajectory.tum"
+    cli_dirs, py_dirs = [], []
+    for k in (1, 2):
+        cli_dirs.append(tmp_path / f"cli_chunk{k}")
+        args = ["refine", "--bag", tunnel["bag"], "--init", init, "--config", tunnel["config"],
+                "--chunk", k, "--of", 2, "--out", cli_dirs[-1]]
+        for s in sets:
+            args += ["--set", s]
+        run_cli(rvlio_bin, *args)
+        py_dirs.append(tmp_path / f"py_chunk{k}")
+        job = rvlio.refine(tunnel["bag"], init, config, out=py_dirs[-1], chunk=k, of=2)
+        assert job.written and job.summary["chunk"]["chunk"] == k
+        for f in ("trajectory.tum", "map.pcd", "chunk.json"):
+            assert filecmp.cmp(py_dirs[-1] / f, cli_dirs[-1] / f, shallow=False), (k, f)
+    run_cli(rvlio_bin, "merge", "--chunks", cli_dirs[1], "--chunks", cli_dirs[0],
+            "--out", tmp_path / "cli_merged")
+    merged = rvlio.merge(reversed(py_dirs), out=tmp_path / "py_merged")
+    assert merged.written and merged.trajectory.shape[1] == 8 and merged.map_points.shape[1] == 3
+    for f in ("trajectory.tum", "map.pcd"):
+        assert filecmp.cmp(tmp_path / "py_merged" / f, tmp_path / "cli_merged" / f, shallow=False)
+    written = np.loadtxt(tmp_path / "py_merged" / "trajectory.tum")
+    np.testing.assert_allclose(merged.trajectory[:, 0], written[:, 0], rtol=0, atol=1e-6)  # s
+    np.testing.assert_allclose(merged.trajectory[:, 1:], written[:, 1:], rtol=0, atol=1e-9)
+    with pytest.raises(ValueError, match="missing chunk 2 of 2"):
+        rvlio.merge([py_dirs[0]])
+    with pytest.raises(ValueError, match="chunk and of go together"):
+        rvlio.refine(tunnel["bag"], init, config, chunk=1)
+    with pytest.raises(ValueError, match="needs 1 <= chunk <= of"):
+        rvlio.refine(tunnel["bag"], init, config, chunk=3, of=2)
