@@ -83,6 +83,13 @@ py::dict RoundDict(const RefineRound& r) {
   return d;
 }
 
+// f() with the GIL released (a long library call that takes no Python object).
+template <class F>
+auto WithoutGil(F&& f) -> decltype(f()) {
+  py::gil_scoped_release release;
+  return f();
+}
+
 // The stop callback of a long call: Ctrl-C (Python's signal handlers, run
 // every 50 ms with the GIL taken back) stops it.
 StopFn StopOn(SignalCheck* signals) {
@@ -132,11 +139,7 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
       last_scans = p.scans;
       signals.CallPython([&] { progress(p.scans, p.fraction); });
     };
-  StatusOr<RunResult> result = Status::Internal("not run");
-  {
-    py::gil_scoped_release release;
-    result = RunRecording(args);
-  }
+  StatusOr<RunResult> result = WithoutGil([&] { return RunRecording(args); });
   signals.Rethrow();  // KeyboardInterrupt (the outputs of the scans done are written)
   RunResult r = Take(std::move(result));
   if (!r.read_error.ok()) Raise(r.read_error);
@@ -196,11 +199,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   }
   SignalCheck signals;
   args.stop = StopOn(&signals);
-  StatusOr<RefineRunResult> result = Status::Internal("not refined");
-  {
-    py::gil_scoped_release release;
-    result = RefineRecording(args);
-  }
+  StatusOr<RefineRunResult> result = WithoutGil([&] { return RefineRecording(args); });
   signals.Rethrow();
   RefineRunResult r = Take(std::move(result));
   RefineOutput o;
@@ -225,11 +224,7 @@ MergeOutput Merge(const py::iterable& chunks, const py::handle& out) {
   MergeArgs args;
   for (const py::handle& c : chunks) args.chunk_dirs.push_back(PathText(c));
   args.out_dir = OutDir(out);
-  StatusOr<MergeResult> result = Status::Internal("not merged");
-  {
-    py::gil_scoped_release release;
-    result = MergeRefineChunks(args);
-  }
+  StatusOr<MergeResult> result = WithoutGil([&] { return MergeRefineChunks(args); });
   MergeResult r = Take(std::move(result));
   MergeOutput o;
   o.trajectory = TrajectoryArray(r.trajectory);
@@ -254,11 +249,7 @@ py::dict Simulate(const std::string& preset, const py::handle& seed, const py::h
   args.format = format;
   SignalCheck signals;
   args.stop = StopOn(&signals);
-  StatusOr<SimulateResult> result = Status::Internal("not simulated");
-  {
-    py::gil_scoped_release release;
-    result = SimulateRecording(args);
-  }
+  StatusOr<SimulateResult> result = WithoutGil([&] { return SimulateRecording(args); });
   signals.Rethrow();  // nothing written
   const SimulateResult r = Take(std::move(result));
   py::dict d;
