@@ -5,12 +5,14 @@
 
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "config_py.h"
 #include "odometry_py.h"
 #include "rvlio/api.h"
+#include "rvlio/io/extrinsic_json.h"
 
 namespace rvlio::python {
 namespace {
@@ -19,6 +21,27 @@ constexpr const char* kStopReason = "KeyboardInterrupt";
 // rvlio.run calls its `progress` function after each new scan result, and
 // while reading without new results at most this often.
 constexpr std::chrono::milliseconds kProgressPeriod{200};
+
+// The six extrinsic columns of scans.csv (NaN for a scan without an
+// estimate), only when some scan carries one.
+template <typename Column>
+void AddExtrinsicColumns(const std::vector<ScanResult>& scans, Column& column) {
+  if (std::none_of(scans.begin(), scans.end(),
+                   [](const ScanResult& r) { return r.T_imu_lidar.has_value(); }))
+    return;
+  const auto rpy_deg = [](const ScanResult& r, int i) {
+    return r.T_imu_lidar ? RpyDeg(r.T_imu_lidar->R)(i) : std::nan("");
+  };
+  const auto t_m = [](const ScanResult& r, int i) {
+    return r.T_imu_lidar ? r.T_imu_lidar->t(i) : std::nan("");
+  };
+  column("ext_roll_deg", [&](const ScanResult& r) { return rpy_deg(r, 0); });
+  column("ext_pitch_deg", [&](const ScanResult& r) { return rpy_deg(r, 1); });
+  column("ext_yaw_deg", [&](const ScanResult& r) { return rpy_deg(r, 2); });
+  column("ext_x_m", [&](const ScanResult& r) { return t_m(r, 0); });
+  column("ext_y_m", [&](const ScanResult& r) { return t_m(r, 1); });
+  column("ext_z_m", [&](const ScanResult& r) { return t_m(r, 2); });
+}
 
 // The per-scan table: the columns of scans.csv as numpy arrays (one row per scan).
 py::dict ScanTable(const std::vector<ScanResult>& scans) {
@@ -66,6 +89,7 @@ py::dict ScanTable(const std::vector<ScanResult>& scans) {
   column("residual_median_m", [](const ScanResult& r) { return r.health.residual_median_m; });
   column("residual_rms_m", [](const ScanResult& r) { return r.health.residual_rms_m; });
   column("diverged", [](const ScanResult& r) { return r.health.divergence_mask != 0; });
+  AddExtrinsicColumns(scans, column);
   return table;
 }
 

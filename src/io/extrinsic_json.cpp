@@ -40,6 +40,7 @@ nlohmann::json ExtrinsicJson(const ExtrinsicReport& r) {
           {"std_ratio_posterior_to_prior", ratio},
           {"T_imu_lidar", PoseJson(r.T_imu_lidar)},
           {"prior_T_imu_lidar", PoseJson(r.T_imu_lidar_prior)},
+          {"map_rebuilds", r.map_rebuilds},
           {"change_from_prior",
            {{"rotation_deg", dphi.norm() * kRadToDeg},
             {"translation_m", dt.norm()},

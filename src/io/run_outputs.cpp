@@ -11,6 +11,7 @@
 #include <pcl/point_types.h>
 
 #include "rvlio/io/atomic_file.h"
+#include "rvlio/io/extrinsic_json.h"
 
 namespace rvlio {
 namespace {
@@ -29,6 +30,17 @@ std::string FormatSeconds(TimeNs t_ns) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.9f", NsToSeconds(t_ns));
   return buf;
+}
+
+// The six extrinsic columns of a scan (empty if the scan carries no estimate).
+void WriteExtrinsicColumns(const std::optional<Pose3>& T_imu_lidar, std::ostream& os) {
+  if (!T_imu_lidar) {
+    os << ",,,,,,";
+    return;
+  }
+  const Eigen::Vector3d rpy = RpyDeg(T_imu_lidar->R);
+  os << ',' << rpy.x() << ',' << rpy.y() << ',' << rpy.z() << ',' << T_imu_lidar->t.x() << ','
+     << T_imu_lidar->t.y() << ',' << T_imu_lidar->t.z();
 }
 
 }  // namespace
@@ -127,7 +139,13 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
   os << "t,status,raw_points,points,constraints,iterations,rv_active,n_alpha_x,n_alpha_y,"
         "n_alpha_z,scv,coplanar,repaired,K,rv_iterations,coplanar_fraction,localizability,"
         "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb,reinforced,nis,residual_median_m,"
-        "residual_rms_m,diverged\n";
+        "residual_rms_m,diverged";
+  // Online extrinsic estimation: its estimate after each scan (roll/pitch/yaw
+  // in degrees as in summary.json, translation in metres).
+  const bool extrinsic = std::any_of(results.begin(), results.end(),
+                                     [](const ScanResult& r) { return r.T_imu_lidar.has_value(); });
+  if (extrinsic) os << ",ext_roll_deg,ext_pitch_deg,ext_yaw_deg,ext_x_m,ext_y_m,ext_z_m";
+  os << '\n';
   for (size_t i = 0; i < results.size(); ++i) {
     const ScanResult& r = results[i];
     const RvReport& v = r.rv;
@@ -141,7 +159,9 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
        << r.mean_acc_imu.y() << ',' << r.mean_acc_imu.z() << ','
        << (i < rss_mb.size() ? rss_mb[i] : std::nan("")) << ',' << v.num_reinforced << ','
        << Optional(r.health.nis_per_dof) << ',' << Optional(r.health.residual_median_m) << ','
-       << Optional(r.health.residual_rms_m) << ',' << DivergenceKindNames(r.health.divergence_mask) << '\n';
+       << Optional(r.health.residual_rms_m) << ',' << DivergenceKindNames(r.health.divergence_mask);
+    if (extrinsic) WriteExtrinsicColumns(r.T_imu_lidar, os);
+    os << '\n';
   }
   return WriteFileAtomically(path, os.str());
 }

@@ -13,7 +13,7 @@ namespace rvlio {
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
     : options_(options),
       filter_(options.ieskf, options.imu, options.constraints, options.rv),
-      map_(options.map),
+      map_(options.map, options.ieskf.estimate_extrinsics),
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
@@ -74,8 +74,8 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.mean_acc_imu = mean_acc_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.status = map_.Empty() ? ScanStatus::kMapInit : Correct(&r);
-  ReportExtrinsic();
-  InsertIntoMap();
+  InsertIntoMap(scan.t_end_ns);
+  ReportExtrinsic(&r);
   filter_.ClearPoseHistory();
   r.t_ns = scan.t_end_ns;
   r.T_world_imu = filter_.state().T_world_imu();
@@ -134,18 +134,19 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   return ScanStatus::kUpdated;
 }
 
-void IeskfOdometry::ReportExtrinsic() {
+void IeskfOdometry::ReportExtrinsic(ScanResult* r) {
   if (!options_.ieskf.estimate_extrinsics) return;
   filter_.CountExcitationScan();
+  r->T_imu_lidar = filter_.state().T_imu_lidar();
   stats_.extrinsic = MakeExtrinsicReport(filter_.extrinsic_excitation(), T_imu_lidar_,
                                          filter_.state().T_imu_lidar());
+  stats_.extrinsic.map_rebuilds = map_.rebuilds();
 }
 
-void IeskfOdometry::InsertIntoMap() {
-  const Pose3 T_world_lidar = filter_.state().T_world_lidar();
-  TransformPoints(T_world_lidar, p_lidar_end_, &p_world_);
-  map_.Insert(p_world_, T_world_lidar.t);
-  output_map_.Insert(p_world_);
+void IeskfOdometry::InsertIntoMap(TimeNs t_ns) {
+  map_.ReanchorIfMoved(filter_.state().T_imu_lidar());
+  const FilterState& x = filter_.state();
+  output_map_.Insert(map_.InsertScan(t_ns, x.T_world_imu(), x.T_imu_lidar(), p_lidar_end_));
 }
 
 }  // namespace rvlio

@@ -1,6 +1,9 @@
 #include "rvlio/odometry/scan_frontend.h"
 
+#include <cmath>
 #include <utility>
+
+#include "rvlio/math/so3.h"
 
 namespace rvlio {
 namespace {
@@ -29,6 +32,29 @@ void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector
   for (size_t i = 0; i < p_lidar.size(); ++i) (*p_world)[i] = T_world_lidar * p_lidar[i];
 }
 
+WorkingMap::WorkingMap(const MapOptions& options, bool reanchor)
+    : options_(options), reanchor_(reanchor && options.reanchor_window > 0.0), map_(options) {}
+
+const std::vector<Eigen::Vector3d>& WorkingMap::InsertScan(
+    TimeNs t_ns, const Pose3& T_world_imu, const Pose3& T_imu_lidar,
+    const std::vector<Eigen::Vector3d>& p_lidar) {
+  if (reanchor_) {
+    if (!T_imu_lidar_built_) T_imu_lidar_built_ = T_imu_lidar;
+    kept_.push_back({t_ns, T_world_imu, p_lidar});
+    while (kept_.front().t_ns < t_ns - SecondsToNs(options_.reanchor_window)) kept_.pop_front();
+  }
+  const Pose3 T_world_lidar = T_world_imu * T_imu_lidar;
+  TransformPoints(T_world_lidar, p_lidar, &p_world_);
+  Insert(p_world_, T_world_lidar.t);
+  return p_world_;
+}
+
+bool WorkingMap::ReanchorIfMoved(const Pose3& T_imu_lidar) {
+  if (!reanchor_ || kept_.empty() || !ExtrinsicMoved(T_imu_lidar)) return false;
+  Rebuild(T_imu_lidar);
+  return true;
+}
+
 void WorkingMap::Insert(const std::vector<Eigen::Vector3d>& p_world,
                         const Eigen::Vector3d& sensor_world) {
   map_.Insert(p_world);
@@ -36,6 +62,23 @@ void WorkingMap::Insert(const std::vector<Eigen::Vector3d>& p_world,
     map_.RemoveFar(sensor_world, map_.options().working_radius);
     scans_since_trim_ = 0;
   }
+}
+
+bool WorkingMap::ExtrinsicMoved(const Pose3& T_imu_lidar) const {
+  const double rotation_rad = so3::Log(T_imu_lidar_built_->R.transpose() * T_imu_lidar.R).norm();
+  return rotation_rad > options_.reanchor_rotation * M_PI / 180.0 ||
+         (T_imu_lidar.t - T_imu_lidar_built_->t).norm() > options_.reanchor_translation;
+}
+
+// The map again from the kept scans only, each at its IMU pose with T_imu_lidar.
+void WorkingMap::Rebuild(const Pose3& T_imu_lidar) {
+  map_.Clear();
+  for (const KeptScan& k : kept_) {
+    TransformPoints(k.T_world_imu * T_imu_lidar, k.p_lidar, &p_world_);
+    map_.Insert(p_world_);
+  }
+  T_imu_lidar_built_ = T_imu_lidar;
+  ++rebuilds_;
 }
 
 bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats) {

@@ -37,7 +37,7 @@ Eigen::Vector3d MeanAcc(const std::vector<ImuSample>& samples, TimeNs t0_ns, Tim
 SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
     : options_(options),
       window_options_(MakeWindowOptions(options)),
-      map_(options.map),
+      map_(options.map, options.smoother.estimate_extrinsics),
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
       initializer_(options.imu.init_duration),
@@ -118,7 +118,7 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
                               : UpdateWindow(scan.t_end_ns, predicted, samples, &r);
   SetNewestFromWindow();
   MarginalizeIfFull();
-  ReportExtrinsic();
+  ReportExtrinsic(&r);
   DropImuBefore(scan.t_end_ns);
   r.t_ns = scan.t_end_ns;
   r.T_world_imu = Pose3(newest_.R_world_imu, newest_.p_world_imu);
@@ -195,7 +195,7 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
   // What the newest state's constraints leave after the solve (divergence monitor).
   const int newest = window_->size() - 1;
   const ResidualStats residuals = ComputeResidualStats(
-      window_->constraints(newest), window_->state(newest).pose.ToPose3(), T_imu_lidar_);
+      window_->constraints(newest), window_->state(newest).pose.ToPose3(), CurrentTImuLidar());
   if (residuals.count > 0) {
     r->health.residual_median_m = residuals.median_abs_m;
     r->health.residual_rms_m = residuals.rms_m;
@@ -209,9 +209,8 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
 
 void SmootherOdometry::InsertIntoWorkingMap(const WindowState& s,
                                             const std::vector<Eigen::Vector3d>& p_lidar) {
-  const Pose3 T_world_lidar = s.pose.ToPose3() * CurrentTImuLidar();
-  TransformPoints(T_world_lidar, p_lidar, &p_world_);
-  map_.Insert(p_world_, T_world_lidar.t);
+  map_.ReanchorIfMoved(CurrentTImuLidar());
+  map_.InsertScan(s.t_ns, s.pose.ToPose3(), CurrentTImuLidar(), p_lidar);
 }
 
 // The oldest state leaves the window: its points enter the output map (and,
@@ -222,10 +221,14 @@ void SmootherOdometry::MarginalizeIfFull() {
   if (!m) return;
   stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   window_filled_ = true;
-  const Pose3 T_world_lidar = m->state.pose.ToPose3() * CurrentTImuLidar();
-  TransformPoints(T_world_lidar, m->p_lidar, &p_world_);
-  output_map_.Insert(p_world_);
-  if (options_.smoother.map_update == "marginalized") map_.Insert(p_world_, T_world_lidar.t);
+  if (options_.smoother.map_update == "marginalized") {
+    map_.ReanchorIfMoved(CurrentTImuLidar());
+    output_map_.Insert(map_.InsertScan(m->state.t_ns, m->state.pose.ToPose3(), CurrentTImuLidar(),
+                                       m->p_lidar));
+  } else {
+    TransformPoints(m->state.pose.ToPose3() * CurrentTImuLidar(), m->p_lidar, &p_world_);
+    output_map_.Insert(p_world_);
+  }
   stats_.marginalization_failures = window_->stats().marginalization_failures;
 }
 
@@ -233,11 +236,13 @@ Pose3 SmootherOdometry::CurrentTImuLidar() const {
   return window_ ? window_->T_imu_lidar() : T_imu_lidar_;
 }
 
-void SmootherOdometry::ReportExtrinsic() {
+void SmootherOdometry::ReportExtrinsic(ScanResult* r) {
   if (!options_.smoother.estimate_extrinsics) return;
   window_->CountExcitationScan();
+  r->T_imu_lidar = window_->T_imu_lidar();
   stats_.extrinsic =
       MakeExtrinsicReport(window_->extrinsic_excitation(), T_imu_lidar_, window_->T_imu_lidar());
+  stats_.extrinsic.map_rebuilds = map_.rebuilds();
 }
 
 void SmootherOdometry::SetNewestFromWindow() {

@@ -34,8 +34,8 @@ class IeskfOdometry : public Odometry {
   // Returns the mean specific force of the samples used (IMU frame).
   Eigen::Vector3d Predict(TimeNs t_end_ns);
   ScanStatus Correct(ScanResult* r);
-  void InsertIntoMap();
-  void ReportExtrinsic();  // ieskf.estimate_extrinsics: stats_.extrinsic
+  void InsertIntoMap(TimeNs t_ns);
+  void ReportExtrinsic(ScanResult* r);  // ieskf.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
 
   OdometryOptions options_;
   Ieskf filter_;
@@ -52,7 +52,6 @@ class IeskfOdometry : public Odometry {
   // Per-scan workspaces, reused to avoid allocation in the hot path.
   Scan downsampled_;
   std::vector<Eigen::Vector3d> p_lidar_end_;
-  std::vector<Eigen::Vector3d> p_world_;
 };
 
 }  // namespace rvlio

@@ -6,6 +6,7 @@
 #include <array>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,9 @@ struct ScanResult {
   double ms = 0.0;  // processing time of this scan: CPU time of the calling thread
   Eigen::Vector3d mean_acc_imu = Eigen::Vector3d::Zero();  // mean specific force over the scan, m/s^2
   ScanHealth health;  // what the divergence monitor read, and what it flagged
+  // The backend's LiDAR-IMU extrinsic after this scan; set only while it is
+  // estimated online (ieskf/smoother.estimate_extrinsics), to follow its convergence.
+  std::optional<Pose3> T_imu_lidar;
 };
 
 // The monitor's view of a scan result (odometry/divergence.h).
@@ -55,6 +59,7 @@ struct ExtrinsicReport {
   Vector6d std_ratio = Vector6d::Ones();  // posterior / prior std per axis, all axes estimated
   Pose3 T_imu_lidar_prior;          // configured
   Pose3 T_imu_lidar;                // final estimate
+  int64_t map_rebuilds = 0;         // working map re-anchored to a moved estimate (map.reanchor_*)
 };
 
 // The report of a backend's excitation monitor and its current estimate.

@@ -49,19 +49,53 @@ void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector
 
 // The map scans are associated against: a VoxelMap whose voxels farther than
 // map.working_radius from the sensor are removed every few insertions.
+//
+// Re-anchoring (on with online extrinsic estimation): a map point keeps the
+// extrinsic it was inserted with, and a voxel keeps its first points, so a
+// map built from a wrong start extrinsic holds the estimate back. With
+// re-anchoring the map also keeps the scans of the last map.reanchor_window
+// seconds (IMU pose and LiDAR points), and when the extrinsic has moved more
+// than map.reanchor_rotation / reanchor_translation since the map was built,
+// ReanchorIfMoved rebuilds it from them with the current extrinsic (the
+// backends call it before each insertion). The IMU poses are the anchor: a
+// rebuilt map agrees with them and the new extrinsic, so the estimator's
+// state stays as it is (docs/extrinsics.md "Map re-anchoring").
 class WorkingMap {
  public:
-  explicit WorkingMap(const MapOptions& options) : map_(options) {}
+  WorkingMap(const MapOptions& options, bool reanchor);
 
-  // Inserts one scan's points (world); sensor_world: the LiDAR position.
-  void Insert(const std::vector<Eigen::Vector3d>& p_world, const Eigen::Vector3d& sensor_world);
+  // Re-anchoring: when T_imu_lidar has moved past the thresholds since the map
+  // was built, rebuilds it from the kept scans, each at its IMU pose with
+  // T_imu_lidar; true if it did.
+  bool ReanchorIfMoved(const Pose3& T_imu_lidar);
+  // Inserts one scan: p_lidar (LiDAR frame) placed at T_world_imu * T_imu_lidar.
+  // Returns the inserted points in the world frame (valid until the next call).
+  const std::vector<Eigen::Vector3d>& InsertScan(TimeNs t_ns, const Pose3& T_world_imu,
+                                                 const Pose3& T_imu_lidar,
+                                                 const std::vector<Eigen::Vector3d>& p_lidar);
 
   const VoxelMap& map() const { return map_; }
   bool Empty() const { return map_.Empty(); }
+  int64_t rebuilds() const { return rebuilds_; }
 
  private:
+  struct KeptScan {
+    TimeNs t_ns;
+    Pose3 T_world_imu;
+    std::vector<Eigen::Vector3d> p_lidar;
+  };
+  void Insert(const std::vector<Eigen::Vector3d>& p_world, const Eigen::Vector3d& sensor_world);
+  bool ExtrinsicMoved(const Pose3& T_imu_lidar) const;
+  void Rebuild(const Pose3& T_imu_lidar);
+
+  MapOptions options_;
+  bool reanchor_;
   VoxelMap map_;
   int scans_since_trim_ = 0;
+  std::deque<KeptScan> kept_;
+  std::optional<Pose3> T_imu_lidar_built_;  // the extrinsic the map was (re)built with
+  int64_t rebuilds_ = 0;
+  std::vector<Eigen::Vector3d> p_world_;
 };
 
 // Screens one IMU sample for the buffer: false (and counted) for a non-finite

@@ -94,7 +94,7 @@ class SmootherOdometry : public Odometry {
   void MarginalizeIfFull();
   void SetNewestFromWindow();
   Pose3 CurrentTImuLidar() const;  // the window's extrinsic (estimate or configured)
-  void ReportExtrinsic();          // smoother.estimate_extrinsics: stats_.extrinsic
+  void ReportExtrinsic(ScanResult* r);  // smoother.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
 
   OdometryOptions options_;
   WindowOptions window_options_;

@@ -186,7 +186,7 @@ struct SimTrajectoryOptions {
     v.Field("sway_amplitude", sway_amplitude,
             Spec().Unit("rad").Range(0.0, 0.5).Help(
                 "handheld/drone sway about all three body axes (0: off); "
-                "0.05 at 0.8 Hz is the 'normal excitation' of docs/extrinsics.md"));
+                "0.1 at 1 Hz is the 'normal excitation' of docs/extrinsics.md"));
     v.Field("sway_frequency", sway_frequency,
             Spec().Unit("Hz").Range(0.01, 20.0).Help("sway frequency of the roll axis; "
                                                      "pitch x1.37, yaw x0.71"));
