@@ -138,3 +138,25 @@ def test_refine_chunks_and_merge_give_the_cli_files(rvlio_bin, tunnel, cli_run, 
         rvlio.refine(tunnel["bag"], init, config, chunk=1)
     with pytest.raises(ValueError, match="needs 1 <= chunk <= of"):
         rvlio.refine(tunnel["bag"], init, config, chunk=3, of=2)
+
+
+EXTRINSIC_COLUMNS = ("ext_roll_deg", "ext_pitch_deg", "ext_yaw_deg", "ext_x_m", "ext_y_m", "ext_z_m")
+
+
+def test_run_table_follows_the_extrinsic_estimate_like_scans_csv(tmp_path, rvlio_bin, tunnel,
+                                                                  py_run):
+    # Without online estimation neither the table nor scans.csv has the columns.
+    assert not set(EXTRINSIC_COLUMNS) & set(py_run[1].scans)
+    cli_out = tmp_path / "cli"
+    run_cli(rvlio_bin, "run", "--bag", tunnel["bag"], "--config", tunnel["config"], "--out",
+            cli_out, "--quiet", "--set", "ieskf.estimate_extrinsics=true")
+    config = rvlio.Config.load(tunnel["config"], set={"ieskf.estimate_extrinsics": True})
+    result = rvlio.run(tunnel["bag"], config)
+    csv = np.genfromtxt(cli_out / "scans.csv", delimiter=",", names=True, dtype=None,
+                        encoding="utf-8")
+    for column in EXTRINSIC_COLUMNS:
+        assert np.all(np.isfinite(result.scans[column])), column
+        np.testing.assert_allclose(result.scans[column], csv[column], rtol=1e-8, atol=1e-12)
+    final = result.summary["extrinsic"]["T_imu_lidar"]
+    np.testing.assert_allclose([result.scans[c][-1] for c in EXTRINSIC_COLUMNS],
+                               final["rpy_deg"] + final["translation_m"], rtol=0, atol=1e-12)
