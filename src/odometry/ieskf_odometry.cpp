@@ -144,7 +144,6 @@ void IeskfOdometry::ReportExtrinsic(ScanResult* r) {
 }
 
 void IeskfOdometry::InsertIntoMap(TimeNs t_ns) {
-  map_.ReanchorIfMoved(filter_.state().T_imu_lidar());
   const FilterState& x = filter_.state();
   output_map_.Insert(map_.InsertScan(t_ns, x.T_world_imu(), x.T_imu_lidar(), p_lidar_end_));
 }

@@ -33,15 +33,16 @@ void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector
 }
 
 WorkingMap::WorkingMap(const MapOptions& options, bool reanchor)
-    : options_(options), reanchor_(reanchor && options.reanchor_window > 0.0), map_(options) {}
+    : reanchor_(reanchor && options.reanchor_window > 0.0), map_(options) {}
 
 const std::vector<Eigen::Vector3d>& WorkingMap::InsertScan(
     TimeNs t_ns, const Pose3& T_world_imu, const Pose3& T_imu_lidar,
     const std::vector<Eigen::Vector3d>& p_lidar) {
   if (reanchor_) {
     if (!T_imu_lidar_built_) T_imu_lidar_built_ = T_imu_lidar;
+    ReanchorIfMoved(T_imu_lidar);
     kept_.push_back({t_ns, T_world_imu, p_lidar});
-    while (kept_.front().t_ns < t_ns - SecondsToNs(options_.reanchor_window)) kept_.pop_front();
+    while (kept_.front().t_ns < t_ns - SecondsToNs(map_.options().reanchor_window)) kept_.pop_front();
   }
   const Pose3 T_world_lidar = T_world_imu * T_imu_lidar;
   TransformPoints(T_world_lidar, p_lidar, &p_world_);
@@ -66,8 +67,8 @@ void WorkingMap::Insert(const std::vector<Eigen::Vector3d>& p_world,
 
 bool WorkingMap::ExtrinsicMoved(const Pose3& T_imu_lidar) const {
   const double rotation_rad = so3::Log(T_imu_lidar_built_->R.transpose() * T_imu_lidar.R).norm();
-  return rotation_rad > options_.reanchor_rotation * M_PI / 180.0 ||
-         (T_imu_lidar.t - T_imu_lidar_built_->t).norm() > options_.reanchor_translation;
+  return rotation_rad > map_.options().reanchor_rotation * M_PI / 180.0 ||
+         (T_imu_lidar.t - T_imu_lidar_built_->t).norm() > map_.options().reanchor_translation;
 }
 
 // The map again from the kept scans only, each at its IMU pose with T_imu_lidar.

@@ -209,7 +209,6 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
 
 void SmootherOdometry::InsertIntoWorkingMap(const WindowState& s,
                                             const std::vector<Eigen::Vector3d>& p_lidar) {
-  map_.ReanchorIfMoved(CurrentTImuLidar());
   map_.InsertScan(s.t_ns, s.pose.ToPose3(), CurrentTImuLidar(), p_lidar);
 }
 
@@ -222,7 +221,6 @@ void SmootherOdometry::MarginalizeIfFull() {
   stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   window_filled_ = true;
   if (options_.smoother.map_update == "marginalized") {
-    map_.ReanchorIfMoved(CurrentTImuLidar());
     output_map_.Insert(map_.InsertScan(m->state.t_ns, m->state.pose.ToPose3(), CurrentTImuLidar(),
                                        m->p_lidar));
   } else {

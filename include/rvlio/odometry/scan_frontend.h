@@ -56,10 +56,10 @@ void TransformPoints(const Pose3& T_world_lidar, const std::vector<Eigen::Vector
 // re-anchoring the map also keeps the scans of the last map.reanchor_window
 // seconds (IMU pose and LiDAR points), and when the extrinsic has moved more
 // than map.reanchor_rotation / reanchor_translation since the map was built,
-// ReanchorIfMoved rebuilds it from them with the current extrinsic (the
-// backends call it before each insertion). The IMU poses are the anchor: a
-// rebuilt map agrees with them and the new extrinsic, so the estimator's
-// state stays as it is (docs/extrinsics.md "Map re-anchoring").
+// it is rebuilt from them with the current extrinsic before the next scan is
+// inserted. The IMU poses are the anchor: a rebuilt map agrees with them and
+// the new extrinsic, so the estimator's state stays as it is
+// (docs/extrinsics.md "Map re-anchoring").
 class WorkingMap {
  public:
   WorkingMap(const MapOptions& options, bool reanchor);
@@ -68,8 +68,9 @@ class WorkingMap {
   // was built, rebuilds it from the kept scans, each at its IMU pose with
   // T_imu_lidar; true if it did.
   bool ReanchorIfMoved(const Pose3& T_imu_lidar);
-  // Inserts one scan: p_lidar (LiDAR frame) placed at T_world_imu * T_imu_lidar.
-  // Returns the inserted points in the world frame (valid until the next call).
+  // Inserts one scan: p_lidar (LiDAR frame) placed at T_world_imu * T_imu_lidar,
+  // after ReanchorIfMoved(T_imu_lidar) when re-anchoring is on. Returns the
+  // inserted points in the world frame (valid until the next call).
   const std::vector<Eigen::Vector3d>& InsertScan(TimeNs t_ns, const Pose3& T_world_imu,
                                                  const Pose3& T_imu_lidar,
                                                  const std::vector<Eigen::Vector3d>& p_lidar);
@@ -88,7 +89,6 @@ class WorkingMap {
   bool ExtrinsicMoved(const Pose3& T_imu_lidar) const;
   void Rebuild(const Pose3& T_imu_lidar);
 
-  MapOptions options_;
   bool reanchor_;
   VoxelMap map_;
   int scans_since_trim_ = 0;
