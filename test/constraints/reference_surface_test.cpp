@@ -86,7 +86,9 @@ TEST(ReferenceSurface, AssociationSearchesAReferenceMapLikeTheVoxelMap) {
   AssociationStats s_ref, s_voxels;
   AssociateWith(scan, T_world_lidar, ref, ConstraintOptions(), &from_ref, &s_ref);
   AssociateWith(scan, T_world_lidar, voxels, ConstraintOptions(), &from_voxels, &s_voxels);
-  ASSERT_EQ(s_ref.num_accepted, 50);
+  EXPECT_GT(s_ref.num_accepted, 30);  // some 5-point neighbourhoods are line-like
+  EXPECT_EQ(s_ref.num_accepted, s_voxels.num_accepted);
+  EXPECT_EQ(s_ref.num_line_like, s_voxels.num_line_like);
   ASSERT_EQ(from_ref.size(), from_voxels.size());
   for (size_t i = 0; i < from_ref.size(); ++i) {
     EXPECT_NEAR(from_ref[i].residual, 0.03, 1e-6);
