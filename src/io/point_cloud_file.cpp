@@ -420,8 +420,14 @@ Status DecodeAscii(const std::string& path, const char* data, size_t size, int64
     if (p == nullptr) return Status::InvalidInput(path + ": truncated before the vertices");
     ++p;
   }
-  PrepareCloud(layout, plan, cloud);
   const uint64_t n = static_cast<uint64_t>(layout.num_points);
+  // Every number takes at least two bytes (a digit and a separator): a header
+  // that declares more cannot be honest, and nothing is allocated for it.
+  const uint64_t at_most = (static_cast<uint64_t>(end - p) + 1) / (2 * layout.record_scalars);
+  if (n > at_most)
+    return Status::InvalidInput(path + ": truncated: the header declares " + std::to_string(n) +
+                                " points, the data can hold at most " + std::to_string(at_most));
+  PrepareCloud(layout, plan, cloud);
   std::vector<double> record(layout.record_scalars);
   std::string token;
   for (uint64_t i = 0; i < n; ++i) {
@@ -463,8 +469,9 @@ Status ReadWholeFile(const std::string& path, std::string* text) {
   return Status::Ok();
 }
 
-Status CheckPoints(const std::string& path, const PointCloudFile& cloud) {
-  if (cloud.points.empty()) return Status::InvalidInput(path + ": empty point cloud (0 points)");
+Status CheckPoints(const std::string& path, const PointCloudFile& cloud, bool allow_empty) {
+  if (cloud.points.empty() && !allow_empty)
+    return Status::InvalidInput(path + ": empty point cloud (0 points)");
   size_t bad = 0;
   for (const Eigen::Vector3d& p : cloud.points) bad += p.allFinite() ? 0 : 1;
   if (bad > 0)
@@ -540,7 +547,7 @@ StatusOr<PointCloudFile> ReadPointCloud(const std::string& path,
   else if (starts_with("#") || starts_with("VERSION") || starts_with("FIELDS"))
     cloud = ReadPcd(path, text, options);
   if (!cloud.ok()) return cloud;
-  if (Status s = CheckPoints(path, *cloud); !s.ok()) return s;
+  if (Status s = CheckPoints(path, *cloud, options.allow_empty); !s.ok()) return s;
   return cloud;
 }
 

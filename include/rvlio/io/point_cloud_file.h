@@ -42,7 +42,8 @@ struct PointCloudFile {
 };
 
 struct PointCloudReadOptions {
-  bool keep_fields = true;  // false: x y z only (less memory)
+  bool keep_fields = true;   // false: x y z only (less memory)
+  bool allow_empty = false;  // true: a cloud of 0 points is read (an rvlio map.pcd may be one)
 };
 
 StatusOr<PointCloudFile> ReadPointCloud(const std::string& path,
