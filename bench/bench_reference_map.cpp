@@ -1,12 +1,15 @@
 // Search structure of a fixed reference cloud (map/reference_map.h): build
 // time and memory over a large cloud, then k nearest neighbours (k = 8
 // within 0.5 m, what the map evaluation asks) for many query points, one
-// thread. Candidates: the project's voxel-hash map (ReferenceMap, at two
+// thread. Counters: build_s and query_s are thread CPU seconds, memory_MB
+// the growth of the resident set while building (run one benchmark per
+// process: freed memory is not returned to the system). Candidates: the project's voxel-hash map (ReferenceMap, at two
 // voxel sizes), PCL's KdTreeFLANN and nanoflann's KD-tree (when its header
 // is installed). Results: docs/map_eval.md.
 //
 //   build/bin/bench_reference_map --benchmark_filter=/10000000/
 //   (the args are reference points / query points)
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <random>
@@ -24,6 +27,7 @@
 #define RVLIO_HAVE_NANOFLANN 1
 #endif
 
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/map/reference_map.h"
 
 namespace rvlio {
@@ -82,19 +86,18 @@ void Report(benchmark::State& state, double build_s, double query_s, double mb, 
   state.counters["mean_d"] = sum;
 }
 
-double Seconds(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+// Thread CPU seconds since t0 (ThreadCpuMs): the machine may be shared.
+double Seconds(double t0_ms) { return (ThreadCpuMs() - t0_ms) * 1e-3; }
 
 void BM_ReferenceMap(benchmark::State& state, double voxel_m) {
   const Scene& s = GetScene(state.range(0), state.range(1));
   for (auto _ : state) {
     const double rss0 = RssMb();
-    auto t0 = std::chrono::steady_clock::now();
+    double t0 = ThreadCpuMs();
     auto map = std::make_unique<ReferenceMap>(s.reference, ReferenceMapOptions{voxel_m});
     const double build_s = Seconds(t0);
     const double mb = RssMb() - rss0;
-    t0 = std::chrono::steady_clock::now();
+    t0 = ThreadCpuMs();
     NeighborBuffer nb;
     double sum = 0.0;
     for (const Eigen::Vector3d& q : s.queries)
@@ -107,7 +110,7 @@ void BM_PclKdTreeFlann(benchmark::State& state) {
   const Scene& s = GetScene(state.range(0), state.range(1));
   for (auto _ : state) {
     const double rss0 = RssMb();
-    auto t0 = std::chrono::steady_clock::now();
+    double t0 = ThreadCpuMs();
     auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     cloud->reserve(s.reference.size());
     for (const Eigen::Vector3d& p : s.reference)
@@ -117,7 +120,7 @@ void BM_PclKdTreeFlann(benchmark::State& state) {
     tree->setInputCloud(cloud);
     const double build_s = Seconds(t0);
     const double mb = RssMb() - rss0;
-    t0 = std::chrono::steady_clock::now();
+    t0 = ThreadCpuMs();
     std::vector<int> idx(kK);
     std::vector<float> d2(kK);
     double sum = 0.0;
@@ -147,7 +150,7 @@ void BM_Nanoflann(benchmark::State& state) {
   const Scene& s = GetScene(state.range(0), state.range(1));
   for (auto _ : state) {
     const double rss0 = RssMb();
-    auto t0 = std::chrono::steady_clock::now();
+    double t0 = ThreadCpuMs();
     auto cloud = std::make_unique<FloatCloud>();
     cloud->xyz.reserve(3 * s.reference.size());
     for (const Eigen::Vector3d& p : s.reference)
@@ -156,7 +159,7 @@ void BM_Nanoflann(benchmark::State& state) {
     auto tree = std::make_unique<NanoTree>(3, *cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
     const double build_s = Seconds(t0);
     const double mb = RssMb() - rss0;
-    t0 = std::chrono::steady_clock::now();
+    t0 = ThreadCpuMs();
     uint32_t idx[kK];
     float d2[kK];
     double sum = 0.0;

@@ -442,9 +442,14 @@ Status DecodeAscii(const std::string& path, const char* data, size_t size, int64
       token.assign(start, p);
       char* parsed_end = nullptr;
       value = std::strtod(token.c_str(), &parsed_end);
-      if (parsed_end == token.c_str() || *parsed_end != '\0')
+      if (parsed_end == token.c_str() || *parsed_end != '\0') {
+        if (p == end)  // the file ends inside this number
+          return Status::InvalidInput(path + ": truncated: the header declares " +
+                                      std::to_string(n) + " points, the data ends in point " +
+                                      std::to_string(i));
         return Status::InvalidInput(path + ": point " + std::to_string(i) + ": '" +
                                     token.substr(0, 20) + "' is not a number");
+      }
     }
     cloud->points[i] = Eigen::Vector3d(record[layout.fields[plan.x].first_scalar],
                                        record[layout.fields[plan.y].first_scalar],
