@@ -236,6 +236,7 @@ struct Sequence {
   std::vector<std::string> sim_overrides;
   std::vector<int64_t> seeds;
   std::vector<std::string> config_files, overrides;
+  std::string ref_map;  // reference cloud, or ""
 };
 
 struct Grid {
@@ -317,7 +318,8 @@ Status ReadRecorded(const GridContext& g, const Node& n, const std::string& wher
 Status ReadSequence(const GridContext& g, const Node& n, const std::string& where, Sequence* seq) {
   if (Status s = ExpectMap(g, n, where); !s.ok()) return s;
   if (Status s =
-          CheckKeys(g, n, where, {"name", "bag", "gt", "simulate", "seeds", "config", "set"});
+          CheckKeys(g, n, where,
+                    {"name", "bag", "gt", "simulate", "seeds", "config", "set", "ref_map"});
       !s.ok())
     return s;
   const Node* name = Find(n, "name");
@@ -331,6 +333,13 @@ Status ReadSequence(const GridContext& g, const Node& n, const std::string& wher
     if (Status s = ReadSeeds(g, Find(n, "seeds"), where + ".seeds", &seq->seeds); !s.ok()) return s;
   } else if (Status s = ReadRecorded(g, n, where, seq); !s.ok()) {
     return s;
+  }
+  if (const Node* ref = Find(n, "ref_map")) {
+    if (ref->kind != Node::Kind::kScalar)
+      return g.Error(*ref, where + ".ref_map", "expected a PCD or PLY file");
+    seq->ref_map = g.Resolve(ref->scalar);
+    if (!fs::is_regular_file(seq->ref_map))
+      return g.Error(*ref, where + ".ref_map", "file not found: " + seq->ref_map);
   }
   if (Status s = ReadConfigFiles(g, Find(n, "config"), where + ".config", &seq->config_files);
       !s.ok())
@@ -489,7 +498,9 @@ std::string CellHash(const Cell& c, const Plan& plan) {
       {"config", files},
       {"set", c.overrides},
       {"eval", "se3,rpe1"}};
-  return HashHex(JsonText(identity, -1));
+  nlohmann::json with_map = identity;
+  if (!c.ref_map.empty()) with_map["ref_map"] = FileIdentity(c.ref_map);  // older hashes unchanged
+  return HashHex(JsonText(with_map, -1));
 }
 
 // Checks the keys and values of a cell's configuration now (the sensor file
@@ -528,6 +539,7 @@ void AddCells(const Grid& grid, const Sequence& seq, int data_index, Plan* plan)
         c.bag = seq.bag;
         c.gt = seq.gt;
       }
+      c.ref_map = seq.ref_map;
       c.config_files = grid.config_files;
       if (data_index >= 0) c.config_files.push_back(plan->data[data_index].sensor_config);
       for (const auto* list : {&seq.config_files, &v.config_files})
@@ -594,6 +606,12 @@ std::vector<std::string> Cell::EvalArgs() const {
   return {"eval", "--gt", gt, "--est", RunDir() + "/trajectory.tum", "--json"};
 }
 
+bool Plan::HasRefMap() const {
+  for (const Cell& c : cells)
+    if (!c.ref_map.empty()) return true;
+  return false;
+}
+
 StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir) {
   const GridContext g(grid_path);
   StatusOr<Node> root = config_detail::ParseYamlFile(grid_path);
@@ -657,7 +675,8 @@ nlohmann::json PlanJson(const Plan& plan) {
                      {"data", c.data_index >= 0 ? nlohmann::json(plan.data[c.data_index].id)
                                                 : nlohmann::json(nullptr)},
                      {"run_argv", c.RunArgs()},
-                     {"eval_argv", c.EvalArgs()}});
+                     {"eval_argv", c.EvalArgs()},
+                     {"ref_map", c.ref_map}});
   }
   return {{"grid", plan.grid_path},
           {"out", plan.out_dir},

@@ -7,8 +7,10 @@
 //   config: [files]                 common to all cells (optional)
 //   set: {key: value}               common overrides (optional)
 //   sequences:                      required, non-empty
-//     - {name, bag, gt, config: [files], set: {..}}                 recorded
-//     - {name, simulate: {preset, duration, set: {..}}, seeds: [..]} simulated
+//     - {name, bag, gt, ref_map, config: [files], set: {..}}        recorded
+//     - {name, simulate: {preset, duration, set: {..}}, seeds: [..], ref_map} simulated
+//   ref_map (optional): a reference cloud (PCD/PLY, the ground truth's frame);
+//     each cell's map.pcd is evaluated against it (map_rms, map_completeness)
 //   variants: {name: {key: value, config: [files]}}   (optional; default one "default")
 //   parameters: {key: [values] | {from, to, step}}    cartesian product (optional)
 //   resources: {cpus, mem_mb, runtime}  per Slurm job of the Snakefile (optional;
@@ -52,6 +54,7 @@ struct Cell {
   std::string dir;      // D/cells/<id>
   int data_index = -1;  // into Plan::data for a simulated sequence
   std::string bag, gt;  // gt may be empty (no metrics then)
+  std::string ref_map;  // reference cloud; empty: no map metrics
   std::vector<std::string> config_files;
   std::vector<std::string> overrides;  // "key=value", applied in order
   std::string RunDir() const { return dir + "/run"; }
@@ -75,6 +78,7 @@ struct Plan {
   std::vector<DataItem> data;
   std::vector<Cell> cells;
   JobResources resources;
+  bool HasRefMap() const;  // some cell has a ref_map: the tables get map columns
 };
 
 // Reads and expands the grid. Every error is InvalidInput with one line that

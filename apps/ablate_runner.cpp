@@ -21,6 +21,8 @@
 
 #include "interrupt.h"
 #include "rvlio/eval/evaluate.h"
+#include "rvlio/eval/map_metrics.h"
+#include "rvlio/io/point_cloud_file.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/trajectory_io.h"
 
@@ -270,8 +272,25 @@ std::string Describe(int status, int* exit_code) {
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
-// Metrics from run/summary.json and the evaluation against ground truth.
-// Returns "" or why the cell failed after a successful run.
+// map_rms and map_completeness of run/map.pcd against the cell's reference
+// cloud (as `rvlio eval --map`); "" or why it failed.
+std::string CollectMapMetrics(const Cell& cell, json* metrics) {
+  if (cell.ref_map.empty()) return "";
+  const PointCloudReadOptions xyz_only{false};
+  StatusOr<PointCloudFile> map = ReadPointCloud(cell.RunDir() + "/map.pcd", xyz_only);
+  if (!map.ok()) return "map eval: " + map.status().message();
+  StatusOr<PointCloudFile> ref = ReadPointCloud(cell.ref_map, xyz_only);
+  if (!ref.ok()) return "map eval: " + ref.status().message();
+  StatusOr<MapEvalResult> r = EvaluateMap(map->points, ref->points, MapEvalOptions());
+  if (!r.ok()) return "map eval: " + r.status().message();
+  (*metrics)["map_rms"] = Number(r->accuracy.rmse);
+  (*metrics)["map_completeness"] = Number(r->completeness);
+  return "";
+}
+
+// Metrics from run/summary.json and the evaluation against ground truth
+// (and the reference cloud). Returns "" or why the cell failed after a
+// successful run.
 std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   const json summary = ReadJsonFile(cell.RunDir() + "/summary.json");
   if (!summary.is_object())
@@ -285,6 +304,8 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
       scans > 0 ? summary.value("rv_active_scans", 0.0) / scans : 0.0;
   for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point"})
     (*metrics)[m] = nullptr;
+  if (!cell.ref_map.empty()) (*metrics)["map_rms"] = (*metrics)["map_completeness"] = nullptr;
+  if (std::string error = CollectMapMetrics(cell, metrics); !error.empty()) return error;
   if (cell.gt.empty()) return "";
   StatusOr<Trajectory> gt = ReadTrajectory(cell.gt);
   if (!gt.ok()) return "eval: " + gt.status().message();
@@ -442,11 +463,16 @@ void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& 
 
 }  // namespace
 
-const std::vector<std::string>& MetricNames() {
+const std::vector<std::string>& MetricNames(bool with_map) {
   static const std::vector<std::string> kNames = {
       "ate_rmse",    "rpe_rmse", "axis_rmse",         "axis_max",
       "end_point", "ms_per_scan", "rtf", "rv_active_fraction"};
-  return kNames;
+  static const std::vector<std::string> kWithMap = [] {
+    std::vector<std::string> names = kNames;
+    names.insert(names.end(), {"map_rms", "map_completeness"});
+    return names;
+  }();
+  return with_map ? kWithMap : kNames;
 }
 
 json ReadCellRecord(const Cell& cell) {

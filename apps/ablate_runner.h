@@ -44,7 +44,8 @@ bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& option
 // null when there is none.
 nlohmann::json ReadCellRecord(const Cell& cell);
 
-// The metric fields of cell.json "metrics", in table order.
-const std::vector<std::string>& MetricNames();
+// The metric fields of cell.json "metrics", in table order (with_map: plus
+// map_rms and map_completeness, for grids with a ref_map).
+const std::vector<std::string>& MetricNames(bool with_map = false);
 
 }  // namespace rvlio::cli::ablate

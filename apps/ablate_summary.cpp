@@ -16,8 +16,9 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Metrics of the grouped table and their Markdown headers.
-const std::vector<std::pair<std::string, std::string>>& TableMetrics() {
+// Metrics of the grouped table and their Markdown headers (with_map: the
+// map columns of a grid with a ref_map too).
+const std::vector<std::pair<std::string, std::string>>& TableMetrics(bool with_map) {
   static const std::vector<std::pair<std::string, std::string>> kMetrics = {
       {"ate_rmse", "ATE [m]"},
       {"rpe_rmse", "RPE [m]"},
@@ -27,7 +28,12 @@ const std::vector<std::pair<std::string, std::string>>& TableMetrics() {
       {"ms_per_scan", "ms/scan"},
       {"rtf", "RTF"},
       {"rv_active_fraction", "RV active"}};
-  return kMetrics;
+  static const std::vector<std::pair<std::string, std::string>> kWithMap = [] {
+    auto metrics = kMetrics;
+    metrics.insert(metrics.end(), {{"map_rms", "map RMS [m]"}, {"map_completeness", "completeness"}});
+    return metrics;
+  }();
+  return with_map ? kWithMap : kMetrics;
 }
 
 std::string Csv(const std::string& s) {
@@ -82,7 +88,7 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
   o << "id,sequence,variant,seed";
   for (const auto& k : plan.param_keys) o << "," << Csv(k);
   o << ",status,exit_code";
-  for (const auto& m : MetricNames()) o << "," << m;
+  for (const auto& m : MetricNames(plan.HasRefMap())) o << "," << m;
   o << ",wall_s,error\n";
   for (size_t i = 0; i < plan.cells.size(); ++i) {
     const Cell& c = plan.cells[i];
@@ -94,7 +100,8 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
     o << "," << status << ","
       << (r.is_object() && r["exit_code"].is_number() ? std::to_string(r["exit_code"].get<int>())
                                                       : "");
-    for (const auto& m : MetricNames()) o << "," << Num(r.is_object() ? MetricOf(r, m) : NAN);
+    for (const auto& m : MetricNames(plan.HasRefMap()))
+      o << "," << Num(r.is_object() ? MetricOf(r, m) : NAN);
     o << "," << Num(r.is_object() ? r.value("wall_s", NAN) : NAN) << ","
       << Csv(r.is_object() && r["error"].is_string() ? r["error"].get<std::string>() : "") << "\n";
   }
@@ -120,7 +127,7 @@ std::vector<Group> GroupCells(const Plan& plan, const std::vector<json>& records
     if (status == "diverged") ++g.diverged;
     if (status != "done") continue;
     ++g.done;
-    for (const auto& [m, header] : TableMetrics()) {
+    for (const auto& [m, header] : TableMetrics(plan.HasRefMap())) {
       const double v = MetricOf(r, m);
       if (std::isfinite(v)) g.values[m].push_back(v);
     }
@@ -133,13 +140,14 @@ std::string TableCsv(const Plan& plan, const std::vector<Group>& groups) {
   o << "sequence,variant";
   for (const auto& k : plan.param_keys) o << "," << Csv(k);
   o << ",cells,n,failed,diverged";
-  for (const auto& [m, header] : TableMetrics()) o << "," << m << "_mean," << m << "_std";
+  const bool with_map = plan.HasRefMap();
+  for (const auto& [m, header] : TableMetrics(with_map)) o << "," << m << "_mean," << m << "_std";
   o << "\n";
   for (const Group& g : groups) {
     o << Csv(g.first->sequence) << "," << Csv(g.first->label);
     for (const auto& [k, v] : g.first->params) o << "," << Csv(v);
     o << "," << g.cells << "," << g.done << "," << g.failed << "," << g.diverged;
-    for (const auto& [m, header] : TableMetrics()) {
+    for (const auto& [m, header] : TableMetrics(with_map)) {
       const Stats s = Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>());
       o << "," << Num(s.mean) << "," << Num(s.std);
     }
@@ -158,17 +166,17 @@ std::string MeanStd(const Stats& s, int precision) {
   return buf;
 }
 
-std::string TableMarkdown(const std::vector<Group>& groups) {
+std::string TableMarkdown(const std::vector<Group>& groups, bool with_map) {
   std::ostringstream o;
   o << "| sequence | variant | n | failed | diverged |";
-  for (const auto& [m, header] : TableMetrics()) o << " " << header << " |";
+  for (const auto& [m, header] : TableMetrics(with_map)) o << " " << header << " |";
   o << "\n|---|---|---|---|---|";
-  for (size_t i = 0; i < TableMetrics().size(); ++i) o << "---|";
+  for (size_t i = 0; i < TableMetrics(with_map).size(); ++i) o << "---|";
   o << "\n";
   for (const Group& g : groups) {
     o << "| " << g.first->sequence << " | " << g.first->label << " | " << g.done << " | "
       << g.failed << " | " << g.diverged << " |";
-    for (const auto& [m, header] : TableMetrics()) {
+    for (const auto& [m, header] : TableMetrics(with_map)) {
       const int precision =
           m == "ms_per_scan" || m == "rtf" ? 2 : (m == "rv_active_fraction" ? 2 : 4);
       o << " "
@@ -183,9 +191,11 @@ std::string TableMarkdown(const std::vector<Group>& groups) {
 std::string MakePlots(const Plan& plan, const SummaryResult& result) {
   if (result.done == 0) return "plots skipped: no finished cell";
   const std::string prefix = (fs::path(plan.out_dir) / "plots" / "summary").string();
-  const PlotResult p =
-      RunPlotScript({"ablation", "--table", plan.out_dir + "/table.csv", "--out", prefix,
-                     "--metric", "ate_rmse", "--metric", "axis_max", "--metric", "ms_per_scan"});
+  std::vector<std::string> args = {"ablation", "--table", plan.out_dir + "/table.csv", "--out",
+                                   prefix, "--metric", "ate_rmse", "--metric", "axis_max",
+                                   "--metric", "ms_per_scan"};
+  if (plan.HasRefMap()) args.insert(args.end(), {"--metric", "map_rms"});
+  const PlotResult p = RunPlotScript(args);
   if (!p.ran) return "plots skipped: " + p.message;
   if (!p.ok) return "plots failed: " + p.message;
   return "plots: " + prefix + "_ablation.png, " + prefix + "_ablation.pdf";
@@ -210,7 +220,7 @@ StatusOr<SummaryResult> WriteSummary(const Plan& plan, bool plots) {
       ++result.failed;
   }
   const std::vector<Group> groups = GroupCells(plan, records);
-  result.table_md = TableMarkdown(groups);
+  result.table_md = TableMarkdown(groups, plan.HasRefMap());
   const fs::path out(plan.out_dir);
   for (const auto& [name, text] :
        {std::pair<const char*, std::string>{"summary.csv", SummaryCsv(plan, records)},

@@ -18,6 +18,8 @@ int CmdCompare(int argc, char** argv) {
       "2 on bad input (before any run).",
       {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
        {"gt", "TUM", "ground-truth trajectory (TUM or KITTI, as rvlio eval)", true},
+       {"ref-map", "FILE", "reference cloud (PCD/PLY, the ground truth's frame): adds map accuracy "
+        "and completeness columns (as rvlio eval --map)"},
        ConfigOption(),
        SetOption(),
        {"out", "DIR", "output folder", true},
@@ -31,6 +33,7 @@ int CmdCompare(int argc, char** argv) {
   CompareRequest req;
   req.bag = args.Get("bag");
   req.gt = args.Get("gt");
+  req.ref_map = args.Get("ref-map");
   req.out_dir = args.Get("out");
   req.config_files = args.GetAll("config");
   req.overrides = args.GetAll("set");

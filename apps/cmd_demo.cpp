@@ -1,7 +1,9 @@
 // `rvlio demo`: simulates the default tunnel, then runs `rvlio compare` on it
 // in-process (IESKF and smoother with RV off and on, refine from the best) and
-// prints the table and where the plots are.
+// prints the table and where the plots are; with the simulator's reference
+// map (data/reference_map.pcd) the table has the map columns too.
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,9 @@ int CmdDemo(int argc, char** argv) {
               data_dir.c_str());
   std::fflush(stdout);
   if (int rc = Invoke(CmdSimulate, sim_args); rc != 0) return rc;
+  // The simulator's survey of the world, where it writes one: map columns.
+  const std::string reference = data_dir + "/reference_map.pcd";
+  if (std::filesystem::is_regular_file(reference)) compare.ref_map = reference;
   return RunCompare(compare);
 }
 

@@ -1,11 +1,15 @@
 // rvlio eval: ATE/RPE of an estimated trajectory against ground truth with the
-// definitions of evo (docs/design.md section 8). Argument parsing and output only;
-// EvaluateFiles and EvalJson (rvlio/api.h) do the work.
+// definitions of evo (docs/design.md section 8), or with --map a map against
+// a reference cloud (docs/map_eval.md). Argument parsing and output only;
+// EvaluateFiles / EvaluateMapFiles and EvalJson / MapEvalJson (rvlio/api.h)
+// do the work.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "rvlio/io/summary_json.h"
@@ -22,9 +26,18 @@ CommandSpec EvalSpec() {
       kName,
       "ATE/RPE of an estimated trajectory against ground truth, with the definitions of the evo\n"
       "tool. Trajectories are TUM (t x y z qx qy qz qw) or KITTI (3x4 rows, assumed 10 Hz)\n"
-      "files, detected by their column count. Exit status 2 on bad input.",
-      {{"gt", "FILE", "reference trajectory", true, false},
-       {"est", "FILE", "estimated trajectory", true, false},
+      "files, detected by their column count.\n"
+      "With --map and --ref-map instead: the map's accuracy against a reference cloud (PCD or\n"
+      "PLY, same frame): point-to-plane and nearest-point distances, completeness, Chamfer\n"
+      "distance, outliers and a profile along the reference's principal axis\n"
+      "(docs/map_eval.md). Exit status 2 on bad input.",
+      {{"gt", "FILE", "reference trajectory (trajectory mode)", false, false},
+       {"est", "FILE", "estimated trajectory (trajectory mode)", false, false},
+       {"map", "FILE", "map to judge, PCD or PLY (map mode)", false, false},
+       {"ref-map", "FILE", "reference cloud, PCD or PLY (map mode)", false, false},
+       {"max-distance", "M", "map mode: inlier / completeness threshold D (default 0.1)", false,
+        false},
+       {"profile-step", "M", "map mode: chainage bin of the profile (default 1)", false, false},
        {"align", "MODE", "se3 | sim3 | origin | none (default se3)", false, false},
        {"rpe-delta", "N", "RPE step (default 1)", false, false},
        {"rpe-unit", "UNIT", "frames | meters (default frames)", false, false},
@@ -79,12 +92,81 @@ void PrintTable(const EvalResult& r, const EvalOptions& options) {
               r.along_axis.max_abs_m);
 }
 
+std::string ReadMapOptions(const Args& args, MapEvalOptions* options) {
+  for (auto [flag, field] :
+       {std::pair<const char*, double*>{"max-distance", &options->max_distance},
+        std::pair<const char*, double*>{"profile-step", &options->profile_step}}) {
+    if (!args.Has(flag)) continue;
+    if (!ParseNumber(args.Get(flag), field) || *field <= 0.0)
+      return std::string("--") + flag + " '" + args.Get(flag) + "' is not a positive number";
+  }
+  return "";
+}
+
+void PrintMapRow(const char* label, const ErrorStats& s) {
+  std::printf("%-16s %10.6f %10.6f %10.6f %10.6f %10.6f %10zu\n", label, s.mean, s.rmse, s.median,
+              s.p95, s.max, s.count);
+}
+
+// The summary, then the (at most) five profile bins of largest RMS.
+void PrintMapTable(const MapEvalResult& r, const std::string& map_path,
+                   const std::string& ref_path) {
+  std::printf("map %s (%zu points) vs reference %s (%zu points), D = %g m\n\n", map_path.c_str(),
+              r.map_points, ref_path.c_str(), r.ref_points, r.max_distance_m);
+  std::printf("%-16s %10s %10s %10s %10s %10s %10s\n", "distance [m]", "mean", "rms", "median",
+              "p95", "max", "points");
+  PrintMapRow("point-to-plane", r.accuracy);
+  PrintMapRow("nearest point", r.nearest);
+  std::printf("\ncompleteness      %.4f   (reference points with a map point within D)\n",
+              r.completeness);
+  std::printf("chamfer [m]       %.6f (mean of both directions, distances capped at D)\n",
+              r.chamfer_m);
+  std::printf("outliers          %.4f   (map points with no reference point within D)\n",
+              r.outlier_fraction);
+  std::printf("no plane          %zu      (inliers at reference edges or corners)\n", r.no_plane);
+  std::vector<const MapProfileBin*> worst;
+  for (const MapProfileBin& b : r.profile)
+    if (b.map_with_plane > 0) worst.push_back(&b);
+  std::sort(worst.begin(), worst.end(),
+            [](const MapProfileBin* a, const MapProfileBin* b) { return a->rms_m > b->rms_m; });
+  if (worst.size() > 5) worst.resize(5);
+  std::printf("\nprofile: %zu bins along the reference's principal axis (all in --json); largest "
+              "rms:\n",
+              r.profile.size());
+  std::printf("%12s %10s %10s %10s %12s\n", "chainage [m]", "rms [m]", "p95 [m]", "points",
+              "completeness");
+  for (const MapProfileBin* b : worst)
+    std::printf("%12.1f %10.6f %10.6f %10zu %12.4f\n", b->chainage_m, b->rms_m, b->p95_m,
+                b->map_with_plane, b->completeness);
+}
+
+int EvalMap(const Args& args) {
+  if (args.Has("gt") || args.Has("est"))
+    return Fail(kName, "--map/--ref-map (map mode) cannot be combined with --gt/--est");
+  if (!args.Has("map") || !args.Has("ref-map"))
+    return Fail(kName, "map mode needs both --map FILE and --ref-map FILE");
+  MapEvalOptions options;
+  if (std::string error = ReadMapOptions(args, &options); !error.empty()) return Fail(kName, error);
+  StatusOr<MapEvalResult> r = EvaluateMapFiles(args.Get("map"), args.Get("ref-map"), options);
+  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  if (args.Has("json"))
+    std::cout << JsonText(MapEvalJson(*r), -1) << "\n";
+  else
+    PrintMapTable(*r, args.Get("map"), args.Get("ref-map"));
+  return 0;
+}
+
 }  // namespace
 
 int CmdEval(int argc, char** argv) {
   const CommandSpec spec = EvalSpec();
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  if (args.Has("map") || args.Has("ref-map")) return EvalMap(args);
+  for (const char* required : {"gt", "est"})  // trajectory mode
+    if (!args.Has(required))
+      return Fail(kName, std::string("missing required option --") + required +
+                             " (or --map FILE --ref-map FILE for a map)");
   EvalOptions options;
   if (std::string error = ReadOptions(args, &options); !error.empty()) return Fail(kName, error);
 

@@ -24,9 +24,12 @@
 #include "plot_runner.h"
 #include "run_pipeline.h"
 #include "window_options.h"
+#include "rvlio/api.h"
 #include "rvlio/eval/evaluate.h"
+#include "rvlio/eval/map_metrics.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
+#include "rvlio/io/point_cloud_file.h"
 #include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/trajectory_io.h"
 
@@ -58,6 +61,7 @@ struct Row {
   int exit_code = 0;
   std::string error;
   std::optional<EvalResult> eval;
+  std::optional<MapEvalResult> map_eval;  // with --ref-map: the run's map.pcd against it
   int scans = 0;
   double ms_per_scan = kNaN;       // run: median CPU ms; refine: wall ms per scan (batch)
   double real_time_factor = kNaN;  // sequence duration / compute time
@@ -152,11 +156,17 @@ nlohmann::json Num(double v) {
   return std::strtod(Exact(v).c_str(), nullptr);
 }
 
+// What every row is evaluated against.
+struct Truth {
+  Trajectory trajectory;
+  std::vector<Eigen::Vector3d> ref_map;  // empty without --ref-map
+};
+
 // ---------------------------------------------------------------------------
 // Input checks: everything that would make every run fail, before any run.
 // ---------------------------------------------------------------------------
 
-int CheckInputs(const CompareRequest& req, Trajectory* truth) {
+int CheckInputs(const CompareRequest& req, Truth* truth) {
   StatusOr<OdometryOptions> options = LoadConfig(req.config_files, req.overrides);
   if (!options.ok()) return Fail(kName, options.status().message());
   for (const Variant& v : StandardVariants()) {
@@ -170,7 +180,12 @@ int CheckInputs(const CompareRequest& req, Trajectory* truth) {
   if (gt->size() < 3)
     return Fail(kName, "--gt: " + req.gt + " has " + std::to_string(gt->size()) +
                            " poses; at least 3 are needed to align and evaluate");
-  *truth = std::move(*gt);
+  truth->trajectory = std::move(*gt);
+  if (!req.ref_map.empty()) {
+    StatusOr<PointCloudFile> ref = ReadPointCloud(req.ref_map, PointCloudReadOptions{false});
+    if (!ref.ok()) return Fail(kName, "--ref-map: " + ref.status().message());
+    truth->ref_map = std::move(ref->points);
+  }
   ReaderOptions inline_io = options->io;
   inline_io.reader_thread = false;  // only the checks at open: read nothing ahead
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
@@ -183,9 +198,26 @@ int CheckInputs(const CompareRequest& req, Trajectory* truth) {
 // Runs
 // ---------------------------------------------------------------------------
 
-void EvaluateRow(const Trajectory& truth, const std::string& dir, Row* row) {
+// The run's map.pcd against the reference cloud, as `rvlio eval --map`; a
+// failure is a warning and leaves the row's map columns empty.
+void EvaluateRowMap(const Truth& truth, const std::string& dir, Row* row) {
+  if (truth.ref_map.empty()) return;
+  const std::string map_path = dir + "/map.pcd";
+  StatusOr<PointCloudFile> map = ReadPointCloud(map_path, PointCloudReadOptions{false});
+  StatusOr<MapEvalResult> m = map.ok() ? EvaluateMap(map->points, truth.ref_map, MapEvalOptions())
+                                       : StatusOr<MapEvalResult>(map.status());
+  if (!m.ok()) {
+    std::fprintf(stderr, "rvlio %s: warning: %s: map evaluation: %s\n", kName, row->name.c_str(),
+                 m.status().message().c_str());
+    return;
+  }
+  row->map_eval = std::move(*m);
+}
+
+void EvaluateRow(const Truth& truth, const std::string& dir, Row* row) {
+  EvaluateRowMap(truth, dir, row);
   StatusOr<Trajectory> est = ReadTum(dir + "/trajectory.tum");
-  StatusOr<EvalResult> e = est.ok() ? Evaluate(truth, *est, EvalOptions())
+  StatusOr<EvalResult> e = est.ok() ? Evaluate(truth.trajectory, *est, EvalOptions())
                                     : StatusOr<EvalResult>(est.status());
   if (!e.ok()) {
     row->exit_code = e.status().exit_code();
@@ -205,10 +237,16 @@ std::string ResultLine(const Row& row) {
   char buf[160];
   std::snprintf(buf, sizeof(buf), "ATE %.4f m, %d scans, %.1f s%s", row.eval->ape_m.rmse,
                 row.scans, row.wall_s, row.diverged ? ", DIVERGED (summary.json divergence)" : "");
-  return buf;
+  std::string line = buf;
+  if (row.map_eval) {
+    std::snprintf(buf, sizeof(buf), "; map RMS %.4f m, completeness %.3f",
+                  row.map_eval->accuracy.rmse, row.map_eval->completeness);
+    line += buf;
+  }
+  return line;
 }
 
-Row RunVariant(const CompareRequest& req, const Variant& v, const Trajectory& truth, Steps* steps) {
+Row RunVariant(const CompareRequest& req, const Variant& v, const Truth& truth, Steps* steps) {
   steps->Say("rvlio run " + v.name + ": " + v.label);
   Row row;
   row.name = v.name;
@@ -259,7 +297,7 @@ void ReadRefineTiming(const std::string& dir, Row* row) {
   row->diverged = j.value(nlohmann::json::json_pointer("/divergence/detected"), false);
 }
 
-Row RunRefine(const CompareRequest& req, const Row& start, const Trajectory& truth, Steps* steps) {
+Row RunRefine(const CompareRequest& req, const Row& start, const Truth& truth, Steps* steps) {
   const std::string dir = req.out_dir + "/" + kRefine;
   steps->Say("rvlio refine from " + start.name + " (log: " + dir + "/refine.log)");
   Row row;
@@ -304,9 +342,17 @@ std::string CsvField(const std::string& text) {
   return quoted + "\"";
 }
 
-std::string CsvText(const std::vector<Row>& rows) {
+// The map columns (with --ref-map): accuracy RMS and completeness, or empty.
+std::string MapCsvFields(const Row& r) {
+  if (!r.map_eval) return ",,";
+  return "," + Exact(r.map_eval->accuracy.rmse) + "," + Exact(r.map_eval->completeness);
+}
+
+std::string CsvText(const std::vector<Row>& rows, bool with_map) {
   std::ostringstream os;
-  os << kCsvHeader;
+  std::string header = kCsvHeader;
+  if (with_map) header.insert(header.size() - 1, ",map_rms_m,map_completeness");
+  os << header;
   for (const Row& r : rows) {
     os << r.name << "," << CsvField(r.label) << "," << r.StatusName() << ","
        << r.exit_code << "," << r.init << "," << r.scans;
@@ -317,6 +363,7 @@ std::string CsvText(const std::vector<Row>& rows) {
     } else {
       os << ",,,,,,";
     }
+    if (with_map) os << (r.measured() ? MapCsvFields(r) : ",,");
     os << "\n";
   }
   return os.str();
@@ -330,8 +377,11 @@ std::string AlignName(const std::vector<Row>& rows) {
 
 std::string MarkdownText(const CompareRequest& req, const std::vector<Row>& rows) {
   std::ostringstream os;
+  const bool with_map = !req.ref_map.empty();
   os << "| variant | ATE [m] | RPE [m] | along-axis max [m] | end-point [m] | ms/scan | "
-        "real-time factor |\n|---|---|---|---|---|---|---|\n";
+        "real-time factor |"
+     << (with_map ? " map RMS [m] | completeness |" : "") << "\n|---|---|---|---|---|---|---|"
+     << (with_map ? "---|---|" : "") << "\n";
   for (const Row& r : rows) {
     os << "| " << r.label << (r.diverged ? " (**diverged**)" : "") << " | ";
     if (r.interrupted) {
@@ -345,20 +395,30 @@ std::string MarkdownText(const CompareRequest& req, const std::vector<Row>& rows
     os << Fixed(r.eval->ape_m.rmse, 4) << " | " << Fixed(r.eval->rpe.trans_m.rmse, 4) << " | "
        << Fixed(r.eval->along_axis.max_abs_m, 4) << " | " << Fixed(r.eval->end_point_error_m, 4)
        << " | " << Fixed(r.ms_per_scan, 2) << (r.name == kRefine ? " (wall)" : "") << " | "
-       << Fixed(r.real_time_factor, 1) << "x |\n";
+       << Fixed(r.real_time_factor, 1) << "x |";
+    if (with_map)
+      os << " " << (r.map_eval ? Fixed(r.map_eval->accuracy.rmse, 4) : "-") << " | "
+         << (r.map_eval ? Fixed(r.map_eval->completeness, 3) : "-") << " |";
+    os << "\n";
   }
   os << "\nBag `" << req.bag << "`, ground truth `" << req.gt << "`. ATE: translation RMSE after "
      << AlignName(rows)
      << " alignment; RPE: 1-frame translation RMSE; along-axis max: largest error along the "
         "principal axis of the ground truth; end-point: error of the last pose. ms/scan: median "
         "CPU time per scan of the odometry (refine: wall time of the batch solve divided by the "
-        "scans); real-time factor: sequence duration / that time.\n";
+        "scans); real-time factor: sequence duration / that time.";
+  if (with_map)
+    os << " Map RMS: point-to-plane RMS distance of the run's map.pcd to the reference cloud `"
+       << req.ref_map << "` over the map points within 0.1 m of it; completeness: the fraction "
+       << "of reference points with a map point within 0.1 m (`rvlio eval --map`).";
+  os << "\n";
   return os.str();
 }
 
-void PrintTable(const std::vector<Row>& rows) {
-  std::printf("\n  %-30s %9s %9s %12s %9s %9s %8s\n", "variant", "ATE [m]", "RPE [m]",
-              "axis max [m]", "end [m]", "ms/scan", "speed");
+void PrintTable(const std::vector<Row>& rows, bool with_map) {
+  std::printf("\n  %-30s %9s %9s %12s %9s %9s %8s%s\n", "variant", "ATE [m]", "RPE [m]",
+              "axis max [m]", "end [m]", "ms/scan", "speed",
+              with_map ? "  map RMS [m]  complete" : "");
   for (const Row& r : rows) {
     if (r.interrupted) {
       std::printf("  %-30s interrupted\n", r.label.c_str());
@@ -368,15 +428,28 @@ void PrintTable(const std::vector<Row>& rows) {
       std::printf("  %-30s failed (exit %d)\n", r.label.c_str(), r.exit_code);
       continue;
     }
-    std::printf("  %-30s %9.4f %9.4f %12.4f %9.4f %9.2f %7.1fx%s\n", r.label.c_str(),
+    std::string map_cols;
+    if (with_map) {
+      char buf[64];
+      if (r.map_eval)
+        std::snprintf(buf, sizeof(buf), "  %11.4f  %8.3f", r.map_eval->accuracy.rmse,
+                      r.map_eval->completeness);
+      else
+        std::snprintf(buf, sizeof(buf), "  %11s  %8s", "-", "-");
+      map_cols = buf;
+    }
+    std::printf("  %-30s %9.4f %9.4f %12.4f %9.4f %9.2f %7.1fx%s%s\n", r.label.c_str(),
                 r.eval->ape_m.rmse, r.eval->rpe.trans_m.rmse, r.eval->along_axis.max_abs_m,
-                r.eval->end_point_error_m, r.ms_per_scan, r.real_time_factor,
+                r.eval->end_point_error_m, r.ms_per_scan, r.real_time_factor, map_cols.c_str(),
                 r.diverged ? "  DIVERGED" : "");
   }
   std::printf("\n  ATE: RMSE after %s alignment; RPE: 1-frame translation RMSE; axis max: largest\n"
               "  error along the tunnel axis; end: end-point error. ms/scan: median CPU time per\n"
               "  scan (refine: wall time of the batch solve per scan); speed: real-time factor.\n",
               AlignName(rows).c_str());
+  if (with_map)
+    std::printf("  map RMS: point-to-plane RMS of map.pcd to the reference cloud (points within\n"
+                "  0.1 m); complete: reference points with a map point within 0.1 m.\n");
 }
 
 nlohmann::json StatsJson(const ErrorStats& s) {
@@ -406,6 +479,11 @@ nlohmann::json RowJson(const CompareRequest& req, const Row& r,
   j["ms_per_scan"] = Num(r.ms_per_scan);
   j["ms_per_scan_kind"] = r.name == kRefine ? "wall, batch solve / scans" : "CPU, median";
   j["real_time_factor"] = Num(r.real_time_factor);
+  if (r.map_eval) {
+    j["map_rms_m"] = Num(r.map_eval->accuracy.rmse);
+    j["map_completeness"] = Num(r.map_eval->completeness);
+    j["map_eval"] = MapEvalJson(*r.map_eval);
+  }
   j["eval"] = {{"matched", e.matched},
                {"align", AlignModeName(e.align)},
                {"ape", StatsJson(e.ape_m)},
@@ -447,8 +525,13 @@ PlotReport DrawPlots(const CompareRequest& req, const std::vector<Row>& rows) {
   if (FindRow(rows, "ieskf_rv_on"))
     jobs.push_back({"rv_profile", {"rv-profile", "--run", req.out_dir + "/ieskf_rv_on", "--gt",
                                    req.gt, "--out", dir}});
-  jobs.push_back({"compare_bars", {"compare-bars", "--table", req.out_dir + "/compare.csv",
-                                   "--out", dir}});
+  std::vector<std::string> bars = {"compare-bars", "--table", req.out_dir + "/compare.csv",
+                                   "--out", dir};
+  if (!req.ref_map.empty())
+    for (const char* metric : {"ate_rmse_m", "rpe_rmse_m", "axis_max_m", "map_rms_m",
+                               "map_completeness"})
+      bars.insert(bars.end(), {"--metric", metric});
+  jobs.push_back({"compare_bars", bars});
   std::vector<std::string> failures;
   for (const auto& [kind, args] : jobs) {
     const PlotResult p = RunPlotScript(args);
@@ -490,6 +573,7 @@ Status WriteJson(const CompareRequest& req, const std::vector<Row>& rows,
   j["command"] = kName;
   j["bag"] = req.bag;
   j["gt"] = req.gt;
+  if (!req.ref_map.empty()) j["ref_map"] = req.ref_map;
   j["config"] = req.config_files;
   j["set"] = req.overrides;
   j["align"] = AlignName(rows);
@@ -537,7 +621,7 @@ int CompareSteps(const CompareRequest& request) {
 
 int RunCompare(const CompareRequest& req) {
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop the running variant, tabulate, 130/143
-  Trajectory truth;
+  Truth truth;
   if (int rc = CheckInputs(req, &truth); rc != 0) return rc;
   Steps steps(req);
   std::vector<Row> rows;
@@ -550,12 +634,14 @@ int RunCompare(const CompareRequest& req) {
     rows.push_back(RunRefine(req, start, truth, &steps));
   }
   const bool any_ok = BestRow(rows) != nullptr;
-  for (const auto& [file, text] : {std::pair<std::string, std::string>{"compare.csv", CsvText(rows)},
-                                   {"compare.md", MarkdownText(req, rows)}}) {
+  const bool with_map = !req.ref_map.empty();
+  for (const auto& [file, text] :
+       {std::pair<std::string, std::string>{"compare.csv", CsvText(rows, with_map)},
+        {"compare.md", MarkdownText(req, rows)}}) {
     if (Status s = WriteFileAtomically(req.out_dir + "/" + file, text); !s.ok())
       return Fail(kName, s.message(), 1);
   }
-  PrintTable(rows);
+  PrintTable(rows, with_map);
   PlotReport plots;
   if (Interrupted()) return ReportInterrupt(req, rows);
   if (req.plots && any_ok) plots = DrawPlots(req, rows);

@@ -13,6 +13,7 @@ namespace rvlio::cli {
 struct CompareRequest {
   std::string bag;
   std::string gt;       // ground-truth trajectory (TUM or KITTI, as `rvlio eval`)
+  std::string ref_map;  // reference cloud (PCD/PLY): map columns when set (docs/map_eval.md)
   std::string out_dir;  // OUT/<variant>/ for each run
   std::vector<std::string> config_files;
   std::vector<std::string> overrides;  // --set key=value, before each variant's own

@@ -19,9 +19,10 @@ packages=(
 # the libFuzzer/ASan runtimes and llvm-symbolizer for scripts/fuzz.sh — gcc's
 # ASan/UBSan runtimes for scripts/sanitize.sh come with build-essential; a
 # Slurm controller, node daemon, client and munge for scripts/slurm_local.sh;
-# GNU time for the peak memory of scripts/refine_scaling.sh).
+# GNU time for the peak memory of scripts/refine_scaling.sh; scipy for the
+# independent check of the map metrics in python/tests/test_evaluate_map.py).
 if [[ "${1:-}" == "--with-test-tools" ]]; then
-  packages+=(python3-pytest snakemake clang-14 libclang-rt-14-dev llvm-14 munge slurmctld slurmd slurm-client)
+  packages+=(python3-pytest python3-scipy snakemake clang-14 libclang-rt-14-dev llvm-14 munge slurmctld slurmd slurm-client)
   packages+=(time)
 fi
 

@@ -708,7 +708,9 @@ COMPARE_TITLES = {"ate_rmse_m": ("ATE (RMSE)", "ATE [m]"),
                   "axis_max_m": ("largest error along the tunnel axis", "along-axis max [m]"),
                   "end_point_m": ("end-point error", "end-point [m]"),
                   "ms_per_scan": ("time per scan", "ms/scan"),
-                  "real_time_factor": ("real-time factor", "real-time factor [x]")}
+                  "real_time_factor": ("real-time factor", "real-time factor [x]"),
+                  "map_rms_m": ("map accuracy (point-to-plane RMS)", "map RMS [m]"),
+                  "map_completeness": ("map completeness", "completeness")}
 
 
 def ReadCompareTable(path, metrics):

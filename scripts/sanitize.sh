@@ -50,6 +50,8 @@ ex=(
   SmootherCliTest.AnImuGapInsideTheWindowIsBridged
   CompareTest.FullCompareWritesTablesEqualToEvalAndPlots
   CompareTest.EveryVariantFailedIsExitOne
+  CompareTest.RefMapAddsMapColumnsEqualToEvalMap
+  MapAccuracyTest.RefineMapIsMoreAccurateThanTheIeskfMapItStartedFrom
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData

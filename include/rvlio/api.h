@@ -26,6 +26,7 @@
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
 #include "rvlio/eval/evaluate.h"
+#include "rvlio/eval/map_metrics.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/sensor_stream.h"
 #include "rvlio/odometry/divergence.h"
@@ -195,5 +196,22 @@ StatusOr<EvalResult> EvaluateFiles(const std::string& gt_path, const std::string
 // `rvlio eval --json`: matched, align, scale, ape, ape_rot_deg, rpe,
 // rpe_rot_deg, end_point_error, along_axis, warnings (10 significant digits).
 nlohmann::json EvalJson(const EvalResult& result);
+
+// ---------------------------------------------------------------------------
+// eval --map: a map against a reference cloud (eval/map_metrics.h)
+// ---------------------------------------------------------------------------
+
+// Reads both clouds (PCD or PLY, io/point_cloud_file.h) and evaluates the
+// map against the reference. InvalidInput, one line naming the file(s), for
+// an unreadable, empty, truncated or NaN cloud, or clouds that do not
+// overlap. Reads only.
+StatusOr<MapEvalResult> EvaluateMapFiles(const std::string& map_path, const std::string& ref_path,
+                                         const MapEvalOptions& options);
+// `rvlio eval --map --json`: map_points, ref_points, max_distance, inliers,
+// no_plane, outlier_fraction, accuracy and nearest {count, mean, rms, median,
+// p95, max}, completeness, chamfer, chamfer_definition, axis {origin,
+// direction}, profile [{chainage, map_points, map_with_plane, rms, median,
+// p95, ref_points, completeness}] (10 significant digits; null for NaN).
+nlohmann::json MapEvalJson(const MapEvalResult& result);
 
 }  // namespace rvlio

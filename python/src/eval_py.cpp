@@ -1,5 +1,6 @@
 // rvlio.evaluate: the evaluation of `rvlio eval` (eval/evaluate.h), evo's
-// definitions of APE and RPE.
+// definitions of APE and RPE; rvlio.evaluate_map: `rvlio eval --map`
+// (eval/map_metrics.h).
 #include "eval_py.h"
 
 #include <pybind11/eigen.h>
@@ -8,6 +9,8 @@
 #include <cmath>
 
 #include "rvlio/eval/evaluate.h"
+#include "rvlio/eval/map_metrics.h"
+#include "rvlio/io/point_cloud_file.h"
 #include "rvlio/io/trajectory_io.h"
 
 namespace rvlio::python {
@@ -76,9 +79,110 @@ py::dict ResultDict(const EvalResult& r) {
   return d;
 }
 
+// A PCD/PLY path or an (N, 3) array of x y z (m).
+std::vector<Eigen::Vector3d> CloudArg(const py::handle& value, const char* what) {
+  if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")) {
+    const std::string path = PathText(value);
+    RequireExisting(path, std::string(what) + " point cloud");
+    return Take(ReadPointCloud(path, PointCloudReadOptions{false})).points;
+  }
+  const auto a = py::array_t<double, py::array::forcecast>::ensure(value);
+  if (!a || a.ndim() != 2 || a.shape(1) != 3)
+    ValueError(std::string(what) + " must be a PCD/PLY file path or an (N, 3) array [x, y, z]");
+  const auto r = a.unchecked<2>();
+  std::vector<Eigen::Vector3d> points(static_cast<size_t>(r.shape(0)));
+  for (py::ssize_t i = 0; i < r.shape(0); ++i) points[i] = {r(i, 0), r(i, 1), r(i, 2)};
+  return points;
+}
+
+py::dict DistanceDict(const ErrorStats& s) {
+  py::dict d;
+  d["count"] = s.count;
+  d["mean"] = s.mean;
+  d["rms"] = s.rmse;
+  d["median"] = s.median;
+  d["p95"] = s.p95;
+  d["max"] = s.max;
+  return d;
+}
+
+// The keys of `rvlio eval --map --json`, unrounded; the profile as columns
+// (numpy arrays) instead of a list of rows.
+py::dict MapResultDict(const MapEvalResult& r) {
+  py::dict d;
+  d["map_points"] = r.map_points;
+  d["ref_points"] = r.ref_points;
+  d["max_distance"] = r.max_distance_m;
+  d["inliers"] = r.inliers;
+  d["no_plane"] = r.no_plane;
+  d["outlier_fraction"] = r.outlier_fraction;
+  d["accuracy"] = DistanceDict(r.accuracy);
+  d["nearest"] = DistanceDict(r.nearest);
+  d["completeness"] = r.completeness;
+  d["chamfer"] = r.chamfer_m;
+  py::dict axis;
+  axis["origin"] = py::cast(r.axis_origin);
+  axis["direction"] = py::cast(r.axis_direction);
+  d["axis"] = axis;
+  const size_t n = r.profile.size();
+  py::array_t<double> chainage(n), rms(n), median(n), p95(n), completeness(n);
+  py::array_t<int64_t> map_points(n), map_with_plane(n), ref_points(n);
+  for (size_t i = 0; i < n; ++i) {
+    const MapProfileBin& b = r.profile[i];
+    chainage.mutable_at(i) = b.chainage_m;
+    rms.mutable_at(i) = b.rms_m;
+    median.mutable_at(i) = b.median_m;
+    p95.mutable_at(i) = b.p95_m;
+    completeness.mutable_at(i) = b.completeness;
+    map_points.mutable_at(i) = static_cast<int64_t>(b.map_points);
+    map_with_plane.mutable_at(i) = static_cast<int64_t>(b.map_with_plane);
+    ref_points.mutable_at(i) = static_cast<int64_t>(b.ref_points);
+  }
+  py::dict profile;
+  profile["chainage"] = chainage;
+  profile["map_points"] = map_points;
+  profile["map_with_plane"] = map_with_plane;
+  profile["rms"] = rms;
+  profile["median"] = median;
+  profile["p95"] = p95;
+  profile["ref_points"] = ref_points;
+  profile["completeness"] = completeness;
+  d["profile"] = profile;
+  return d;
+}
+
 }  // namespace
 
 void BindEval(py::module_& m) {
+  m.def(
+      "evaluate_map",
+      [](const py::handle& map, const py::handle& ref, double max_distance, double profile_step,
+         int num_neighbors, double search_radius, int threads) {
+        MapEvalOptions options;
+        options.max_distance = max_distance;
+        options.profile_step = profile_step;
+        options.surface.num_neighbors = num_neighbors;
+        options.surface.search_radius = search_radius;
+        options.threads = threads;
+        Check(options.Validate());
+        const std::vector<Eigen::Vector3d> map_points = CloudArg(map, "map");
+        const std::vector<Eigen::Vector3d> ref_points = CloudArg(ref, "ref");
+        StatusOr<MapEvalResult> result = Status::Internal("not evaluated");
+        {
+          py::gil_scoped_release release;
+          result = EvaluateMap(map_points, ref_points, options);
+        }
+        return MapResultDict(Take(std::move(result)));
+      },
+      py::arg("map"), py::arg("ref"), py::kw_only(), py::arg("max_distance") = 0.1,
+      py::arg("profile_step") = 1.0, py::arg("num_neighbors") = 8, py::arg("search_radius") = 0.5,
+      py::arg("threads") = 1,
+      "Accuracy of a map against a reference cloud (`rvlio eval --map --json`, unrounded; "
+      "docs/map_eval.md). map/ref: PCD or PLY paths or (N, 3) arrays [x, y, z] in metres, one "
+      "frame. Points are searched in single precision. Returns a dict: accuracy and nearest "
+      "{count, mean, rms, median, p95, max} (m), completeness, chamfer, outlier_fraction, "
+      "inliers, no_plane, axis and profile (columns as arrays).");
+
   m.def(
       "evaluate",
       [](const py::handle& gt, const py::handle& est, const std::string& align, double max_dt,

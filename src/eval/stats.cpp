@@ -16,6 +16,18 @@ double Median(std::vector<double> v) {
   return 0.5 * (lower + upper);
 }
 
+// numpy.percentile(v, 100 q) with linear interpolation between the two
+// order statistics around q (n - 1).
+double Percentile(std::vector<double> v, double q) {
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  std::nth_element(v.begin(), v.begin() + lo, v.end());
+  const double a = v[lo];
+  if (lo + 1 >= v.size()) return a;
+  const double b = *std::min_element(v.begin() + lo + 1, v.end());
+  return a + (pos - static_cast<double>(lo)) * (b - a);
+}
+
 }  // namespace
 
 ErrorStats ComputeStats(const std::vector<double>& errors) {
@@ -37,6 +49,7 @@ ErrorStats ComputeStats(const std::vector<double>& errors) {
   s.min = *lo;
   s.max = *hi;
   s.median = Median(errors);
+  s.p95 = Percentile(errors, 0.95);
   return s;
 }
 

@@ -12,6 +12,7 @@
 
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/extrinsic_json.h"
+#include "rvlio/io/point_cloud_file.h"
 
 namespace rvlio {
 namespace {
@@ -72,53 +73,13 @@ Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& 
   return writer.Commit();
 }
 
-namespace {
-
-// The header of a map.pcd up to "DATA binary": the point count, or -1 when
-// the fields are not x y z float32.
-int64_t ParseMapPcdHeader(std::istream& in) {
-  std::string line;
-  int64_t points = -1;
-  bool xyz = false, floats = false, sizes = false;
-  while (std::getline(in, line)) {
-    std::istringstream fields(line);
-    std::string key, rest;
-    fields >> key;
-    if (key == "POINTS") {
-      if (!(fields >> points) || points < 0) return -1;
-      continue;
-    }
-    std::getline(fields, rest);
-    if (key == "FIELDS") xyz = rest == " x y z";
-    if (key == "SIZE") sizes = rest == " 4 4 4";
-    if (key == "TYPE") floats = rest == " F F F";
-    if (key == "DATA") return rest == " binary" && xyz && sizes && floats ? points : -1;
-  }
-  return -1;
-}
-
-}  // namespace
-
 StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::InvalidInput(path + ": cannot open");
-  const int64_t n = ParseMapPcdHeader(in);
-  if (n < 0)
-    return Status::InvalidInput(path + ": not a binary x y z float32 PCD as rvlio writes them");
-  float xyz[3];
-  const std::streamoff data_begin = in.tellg();
-  in.seekg(0, std::ios::end);
-  const std::streamoff bytes = in.tellg() - data_begin;
-  in.seekg(data_begin);
-  if (bytes / static_cast<std::streamoff>(sizeof(xyz)) < n)
-    return Status::InvalidInput(path + ": holds " + std::to_string(bytes / sizeof(xyz)) +
-                                " of its " + std::to_string(n) + " points");
-  std::vector<Eigen::Vector3d> p_world(static_cast<size_t>(n));
-  for (int64_t i = 0; i < n; ++i) {
-    in.read(reinterpret_cast<char*>(xyz), sizeof(xyz));
-    p_world[i] = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
-  }
-  return p_world;
+  PointCloudReadOptions options;
+  options.keep_fields = false;
+  options.allow_empty = true;  // a run over too few scans writes an empty map
+  StatusOr<PointCloudFile> cloud = ReadPointCloud(path, options);
+  if (!cloud.ok()) return cloud.status();
+  return std::move(cloud->points);
 }
 
 namespace {

@@ -269,7 +269,7 @@ bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
     const Slot& s = slots_[slot];
     if (s.count >= max_points_) return false;
     const float* x = pool_.data() + s.offset;
-    for (int i = 0; i < s.count; ++i) {
+    for (int i = 0; min_d2_ > 0.0f && i < s.count; ++i) {  // no test when every point is kept
       const float dx = x[i] - px, dy = x[i + s.capacity] - py, dz = x[i + 2 * s.capacity] - pz;
       if (dx * dx + dy * dy + dz * dz < min_d2_) return false;
     }

@@ -197,6 +197,26 @@ TEST_F(AblatePlanTest, PlanIsStableAndTheHashFollowsTheConfiguration) {
   EXPECT_NE(edited["cells"][0]["hash"], before["cells"][0]["hash"]);
 }
 
+// A sequence's ref_map reaches its cells (and only its cells' hashes).
+TEST_F(AblatePlanTest, RefMapReachesTheCellsOfItsSequence) {
+  WriteText(dir_ + "/ref.pcd", "not read at plan time");
+  const json before = PlanJson(Grid(kGrid));
+  std::string with = kGrid;
+  with.replace(with.find("    gt: rec_gt.tum\n"), 19, "    gt: rec_gt.tum\n    ref_map: ref.pcd\n");
+  const json after = PlanJson(Grid(with, "m.yaml"));
+  ASSERT_EQ(after["cells"].size(), before["cells"].size());
+  for (size_t i = 0; i < after["cells"].size(); ++i) {
+    const bool rec = after["cells"][i]["sequence"] == "rec";
+    EXPECT_EQ(after["cells"][i]["ref_map"], rec ? dir_ + "/ref.pcd" : "") << i;
+    EXPECT_EQ(after["cells"][i]["hash"] != before["cells"][i]["hash"], rec) << i;
+  }
+  std::string missing = kGrid;
+  missing.replace(missing.find("    gt: rec_gt.tum\n"), 19, "    gt: rec_gt.tum\n    ref_map: no.pcd\n");
+  const ToolRun r = Plan(Grid(missing, "bad.yaml"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("sequences[1].ref_map: file not found"), std::string::npos) << r.err;
+}
+
 // The grid's `resources:` block reaches the plan (the Snakefile's Slurm jobs)
 // and does not change any cell: it is not part of the configuration hash.
 TEST_F(AblatePlanTest, ResourcesReachThePlanWithoutChangingTheCells) {

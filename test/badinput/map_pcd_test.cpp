@@ -1,6 +1,6 @@
 // ReadMapPcd (io/run_outputs.h), which `rvlio merge` uses on the chunks'
-// maps: reads back what WriteMapPcd wrote, and refuses other, truncated or
-// lying files with InvalidInput naming the file instead of crashing or
+// maps: reads back what WriteMapPcd wrote, and refuses truncated, lying or
+// foreign files with InvalidInput naming the file instead of crashing or
 // allocating what the header claims.
 #include <filesystem>
 #include <fstream>
@@ -51,7 +51,8 @@ TEST_F(MapPcdTest, OtherTruncatedOrLyingFilesAreInvalidInput) {
   };
   std::string lying = header;
   lying.replace(lying.find("POINTS 2"), 8, "POINTS 999999999999");
-  const std::string ascii = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2 3\n";
+  // An ASCII header that claims more points than its bytes can hold.
+  const std::string ascii = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 99999999999\nDATA ascii\n1 2 3\n";
   for (const std::string& path :
        {write("truncated.pcd", bytes.substr(0, bytes.size() - 5)), write("lying.pcd", lying),
         write("ascii.pcd", ascii), write("garbage.pcd", "not a pcd"), Path("missing.pcd")}) {

@@ -313,6 +313,44 @@ TEST_F(CompareTest, FailedVariantIsRecordedAndTheRestGoOn) {
   EXPECT_FALSE(fs::exists(out + "/refine"));
 }
 
+// --ref-map: map columns equal to `rvlio eval --map` on the row's map.pcd.
+// The reference is an earlier run's map of the same tunnel (any cloud in the
+// ground truth's frame will do); three variants are blocked to keep it short.
+TEST_F(CompareTest, RefMapAddsMapColumnsEqualToEvalMap) {
+  const std::string ref = dir_ + "/ref_run";
+  const ToolRun run = RunTool("run --bag " + Bag() + " --config " + dir_ +
+                                  "/data/tunnel.yaml --set backend=smoother --out " + ref +
+                                  " --quiet",
+                              dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string out = dir_ + "/with_map";
+  fs::create_directories(out);
+  for (const char* v : {"ieskf_rv_on", "smoother_rv_off", "smoother_rv_on"})
+    std::ofstream(out + "/" + v) << "in the way\n";
+  const ToolRun r =
+      RunTool(CompareArgs(out, "--no-refine --no-plots --ref-map " + ref + "/map.pcd"), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::string> header;
+  const std::vector<CsvRow> rows = ReadCsv(out + "/compare.csv", &header);
+  ASSERT_EQ(rows.size(), 4u);
+  const ToolRun eval = RunTool("eval --map " + out + "/ieskf_rv_off/map.pcd --ref-map " + ref +
+                                   "/map.pcd --json",
+                               dir_);
+  ASSERT_EQ(eval.exit_code, 0) << eval.err;
+  const nlohmann::json e = nlohmann::json::parse(eval.out);
+  EXPECT_NEAR(Number(rows[0], "map_rms_m"), e["accuracy"]["rms"].get<double>(), 1e-9);
+  EXPECT_NEAR(Number(rows[0], "map_completeness"), e["completeness"].get<double>(), 1e-9);
+  EXPECT_LT(Number(rows[0], "map_rms_m"), 0.05);  // two maps of one tunnel
+  EXPECT_GT(Number(rows[0], "map_completeness"), 0.5);
+  EXPECT_TRUE(std::isnan(Number(rows[1], "map_rms_m")));  // failed row: empty
+  const nlohmann::json j = nlohmann::json::parse(ReadFile(out + "/compare.json"));
+  EXPECT_EQ(j["ref_map"], ref + "/map.pcd");
+  EXPECT_NEAR(j["variants"][0]["map_rms_m"].get<double>(), e["accuracy"]["rms"].get<double>(), 1e-9);
+  EXPECT_TRUE(j["variants"][0]["map_eval"]["profile"].is_array());
+  EXPECT_NE(ReadFile(out + "/compare.md").find("map RMS [m]"), std::string::npos);
+  EXPECT_NE(r.out.find("map RMS"), std::string::npos) << r.out;
+}
+
 TEST_F(CompareTest, EveryVariantFailedIsExitOne) {
   const std::string out = dir_ + "/all_blocked";
   fs::create_directories(out);
@@ -338,6 +376,8 @@ TEST_F(CompareTest, BadInputIsOneLineAndExitTwoBeforeAnyRun) {
   ExpectBadInput("compare --bag " + dir_ + "/missing.bag --gt " + Truth() + " --out " + bad,
                  dir_ + "/missing.bag");
   ExpectBadInput(CompareArgs(bad, "--set rv.epss0=0.5"), "rv.epss0");
+  ExpectBadInput(CompareArgs(bad, "--ref-map " + dir_ + "/missing_ref.pcd"),
+                 "--ref-map: " + dir_ + "/missing_ref.pcd: cannot open");
 }
 
 }  // namespace

@@ -13,9 +13,11 @@
 // The association is a template over Search, so the call resolves at compile
 // time: the per-point loop has no virtual call and each map keeps its own
 // neighbour record (the refinement map adds the scan each neighbour came from).
-// Specializations: VoxelMap here, LeaveOneOutSearch in smoother/refine_map.h.
+// Specializations: VoxelMap and ReferenceMap here, LeaveOneOutSearch in
+// smoother/refine_map.h.
 #include <Eigen/Core>
 
+#include "rvlio/map/reference_map.h"
 #include "rvlio/map/voxel_map.h"
 
 namespace rvlio {
@@ -28,6 +30,16 @@ template <>
 struct NeighborSearchTraits<VoxelMap> {
   using Neighbors = NeighborBuffer;
   static int KNearest(const VoxelMap& map, const Eigen::Vector3d& q_world, int k,
+                      double max_dist, Neighbors* out) {
+    return map.KNearest(q_world, k, max_dist, out);
+  }
+};
+
+// A fixed reference cloud (localization in a prior map, map evaluation).
+template <>
+struct NeighborSearchTraits<ReferenceMap> {
+  using Neighbors = NeighborBuffer;
+  static int KNearest(const ReferenceMap& map, const Eigen::Vector3d& q_world, int k,
                       double max_dist, Neighbors* out) {
     return map.KNearest(q_world, k, max_dist, out);
   }

@@ -13,8 +13,9 @@ namespace rvlio {
 
 // Binary PCD (x y z float32; header made by PCL), written atomically.
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
-// Reads a map WriteMapPcd wrote (binary, fields x y z float32, one row per
-// point). InvalidInput naming the file for anything else, or a short file.
+// Reads the points of a map.pcd (any PCD or PLY, point_cloud_file.h: the one
+// point-cloud reader; an empty cloud is allowed). InvalidInput naming the
+// file for an unreadable, malformed, truncated or non-finite cloud.
 StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
 
 // One row per scan: time, status, point and constraint counts, the RV report,

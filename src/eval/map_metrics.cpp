@@ -1,0 +1,195 @@
+#include "rvlio/eval/map_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "rvlio/common/parallel.h"
+
+namespace rvlio {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kChunk = 4096;  // points per parallel work item (fixed: results independent of threads)
+
+// Per MAP point: nearest distance (NaN beyond the search radius) and
+// |point-to-plane| (NaN without a valid plane).
+struct MapPointDistances {
+  std::vector<double> nearest_m, plane_m;
+};
+
+MapPointDistances MapToReference(const std::vector<Eigen::Vector3d>& map_points,
+                                 const ReferenceMap& ref, const MapEvalOptions& options) {
+  MapPointDistances d;
+  const size_t n = map_points.size();
+  d.nearest_m.assign(n, kNaN);
+  d.plane_m.assign(n, kNaN);
+  SurfaceQueryOptions surface = options.surface;
+  // The plane search must reach at least as far as the inlier test.
+  surface.search_radius = std::max(surface.search_radius, options.max_distance);
+  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
+  ParallelFor(0, chunks, options.threads, [&](int chunk, int) {
+    NeighborBuffer neighbors;
+    const size_t end = std::min(n, static_cast<size_t>(chunk + 1) * kChunk);
+    for (size_t i = static_cast<size_t>(chunk) * kChunk; i < end; ++i) {
+      const SurfaceDistance s = QueryReferenceSurface(ref, map_points[i], surface, &neighbors);
+      d.nearest_m[i] = s.nearest_m;
+      if (s.has_surface()) d.plane_m[i] = std::abs(s.signed_m);
+    }
+  });
+  return d;
+}
+
+// Per REF point: distance to the nearest MAP point within D (NaN beyond).
+std::vector<double> ReferenceToMap(const std::vector<Eigen::Vector3d>& ref_points,
+                                   const ReferenceMap& map, const MapEvalOptions& options) {
+  const size_t n = ref_points.size();
+  std::vector<double> nearest_m(n, kNaN);
+  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
+  ParallelFor(0, chunks, options.threads, [&](int chunk, int) {
+    NeighborBuffer neighbors;
+    const size_t end = std::min(n, static_cast<size_t>(chunk + 1) * kChunk);
+    for (size_t i = static_cast<size_t>(chunk) * kChunk; i < end; ++i)
+      if (map.KNearest(ref_points[i], 1, options.max_distance, &neighbors) == 1)
+        nearest_m[i] = std::sqrt(neighbors.dist2[0]);
+  });
+  return nearest_m;
+}
+
+size_t BinOf(double chainage_m, double step_m) {
+  return static_cast<size_t>(std::max(0.0, std::floor(chainage_m / step_m)));
+}
+
+std::vector<MapProfileBin> Profile(const std::vector<Eigen::Vector3d>& map_points,
+                                   const std::vector<Eigen::Vector3d>& ref_points,
+                                   const MapPointDistances& d, const std::vector<double>& ref_nearest,
+                                   const ChainageAxis& axis, const MapEvalOptions& options) {
+  double max_chainage = 0.0;
+  for (const Eigen::Vector3d& p : ref_points) max_chainage = std::max(max_chainage, axis.Chainage(p));
+  const size_t bins = BinOf(max_chainage, options.profile_step) + 1;
+  std::vector<MapProfileBin> profile(bins);
+  std::vector<std::vector<double>> plane(bins);
+  std::vector<size_t> covered(bins, 0);
+  for (size_t b = 0; b < bins; ++b) profile[b].chainage_m = b * options.profile_step;
+  for (size_t i = 0; i < ref_points.size(); ++i) {
+    const size_t b = std::min(bins - 1, BinOf(axis.Chainage(ref_points[i]), options.profile_step));
+    ++profile[b].ref_points;
+    covered[b] += std::isnan(ref_nearest[i]) ? 0 : 1;
+  }
+  for (size_t i = 0; i < map_points.size(); ++i) {
+    const double c = axis.Chainage(map_points[i]);
+    if (c < 0.0 || c >= bins * options.profile_step) continue;  // beyond the reference
+    const size_t b = BinOf(c, options.profile_step);
+    ++profile[b].map_points;
+    if (d.nearest_m[i] <= options.max_distance && !std::isnan(d.plane_m[i]))
+      plane[b].push_back(d.plane_m[i]);
+  }
+  for (size_t b = 0; b < bins; ++b) {
+    MapProfileBin& bin = profile[b];
+    bin.completeness = bin.ref_points == 0 ? kNaN : static_cast<double>(covered[b]) / bin.ref_points;
+    bin.map_with_plane = plane[b].size();
+    if (plane[b].empty()) {
+      bin.rms_m = bin.median_m = bin.p95_m = kNaN;
+      continue;
+    }
+    const ErrorStats s = ComputeStats(std::move(plane[b]));
+    bin.rms_m = s.rmse;
+    bin.median_m = s.median;
+    bin.p95_m = s.p95;
+  }
+  return profile;
+}
+
+Status CheckCloud(const std::vector<Eigen::Vector3d>& points, const char* which) {
+  if (points.empty()) return Status::InvalidInput(std::string(which) + " has no points");
+  size_t bad = 0;
+  for (const Eigen::Vector3d& p : points) bad += p.allFinite() ? 0 : 1;
+  if (bad > 0)
+    return Status::InvalidInput(std::string(which) + ": " + std::to_string(bad) + " of " +
+                                std::to_string(points.size()) +
+                                " points have a non-finite coordinate (NaN or inf)");
+  return Status::Ok();
+}
+
+}  // namespace
+
+ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points) {
+  ChainageAxis axis;
+  if (points.empty()) return axis;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) C.noalias() += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+  Eigen::Vector3d dir = es.eigenvectors().col(2);
+  Eigen::Index largest = 0;
+  dir.cwiseAbs().maxCoeff(&largest);
+  if (dir(largest) < 0.0) dir = -dir;
+  double min_c = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& p : points) min_c = std::min(min_c, dir.dot(p - mean));
+  axis.origin = mean + min_c * dir;
+  axis.direction = dir;
+  return axis;
+}
+
+StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
+                                    const std::vector<Eigen::Vector3d>& ref_points,
+                                    const MapEvalOptions& options) {
+  if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
+  if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+  const double D = options.max_distance;
+  MapEvalResult r;
+  r.map_points = map_points.size();
+  r.ref_points = ref_points.size();
+  r.max_distance_m = D;
+
+  MapPointDistances d;
+  {
+    const ReferenceMap ref(ref_points, options.search);
+    d = MapToReference(map_points, ref, options);
+  }  // the reference's search structure is freed before the map's is built
+  std::vector<double> plane, nearest;
+  double chamfer_map = 0.0;
+  for (size_t i = 0; i < d.nearest_m.size(); ++i) {
+    const bool inlier = d.nearest_m[i] <= D;  // false for NaN
+    chamfer_map += inlier ? d.nearest_m[i] : D;
+    if (!inlier) continue;
+    nearest.push_back(d.nearest_m[i]);
+    if (std::isnan(d.plane_m[i])) ++r.no_plane;
+    else plane.push_back(d.plane_m[i]);
+  }
+  r.inliers = nearest.size();
+  if (r.inliers == 0)
+    return Status::InvalidInput("the map and the reference do not overlap: no map point lies within " +
+                                std::to_string(D) + " m of a reference point (different frames or units?)");
+  r.outlier_fraction = 1.0 - static_cast<double>(r.inliers) / r.map_points;
+  r.accuracy = ComputeStats(std::move(plane));
+  r.nearest = ComputeStats(std::move(nearest));
+
+  std::vector<double> ref_nearest;
+  {
+    const ReferenceMap map(map_points, options.search);
+    ref_nearest = ReferenceToMap(ref_points, map, options);
+  }
+  size_t covered = 0;
+  double chamfer_ref = 0.0;
+  for (double e : ref_nearest) {
+    covered += std::isnan(e) ? 0 : 1;
+    chamfer_ref += std::isnan(e) ? D : e;
+  }
+  r.completeness = static_cast<double>(covered) / r.ref_points;
+  r.chamfer_m = 0.5 * (chamfer_map / r.map_points + chamfer_ref / r.ref_points);
+
+  const ChainageAxis axis = PrincipalAxis(ref_points);
+  r.axis_origin = axis.origin;
+  r.axis_direction = axis.direction;
+  r.profile = Profile(map_points, ref_points, d, ref_nearest, axis, options);
+  return r;
+}
+
+}  // namespace rvlio

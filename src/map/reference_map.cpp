@@ -1,0 +1,28 @@
+#include "rvlio/map/reference_map.h"
+
+namespace rvlio {
+
+namespace {
+
+MapOptions StaticMapOptions(const ReferenceMapOptions& options) {
+  MapOptions m;
+  m.voxel_size = options.voxel_size;
+  m.max_points_per_voxel = 65535;  // the largest block a voxel can hold
+  m.min_point_distance = 0.0;      // keep every point
+  return m;
+}
+
+}  // namespace
+
+ReferenceMap::ReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
+                           const ReferenceMapOptions& options)
+    : map_(StaticMapOptions(options)) {
+  for (const Eigen::Vector3d& p : p_ref) {
+    if (map_.InsertPoint(p))
+      bounds_.extend(p.cast<float>().cast<double>());  // the stored (float) coordinates
+    else
+      ++num_skipped_;
+  }
+}
+
+}  // namespace rvlio

@@ -1,0 +1,158 @@
+// Map metrics (eval/map_metrics.h) on constructed clouds with known answers.
+#include "rvlio/eval/map_metrics.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace rvlio {
+namespace {
+
+// Random points on z = offset over [-2, 2]^2 with Gaussian noise along z,
+// keeping those that `keep` accepts.
+template <class Keep>
+std::vector<Eigen::Vector3d> Plane(int n, double offset_m, double noise_m, unsigned seed, Keep keep) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::normal_distribution<double> noise(0.0, noise_m);
+  std::vector<Eigen::Vector3d> p;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d x(u(rng), u(rng), offset_m + (noise_m > 0 ? noise(rng) : 0.0));
+    if (keep(x)) p.push_back(x);
+  }
+  return p;
+}
+std::vector<Eigen::Vector3d> Plane(int n, double offset_m, double noise_m, unsigned seed) {
+  return Plane(n, offset_m, noise_m, seed, [](const Eigen::Vector3d&) { return true; });
+}
+
+TEST(MapMetrics, NoisyPlaneOffsetByTwoCentimetres) {
+  const std::vector<Eigen::Vector3d> ref = Plane(200000, 0.0, 0.0005, 1);
+  const std::vector<Eigen::Vector3d> map = Plane(40000, 0.02, 0.002, 2);
+  StatusOr<MapEvalResult> r = EvaluateMap(map, ref, MapEvalOptions());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_NEAR(r->accuracy.mean, 0.02, 0.0005);
+  EXPECT_NEAR(r->accuracy.median, 0.02, 0.0005);
+  EXPECT_NEAR(r->accuracy.rmse, std::sqrt(0.02 * 0.02 + 0.002 * 0.002), 0.0005);
+  EXPECT_GT(r->accuracy.p95, r->accuracy.median);
+  EXPECT_LT(r->accuracy.max, 0.04);
+  // The nearest reference point is never closer than the plane.
+  EXPECT_GE(r->nearest.mean, r->accuracy.mean - 1e-4);
+  EXPECT_EQ(r->outlier_fraction, 0.0);
+  EXPECT_GT(r->completeness, 0.999);
+  EXPECT_EQ(r->map_points, map.size());
+  EXPECT_EQ(r->ref_points, ref.size());
+  // Chamfer: both directions are about the 2 cm offset (plus spacing).
+  EXPECT_GT(r->chamfer_m, 0.02);
+  EXPECT_LT(r->chamfer_m, 0.03);
+}
+
+TEST(MapMetrics, HalfAPlaneIsHalfComplete) {
+  const std::vector<Eigen::Vector3d> ref = Plane(100000, 0.0, 0.0, 3);
+  std::vector<Eigen::Vector3d> map;
+  for (const Eigen::Vector3d& p : ref)
+    if (p.x() < 0.0) map.push_back(p);
+  MapEvalOptions options;
+  options.max_distance = 0.01;
+  StatusOr<MapEvalResult> r = EvaluateMap(map, ref, options);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_NEAR(r->completeness, 0.5, 0.01);
+  EXPECT_LT(r->accuracy.max, 1e-6);  // the map lies on the reference
+  EXPECT_EQ(r->outlier_fraction, 0.0);
+}
+
+TEST(MapMetrics, AHoleInTheReferenceMakesOutliersNotErrors) {
+  const double hole_m = 1.0;
+  const std::vector<Eigen::Vector3d> ref = Plane(
+      200000, 0.0, 0.0, 4, [&](const Eigen::Vector3d& p) { return p.head<2>().norm() > hole_m; });
+  const std::vector<Eigen::Vector3d> map = Plane(40000, 0.0, 0.001, 5);
+  MapEvalOptions options;
+  StatusOr<MapEvalResult> r = EvaluateMap(map, ref, options);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  // Map points farther than D inside the hole's rim have no reference.
+  const double r_in = hole_m - options.max_distance;
+  EXPECT_NEAR(r->outlier_fraction, M_PI * r_in * r_in / 16.0, 0.01);
+  EXPECT_GT(r->completeness, 0.999);
+  EXPECT_LT(r->accuracy.rmse, 0.0015);  // the rest lies on the plane (1 mm noise)
+  // Inliers near the rim, whose k neighbours are not all within the search
+  // radius or lie on one side, are counted, not measured.
+  EXPECT_EQ(r->inliers, r->accuracy.count + r->no_plane);
+}
+
+TEST(MapMetrics, ProfileFindsTheDisplacedSection) {
+  // Two walls y = +-2 along x in [0, 20]; the map's walls converge by 5 cm
+  // each over x in [12, 13).
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> along(0.0, 20.0), up(0.0, 3.0);
+  std::vector<Eigen::Vector3d> ref, map;
+  for (int i = 0; i < 200000; ++i) {
+    const double side = (i % 2 == 0) ? 2.0 : -2.0;
+    ref.emplace_back(along(rng), side, up(rng));
+  }
+  for (int i = 0; i < 40000; ++i) {
+    const double x = along(rng), side = (i % 2 == 0) ? 2.0 : -2.0;
+    const double bulge = (x >= 12.0 && x < 13.0) ? -0.05 * side / 2.0 : 0.0;
+    map.emplace_back(x, side + bulge, up(rng));
+  }
+  StatusOr<MapEvalResult> r = EvaluateMap(map, ref, MapEvalOptions());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_NEAR(std::abs(r->axis_direction.x()), 1.0, 1e-3);
+  ASSERT_GE(r->profile.size(), 20u);
+  for (const MapProfileBin& b : r->profile) {
+    if (b.map_with_plane == 0) continue;
+    const double mid = b.chainage_m + 0.5;
+    const bool displaced = std::abs(mid - 12.5) < 0.5;
+    if (displaced) {
+      EXPECT_NEAR(b.median_m, 0.05, 0.003) << b.chainage_m;
+    } else if (std::abs(mid - 12.5) > 1.5) {
+      EXPECT_LT(b.p95_m, 1e-5) << b.chainage_m;
+    }
+    EXPECT_GT(b.completeness, 0.98) << b.chainage_m;
+  }
+}
+
+TEST(MapMetrics, ResultsDoNotDependOnTheThreadCount) {
+  const std::vector<Eigen::Vector3d> ref = Plane(50000, 0.0, 0.001, 7);
+  const std::vector<Eigen::Vector3d> map = Plane(20000, 0.01, 0.003, 8);
+  MapEvalOptions one, two;
+  two.threads = 2;
+  StatusOr<MapEvalResult> a = EvaluateMap(map, ref, one), b = EvaluateMap(map, ref, two);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->accuracy.rmse, b->accuracy.rmse);
+  EXPECT_EQ(a->accuracy.p95, b->accuracy.p95);
+  EXPECT_EQ(a->completeness, b->completeness);
+  EXPECT_EQ(a->chamfer_m, b->chamfer_m);
+}
+
+TEST(MapMetrics, RefusesEmptyNonFiniteAndDisjointClouds) {
+  const std::vector<Eigen::Vector3d> ref = Plane(1000, 0.0, 0.0, 9);
+  std::vector<Eigen::Vector3d> far = ref;
+  for (Eigen::Vector3d& p : far) p.x() += 1000.0;  // another frame
+  std::vector<Eigen::Vector3d> nan = ref;
+  nan[3].z() = std::numeric_limits<double>::quiet_NaN();
+  const MapEvalOptions o;
+  EXPECT_NE(EvaluateMap({}, ref, o).status().message().find("the map has no points"),
+            std::string::npos);
+  EXPECT_NE(EvaluateMap(ref, {}, o).status().message().find("the reference has no points"),
+            std::string::npos);
+  EXPECT_NE(EvaluateMap(nan, ref, o).status().message().find("1 of 1000 points"), std::string::npos);
+  const StatusOr<MapEvalResult> disjoint = EvaluateMap(far, ref, o);
+  ASSERT_FALSE(disjoint.ok());
+  EXPECT_EQ(disjoint.status().exit_code(), 2);
+  EXPECT_NE(disjoint.status().message().find("do not overlap"), std::string::npos);
+}
+
+TEST(MapMetrics, PrincipalAxisStartsAtTheSmallestProjection) {
+  std::vector<Eigen::Vector3d> p;
+  for (int i = 0; i <= 100; ++i) p.emplace_back(-5.0 + 0.1 * i, 0.01 * (i % 3), 0.0);
+  const ChainageAxis axis = PrincipalAxis(p);
+  EXPECT_NEAR(axis.direction.x(), 1.0, 1e-6);
+  EXPECT_NEAR(axis.Chainage(p.front()), 0.0, 1e-9);
+  EXPECT_NEAR(axis.Chainage(p.back()), 10.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace rvlio

@@ -1,0 +1,184 @@
+// Reading PCD and PLY clouds (io/point_cloud_file.h): files written by PCL's
+// own writers in every encoding read back to the same points and fields;
+// hand-written files for the cases PCL does not write (big-endian PLY, an
+// element before the vertices); and every refusal, one line naming the file.
+#include "rvlio/io/point_cloud_file.h"
+
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace rvlio {
+namespace {
+
+namespace fs = std::filesystem;
+
+class PointCloudFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("rvlio_pcf_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string Write(const std::string& name, const std::string& bytes) const {
+    std::ofstream(Path(name), std::ios::binary) << bytes;
+    return Path(name);
+  }
+  static pcl::PointCloud<pcl::PointXYZI> Cloud(int n) {
+    pcl::PointCloud<pcl::PointXYZI> c;
+    for (int i = 0; i < n; ++i) {
+      pcl::PointXYZI p;
+      p.x = 0.5f * i;
+      p.y = -1.25f + 0.001f * i;
+      p.z = 3.0f;
+      p.intensity = static_cast<float>(i % 7);
+      c.push_back(p);
+    }
+    return c;
+  }
+  static void ExpectSame(const PointCloudFile& f, const pcl::PointCloud<pcl::PointXYZI>& c) {
+    ASSERT_EQ(f.points.size(), c.size());
+    const PointCloudField* intensity = f.Field("intensity");
+    ASSERT_NE(intensity, nullptr);
+    // Binary encodings are exact; PCL's ASCII writers print 8 digits.
+    for (size_t i = 0; i < c.size(); ++i) {
+      EXPECT_NEAR(f.points[i].x(), c[i].x, 1e-6);
+      EXPECT_NEAR(f.points[i].y(), c[i].y, 1e-6);
+      EXPECT_NEAR(f.points[i].z(), c[i].z, 1e-6);
+      EXPECT_EQ(intensity->values[i], c[i].intensity);
+      if (f.format.find("ascii") == std::string::npos) EXPECT_EQ(f.points[i].y(), c[i].y);
+    }
+  }
+  fs::path dir_;
+};
+
+TEST_F(PointCloudFileTest, ReadsPclPcdInEveryEncoding) {
+  const pcl::PointCloud<pcl::PointXYZI> c = Cloud(1000);
+  pcl::PCDWriter w;
+  ASSERT_EQ(w.writeASCII(Path("a.pcd"), c), 0);
+  ASSERT_EQ(w.writeBinary(Path("b.pcd"), c), 0);
+  ASSERT_EQ(w.writeBinaryCompressed(Path("c.pcd"), c), 0);
+  for (const char* name : {"a.pcd", "b.pcd", "c.pcd"}) {
+    SCOPED_TRACE(name);
+    StatusOr<PointCloudFile> f = ReadPointCloud(Path(name));
+    ASSERT_TRUE(f.ok()) << f.status().message();
+    ExpectSame(*f, c);
+  }
+  EXPECT_EQ(ReadPointCloud(Path("c.pcd"))->format, "pcd binary_compressed");
+  StatusOr<PointCloudFile> xyz_only = ReadPointCloud(Path("b.pcd"), PointCloudReadOptions{false});
+  ASSERT_TRUE(xyz_only.ok());
+  EXPECT_TRUE(xyz_only->fields.empty());
+}
+
+TEST_F(PointCloudFileTest, ReadsPclPlyAsciiAndBinary) {
+  const pcl::PointCloud<pcl::PointXYZI> c = Cloud(500);
+  pcl::PLYWriter w;
+  ASSERT_EQ(w.write(Path("a.ply"), c, false), 0);
+  ASSERT_EQ(w.write(Path("b.ply"), c, true), 0);
+  for (const char* name : {"a.ply", "b.ply"}) {
+    SCOPED_TRACE(name);
+    StatusOr<PointCloudFile> f = ReadPointCloud(Path(name));
+    ASSERT_TRUE(f.ok()) << f.status().message();
+    ExpectSame(*f, c);
+  }
+}
+
+// Big-endian doubles and a uchar, after an element of another kind.
+TEST_F(PointCloudFileTest, ReadsBigEndianPlyAfterAnotherElement) {
+  std::string bytes =
+      "ply\nformat binary_big_endian 1.0\ncomment test\nelement camera 1\nproperty float f\n"
+      "element vertex 2\nproperty double x\nproperty double y\nproperty double z\n"
+      "property uchar red\nend_header\n";
+  bytes.append(4, '\x7f');  // the camera record
+  auto put_double = [&](double v) {
+    char b[8];
+    std::memcpy(b, &v, 8);
+    for (int i = 7; i >= 0; --i) bytes.push_back(b[i]);
+  };
+  put_double(1.5), put_double(-2.0), put_double(1e-3), bytes.push_back('\xff');
+  put_double(10.0), put_double(20.0), put_double(30.0), bytes.push_back('\x07');
+  StatusOr<PointCloudFile> f = ReadPointCloud(Write("be.ply", bytes));
+  ASSERT_TRUE(f.ok()) << f.status().message();
+  ASSERT_EQ(f->points.size(), 2u);
+  EXPECT_EQ(f->points[0], Eigen::Vector3d(1.5, -2.0, 1e-3));
+  EXPECT_EQ(f->points[1], Eigen::Vector3d(10.0, 20.0, 30.0));
+  EXPECT_EQ(f->Field("red")->values[0], 255.0f);
+  EXPECT_EQ(f->Field("red")->values[1], 7.0f);
+}
+
+// The message of a refused file: one line that names it.
+void ExpectRefused(const StatusOr<PointCloudFile>& f, const std::string& path,
+                   const std::string& words) {
+  ASSERT_FALSE(f.ok());
+  const std::string& m = f.status().message();
+  EXPECT_EQ(f.status().exit_code(), 2);
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  EXPECT_EQ(m.rfind(path, 0), 0u) << m;
+  EXPECT_NE(m.find(words), std::string::npos) << m;
+}
+
+TEST_F(PointCloudFileTest, RefusesBadFilesWithOneLineNamingThem) {
+  const pcl::PointCloud<pcl::PointXYZI> c = Cloud(100);
+  pcl::PCDWriter w;
+  ASSERT_EQ(w.writeBinary(Path("b.pcd"), c), 0);
+  ASSERT_EQ(w.writeBinaryCompressed(Path("c.pcd"), c), 0);
+  ASSERT_EQ(w.writeASCII(Path("a.pcd"), c), 0);
+  auto truncate = [&](const std::string& name, size_t drop) {
+    const size_t size = fs::file_size(Path(name));
+    fs::resize_file(Path(name), size - drop);
+    return Path(name);
+  };
+  ExpectRefused(ReadPointCloud(Path("missing.pcd")), Path("missing.pcd"), "cannot open");
+  ExpectRefused(ReadPointCloud(dir_.string()), dir_.string(), "directory");
+  ExpectRefused(ReadPointCloud(Write("e.pcd", "")), Path("e.pcd"), "empty file");
+  ExpectRefused(ReadPointCloud(Write("t.txt", "hello\n")), Path("t.txt"), "not a PCD or PLY");
+  ExpectRefused(ReadPointCloud(truncate("b.pcd", 10)), Path("b.pcd"), "truncated");
+  ExpectRefused(ReadPointCloud(truncate("c.pcd", 10)), Path("c.pcd"), "truncated");
+  ExpectRefused(ReadPointCloud(truncate("a.pcd", 40)), Path("a.pcd"), "truncated");
+  ExpectRefused(ReadPointCloud(Write("z.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
+                                              "WIDTH 0\nHEIGHT 1\nPOINTS 0\nDATA ascii\n")),
+                Path("z.pcd"), "empty point cloud");
+  ExpectRefused(ReadPointCloud(Write("n.pcd", "FIELDS x y z\nPOINTS 3\nDATA ascii\n"
+                                              "1 2 3\nnan 0 0\n0 inf 1\n")),
+                Path("n.pcd"), "2 of 3 points have a non-finite coordinate");
+  ExpectRefused(ReadPointCloud(Write("x.pcd", "FIELDS a b c\nPOINTS 1\nDATA ascii\n1 2 3\n")),
+                Path("x.pcd"), "no x, y and z");
+  ExpectRefused(ReadPointCloud(Write("w.pcd", "FIELDS x y z\nPOINTS 1\nDATA ascii\n1 two 3\n")),
+                Path("w.pcd"), "not a number");
+  ExpectRefused(ReadPointCloud(Write("h.ply", "ply\nformat ascii 1.0\nelement vertex 2\n"
+                                              "property float x\nproperty float y\n"
+                                              "property float z\nend_header\n0 0 0\n")),
+                Path("h.ply"), "truncated");
+  ExpectRefused(ReadPointCloud(Write("f.ply", "ply\nformat ascii 1.0\nelement face 2\n"
+                                              "property list uchar int vertex_indices\nend_header\n")),
+                Path("f.ply"), "no vertex element");
+}
+
+TEST_F(PointCloudFileTest, ReadingLeavesTheFileAndItsFolderUnchanged) {
+  pcl::PCDWriter w;
+  ASSERT_EQ(w.writeBinaryCompressed(Path("c.pcd"), Cloud(50)), 0);
+  const auto before = fs::last_write_time(Path("c.pcd"));
+  const auto size = fs::file_size(Path("c.pcd"));
+  ASSERT_TRUE(ReadPointCloud(Path("c.pcd")).ok());
+  EXPECT_EQ(fs::last_write_time(Path("c.pcd")), before);
+  EXPECT_EQ(fs::file_size(Path("c.pcd")), size);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+}  // namespace
+}  // namespace rvlio
