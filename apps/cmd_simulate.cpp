@@ -4,6 +4,8 @@
 //                    ROS 2 CDR messages)
 //   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
+//   DIR/reference_map.pcd  with --reference-map: a static laser-scanner
+//                    survey of the world (docs/simulator.md)
 // Argument parsing and the summary line only: SimulateRecording (rvlio/api.h)
 // does the work.
 #include <cerrno>
@@ -37,10 +39,18 @@ CommandSpec SimulateSpec() {
           "NAME.db3, ROS 2, with --format), DIR/NAME_gt.tum\n"
           "(true IMU pose in the world frame, 100 Hz) and DIR/NAME.yaml (sensor configuration for\n"
           "`rvlio run --config`). Deterministic: the same options and seed give the same files.\n"
+          "--reference-map also writes DIR/reference_map.pcd, a static laser-scanner survey of\n"
+          "the world in the ground truth's frame (survey.* keys; docs/simulator.md).\n"
           "Presets: " +
               PresetList() + ".",
           {{"preset", "NAME", "world, sensors and flight (default tunnel)", false, false},
-           {"seed", "N", "random seed (default 1)", false, false},
+           {"seed", "N", "random seed of the world (and of the flight; default 1)", false, false},
+           {"flight-seed", "N",
+            "seed of the flight only (motion, IMU and LiDAR noise): another flight through the "
+            "same world (default: --seed)", false, false},
+           {"reference-map", "", "also write DIR/reference_map.pcd (a survey of the world)", false,
+            false},
+           {"reference-map-only", "", "write only DIR/reference_map.pcd (no flight)", false, false},
            {"duration", "S", "seconds of data (default: the preset's)", false, false},
            {"lidar-msg", "TYPE",
             "pointcloud2 (Ouster layout, default) or livox (livox_ros_driver/CustomMsg on "
@@ -78,6 +88,13 @@ std::string ReadArgs(const Args& args, SimulateArgs* sim) {
       return "--seed '" + args.Get("seed") + "' is not a non-negative integer";
     sim->seed = seed;
   }
+  if (args.Has("flight-seed")) {
+    if (!ParseInt64(args.Get("flight-seed"), &seed) || seed < 0)
+      return "--flight-seed '" + args.Get("flight-seed") + "' is not a non-negative integer";
+    sim->flight_seed = seed;
+  }
+  sim->reference_map = args.Has("reference-map");
+  sim->reference_map_only = args.Has("reference-map-only");
   double duration = 0.0;
   if (args.Has("duration")) {
     if (!ParseDouble(args.Get("duration"), &duration) || duration <= 0.0)
@@ -116,6 +133,14 @@ int CmdSimulate(int argc, char** argv) {
     return InterruptExitCode();
   }
   std::error_code ec;
+  if (!r->reference_map_path.empty())
+    std::printf("rvlio simulate: reference map: %lld points from %d stations -> %s (%.1f MB) in "
+                "%.1f s\n",
+                static_cast<long long>(r->reference_map_points), r->reference_map_stations,
+                r->reference_map_path.c_str(),
+                static_cast<double>(std::filesystem::file_size(r->reference_map_path, ec)) / 1e6,
+                r->reference_map_s);
+  if (sim.reference_map_only) return 0;
   const double mb = static_cast<double>(std::filesystem::file_size(r->bag_path, ec)) / 1e6;
   std::printf(
       "rvlio simulate: %s: %lld scans (%dx%d), %lld IMU samples, %.1f s of data -> %s "

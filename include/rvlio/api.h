@@ -160,7 +160,10 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args);
 
 struct SimulateArgs {
   std::string preset = "tunnel";         // sim::PresetNames()
-  std::optional<int64_t> seed;           // default: the preset's
+  std::optional<int64_t> seed;           // default: the preset's (the world's seed)
+  std::optional<int64_t> flight_seed;    // default: seed (simulator key flight_seed)
+  bool reference_map = false;            // also write OUT_DIR/reference_map.pcd (survey.enabled)
+  bool reference_map_only = false;       // write only OUT_DIR/reference_map.pcd
   std::optional<double> duration_s;      // default: the preset's
   std::vector<std::string> overrides;    // simulator "key=value", applied last
   std::string lidar_msg = "pointcloud2"; // or "livox"
@@ -173,6 +176,12 @@ struct SimulateArgs {
 
 struct SimulateResult {
   std::string bag_path, gt_path, config_path;  // NAME.bag|mcap|db3, NAME_gt.tum, NAME.yaml
+  // reference_map.pcd (binary PCD, x y z float32, world frame = the ground
+  // truth's, m) when the survey ran, else "".
+  std::string reference_map_path;
+  int64_t reference_map_points = 0;
+  int reference_map_stations = 0;
+  double reference_map_s = 0.0;  // wall time of the survey
   int64_t scans = 0, imu_samples = 0;
   int rows = 0, cols = 0;     // LiDAR rows x columns
   double duration_s = 0.0;    // of simulated data

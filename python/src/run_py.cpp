@@ -261,10 +261,13 @@ MergeOutput Merge(const py::iterable& chunks, const py::handle& out) {
 
 py::dict Simulate(const std::string& preset, const py::handle& seed, const py::handle& duration,
                   const py::handle& out, const std::string& name, const std::string& format,
-                  const std::string& lidar_msg, const py::handle& set) {
+                  const std::string& lidar_msg, const py::handle& set,
+                  const py::handle& flight_seed, bool reference_map) {
   SimulateArgs args;
   args.preset = preset;
   if (!seed.is_none()) args.seed = seed.cast<int64_t>();
+  if (!flight_seed.is_none()) args.flight_seed = flight_seed.cast<int64_t>();
+  args.reference_map = reference_map;
   if (!duration.is_none()) args.duration_s = duration.cast<double>();
   args.overrides = Overrides(set);
   args.lidar_msg = lidar_msg;
@@ -283,6 +286,8 @@ py::dict Simulate(const std::string& preset, const py::handle& seed, const py::h
   d["scans"] = r.scans;
   d["imu_samples"] = r.imu_samples;
   d["duration_s"] = r.duration_s;
+  d["reference_map"] = r.reference_map_path.empty() ? py::object(py::none())
+                                                     : py::object(py::str(r.reference_map_path));
   return d;
 }
 
@@ -345,9 +350,12 @@ void BindRun(py::module_& m) {
   m.def("simulate", &Simulate, py::arg("preset") = "tunnel", py::kw_only(),
         py::arg("seed") = py::none(), py::arg("duration") = py::none(), py::arg("out"),
         py::arg("name") = "", py::arg("format") = "bag", py::arg("lidar_msg") = "pointcloud2",
-        py::arg("set") = py::none(),
+        py::arg("set") = py::none(), py::arg("flight_seed") = py::none(),
+        py::arg("reference_map") = false,
         "`rvlio simulate`: writes OUT/NAME.bag (or .mcap / .db3), OUT/NAME_gt.tum and "
         "OUT/NAME.yaml (the config for rvlio.Config.load); returns their paths and counts. "
+        "flight_seed: another flight through the same world (--flight-seed); reference_map: "
+        "also OUT/reference_map.pcd, a survey of the world (--reference-map). "
         "Ctrl-C raises KeyboardInterrupt and leaves no recording.");
 }
 

@@ -46,3 +46,22 @@ def test_livox_custom_messages(tmp_path):
     assert layout == "livox_custom"
     scans = [m for m in got if m.kind == "scan"]
     assert len(scans) >= 10 and all(len(s) > 100 for s in scans)
+
+
+def test_second_flight_through_the_same_world_and_its_reference_map(tmp_path):
+    """flight_seed changes the flight, not the world: the same path and the
+    same reference map, another yaw motion."""
+    cheap = {"lidar.columns": 64, "survey.angular_step": 1.0, "survey.voxel_size": 0.1,
+             "survey.x_max": 10.0}
+    a = rvlio.simulate("tunnel", seed=5, duration=5, out=tmp_path / "a", reference_map=True,
+                       set=cheap)
+    b = rvlio.simulate("tunnel", seed=5, flight_seed=6, duration=5, out=tmp_path / "b",
+                       reference_map=True, set=cheap)
+    assert a["reference_map"].endswith("reference_map.pcd")
+    with open(a["reference_map"], "rb") as fa, open(b["reference_map"], "rb") as fb:
+        assert fa.read() == fb.read()
+    ga, gb = np.loadtxt(a["ground_truth"]), np.loadtxt(b["ground_truth"])
+    np.testing.assert_array_equal(ga[:, :4], gb[:, :4])  # time and position
+    assert not np.array_equal(ga[:, 4:], gb[:, 4:])  # orientation: another yaw motion
+    assert rvlio.simulate("tunnel", seed=5, duration=1, out=tmp_path / "c",
+                          set=cheap)["reference_map"] is None

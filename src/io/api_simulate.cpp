@@ -4,6 +4,8 @@
 //                    (format mcap: DIR/NAME.mcap, db3: DIR/NAME.db3, ROS 2 CDR)
 //   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
+//   DIR/reference_map.pcd  with survey.enabled: a static survey of the world
+//                    (binary PCD, x y z float32, the ground truth's world frame)
 // `rvlio simulate` is this call plus argument parsing, signals and its line.
 #include <algorithm>
 #include <chrono>
@@ -14,6 +16,7 @@
 
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
+#include "rvlio/io/run_outputs.h"
 #include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/trajectory_io.h"
 #include "rvlio/sim/presets.h"
@@ -23,6 +26,7 @@ namespace rvlio {
 namespace {
 
 constexpr double kGroundTruthRate = 100.0;  // Hz
+constexpr const char* kReferenceMapFile = "reference_map.pcd";
 
 // Preset, then seed / duration, then each override (applied last), then
 // validation.
@@ -42,6 +46,13 @@ Status ResolveOptions(const SimulateArgs& args, SimOptions* options) {
       return Status::InvalidInput("seed " + std::to_string(*args.seed) + " is negative");
     options->seed = *args.seed;
   }
+  if (args.flight_seed) {
+    if (*args.flight_seed < 0)
+      return Status::InvalidInput("flight seed " + std::to_string(*args.flight_seed) +
+                                  " is negative");
+    options->flight_seed = *args.flight_seed;
+  }
+  if (args.reference_map || args.reference_map_only) options->survey.enabled = true;
   if (args.duration_s) {
     if (!(*args.duration_s > 0.0) || !std::isfinite(*args.duration_s))
       return Status::InvalidInput("duration " + std::to_string(*args.duration_s) +
@@ -70,6 +81,12 @@ Status ResolveFormat(const SimulateArgs& args, BagWriterOptions* format, std::st
   return Status::Ok();
 }
 
+// ", flight seed N" when the flight has its own seed ("" otherwise, which
+// keeps the files of a default run as they were).
+std::string FlightSeedNote(const SimOptions& o) {
+  return o.flight_seed >= 0 ? ", flight seed " + std::to_string(o.flight_seed) : "";
+}
+
 std::string Num(double v) {
   std::ostringstream os;
   os.precision(10);
@@ -86,7 +103,8 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
   std::ostringstream y;
   y << "# Sensor configuration of the simulated sequence '" << name << "' (rvlio simulate, seed "
-    << o.seed << ").\n# Use: rvlio run --bag " << bag_file << " --config " << name
+    << o.seed << FlightSeedNote(o) << ").\n# Use: rvlio run --bag " << bag_file << " --config "
+    << name
     << ".yaml --out DIR\n"
     << "lidar:\n"
     << "  topic: " << o.lidar.topic << "\n"
@@ -141,7 +159,23 @@ Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool l
 
 std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
   return "ground truth of '" + name + "' (rvlio simulate, seed " + std::to_string(o.seed) +
+         FlightSeedNote(o) +
          "): T_world_imu, world = gravity-aligned, origin and yaw of the IMU at start";
+}
+
+// The reference map (options.survey), surveyed before anything is written
+// so that a bad crop leaves no file.
+Status RunSurvey(const sim::Simulator& simulator, SimulateResult* r,
+                 std::vector<Eigen::Vector3d>* p_world) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  StatusOr<sim::SurveyResult> survey = simulator.Survey();
+  if (!survey.ok()) return survey.status();
+  r->reference_map_points = static_cast<int64_t>(survey->p_world.size());
+  r->reference_map_stations = static_cast<int>(survey->stations.size());
+  r->reference_map_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  *p_world = std::move(survey->p_world);
+  return Status::Ok();
 }
 
 }  // namespace
@@ -179,6 +213,18 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
   if (!simulator.ok()) return simulator.status();
   SimulateResult r;
+  std::vector<Eigen::Vector3d> reference_map;
+  if (options.survey.enabled) {
+    if (Status s = RunSurvey(**simulator, &r, &reference_map); !s.ok()) return s;
+  }
+  const std::string map_path = (dir / kReferenceMapFile).string();
+  if (args.reference_map_only) {
+    if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
+    r.reference_map_path = map_path;
+    r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+    return r;
+  }
   r.bag_path = (dir / (name + extension)).string();
   if (Status s = WriteBag(**simulator, r.bag_path, livox, format, args.stop, &r.stop_reason);
       !s.ok())
@@ -192,6 +238,10 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   if (Status s = WriteTum(r.gt_path, gt, GroundTruthHeader(options, name)); !s.ok()) return s;
   r.config_path = (dir / (name + ".yaml")).string();
   if (Status s = WriteFileAtomically(r.config_path, yaml); !s.ok()) return s;
+  if (options.survey.enabled) {
+    if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
+    r.reference_map_path = map_path;
+  }
   r.scans = (*simulator)->scan_count();
   r.imu_samples = (*simulator)->imu_count();
   r.rows = (*simulator)->lidar().rows();

@@ -173,6 +173,47 @@ HeightField::HeightField(std::vector<Wave> waves) : waves_(std::move(waves)) {
   }
 }
 
+namespace {
+// c(s) = 0.5 (1 + cos(2 pi s)) on |s| < 1/2 (else 0) of s = (x - center) /
+// length, and its derivative with respect to x; length 0: c = 1.
+double RaisedCosine(double x, double center, double length, double* dc_dx) {
+  *dc_dx = 0.0;
+  if (length <= 0.0) return 1.0;
+  const double s = (x - center) / length;
+  if (std::abs(s) >= 0.5) return 0.0;
+  *dc_dx = -M_PI / length * std::sin(2.0 * M_PI * s);
+  return 0.5 * (1.0 + std::cos(2.0 * M_PI * s));
+}
+// Largest |c'| and |c''| of the raised cosine of that length (0: uniform).
+double RaisedCosineSlope(double length) { return length > 0.0 ? M_PI / length : 0.0; }
+double RaisedCosineCurvature(double length) {
+  return length > 0.0 ? 2.0 * M_PI * M_PI / (length * length) : 0.0;
+}
+}  // namespace
+
+void HeightField::AddBump(const Bump& bump) {
+  bumps_.push_back(bump);
+  const double a = std::abs(bump.amplitude);
+  const double su = RaisedCosineSlope(bump.u_length), sv = RaisedCosineSlope(bump.v_length);
+  amplitude_bound_ += a;
+  slope_bound_ += a * std::hypot(su, sv);
+  // Along a unit direction (p, q): p^2 b_uu + 2 p q b_uv + q^2 b_vv, with
+  // |2 p q| <= 1 and p^2, q^2 <= 1.
+  curvature_bound_ += a * (RaisedCosineCurvature(bump.u_length) +
+                           RaisedCosineCurvature(bump.v_length) + su * sv);
+}
+
+void HeightField::AddBumps(double u, double v, double* h, double* du, double* dv) const {
+  for (const Bump& b : bumps_) {
+    double cu_du = 0.0, cv_dv = 0.0;
+    const double cu = RaisedCosine(u, b.u_center, b.u_length, &cu_du);
+    const double cv = RaisedCosine(v, b.v_center, b.v_length, &cv_dv);
+    *h += b.amplitude * cu * cv;
+    if (du != nullptr) *du += b.amplitude * cu_du * cv;
+    if (dv != nullptr) *dv += b.amplitude * cu * cv_dv;
+  }
+}
+
 HeightField HeightField::Random(Rng& rng, int components, double amplitude, double lambda_min,
                                 double lambda_max) {
   if (components <= 0 || amplitude <= 0.0) return HeightField();
@@ -199,6 +240,7 @@ double HeightField::Height(double u, double v) const {
     SinCos(w.ku * u + w.kv * v + w.phase, &s, &c);
     h += w.amplitude * s;
   }
+  AddBumps(u, v, &h, nullptr, nullptr);
   return h;
 }
 
@@ -212,6 +254,7 @@ double HeightField::Height(double u, double v, double* dh_du, double* dh_dv) con
     hu += w.amplitude * w.ku * c;
     hv += w.amplitude * w.kv * c;
   }
+  AddBumps(u, v, &h, &hu, &hv);
   *dh_du = hu;
   *dh_dv = hv;
   return h;
@@ -296,6 +339,11 @@ double Box::Distance(const Eigen::Vector3d& p) const {
   return std::abs(outside + inside);
 }
 
+bool Box::Contains(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d q = (R_world_box.transpose() * (p - center)).cwiseAbs() - half;
+  return q.maxCoeff() <= 0.0;
+}
+
 Eigen::AlignedBox3d Box::Bounds() const {
   const Eigen::Vector3d extent = R_world_box.cwiseAbs() * half;
   return Eigen::AlignedBox3d(center - extent, center + extent);
@@ -335,6 +383,12 @@ double Cylinder::Distance(const Eigen::Vector3d& p) const {
   const double outside = std::hypot(std::max(dr, 0.0), std::max(dz, 0.0));
   const double inside = std::min(std::max(dr, dz), 0.0);
   return std::abs(outside + inside);
+}
+
+bool Cylinder::Contains(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d w = p - center;
+  const double wa = w.dot(axis);
+  return std::abs(wa) <= half_length && (w - wa * axis).squaredNorm() <= radius * radius;
 }
 
 Eigen::AlignedBox3d Cylinder::Bounds() const {

@@ -55,6 +55,10 @@ Status SimOptions::Validate() {
     return Status::InvalidInput(
         "world.roughness_wavelength_max must not be below "
         "world.roughness_wavelength_min");
+  if (!(survey.x_max > survey.x_min))
+    return Status::InvalidInput("survey.x_max must be greater than survey.x_min");
+  if (!(survey.max_range > survey.min_range))
+    return Status::InvalidInput("survey.max_range must be greater than survey.min_range");
   if (world.start_height >= world.height - 0.3)
     return Status::InvalidInput("world.start_height must be below world.height - 0.3");
   return CheckWaypoints(*this);

@@ -9,6 +9,7 @@ namespace rvlio::sim {
 
 namespace {
 constexpr uint64_t kScanStreamBase = 1000;  // scan k draws noise from stream kScanStreamBase + k
+constexpr double kPathStep = 0.1;           // m between flight path samples for the world builder
 
 Pose3 ExtrinsicPose(const ExtrinsicsOptions& e) {
   const auto& q = e.rotation_xyzw;
@@ -25,29 +26,41 @@ StatusOr<std::unique_ptr<Simulator>> Simulator::Create(const SimOptions& options
 }
 
 Simulator::Simulator(const SimOptions& options) : options_(options), lidar_(options.lidar) {
-  const uint64_t seed = static_cast<uint64_t>(options.seed);
+  const uint64_t flight_seed = options.FlightSeed();
   t0_ns_ = SecondsToNs(options.start_time);
   t_end_ns_ = t0_ns_ + SecondsToNs(options.duration);
   T_imu_lidar_ = ExtrinsicPose(options.extrinsics.imu_T_lidar);
-  trajectory_ =
-      std::make_unique<FlightTrajectory>(*ParseWaypoints(options.trajectory.waypoints),
-                                         options.trajectory, options.imu.gravity, t0_ns_, seed);
+  trajectory_ = std::make_unique<FlightTrajectory>(*ParseWaypoints(options.trajectory.waypoints),
+                                                   options.trajectory, options.imu.gravity, t0_ns_,
+                                                   flight_seed);
   layout_ = MakeLayout(options.world);
-  world_ = BuildWorld(options.world, trajectory_->SamplePath(0.1), seed);
+  // The world depends on the world seed and the flight path (features keep
+  // clear of it), which the flight seed does not change.
+  world_ = BuildWorld(options.world, trajectory_->SamplePath(kPathStep),
+                      static_cast<uint64_t>(options.seed));
   scan_count_ = (t_end_ns_ - t0_ns_) / lidar_.period_ns();
-  ImuSimulator imu(*trajectory_, options.imu, seed);
+  ImuSimulator imu(*trajectory_, options.imu, flight_seed);
   while (imu.SampleTime(imu_count_) <= t_end_ns_) ++imu_count_;
 }
 
+StatusOr<SurveyResult> Simulator::Survey() const {
+  const uint64_t seed = static_cast<uint64_t>(options_.seed);
+  if (options_.survey.deformed || options_.world.deformation.amplitude == 0.0)
+    return SurveyWorld(world_, layout_, options_.survey, seed);
+  SimWorldOptions undeformed = options_.world;
+  undeformed.deformation.amplitude = 0.0;
+  const World world = BuildWorld(undeformed, trajectory_->SamplePath(kPathStep), seed);
+  return SurveyWorld(world, layout_, options_.survey, seed);
+}
+
 Scan Simulator::SimulateScan(int64_t k) const {
-  Rng rng =
-      Rng::Stream(static_cast<uint64_t>(options_.seed), kScanStreamBase + static_cast<uint64_t>(k));
+  Rng rng = Rng::Stream(options_.FlightSeed(), kScanStreamBase + static_cast<uint64_t>(k));
   return CastScan(world_, *trajectory_, lidar_, options_.lidar, T_imu_lidar_, ScanStartTime(k),
                   rng);
 }
 
 bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan) const {
-  ImuSimulator imu(*trajectory_, options_.imu, static_cast<uint64_t>(options_.seed));
+  ImuSimulator imu(*trajectory_, options_.imu, options_.FlightSeed());
   int64_t imu_done = 0;
   auto emit_imu_until = [&](TimeNs t_ns) {
     for (; imu_done < imu_count_ && imu.NextTime() <= t_ns; ++imu_done)

@@ -34,6 +34,11 @@ void World::AddCylinder(const Cylinder& cylinder, float reflectivity) {
   finalized_ = false;
 }
 
+void World::DeformFace(int index, const HeightField::Bump& bump) {
+  RVLIO_CHECK(index >= 0 && static_cast<size_t>(index) < faces_.size());
+  faces_[static_cast<size_t>(index)].relief.AddBump(bump);
+}
+
 std::vector<Eigen::AlignedBox3d> World::FeatureBounds() const {
   std::vector<Eigen::AlignedBox3d> out;
   for (const Feature& f : features_)
@@ -136,6 +141,14 @@ double World::DistanceToSurface(const Eigen::Vector3d& p) const {
   for (const Box& b : boxes_) d = std::min(d, b.Distance(p));
   for (const Cylinder& c : cylinders_) d = std::min(d, c.Distance(p));
   return d;
+}
+
+bool World::InsideFeature(const Eigen::Vector3d& p) const {
+  for (const Box& b : boxes_)
+    if (b.Contains(p)) return true;
+  for (const Cylinder& c : cylinders_)
+    if (c.Contains(p)) return true;
+  return false;
 }
 
 }  // namespace rvlio::sim

@@ -103,6 +103,7 @@ class Builder {
       f.holes = holes[side];
       world_.AddFace(std::move(f), 80.f);
     }
+    Deform();
     // Front and back walls (u = y, v = z).
     if (!open) {
       Face f = MakeFace(0, x0, {yc - hw - m, yc + hw + m, zf - m, zc + m}, true);
@@ -115,6 +116,32 @@ class Builder {
       world_.AddFace(std::move(f), 80.f);
     }
     if (backdrop) AddBackdrop(m);
+  }
+
+  // world.deformation on the floor (face 0), ceiling (1), right (2, -y) or
+  // left (3, +y) wall, in that face's (u, v) coordinates and signed towards
+  // the inside. Draws no random number: the rest of the world is unchanged.
+  void Deform() {
+    const SimDeformationOptions& d = o_.deformation;
+    if (d.amplitude == 0.0) return;
+    const bool wall = d.surface == "left" || d.surface == "right";
+    const int face = d.surface == "floor" ? 0 : d.surface == "ceiling" ? 1
+                     : d.surface == "right" ? 2 : 3;
+    const bool inside_is_plus = d.surface == "floor" || d.surface == "right";
+    HeightField::Bump b;
+    b.amplitude = inside_is_plus ? d.amplitude : -d.amplitude;
+    if (wall) {  // u = z (height above the floor), v = x
+      b.u_center = L_.z_floor + d.across_center;
+      b.u_length = d.across_length;
+      b.v_center = d.x_center;
+      b.v_length = d.length;
+    } else {  // u = x, v = y (offset from the centre line)
+      b.u_center = d.x_center;
+      b.u_length = d.length;
+      b.v_center = L_.y_center + d.across_center;
+      b.v_length = d.across_length;
+    }
+    world_.DeformFace(face, b);
   }
 
   // Flat walls kBackdrop outside the hall, seen through its doorways.

@@ -62,6 +62,41 @@ TEST(HeightField, MatchesLibmAndItsGradientMatchesFiniteDifferences) {
   }
 }
 
+// Raised-cosine bumps (deformations) on top of the waves: value, gradient
+// and the bounds the ray caster relies on.
+TEST(HeightField, BumpsAreRaisedCosinesWithinTheirBounds) {
+  Rng rng(5);
+  HeightField hf = HeightField::Random(rng, 3, 0.02, 0.8, 4.0);
+  hf.AddBump({0.05, 1.0, 4.0, -2.0, 0.0});   // uniform in v
+  hf.AddBump({-0.08, -3.0, 2.0, 1.0, 1.5});  // a patch
+  EXPECT_NEAR(hf.amplitude_bound(), 0.02 + 0.05 + 0.08, 1e-12);
+  EXPECT_FALSE(hf.flat());
+  HeightField waves_only = HeightField(hf.waves());
+  // At the first bump's centre, any v: +5 cm; at half its half-length: 2.5 cm.
+  EXPECT_NEAR(hf.Height(1.0, 17.0) - waves_only.Height(1.0, 17.0), 0.05, 1e-15);
+  EXPECT_NEAR(hf.Height(2.0, 17.0) - waves_only.Height(2.0, 17.0), 0.025, 1e-15);
+  EXPECT_EQ(hf.Height(3.0, 17.0), waves_only.Height(3.0, 17.0));
+  EXPECT_NEAR(hf.Height(-3.0, 1.0) - waves_only.Height(-3.0, 1.0), -0.08, 1e-15);
+  double max_slope = 0.0, max_curv = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    const double u = rng.Uniform(-6.0, 6.0), v = rng.Uniform(-3.0, 3.0);
+    double hu = 0, hv = 0;
+    const double h = hf.Height(u, v, &hu, &hv);
+    EXPECT_NEAR(hf.Height(u, v), h, 1e-15);
+    EXPECT_LE(std::abs(h), hf.amplitude_bound() + 1e-15);
+    max_slope = std::max(max_slope, std::hypot(hu, hv));
+    const double e = 1e-5;
+    EXPECT_NEAR(hu, (hf.Height(u + e, v) - hf.Height(u - e, v)) / (2 * e), 1e-7);
+    EXPECT_NEAR(hv, (hf.Height(u, v + e) - hf.Height(u, v - e)) / (2 * e), 1e-7);
+    const double a = rng.Uniform(0, 2 * M_PI), du = std::cos(a), dv = std::sin(a), d = 1e-3;
+    const double second = (hf.Height(u + d * du, v + d * dv) - 2 * h +
+                           hf.Height(u - d * du, v - d * dv)) / (d * d);
+    max_curv = std::max(max_curv, std::abs(second));
+  }
+  EXPECT_LE(max_slope, hf.slope_bound());
+  EXPECT_LE(max_curv, hf.curvature_bound() * 1.001);
+}
+
 // g(t) = signed height of the ray point above the face's surface.
 double Above(const Face& f, const Ray& r, double t) {
   const Eigen::Vector3d p = r.origin + t * r.dir;
@@ -114,6 +149,39 @@ TEST(Face, RoughIntersectionIsTheFirstCrossing) {
   }
   EXPECT_GT(grazing, 400);
   EXPECT_GT(hits, 1500);
+}
+
+// A flat face with a steep bump (a 30 cm bulge over 1 m): rays at every
+// incidence hit the bumped surface, and no crossing comes before the hit.
+TEST(Face, BumpedSurfaceIntersectionIsTheFirstCrossing) {
+  Rng rng(17);
+  Face f;
+  f.axis = 2;
+  f.offset = -1.0;
+  f.bounds = {-1e4, 1e4, -1e4, 1e4};
+  f.relief.AddBump({0.3, 0.0, 1.0, 0.0, 1.0});
+  int hits = 0, on_bump = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    Ray r;
+    r.origin = Eigen::Vector3d(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(-0.6, 1.0));
+    const double el = -std::pow(10.0, rng.Uniform(-2.0, 0.0)) * M_PI / 2;
+    // Aim near the bump so that many rays meet its flanks.
+    const double az = std::atan2(-r.origin.y(), -r.origin.x()) + rng.Uniform(-0.3, 0.3);
+    r.dir = Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    double t = 0;
+    const bool hit = f.Intersect(r, 0.0, 200.0, &t);
+    ASSERT_GT(Above(f, r, 0.0), 0.0);
+    const double end = hit ? t : 200.0;
+    for (double s = 0.001; s < end - 0.002; s += 0.001)
+      ASSERT_GT(Above(f, r, s), 0.0) << "crossing at " << s << " before reported hit " << end;
+    if (!hit) continue;
+    ++hits;
+    EXPECT_LT(std::abs(Above(f, r, t)), 1e-7);
+    const Eigen::Vector3d p = r.origin + t * r.dir;
+    on_bump += std::abs(p.x()) < 0.5 && std::abs(p.y()) < 0.5;
+  }
+  EXPECT_GT(hits, 900);
+  EXPECT_GT(on_bump, 100);
 }
 
 TEST(Face, BoundsAndHolesLetRaysThrough) {

@@ -19,10 +19,12 @@ struct Ray {
 };
 
 // Smooth deterministic displacement h(u, v) = sum_k A_k sin(a_k u + b_k v + phi_k)
-// (m). Its magnitude is bounded by amplitude_bound() = sum |A_k|, its
-// gradient norm by slope_bound() = sum |A_k| |(a_k, b_k)| and its second
-// directional derivative along a unit (u, v) direction by curvature_bound() =
-// sum |A_k| |(a_k, b_k)|^2.
+// + sum_j b_j(u, v) (m): waves plus raised-cosine patches (Bump, a local
+// deformation). Its magnitude is bounded by amplitude_bound() = sum |A_k| +
+// sum |B_j|, its gradient norm by slope_bound() = sum |A_k| |(a_k, b_k)| + ...
+// and its second directional derivative along a unit (u, v) direction by
+// curvature_bound() = sum |A_k| |(a_k, b_k)|^2 + ... (the bumps' terms in
+// AddBump).
 class HeightField {
  public:
   struct Wave {
@@ -30,8 +32,18 @@ class HeightField {
     double ku, kv;     // rad/m
     double phase;      // rad
   };
+  // b(u, v) = amplitude c((u - u_center) / u_length) c((v - v_center) / v_length)
+  // with c(s) = 0.5 (1 + cos(2 pi s)) for |s| < 1/2, else 0; a length of 0
+  // makes c = 1 along that axis (uniform). C1: value and slope vanish at the
+  // edge of the patch.
+  struct Bump {
+    double amplitude = 0.0;          // m, at the centre
+    double u_center = 0.0, u_length = 0.0;  // m (length 0: uniform in u)
+    double v_center = 0.0, v_length = 0.0;  // m (length 0: uniform in v)
+  };
   HeightField() = default;
   explicit HeightField(std::vector<Wave> waves);
+  void AddBump(const Bump& bump);
   // `components` waves with random directions, wavelengths log-uniform in
   // [lambda_min, lambda_max], amplitudes proportional to the wavelength
   // (similar slope per wave) and summing to `amplitude`.
@@ -43,11 +55,16 @@ class HeightField {
   double amplitude_bound() const { return amplitude_bound_; }
   double slope_bound() const { return slope_bound_; }
   double curvature_bound() const { return curvature_bound_; }
-  bool flat() const { return waves_.empty(); }
+  bool flat() const { return waves_.empty() && bumps_.empty(); }
   const std::vector<Wave>& waves() const { return waves_; }
+  const std::vector<Bump>& bumps() const { return bumps_; }
 
  private:
+  // Adds the bumps' value (and gradient when du, dv are given) to *h.
+  void AddBumps(double u, double v, double* h, double* du, double* dv) const;
+
   std::vector<Wave> waves_;
+  std::vector<Bump> bumps_;
   double amplitude_bound_ = 0.0;
   double slope_bound_ = 0.0;
   double curvature_bound_ = 0.0;
@@ -94,6 +111,7 @@ struct Box {
   // inside the box.
   bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
   double Distance(const Eigen::Vector3d& p) const;  // |signed distance|
+  bool Contains(const Eigen::Vector3d& p) const;    // p inside or on the box
   Eigen::AlignedBox3d Bounds() const;
 };
 
@@ -107,6 +125,7 @@ struct Cylinder {
 
   bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
   double Distance(const Eigen::Vector3d& p) const;  // |signed distance|
+  bool Contains(const Eigen::Vector3d& p) const;    // p inside or on the cylinder
   Eigen::AlignedBox3d Bounds() const;
 };
 

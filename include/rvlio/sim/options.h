@@ -15,6 +15,46 @@
 
 namespace rvlio {
 
+// A local deformation of one surface of the shell (a convergence or a
+// bulge): the surface moves by
+//   amplitude * c((x - x_center) / length) * c((a - across_center) / across_length),
+//   c(s) = 0.5 (1 + cos(2 pi s)) for |s| < 1/2, else 0,
+// along its normal, positive towards the inside of the tunnel. x is world x
+// (the tunnel axis, the simulator's chainage); a is the coordinate across the
+// surface: the height above the floor on a wall, the y offset from the centre
+// line on the floor or ceiling; across_length 0 means uniform across the
+// whole surface (a convergence). The raised cosine is smooth (C1), its
+// full width at half amplitude is half its length.
+struct SimDeformationOptions {
+  std::string surface = "left";  // left (+y wall) | right (-y wall) | ceiling | floor
+  double amplitude = 0.0;        // m, towards the inside (0: off; < 0: outwards)
+  double x_center = 30.0;        // m, world x of the centre
+  double length = 10.0;          // m, full extent along x
+  double across_center = 2.0;    // m, height above the floor (walls) / y offset (floor, ceiling)
+  double across_length = 0.0;    // m, full extent across (0: the whole surface)
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("surface", surface,
+            Spec()
+                .Choices({"left", "right", "ceiling", "floor"})
+                .Help("deformed surface: left (+y wall), right (-y wall), ceiling, floor"));
+    v.Field("amplitude", amplitude,
+            Spec().Unit("m").Range(-1.0, 1.0).Help(
+                "displacement at the centre, positive towards the inside (0: off)"));
+    v.Field("x_center", x_center,
+            Spec().Unit("m").Range(-20000.0, 20000.0).Help("world x of the centre"));
+    v.Field("length", length,
+            Spec().Unit("m").Range(0.1, 20000.0).Help("full extent along x (raised cosine)"));
+    v.Field("across_center", across_center,
+            Spec().Unit("m").Range(-200.0, 200.0).Help(
+                "centre across the surface: height above the floor (walls), y offset from the "
+                "centre line (floor, ceiling)"));
+    v.Field("across_length", across_length,
+            Spec().Unit("m").Range(0.0, 400.0).Help("full extent across (0: the whole surface)"));
+  }
+};
+
 // Geometry of the simulated world: a rectangular tunnel (or a closed hall)
 // with rough surfaces, a feature-rich entrance region and sparse features.
 struct SimWorldOptions {
@@ -38,6 +78,7 @@ struct SimWorldOptions {
   double pillar_spacing = 0.0;   // m, grid of floor-to-ceiling pillars (0: none; hall)
   int openings = 0;              // doorways in the hall walls (hall only)
   bool stairs = false;           // a flight of stairs along a wall (hall only)
+  SimDeformationOptions deformation;  // a convergence or bulge of one surface (default off)
 
   template <class V>
   void Visit(V& v) {
@@ -72,6 +113,7 @@ struct SimWorldOptions {
             Spec().Unit("m").Range(0.0, 1000.0).Help("pillar grid spacing (0: none)"));
     v.Field("openings", openings, Spec().Range(0, 32).Help("doorways in the hall walls"));
     v.Field("stairs", stairs, Spec().Help("a flight of stairs (hall)"));
+    v.Section("deformation", deformation);
   }
 };
 
@@ -193,8 +235,53 @@ struct SimTrajectoryOptions {
   }
 };
 
+// A static terrestrial laser-scanner survey of the world (the reference map
+// of `rvlio simulate --reference-map`, sim/survey.h): stations along the
+// tunnel's centre line, dense rays over the full sphere from each, range
+// noise, the union thinned to one real point per voxel.
+struct SimSurveyOptions {
+  bool enabled = false;          // write the reference map
+  bool deformed = false;         // survey the deformed world (default: world.deformation ignored)
+  double station_spacing = 5.0;  // m along x between stations (at most)
+  double station_height = 1.5;   // m above the floor (raised in 0.5 m steps where a feature is)
+  double angular_step = 0.3;     // deg between neighbouring rays (both directions)
+  double range_noise = 0.002;    // m, std of the Gaussian range noise
+  double min_range = 0.5;        // m
+  double max_range = 30.0;       // m
+  double voxel_size = 0.05;      // m, one point per voxel in the map
+  double x_min = -1.0e4;         // m, world x range of stations and points (crop)
+  double x_max = 1.0e4;          // m
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("enabled", enabled, Spec().Help("write DIR/reference_map.pcd (--reference-map)"));
+    v.Field("deformed", deformed,
+            Spec().Help("the survey sees world.deformation (default: the undeformed world)"));
+    v.Field("station_spacing", station_spacing,
+            Spec().Unit("m").Range(0.5, 1000.0).Help("largest distance between stations along x"));
+    v.Field("station_height", station_height,
+            Spec().Unit("m").Range(0.1, 100.0).Help("scanner height above the floor"));
+    v.Field("angular_step", angular_step,
+            Spec().Unit("deg").Range(0.02, 5.0).Help("angle between neighbouring rays"));
+    v.Field("range_noise", range_noise,
+            Spec().Unit("m").Range(0.0, 0.1).Help("range noise std of the scanner"));
+    v.Field("min_range", min_range, Spec().Unit("m").Range(0.0, 100.0));
+    v.Field("max_range", max_range, Spec().Unit("m").Range(1.0, 2000.0));
+    v.Field("voxel_size", voxel_size,
+            Spec().Unit("m").Range(0.005, 1.0).Help("map thinning: one point per voxel"));
+    v.Field("x_min", x_min,
+            Spec().Unit("m").Range(-1.0e5, 1.0e5).Help("survey only world x >= x_min (crop)"));
+    v.Field("x_max", x_max,
+            Spec().Unit("m").Range(-1.0e5, 1.0e5).Help("survey only world x <= x_max (crop)"));
+  }
+};
+
 struct SimOptions {
-  int64_t seed = 1;           // every random choice derives from it
+  int64_t seed = 1;           // world seed: every random choice of the world derives from it
+  // The flight's seed (trajectory yaw/sway phases, IMU noise and bias walk,
+  // LiDAR noise and dropout); -1: the world seed. A second flight through the
+  // same world keeps `seed` and changes this one.
+  int64_t flight_seed = -1;
   double duration = 50.0;     // s of data
   double start_time = 1.7e9;  // s, absolute time of the first sample (ROS stamps)
   SimWorldOptions world;
@@ -202,10 +289,14 @@ struct SimOptions {
   SimImuOptions imu;
   SimTrajectoryOptions trajectory;
   ExtrinsicsSection extrinsics = DefaultExtrinsics();  // LiDAR pose in the IMU frame
+  SimSurveyOptions survey;
 
   template <class V>
   void Visit(V& v) {
-    v.Field("seed", seed, Spec().Min(0).Help("random seed"));
+    v.Field("seed", seed, Spec().Min(0).Help("random seed (the world's; the flight's by default)"));
+    v.Field("flight_seed", flight_seed,
+            Spec().Min(-1).Help("seed of the flight: trajectory motion, IMU and LiDAR noise "
+                                "(-1: seed); the world stays that of seed"));
     v.Field("duration", duration, Spec().Unit("s").Range(0.2, 36000.0));
     v.Field("start_time", start_time,
             Spec().Unit("s").Range(1.0, 4.0e9).Help("absolute time of the first sample"));
@@ -214,6 +305,12 @@ struct SimOptions {
     v.Section("imu", imu);
     v.Section("trajectory", trajectory);
     v.Section("extrinsics", extrinsics);
+    v.Section("survey", survey);
+  }
+
+  // The seed of the flight: flight_seed, or seed when flight_seed is -1.
+  uint64_t FlightSeed() const {
+    return static_cast<uint64_t>(flight_seed >= 0 ? flight_seed : seed);
   }
 
   // Ranges of every key, then the cross-field rules (src/sim/options.cpp).

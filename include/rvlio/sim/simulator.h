@@ -7,6 +7,10 @@
 // options.start_time; IMU samples every 1/imu.rate; scans start on the fixed
 // grid t0 + k / lidar.rate and are emitted after every IMU sample up to their
 // end (start + period). Only whole scans within [t0, t0 + duration] are made.
+//
+// Seeds: the world (shell relief, features) comes from options.seed; the
+// flight (yaw and sway phases, IMU noise, LiDAR noise) from
+// options.FlightSeed(), which is the world seed unless flight_seed is set.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -16,6 +20,7 @@
 #include "rvlio/math/pose.h"
 #include "rvlio/sim/lidar_sim.h"
 #include "rvlio/sim/options.h"
+#include "rvlio/sim/survey.h"
 #include "rvlio/sim/trajectory.h"
 #include "rvlio/sim/world.h"
 #include "rvlio/sim/world_builder.h"
@@ -35,6 +40,10 @@ class Simulator {
   bool Run(const ImuCallback& on_imu, const ScanCallback& on_scan) const;
   // Scan k alone (the same as the k-th scan of Run; noise from its own stream).
   Scan SimulateScan(int64_t k) const;
+  // The reference map (options().survey): a static survey of the world,
+  // undeformed unless survey.deformed. Depends on the world seed only, not on
+  // the flight seed. InvalidInput when the crop leaves nothing to survey.
+  StatusOr<SurveyResult> Survey() const;
 
   TruthState TruthAt(TimeNs t_ns) const { return trajectory_->At(t_ns); }
   // T_world_imu from t0 to t0 + duration every 1/rate_hz s.

@@ -27,6 +27,8 @@ class World {
   void AddFace(Face face, float reflectivity);
   void AddBox(const Box& box, float reflectivity);
   void AddCylinder(const Cylinder& cylinder, float reflectivity);
+  // Adds a raised-cosine patch to the relief of face `index` (a deformation).
+  void DeformFace(int index, const HeightField::Bump& bump);
   // Builds the feature buckets; call after the last Add*, before Raycast.
   void Finalize(double bucket_size = 1.0);
 
@@ -35,6 +37,8 @@ class World {
                RayHit* hit) const;
   // Distance from p to the nearest surface of any shape (m).
   double DistanceToSurface(const Eigen::Vector3d& p) const;
+  // True when p lies inside a box or cylinder.
+  bool InsideFeature(const Eigen::Vector3d& p) const;
 
   const std::vector<Face>& faces() const { return faces_; }
   const std::vector<Box>& boxes() const { return boxes_; }
