@@ -73,6 +73,7 @@ int Summarize(const ablate::Plan& plan, const Args& args) {
     std::printf("rvlio ablate: %d cells diverged (status diverged in summary.csv; left out of the "
                 "means)\n", r->diverged);
   std::printf("rvlio ablate: %s\n", r->plot_note.c_str());
+  WriteFolderReport(kName, plan.out_dir, false);
   return 0;
 }
 

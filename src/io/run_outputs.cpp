@@ -74,51 +74,91 @@ Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& 
 
 namespace {
 
-// The header of a map.pcd up to "DATA binary": the point count, or -1 when
-// the fields are not x y z float32.
-int64_t ParseMapPcdHeader(std::istream& in) {
+// The header of a map.pcd up to "DATA binary": the point count and the names
+// of its fields (x y z first, then any extra ones), or points -1 when it is not
+// a binary PCD of float32 fields starting with x y z.
+struct MapPcdHeader {
+  int64_t points = -1;
+  std::vector<std::string> fields;
+};
+
+std::vector<std::string> Words(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> words;
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+MapPcdHeader ParseMapPcdHeader(std::istream& in) {
+  MapPcdHeader header;
   std::string line;
   int64_t points = -1;
-  bool xyz = false, floats = false, sizes = false;
+  std::vector<std::string> fields, sizes, types, counts;
   while (std::getline(in, line)) {
-    std::istringstream fields(line);
+    std::istringstream words(line);
     std::string key, rest;
-    fields >> key;
+    words >> key;
+    std::getline(words, rest);
     if (key == "POINTS") {
-      if (!(fields >> points) || points < 0) return -1;
-      continue;
+      std::istringstream n(rest);
+      if (!(n >> points) || points < 0) return header;
     }
-    std::getline(fields, rest);
-    if (key == "FIELDS") xyz = rest == " x y z";
-    if (key == "SIZE") sizes = rest == " 4 4 4";
-    if (key == "TYPE") floats = rest == " F F F";
-    if (key == "DATA") return rest == " binary" && xyz && sizes && floats ? points : -1;
+    if (key == "FIELDS") fields = Words(rest);
+    if (key == "SIZE") sizes = Words(rest);
+    if (key == "TYPE") types = Words(rest);
+    if (key == "COUNT") counts = Words(rest);
+    if (key != "DATA") continue;
+    const bool xyz = fields.size() >= 3 && fields[0] == "x" && fields[1] == "y" && fields[2] == "z";
+    bool floats = xyz && sizes.size() == fields.size() && types.size() == fields.size();
+    for (size_t i = 0; floats && i < fields.size(); ++i)
+      floats = sizes[i] == "4" && types[i] == "F" && (counts.size() <= i || counts[i] == "1");
+    if (Words(rest) == std::vector<std::string>{"binary"} && floats) {
+      header.points = points;
+      header.fields = fields;
+    }
+    return header;
   }
-  return -1;
+  return header;
 }
 
 }  // namespace
 
-StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path) {
+StatusOr<MapCloud> ReadMapCloud(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::InvalidInput(path + ": cannot open");
-  const int64_t n = ParseMapPcdHeader(in);
-  if (n < 0)
-    return Status::InvalidInput(path + ": not a binary x y z float32 PCD as rvlio writes them");
-  float xyz[3];
+  const MapPcdHeader header = ParseMapPcdHeader(in);
+  if (header.points < 0)
+    return Status::InvalidInput(path + ": not a binary PCD of float32 fields x y z [...] as rvlio "
+                                "writes them");
+  const int64_t n = header.points;
+  const size_t stride = header.fields.size();
   const std::streamoff data_begin = in.tellg();
   in.seekg(0, std::ios::end);
-  const std::streamoff bytes = in.tellg() - data_begin;
+  const std::streamoff row_bytes = static_cast<std::streamoff>(stride * sizeof(float));
+  const std::streamoff rows = (in.tellg() - data_begin) / row_bytes;
   in.seekg(data_begin);
-  if (bytes / static_cast<std::streamoff>(sizeof(xyz)) < n)
-    return Status::InvalidInput(path + ": holds " + std::to_string(bytes / sizeof(xyz)) +
-                                " of its " + std::to_string(n) + " points");
-  std::vector<Eigen::Vector3d> p_world(static_cast<size_t>(n));
+  if (rows < n)
+    return Status::InvalidInput(path + ": holds " + std::to_string(rows) + " of its " +
+                                std::to_string(n) + " points");
+  MapCloud cloud;
+  cloud.p_world.resize(static_cast<size_t>(n));
+  for (size_t f = 3; f < stride; ++f)
+    cloud.fields.emplace_back(header.fields[f], std::vector<float>(static_cast<size_t>(n)));
+  std::vector<float> row(stride);
   for (int64_t i = 0; i < n; ++i) {
-    in.read(reinterpret_cast<char*>(xyz), sizeof(xyz));
-    p_world[i] = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+    in.read(reinterpret_cast<char*>(row.data()), row_bytes);
+    cloud.p_world[i] = Eigen::Vector3d(row[0], row[1], row[2]);
+    for (size_t f = 3; f < stride; ++f) cloud.fields[f - 3].second[i] = row[f];
   }
-  return p_world;
+  return cloud;
+}
+
+StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path) {
+  StatusOr<MapCloud> cloud = ReadMapCloud(path);
+  if (!cloud.ok()) return cloud.status();
+  if (!cloud->fields.empty())
+    return Status::InvalidInput(path + ": not a binary x y z float32 PCD as rvlio writes them");
+  return std::move(cloud->p_world);
 }
 
 namespace {

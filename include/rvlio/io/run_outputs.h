@@ -1,6 +1,7 @@
 #pragma once
 // The files `rvlio run` writes (docs/design.md section 7), each atomically.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -16,6 +17,17 @@ Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& 
 // Reads a map WriteMapPcd wrote (binary, fields x y z float32, one row per
 // point). InvalidInput naming the file for anything else, or a short file.
 StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
+
+// A map.pcd with per-point float32 fields after x y z (e.g. `deviation_m`,
+// the distance to a reference map), in the file's order.
+struct MapCloud {
+  std::vector<Eigen::Vector3d> p_world;
+  std::vector<std::pair<std::string, std::vector<float>>> fields;  // name, one value per point
+};
+// Reads a binary PCD whose fields are all float32, x y z first (what
+// WriteMapPcd writes, optionally with extra fields). InvalidInput naming the
+// file for anything else, or a short file.
+StatusOr<MapCloud> ReadMapCloud(const std::string& path);
 
 // One row per scan: time, status, point and constraint counts, the RV report,
 // the processing time and `rss_mb[i]`, the process's resident memory (MB) when
