@@ -51,7 +51,7 @@ var RvlioReport = (function () {
   }
 
   // series: [{x: Float32Array, y: Float32Array, color, width, dash, step}]
-  // opts: {equal: bool (same scale on both axes), xlabel, ylabel}
+  // opts: {xlabel, ylabel}
   function linePlot(canvas, series, opts) {
     var ctx = canvas.getContext("2d");
     var W = canvas.width, H = canvas.height, L = 58, R = 12, T = 12, B = 36;
@@ -61,11 +61,6 @@ var RvlioReport = (function () {
     var pad = function (r) { var d = 0.04 * (r[1] - r[0]); return [r[0] - d, r[1] + d]; };
     xr = pad(xr); yr = pad(yr);
     var pw = W - L - R, ph = H - T - B;
-    if (opts.equal) {  // metres on both axes: one scale, centred
-      var s = Math.max((xr[1] - xr[0]) / pw, (yr[1] - yr[0]) / ph);
-      var xc = 0.5 * (xr[0] + xr[1]), yc = 0.5 * (yr[0] + yr[1]);
-      xr = [xc - 0.5 * s * pw, xc + 0.5 * s * pw]; yr = [yc - 0.5 * s * ph, yc + 0.5 * s * ph];
-    }
     var X = function (v) { return L + (v - xr[0]) / (xr[1] - xr[0]) * pw; };
     var Y = function (v) { return T + ph - (v - yr[0]) / (yr[1] - yr[0]) * ph; };
     ctx.font = "11px sans-serif"; ctx.strokeStyle = "#e4e4e4"; ctx.fillStyle = "#444"; ctx.lineWidth = 1;
@@ -157,9 +152,9 @@ var RvlioReport = (function () {
       legend.appendChild(sp);
     });
     document.getElementById("trajectory-caption").textContent = model.gt
-      ? "Estimates aligned to the ground truth (" + model.gt.file + ") as rvlio eval aligns them."
+      ? "Estimates aligned to the ground truth (" + model.gt.file + ") as rvlio eval aligns them. The top view scales its axes separately, so sideways error shows in a long tunnel."
       : "No ground truth: estimates in their own world frame; no along-axis error.";
-    linePlot(document.getElementById("topview"), top, {equal: true, xlabel: "x [m]", ylabel: "y [m]"});
+    linePlot(document.getElementById("topview"), top, {xlabel: "x [m]", ylabel: "y [m]"});
     linePlot(document.getElementById("axiserror"), axis, {xlabel: "t [s]", ylabel: "along-axis error [m]"});
   }
 

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -63,8 +64,8 @@ BrowserRun RunChromium(const std::vector<std::string>& extra, const std::string&
                                    "--disable-background-networking", "--disable-component-update",
                                    "--disable-sync", "--user-data-dir=" + profile,
                                    "--enable-logging=stderr", "--v=0",
-                                   "--enable-unsafe-swiftshader", "--use-angle=swiftshader",
-                                   kWindowSize};
+                                   // WebGL without a GPU: software rendering (SwiftShader)
+                                   "--enable-unsafe-swiftshader", kWindowSize};
   args.insert(args.end(), extra.begin(), extra.end());
   const std::string out = scratch + "/" + tag + ".out", err = scratch + "/" + tag + ".err";
   posix_spawn_file_actions_t actions;
@@ -225,10 +226,14 @@ TEST(ReportBrowserTest, PageLoadsWithoutConsoleErrorsDrawsTheMapAndHoldsTheRunsF
       RunChromium({"--screenshot=" + shot, "file://" + page}, dir, "shot");
   ASSERT_FALSE(shot_run.timed_out);
   ASSERT_EQ(shot_run.exit_code, 0) << shot_run.err;
+  // chromium logs every console message (log, warning, error, an uncaught
+  // exception) as an INFO:CONSOLE line; the page writes none. The one line
+  // allowed is the software GL driver's note on reading pixels back.
   for (const BrowserRun* r : {&dom_run, &shot_run}) {
-    std::smatch m;
-    EXPECT_FALSE(std::regex_search(r->err, m, std::regex(R"(CONSOLE.*(rror|Uncaught|arning))")))
-        << m.str(0);
+    std::istringstream lines(r->err);
+    for (std::string line; std::getline(lines, line);)
+      if (line.find(":CONSOLE") != std::string::npos)
+        EXPECT_NE(line.find("GL Driver Message"), std::string::npos) << line;
   }
   const std::string rect = Attribute(dom, "data-rect");  // x,y,width,height of the map's canvas
   int x0 = 0, y0 = 0, w = 0, h = 0;
