@@ -2,7 +2,6 @@
 // ablate or run folder (docs/report.md). compare, demo and ablate call
 // WriteFolderReport at their end.
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 
 #include "cli.h"
@@ -13,7 +12,7 @@ namespace rvlio::cli {
 namespace {
 
 constexpr const char* kName = "report";
-constexpr size_t kMaxPointsLimit = 50000000;
+constexpr long long kMaxPointsLimit = 50000000;
 
 CommandSpec ReportSpec() {
   return {kName,
@@ -28,9 +27,8 @@ CommandSpec ReportSpec() {
 int ReadMaxPoints(const Args& args, size_t* max_points) {
   if (!args.Has("max-points")) return 0;
   const std::string text = args.Get("max-points");
-  char* end = nullptr;
-  const long long v = std::strtoll(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || v < 1 || v > static_cast<long long>(kMaxPointsLimit))
+  long long v = 0;
+  if (!ParseWholeNumber(text, 1, kMaxPointsLimit, &v))
     return Fail(kName, "--max-points '" + text + "' is not a whole number in [1, " +
                            std::to_string(kMaxPointsLimit) + "]");
   *max_points = static_cast<size_t>(v);

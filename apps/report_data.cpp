@@ -242,7 +242,11 @@ StatusOr<Collected> CollectCompare(const std::string& dir, FolderKind kind) {
     if (status == "ok") ranked.emplace_back(name, Metric(v, "ate_rmse_m"));
   }
   c.gt = Resolve(j.value("gt", ""), recorded_out, dir);
-  c.table = TableJson(rows, {"label", "status"}, {"eval", "overrides"});
+  // compare's own metrics first, in its table's order; any other column after.
+  c.table = TableJson(rows,
+                      {"label", "status", "ate_rmse_m", "rpe_rmse_m", "axis_max_m", "end_point_m",
+                       "ms_per_scan", "real_time_factor"},
+                      {"eval", "overrides"});
   // refine is what compare recommends when it ran cleanly; else the best ATE.
   for (const RunEntry& r : c.runs)
     if (r.name == "refine" && r.status == "ok") c.map_run = r.name;

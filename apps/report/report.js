@@ -114,20 +114,33 @@ var RvlioReport = (function () {
     return v.toFixed(a >= 100 ? 1 : 4);
   }
 
+  function valueCell(v, column) {
+    var td = el("td", {"data-column": column}, fmtValue(v));
+    if (typeof v === "number") td.setAttribute("data-value", String(v));
+    else td.className = "text";
+    return td;
+  }
+
+  // One row per variant or cell; a single row (a run folder) is shown
+  // transposed, one line per column.
   function drawTable(table) {
     var t = document.getElementById("metrics");
+    if (table.rows.length === 1) {
+      table.columns.forEach(function (c, i) {
+        var tr = el("tr");
+        tr.appendChild(el("th", {}, c));
+        tr.appendChild(valueCell(table.rows[0][i], c));
+        t.appendChild(tr);
+      });
+      return;
+    }
     var head = el("tr");
     table.columns.forEach(function (c) { head.appendChild(el("th", {}, c)); });
     t.appendChild(head);
     var status = table.columns.indexOf("status");
     table.rows.forEach(function (row) {
       var tr = el("tr", status >= 0 ? {"class": String(row[status])} : {});
-      row.forEach(function (v, i) {
-        var td = el("td", {"data-column": table.columns[i]}, fmtValue(v));
-        if (typeof v === "number") td.setAttribute("data-value", String(v));
-        else td.className = "text";
-        tr.appendChild(td);
-      });
+      row.forEach(function (v, i) { tr.appendChild(valueCell(v, table.columns[i])); });
       t.appendChild(tr);
     });
   }
