@@ -16,9 +16,10 @@ constexpr long long kMaxPointsLimit = 50000000;
 
 CommandSpec ReportSpec() {
   return {kName,
-          "DIR first: rvlio report DIR [options]. Writes DIR/report.html, one page that opens offline in a browser: the trajectories\n"
-          "over the ground truth, the RV activity and health per scan, the map as a 3D point\n"
-          "cloud and the table of metrics. DIR is a compare, demo, ablate or run output folder.",
+          "The folder comes first: rvlio report DIR [options]. Writes DIR/report.html, one\n"
+          "page that opens offline in a browser: the trajectories over the ground truth, the\n"
+          "RV activity and health per scan, the map as a 3D point cloud and the table of\n"
+          "metrics. DIR is a compare, demo, ablate or run output folder.",
           {{"out", "FILE", "write the page here instead of DIR/report.html"},
            {"gt", "FILE", "ground truth for a run folder (TUM or KITTI; compare/ablate know theirs)"},
            {"max-points", "N", "map points embedded at most (default 1000000; more are thinned)"}}};

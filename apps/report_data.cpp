@@ -111,13 +111,13 @@ json ScansJson(const ScanTable& scans, double t0_s) {
   if (t == nullptr) return nullptr;
   std::vector<float> times;
   for (double v : *t) times.push_back(ToFloat(v - t0_s));
-  json columns = json::object();
+  json columns = json::array();  // in PlottedScanColumns' order
   for (const std::string& name : PlottedScanColumns()) {
     const std::vector<double>* c = scans.Find(name);
     if (c == nullptr) continue;
     std::vector<float> values;
     for (double v : *c) values.push_back(ToFloat(v));
-    columns[name] = ReportArray(values);
+    columns.push_back({{"name", name}, {"values", ReportArray(values)}});
   }
   return {{"t", ReportArray(times)}, {"n", times.size()}, {"columns", columns}};
 }
@@ -138,6 +138,7 @@ json RunJson(const RunEntry& run, const Trajectory* truth, double t0_s,
     j["axis_error"] = {{"t", ReportArray(aligned->axis_t)},
                        {"err", ReportArray(aligned->axis_err_m)},
                        {"n", aligned->axis_t.size()}};
+  if (!IsFile(run.dir + "/scans.csv")) return j;  // refine writes none
   if (StatusOr<ScanTable> scans = ReadScanTable(run.dir + "/scans.csv"); scans.ok())
     j["scans"] = ScansJson(*scans, t0_s);
   else

@@ -182,11 +182,12 @@ var RvlioReport = (function () {
       var r = runs[Number(select.value)], box = document.getElementById("scan-panels");
       box.innerHTML = "";
       var t = decode(r.scans.t);
-      Object.keys(r.scans.columns).forEach(function (name) {
+      r.scans.columns.forEach(function (column) {
+        var name = column.name;
         var fig = el("figure"), c = el("canvas", {width: "420", height: "180", "data-column": name});
         fig.appendChild(c); fig.appendChild(el("figcaption", {}, name)); box.appendChild(fig);
         var step = name === "rv_active" || name === "diverged" || name === "localized";
-        linePlot(c, [{x: t, y: decode(r.scans.columns[name]), color: "#1f77b4", step: step}], {xlabel: "t [s]"});
+        linePlot(c, [{x: t, y: decode(column.values), color: "#1f77b4", step: step}], {xlabel: "t [s]"});
       });
       document.getElementById("scan-caption").textContent = r.scans.n + " scans (columns of its scans.csv)";
     };

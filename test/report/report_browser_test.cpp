@@ -231,9 +231,11 @@ TEST(ReportBrowserTest, PageLoadsWithoutConsoleErrorsDrawsTheMapAndHoldsTheRunsF
   // allowed is the software GL driver's note on reading pixels back.
   for (const BrowserRun* r : {&dom_run, &shot_run}) {
     std::istringstream lines(r->err);
-    for (std::string line; std::getline(lines, line);)
-      if (line.find(":CONSOLE") != std::string::npos)
+    for (std::string line; std::getline(lines, line);) {
+      if (line.find(":CONSOLE") != std::string::npos) {
         EXPECT_NE(line.find("GL Driver Message"), std::string::npos) << line;
+      }
+    }
   }
   const std::string rect = Attribute(dom, "data-rect");  // x,y,width,height of the map's canvas
   int x0 = 0, y0 = 0, w = 0, h = 0;

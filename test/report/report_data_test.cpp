@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -182,11 +183,17 @@ TEST_F(ReportDataTest, RunFolderWithDeviationIsThinnedAndColouredByDeviation) {
   for (float e : err) EXPECT_NEAR(e, 0.0f, 1e-5f);
   EXPECT_EQ(DecodeArray(run["trajectory"]["t"]).back(), 10.0f);  // seconds from the first GT pose
   // scans.csv: the plotted columns present in the file, diverged as 0/1, empty as NaN.
-  const json& cols = run["scans"]["columns"];
-  EXPECT_EQ(DecodeArray(cols["rv_active"]), (std::vector<float>{0.0f, 1.0f}));
-  EXPECT_EQ(DecodeArray(cols["diverged"]), (std::vector<float>{0.0f, 1.0f}));
-  EXPECT_TRUE(std::isnan(DecodeArray(cols["nis"])[1]));
-  EXPECT_FALSE(cols.contains("status"));
+  std::map<std::string, std::vector<float>> cols;
+  std::vector<std::string> order;
+  for (const json& c : run["scans"]["columns"]) {
+    order.push_back(c["name"]);
+    cols[c["name"]] = DecodeArray(c["values"]);
+  }
+  EXPECT_EQ(order, (std::vector<std::string>{"rv_active", "coplanar_fraction", "nis",
+                                             "residual_rms_m", "diverged"}));
+  EXPECT_EQ(cols["rv_active"], (std::vector<float>{0.0f, 1.0f}));
+  EXPECT_EQ(cols["diverged"], (std::vector<float>{0.0f, 1.0f}));
+  EXPECT_TRUE(std::isnan(cols["nis"][1]));
   // The table: the summary's numbers (nested one level), the eval metrics, no config.
   const json& table = (*m)["table"];
   const std::vector<std::string> columns = table["columns"];
