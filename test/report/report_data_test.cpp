@@ -228,6 +228,7 @@ TEST_F(ReportDataTest, RunWithoutDeviationIsColouredByHeightAndBadGtIsInvalidInp
 // (paths in compare.json relative to that one), with a map column compare
 // does not have today.
 TEST_F(ReportDataTest, CompareFolderShowsEveryVariantAndAnyMetricColumn) {
+  fs::create_directories(Path("cmp/data"));
   ASSERT_TRUE(WriteTum(Path("cmp/data/gt.tum"), Straight(0.0)).ok());
   WriteRun("cmp/ieskf_rv_on", Straight(0.02), 20, false);
   WriteRun("cmp/refine", Straight(0.0), 20, false);
