@@ -1,6 +1,8 @@
 #include "cli.h"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 namespace rvlio::cli {
@@ -81,4 +83,13 @@ int EngineComesLater(const CommandSpec& spec, int argc, char** argv, const std::
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   return Fail(spec.name, "this build has no " + what + " yet; it lands with a later issue", 2);
 }
+bool ParseWholeNumber(const std::string& text, long long min, long long max, long long* value) {
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno != 0 || v < min || v > max) return false;
+  *value = v;
+  return true;
+}
+
 }  // namespace rvlio::cli

@@ -36,6 +36,10 @@ class Args {
 int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out);
 void PrintUsage(const CommandSpec& spec);
 
+// The whole number written in `text` (decimal, nothing else) when it lies in
+// [min, max]; false otherwise, `value` untouched.
+bool ParseWholeNumber(const std::string& text, long long min, long long max, long long* value);
+
 // One-line error on stderr in the contract's form: "rvlio CMD: error: MSG".
 int Fail(const std::string& command, const std::string& message, int exit_code = 2);
 

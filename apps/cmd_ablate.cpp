@@ -54,9 +54,8 @@ int ReadJobs(const Args& args, int* jobs) {
   *jobs = 1;
   if (!args.Has("jobs")) return 0;
   const std::string text = args.Get("jobs");
-  char* end = nullptr;
-  const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || v < 1 || v > kMaxJobs)
+  long long v = 0;
+  if (!ParseWholeNumber(text, 1, kMaxJobs, &v))
     return Fail(kName, "--jobs '" + text + "' is not a whole number in [1, " +
                            std::to_string(kMaxJobs) + "]");
   *jobs = static_cast<int>(v);
@@ -73,6 +72,7 @@ int Summarize(const ablate::Plan& plan, const Args& args) {
     std::printf("rvlio ablate: %d cells diverged (status diverged in summary.csv; left out of the "
                 "means)\n", r->diverged);
   std::printf("rvlio ablate: %s\n", r->plot_note.c_str());
+  WriteFolderReport(kName, plan.out_dir, false);
   return 0;
 }
 

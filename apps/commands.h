@@ -1,6 +1,8 @@
 #pragma once
 // The subcommands of docs/design.md section 7. Each returns the process exit
 // status: 0 success, 2 bad input or configuration, 1 internal failure.
+#include <string>
+
 namespace rvlio::cli {
 
 int CmdRun(int argc, char** argv);
@@ -12,5 +14,10 @@ int CmdCompare(int argc, char** argv);
 int CmdAblate(int argc, char** argv);
 int CmdInfo(int argc, char** argv);
 int CmdDemo(int argc, char** argv);
+int CmdReport(int argc, char** argv);
+
+// Writes DIR/report.html for the folder `command` just wrote (compare, demo,
+// ablate); a failure is a warning line, never the command's failure.
+void WriteFolderReport(const std::string& command, const std::string& dir, bool quiet);
 
 }  // namespace rvlio::cli

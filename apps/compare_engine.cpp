@@ -649,6 +649,7 @@ int RunCompare(const CompareRequest& req) {
   std::printf("\n  tables: %s/compare.{csv,md,json}; runs: %s/<variant>/\n", req.out_dir.c_str(),
               req.out_dir.c_str());
   if (req.plots) PrintPlotReport(req, plots);
+  WriteFolderReport(kName, req.out_dir, req.quiet);
   int diverged = 0;
   for (const Row& r : rows) diverged += r.diverged ? 1 : 0;
   if (!any_ok && diverged > 0)

@@ -14,16 +14,18 @@ packages=(
   pluginlib-dev libclass-loader-dev librcpputils-dev libament-index-cpp-dev
   python3-rosbag python3-matplotlib python3-yaml
   libtbb-dev pybind11-dev python3-dev python3-numpy
+  libjs-three
 )
 # Extra packages the test command needs (Snakemake workflow test; clang with
 # the libFuzzer/ASan runtimes and llvm-symbolizer for scripts/fuzz.sh — gcc's
 # ASan/UBSan runtimes for scripts/sanitize.sh come with build-essential; a
 # Slurm controller, node daemon, client and munge for scripts/slurm_local.sh;
 # GNU time for the peak memory of scripts/refine_scaling.sh; scipy for the
-# independent check of the map metrics in python/tests/test_evaluate_map.py).
+# independent check of the map metrics in python/tests/test_evaluate_map.py;
+# chromium for the headless browser test of report.html).
 if [[ "${1:-}" == "--with-test-tools" ]]; then
   packages+=(python3-pytest python3-scipy snakemake clang-14 libclang-rt-14-dev llvm-14 munge slurmctld slurmd slurm-client)
-  packages+=(time)
+  packages+=(time chromium)
 fi
 
 missing=()

@@ -19,6 +19,7 @@
 #   5. the installed `rvlio simulate` and `rvlio run` give run_recording's
 #      recording, trajectory, map and per-scan table byte for byte (the
 #      command is that API)
+#   6. the installed `rvlio report` writes a self-contained page for that run
 #
 # P is removed at the end, also on failure. Prints "ok - ..." / "FAIL - ..."
 # per check and ends with "install: N passed, M failed"; exit 1 on a failure.
@@ -159,6 +160,15 @@ cli_simulate_equals_api() {
 check "the installed rvlio simulate writes run_recording's bag, ground truth and sensor config byte for byte" \
   cli_simulate_equals_api
 check "the installed rvlio run writes run_recording's trajectory.tum, map.pcd and scans.csv (but timings) byte for byte" cli_equals_api
+# 6. the installed report carries its page, script and three.js (compiled in)
+cli_report_self_contained() {
+  "$prefix/bin/rvlio" report "$work/cli" --gt "$work/api/data/tunnel_gt.tum" --out "$work/report.html" >&2 ||
+    return 1
+  grep -q 'REVISION' "$work/report.html" && grep -q 'RvlioReport' "$work/report.html" &&
+    ! grep -q '@RVLIO_' "$work/report.html"
+}
+check "the installed rvlio report writes a self-contained report.html (three.js and its script inlined)" \
+  cli_report_self_contained
 
 echo "install: prefix $(du -sh "$prefix" | cut -f1) ($(du -sh "$prefix/lib" | cut -f1) in lib)"
 echo "install: $passed passed, $failed failed"

@@ -39,7 +39,9 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # on every storage, one divergence detection, one refine interruption, one
 # compare with a failing variant. PlotScriptTest runs Python only. The refine
 # memory bound measures a Release build's peak (ASan's shadow memory is not
-# ours); the chunk jobs' bad-input and partial-init cases stay.
+# ours); the chunk jobs' bad-input and partial-init cases stay. The report's
+# browser test runs chromium, not our code, once the page is written (its data
+# extraction stays here: ReportDataTest, ReportArrayTest, ...).
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -75,6 +77,7 @@ ex=(
   RefineSignalsTest.KilledAfterARoundThenResumedEqualsTheUninterruptedResult
   RefineMemory.PeakPerScanOfA400ScanRefineStaysBounded
   RefineChunksCliTest.MergedChunksAgreeWithTheWholeRefineHaveNoBorderStepsAndRefuseBadSets
+  'ReportBrowserTest\..*'
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

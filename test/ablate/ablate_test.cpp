@@ -340,6 +340,17 @@ void CheckTable(const json& plan, const std::string& out) {
   EXPECT_EQ(broken->at("ate_rmse_mean"), "");
   EXPECT_EQ(ReadCsv(out + "/summary.csv").size(), 6u);
   EXPECT_NE(ReadFile(out + "/table.md").find("| tunnel | rv_on | 2 | 0 |"), std::string::npos);
+  // report.html (docs/report.md): the page's data holds one table row per cell.
+  const std::string report = ReadFile(out + "/report.html");
+  const std::string open = "<script id=\"rvlio-data\" type=\"application/json\">";
+  const size_t begin = report.find(open);
+  ASSERT_NE(begin, std::string::npos);
+  const json page = json::parse(report.substr(begin + open.size(),
+                                              report.find("</script>", begin) - begin - open.size()),
+                                nullptr, false);
+  ASSERT_TRUE(page.is_object());
+  EXPECT_EQ(page["kind"], "ablate");
+  EXPECT_EQ(page["table"]["rows"].size(), 6u);
 }
 
 void CheckResume(const json& plan, const std::string& dir) {

@@ -274,6 +274,10 @@ TEST_F(CompareTest, FullCompareWritesTablesEqualToEvalAndPlots) {
   CheckOutputs(out, full);
   CheckNumbersEqualEval(out, Truth(), dir_);
   CheckAccuracyAndRefineStart(out);
+  // report.html (docs/report.md) for the folder, its line on stdout; its
+  // contents are checked in test/report.
+  EXPECT_TRUE(fs::is_regular_file(out + "/report.html"));
+  EXPECT_NE(full.out.find("report: " + out + "/report.html"), std::string::npos) << full.out;
   if (!PlotScriptUsable()) {
     EXPECT_NE(full.out.find("plots skipped: "), std::string::npos) << full.out;
     GTEST_SKIP() << "rvlio_plot.py check failed (no python3 with matplotlib): every other "

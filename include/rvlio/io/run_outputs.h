@@ -1,6 +1,7 @@
 #pragma once
 // The files `rvlio run` writes (docs/design.md section 7), each atomically.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>

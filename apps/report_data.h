@@ -1,0 +1,65 @@
+#pragma once
+// The data of `rvlio report` (docs/report.md): what a compare, demo, ablate or
+// run folder holds, gathered into one JSON model that report.html draws.
+// Arrays travel as base64 of little-endian float32 (ReportArray), so a 100 s
+// run stays compact; the map is thinned by a stride to at most
+// ReportOptions::max_points points and the page says so.
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "rvlio/common/status.h"
+
+namespace rvlio::cli::report {
+
+enum class FolderKind { kCompare, kDemo, kAblate, kRun };
+const char* FolderKindName(FolderKind kind);
+
+// compare.json -> compare (demo when a data/ folder with the simulation sits
+// next to it), plan.json + cells/ -> ablate, summary.json + trajectory.tum ->
+// run. InvalidInput naming the folder when it is missing or holds none.
+StatusOr<FolderKind> DetectFolderKind(const std::string& dir);
+
+struct ReportOptions {
+  std::string gt;                // ground truth for a run folder (compare/ablate name their own)
+  size_t max_points = 1000000;   // map points embedded at most (stride thinning above)
+  size_t max_runs = 12;          // trajectories drawn at most (ablate grids can be large)
+};
+
+// base64 of the values as little-endian float32 (the page decodes it into a
+// Float32Array).
+std::string ReportArray(const std::vector<float>& values);
+
+// Every stride-th point so that at most max_points remain (stride 1 keeps all).
+size_t ThinningStride(size_t points, size_t max_points);
+
+// One column of scans.csv per name (NaN where a field is empty or not a
+// number; a non-empty `diverged` field counts 1). Header-less or unreadable
+// files are InvalidInput naming the file.
+struct ScanTable {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+  const std::vector<double>* Find(const std::string& name) const;
+};
+StatusOr<ScanTable> ReadScanTable(const std::string& path);
+
+// The columns of a metrics table from JSON rows: the given leading keys, then
+// every number or boolean at the top level of any row, then those of nested
+// objects one level down as "parent.key" (skipping the `skip` objects), in the
+// order they first appear. Map metrics added to compare.json or cell.json thus
+// appear without a change here.
+std::vector<std::string> MetricColumns(const std::vector<nlohmann::json>& rows,
+                                       const std::vector<std::string>& leading,
+                                       const std::vector<std::string>& skip);
+// The value of a "parent.key" or "key" column in `row` (null when absent).
+nlohmann::json ColumnValue(const nlohmann::json& row, const std::string& column);
+
+// The whole model for `dir` (DetectFolderKind first). InvalidInput when the
+// folder holds nothing reportable or a file it names cannot be read.
+StatusOr<nlohmann::json> BuildReportModel(const std::string& dir, const ReportOptions& options);
+
+}  // namespace rvlio::cli::report
