@@ -81,7 +81,7 @@ __attribute__((visibility("default"))) void getPlugins(const std::string& packag
   if (dir.empty()) return;
   std::ifstream in(dir + "/package.xml");
   const std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::regex tag("<" + package + R"(\s[^>]*\b)" + attribute + R"(\s*=\s*"([^"]*)")");
+  const std::regex tag("<" + package + R"re(\s[^>]*\b)re" + attribute + R"re(\s*=\s*"([^"]*)")re");
   for (std::sregex_iterator it(xml.begin(), xml.end(), tag), end; it != end; ++it) {
     std::string value = (*it)[1].str();
     const std::string prefix = "${prefix}";

@@ -58,7 +58,7 @@ struct DivergenceOptions {
   double max_residual_ratio = 2.5;     // window median of median |r| / lidar_noise (0.075 m; 2.7x normal)
   double min_inlier_fraction = 0.15;   // window mean of constraints / points (normal >= 0.31)
   double max_gravity_error = 0.5;      // relative error of the window mean |f| vs imu.gravity
-  double max_lidar_rotation_deg = 0.5;  // window mean of the LiDAR-only rotation step (IESKF)
+  double max_lidar_rotation_deg = 0.15;  // deg, window mean of the LiDAR-only rotation step (IESKF; normal < 0.1)
 
   template <class V>
   void Visit(V& v) {
