@@ -612,7 +612,21 @@ bool Plan::HasRefMap() const {
   return false;
 }
 
-StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir) {
+// The number of cells the grid expands to (a double: the product of the
+// ranges may exceed int64), and how it is made up.
+double CountCells(const Grid& grid, std::string* how) {
+  double data = 0.0, combos = 1.0;
+  for (const Sequence& seq : grid.sequences) data += seq.simulated ? seq.seeds.size() : 1.0;
+  for (const auto& p : grid.parameters) combos *= static_cast<double>(p.second.size());
+  char text[160];
+  std::snprintf(text, sizeof(text), "%.0f sequences x seeds, %zu variants, %.0f parameter combinations",
+                data, grid.variants.size(), combos);
+  *how = text;
+  return data * static_cast<double>(grid.variants.size()) * combos;
+}
+
+StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir,
+                        int64_t max_cells) {
   const GridContext g(grid_path);
   StatusOr<Node> root = config_detail::ParseYamlFile(grid_path);
   if (!root.ok()) {
@@ -621,6 +635,15 @@ StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir
   }
   StatusOr<Grid> grid = ReadGrid(g, *root);
   if (!grid.ok()) return grid.status();
+  std::string how;
+  const double cells = CountCells(*grid, &how);
+  if (cells > static_cast<double>(max_cells)) {
+    char count[64];
+    std::snprintf(count, sizeof(count), "%.6g", cells);
+    return Status::InvalidInput(grid_path + ": the grid has " + count + " cells (" + how +
+                                "), more than the limit of " + std::to_string(max_cells) +
+                                "; --max-cells N allows more");
+  }
   Plan plan;
   plan.grid_path = grid_path;
   plan.out_dir = out_dir;

@@ -41,13 +41,21 @@ int Fail(const std::string& command, const std::string& message, int exit_code) 
 }
 
 int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out) {
+  const OptionSpec* list = nullptr;  // the repeatable option whose values may follow
   for (int i = first; i < argc; ++i) {
     std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
       PrintUsage(spec);
       return -1;
     }
-    if (arg.rfind("--", 0) != 0) return Fail(spec.name, "unexpected argument '" + arg + "' (see --help)");
+    if (arg.rfind("--", 0) != 0) {
+      // A repeatable option takes a list: `--chunks A B C` is `--chunks A --chunks B --chunks C`
+      // (the usage line shows it as `--chunks DIR ...`).
+      if (list == nullptr) return Fail(spec.name, "unexpected argument '" + arg + "' (see --help)");
+      if (arg.empty()) return Fail(spec.name, "option --" + list->name + " has an empty value");
+      out->values_[list->name].push_back(arg);
+      continue;
+    }
     std::string name = arg.substr(2), value;
     bool inline_value = false;
     if (auto eq = name.find('='); eq != std::string::npos) {
@@ -65,10 +73,15 @@ int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out) 
     } else if (opt->value.empty() && inline_value) {
       return Fail(spec.name, "option --" + name + " takes no value");
     }
+    // An empty value is never meaningful and would reach the library as "not
+    // given" (an empty output folder means "write nothing" to the API).
+    if (!opt->value.empty() && value.empty())
+      return Fail(spec.name, "option --" + name + " has an empty value");
     auto& slot = out->values_[name];
     if (!opt->repeatable && !slot.empty())
       return Fail(spec.name, "option --" + name + " given more than once");
     slot.push_back(value);
+    list = opt->repeatable && !opt->value.empty() ? opt : nullptr;
   }
   for (const auto& o : spec.options)
     if (o.required && !out->Has(o.name)) return Fail(spec.name, "missing required option --" + o.name);

@@ -1,6 +1,7 @@
 #pragma once
 // Minimal argument parsing for the rvlio subcommands: `--name value`,
-// `--name=value`, repeatable options and boolean flags. Parsing errors are
+// `--name=value`, repeatable options (which also take a list: `--chunks A B`)
+// and boolean flags; an empty value is refused. Parsing errors are
 // bad input (exit 2) with a one-line message.
 #include <map>
 #include <string>

@@ -4,6 +4,7 @@
 // and --summarize are the machine interface of workflow/Snakefile.
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -35,6 +36,9 @@ CommandSpec AblateSpec() {
           {{"grid", "FILE", "grid description (YAML, see workflow/README.md)", true},
            {"out", "DIR", "output folder", true},
            {"jobs", "N", "cells run in parallel (default 1)"},
+           {"max-cells", "N",
+            "largest grid accepted (default " + std::to_string(ablate::kDefaultMaxCells) +
+                " cells)"},
            {"plan", "", "print the expanded cells as JSON and exit (runs nothing)"},
            {"summarize", "", "only build the summary from the finished cells"},
            {"cell", "ID", "run only this cell of the plan (Snakemake jobs)"},
@@ -47,6 +51,20 @@ std::string SelfPath() {
   std::error_code ec;
   const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
   return ec ? std::string("rvlio") : p.string();
+}
+
+// Returns 0 and sets `max_cells`, or the exit status after an error.
+int ReadMaxCells(const Args& args, int64_t* max_cells) {
+  *max_cells = ablate::kDefaultMaxCells;
+  if (!args.Has("max-cells")) return 0;
+  const std::string text = args.Get("max-cells");
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno != 0 || v < 1)
+    return Fail(kName, "--max-cells '" + text + "' is not a positive whole number");
+  *max_cells = v;
+  return 0;
 }
 
 // Returns 0 and sets `jobs`, or the exit status after an error.
@@ -111,7 +129,9 @@ int CmdAblate(int argc, char** argv) {
   options.rvlio_bin = SelfPath();
   options.progress = !args.Has("quiet");
 
-  StatusOr<ablate::Plan> plan = ablate::LoadPlan(args.Get("grid"), args.Get("out"));
+  int64_t max_cells = 0;
+  if (int rc = ReadMaxCells(args, &max_cells); rc != 0) return rc;
+  StatusOr<ablate::Plan> plan = ablate::LoadPlan(args.Get("grid"), args.Get("out"), max_cells);
   if (!plan.ok()) return Fail(kName, plan.status().message(), plan.status().exit_code());
   if (args.Has("plan")) {
     std::cout << JsonText(ablate::PlanJson(*plan)) << "\n";
@@ -127,6 +147,9 @@ int CmdAblate(int argc, char** argv) {
           WriteFileAtomically(plan->out_dir + "/plan.json", JsonText(ablate::PlanJson(*plan)) + "\n");
       !s.ok())
     return Fail(kName, s.message(), s.exit_code());
+  if (options.progress)
+    std::printf("rvlio ablate: the grid has %zu cells (%zu simulated sequences) -> %s\n",
+                plan->cells.size(), plan->data.size(), plan->out_dir.c_str());
   const ablate::RunCounts c = ablate::RunPlan(*plan, options);
   if (Interrupted()) return ReportInterrupt(c);
   std::printf("rvlio ablate: %d cells: %d already done, %d run now (%d done, %d failed)\n", c.total,

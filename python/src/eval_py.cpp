@@ -39,6 +39,11 @@ Trajectory TrajectoryArg(const py::handle& value, const char* what) {
     p.p_world_imu = {r(i, 1), r(i, 2), r(i, 3)};
     p.q_world_imu = Eigen::Quaterniond(r(i, 7), r(i, 4), r(i, 5), r(i, 6)).normalized();
   }
+  bool earlier = false;  // the order the file readers enforce
+  if (const size_t i = FirstStampOrderViolation(t, &earlier); i > 0)
+    ValueError(std::string(what) + " row " + std::to_string(i) +
+               (earlier ? ": time stamp earlier than the previous row's; stamps must not decrease"
+                        : ": time stamp is the third in a row; stamps must increase"));
   return t;
 }
 

@@ -127,7 +127,14 @@ ReadWindow Window(double start, double duration) {
   return w;
 }
 
-std::string OutDir(const py::handle& out) { return out.is_none() ? "" : PathText(out); }
+// The output folder; None writes nothing. An empty path is refused: the
+// library reads "" as "write nothing", and the results would be lost quietly.
+std::string OutDir(const py::handle& out) {
+  if (out.is_none()) return "";
+  std::string dir = PathText(out);
+  if (dir.empty()) ValueError("out is an empty path: give a folder, or None to write nothing");
+  return dir;
+}
 
 struct RunOutput {
   py::array_t<double> trajectory;

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Cholesky>
 
@@ -102,6 +103,18 @@ Matrix24d ExcitationCovariance(const Matrix24d& P0, const Vector6d& extrinsic_st
     P(FilterState::kExtRot + i, FilterState::kExtRot + i) = extrinsic_std(i) * extrinsic_std(i);
   }
   return P;
+}
+
+// The rotation step of the point-to-plane normal equations alone (columns
+// [dtheta, dp, ...]: the first three), position held; NaN when the rotation
+// is not observable from them.
+double LidarOnlyRotationDeg(const Matrix12d& HtRinvH, const Vector12d& HtRinvz) {
+  const Eigen::Matrix3d H_rr = HtRinvH.topLeftCorner<3, 3>();
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(H_rr);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0))
+    return std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector3d dtheta = -ldlt.solve(HtRinvz.head<3>());
+  return dtheta.allFinite() ? dtheta.norm() * 180.0 / M_PI : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace
@@ -260,7 +273,10 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
     const Vector24d dx = -ldlt.solve(b);
     S = ldlt.solve(Matrix24d::Identity());
     // At x = x0 (e = 0): z^T (H P0 H^T + R)^-1 z = z^T R^-1 z - b^T A^-1 b = z^T R^-1 z + b^T dx.
-    if (it == 0) result.nis_per_dof = (zRinvz + b.dot(dx)) / result.num_constraints;
+    if (it == 0) {
+      result.nis_per_dof = (zRinvz + b.dot(dx)) / result.num_constraints;
+      result.lidar_rotation_deg = LidarOnlyRotationDeg(HtRinvH, HtRinvz);
+    }
     x = Boxplus(x, dx);
     result.iterations = it + 1;
     result.last_step_norm = dx.norm();

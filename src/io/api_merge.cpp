@@ -73,6 +73,28 @@ Status ParseManifest(const std::string& path, const json& m, RefineJobSpan* span
   return Status::Ok();
 }
 
+// trajectory.tum must be the one the chunk wrote: as many poses as it refined,
+// from its first to its last stamp (a file cut short, or replaced, is refused).
+Status CheckTrajectoryAgainstManifest(const std::string& path, const json& m,
+                                      const Trajectory& trajectory) {
+  for (const char* key : {"scans_refined", "t_first_ns", "t_last_ns"})
+    if (!m.contains(key) || !m[key].is_number_integer())
+      return Status::InvalidInput(path + ": no integer \"" + std::string(key) + "\"");
+  const int64_t scans = m["scans_refined"].get<int64_t>();
+  const TimeNs first_ns = m["t_first_ns"].get<TimeNs>(), last_ns = m["t_last_ns"].get<TimeNs>();
+  const std::string tum = FilePath(std::filesystem::path(path).parent_path().string(), "trajectory.tum");
+  if (static_cast<int64_t>(trajectory.size()) != scans)
+    return Status::InvalidInput(tum + " has " + std::to_string(trajectory.size()) + " poses, but " +
+                                path + " records " + std::to_string(scans) +
+                                " refined scans: the trajectory is cut short or not this chunk's");
+  if (trajectory.front().t_ns != first_ns || trajectory.back().t_ns != last_ns)
+    return Status::InvalidInput(tum + " spans " + std::to_string(trajectory.front().t_ns) + " .. " +
+                                std::to_string(trajectory.back().t_ns) + " ns, but " + path +
+                                " records " + std::to_string(first_ns) + " .. " +
+                                std::to_string(last_ns) + ": not this chunk's trajectory");
+  return Status::Ok();
+}
+
 StatusOr<ChunkFolder> ReadChunkFolder(const std::string& dir) {
   ChunkFolder c;
   c.dir = dir;
@@ -85,6 +107,8 @@ StatusOr<ChunkFolder> ReadChunkFolder(const std::string& dir) {
   StatusOr<Trajectory> trajectory = ReadTum(FilePath(dir, "trajectory.tum"));
   if (!trajectory.ok()) return trajectory.status();
   c.job.trajectory = std::move(*trajectory);
+  if (Status s = CheckTrajectoryAgainstManifest(manifest, c.manifest, c.job.trajectory); !s.ok())
+    return s;
   const json summary = json::parse(ReadFileText(FilePath(dir, "summary.json")), nullptr, false);
   if (summary.is_object() && summary.contains("warnings") && summary["warnings"].is_array())
     for (const json& w : summary["warnings"])

@@ -322,8 +322,9 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args) {
       args.bag, args.options.lidar, args.options.imu, args.window, args.options.io);
   if (!reader.ok()) return reader.status();
   const bool write = !args.out_dir.empty();
+  OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
   if (write)
-    if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
+    if (Status s = out_folder.Prepare(); !s.ok()) return s;
 
   RefineRunResult r;
   int64_t raw_points = 0;
@@ -358,10 +359,12 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args) {
                                    args.options.constraints.lidar_noise, args.options.imu.gravity);
   times.wall_s = SecondsSince(t0);
   r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
+  r.summary["truncated"] = (*reader)->truncated();
   r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
   if (job) r.summary["chunk"] = r.chunk;
   if (!write) return r;
   if (Status s = WriteOutputs(args.out_dir, r); !s.ok()) return s;
+  out_folder.Keep();
   r.written = true;
   return r;
 }

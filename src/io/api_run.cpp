@@ -38,6 +38,7 @@ nlohmann::json StatsJson(const OdometryStats& o, const SensorReaderStats& r) {
           {"imu_factors_skipped", o.imu_factors_skipped},
           {"marginalization_failures", o.marginalization_failures},
           {"scans_out_of_order", o.scans_out_of_order},
+          {"scans_after_imu", o.scans_after_imu},
           {"imu_non_finite", o.imu_non_finite},
           {"time_split_ms",
            {{"association", o.association_ms},
@@ -55,6 +56,7 @@ int RvActiveScans(const std::vector<ScanResult>& results) {
 struct RunData {
   TimeNs first_ns = -1, last_ns = -1;
   double wall_s = 0.0;
+  bool truncated = false;  // the recording was cut short (SensorBagReader::truncated)
 };
 
 nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
@@ -82,6 +84,7 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   j["divergence"] = DivergenceJson(odo.divergence());
   if (odo.stats().extrinsic.enabled) j["extrinsic"] = ExtrinsicJson(odo.stats().extrinsic);
   j["warnings"] = result.warnings;
+  j["truncated"] = data.truncated;
   j["interrupted"] = result.stopped;
   if (result.stopped) {
     j["signal"] = result.stop_reason;
@@ -122,11 +125,26 @@ std::string NoScanMessage(const std::string& bag, const OdometryOptions& o,
     return "no usable IMU sample on imu.topic '" + o.imu.topic + "' in " + bag + " (" +
            std::to_string(r.imu_invalid) + " invalid, " + std::to_string(r.imu_duplicates) +
            " repeated, " + std::to_string(r.imu_non_monotonic) + " out of order)";
-  return "no scan could be processed from " + bag + ": " + std::to_string(r.scans) +
-         " scans read, " + std::to_string(r.scans_before_first_imu) +
-         " before the first IMU sample, " + std::to_string(odo.scans_too_few_points) +
-         " with too few points, " + std::to_string(odo.scans_before_imu) +
-         " during the IMU initialization";
+  std::string text = "no scan could be processed from " + bag + ": " + std::to_string(r.scans) +
+                     " scans read, " + std::to_string(r.scans_before_first_imu) +
+                     " before the first IMU sample, " + std::to_string(odo.scans_too_few_points) +
+                     " with too few points, " + std::to_string(odo.scans_before_imu) +
+                     " during the IMU initialization, " + std::to_string(odo.scans_out_of_order) +
+                     " out of order, " + std::to_string(odo.scans_after_imu) +
+                     " after the last IMU sample";
+  const int64_t imu_dropped = r.imu_invalid + r.imu_duplicates + r.imu_non_monotonic;
+  if (!odo.initialized || imu_dropped > 0)
+    text += "; imu.topic '" + o.imu.topic + "' gave " + std::to_string(r.imu_samples) +
+            " usable samples" + (odo.initialized ? "" : " (too few for imu.init_duration)") +
+            ", " + std::to_string(r.imu_duplicates) + " repeating the previous stamp, " +
+            std::to_string(r.imu_non_monotonic) + " out of order, " +
+            std::to_string(r.imu_invalid) + " invalid";
+  if (o.lidar.time_offset != 0.0) {
+    char offset[96];
+    std::snprintf(offset, sizeof(offset), "; lidar.time_offset %g s moves every scan", o.lidar.time_offset);
+    text += offset;
+  }
+  return text;
 }
 
 // Appends the poses of the results not streamed yet to trajectory.partial.tum;
@@ -235,6 +253,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& args) {
   const auto t0 = Clock::now();
   Process(args, reader->get(), odo->get(), &partial, &stream_warnings, &data, &result);
   data.wall_s = SecondsSince(t0);
+  data.truncated = (*reader)->truncated();
 
   const SensorReaderStats& reader_stats = (*reader)->stats();
   result.warnings = ReaderWarnings(reader_stats, args.options.lidar, args.options.imu);

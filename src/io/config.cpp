@@ -101,8 +101,13 @@ int LineOf(const YAML::Node& y) { return y.Mark().line >= 0 ? y.Mark().line + 1 
 constexpr int kMaxDepth = 64;
 constexpr size_t kMaxValues = 10000;  // config/default.yaml has 84
 
+// When the budget runs out, the rest of the document converts to nulls (keys
+// are kept) and the error waits in Node::over_budget, so that a loader that
+// knows its keys can first name an unknown one (a large unknown section is
+// a likelier mistake than an alias bomb).
 struct ConvertBudget {
   size_t values_left = kMaxValues;
+  std::string error;  // the first value over the budget
 };
 
 // yaml-cpp document -> Node; `path` is the dotted key of `y` for messages.
@@ -117,10 +122,13 @@ Status Convert(const YAML::Node& y, const std::string& path, const std::string& 
     return Status::InvalidInput(what() + " in " + Where(source, out->line) +
                                 ": nested deeper than " + std::to_string(kMaxDepth) +
                                 " levels (a recursive alias?)");
-  if (budget->values_left == 0)
-    return Status::InvalidInput(what() + " in " + Where(source, out->line) + ": more than " +
-                                std::to_string(kMaxValues) +
-                                " values (aliases expanding exponentially?)");
+  if (budget->values_left == 0) {
+    if (budget->error.empty())
+      budget->error = what() + " in " + Where(source, out->line) + ": more than " +
+                      std::to_string(kMaxValues) + " values (aliases expanding exponentially?)";
+    out->kind = Node::Kind::kNull;
+    return Status::Ok();
+  }
   --budget->values_left;
   if (y.IsNull()) {
     out->kind = Node::Kind::kNull;
@@ -171,6 +179,7 @@ StatusOr<Node> LoadYaml(const std::string& text, const std::string& source, OnEr
   ConvertBudget budget;
   Status s = Convert(y, "", source, 0, &budget, &root);
   if (!s.ok()) return s;
+  root.over_budget = budget.error;
   return root;
 }
 
@@ -274,7 +283,22 @@ std::string Where(const std::string& source, int line) {
   return line > 0 ? source + ":" + std::to_string(line) : source;
 }
 
-StatusOr<Node> ParseYamlText(const std::string& text, const std::string& source) {
+Status FirstUnknownKey(const Node& n, const std::string& prefix, const std::string& source,
+                       const std::vector<std::string>& known_keys) {
+  if (n.kind != Node::Kind::kMap) return Status::Ok();
+  for (size_t i = 0; i < n.keys.size(); ++i) {
+    const std::string key = options_detail::Join(prefix, n.keys[i].c_str());
+    const bool known = std::any_of(known_keys.begin(), known_keys.end(), [&key](const std::string& k) {
+      return k == key || k.rfind(key + ".", 0) == 0;
+    });
+    if (!known) return UnknownKey(key, Where(source, n.key_lines[i]), known_keys);
+    if (Status s = FirstUnknownKey(n.items[i], key, source, known_keys); !s.ok()) return s;
+  }
+  return Status::Ok();
+}
+
+StatusOr<Node> ParseYamlText(const std::string& text, const std::string& source,
+                             bool keep_over_budget) {
   StatusOr<Node> root = LoadYaml(text, source, [&](const YAML::Exception& e) {
     std::ostringstream os;
     os << source << ":" << e.mark.line + 1 << ":" << e.mark.column + 1
@@ -282,13 +306,15 @@ StatusOr<Node> ParseYamlText(const std::string& text, const std::string& source)
     return Status::InvalidInput(os.str());
   });
   if (!root.ok()) return root;
+  if (!keep_over_budget && !root->over_budget.empty())
+    return Status::InvalidInput(root->over_budget);
   const Node::Kind kind = root->kind;
   if (kind != Node::Kind::kMap && kind != Node::Kind::kNull)
     return Status::InvalidInput(source + ": expected a mapping of keys at the top level, got " +
                                 Describe(*root));
   return root;
 }
-StatusOr<Node> ParseYamlFile(const std::string& path) {
+StatusOr<Node> ParseYamlFile(const std::string& path, bool keep_over_budget) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return Status::InvalidInput(path + ": config file not found");
@@ -296,7 +322,7 @@ StatusOr<Node> ParseYamlFile(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (!in) return Status::InvalidInput(path + ": cannot read config file");
-  return ParseYamlText(text.str(), path);
+  return ParseYamlText(text.str(), path, keep_over_budget);
 }
 
 StatusOr<Node> ParseOverride(const std::string& assignment) {
@@ -315,6 +341,7 @@ StatusOr<Node> ParseOverride(const std::string& assignment) {
                                 e.msg + ")");
   });
   if (!value.ok()) return value.status();
+  if (!value->over_budget.empty()) return Status::InvalidInput(value->over_budget);
   Node node = std::move(value).value();
   for (auto it = parts.rbegin(); it != parts.rend(); ++it) {
     Node map;

@@ -25,6 +25,18 @@ Status PrepareOutputDir(const std::string& dir) {
   return Status::Ok();
 }
 
+Status OutputFolder::Prepare() {
+  std::error_code ec;
+  created_ = !std::filesystem::exists(dir_, ec);
+  return PrepareOutputDir(dir_);
+}
+
+OutputFolder::~OutputFolder() {
+  if (!created_ || keep_) return;
+  std::error_code ec;
+  std::filesystem::remove(dir_, ec);  // only when empty
+}
+
 OutputStage::~OutputStage() {
   if (stage_dir_.empty()) return;
   std::error_code ec;

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,37 @@ StatusOr<RecordingKind> DetectDirectory(const std::string& path) {
 // ---------------------------------------------------------------------------
 // sqlite3
 
+// SQLite URI of a file opened read-only as immutable: SQLite then takes no
+// locks and creates no -shm/-wal/-journal file next to it, so a recording on
+// read-only storage, or in a folder the user cannot write, opens (rosbag2
+// writes WAL-mode databases, whose plain read-only open needs a writable
+// -shm), and reading never changes the recording's folder. The path is
+// percent-encoded where the URI syntax needs it.
+std::string ImmutableUri(const std::string& path) {
+  std::string uri = "file:";
+  if (!path.empty() && path[0] == '/') uri += "//";  // file:///abs/path
+  for (const char c : path) {
+    if (c == '%' || c == '?' || c == '#') {
+      char hex[4];
+      std::snprintf(hex, sizeof(hex), "%%%02X", static_cast<unsigned char>(c));
+      uri += hex;
+    } else {
+      uri += c;
+    }
+  }
+  return uri + "?mode=ro&immutable=1";
+}
+
+// A write-ahead log left next to a database (its writer did not close it):
+// with immutable=1 its content is not read; say so.
+std::vector<std::string> WalWarnings(const std::string& path) {
+  std::error_code ec;
+  const std::string wal = path + "-wal";
+  if (!fs::is_regular_file(wal, ec) || fs::file_size(wal, ec) == 0 || ec) return {};
+  return {"db3 '" + path + "' has a write-ahead log '" + wal +
+          "' (the recording was not closed cleanly): messages only in it are not read"};
+}
+
 class SqliteSource final : public RecordingSource {
  public:
   explicit SqliteSource(std::string path) : path_(std::move(path)) {}
@@ -50,8 +82,10 @@ class SqliteSource final : public RecordingSource {
   }
 
   Status Init() {
-    if (sqlite3_open_v2(path_.c_str(), &db_, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK)
+    if (sqlite3_open_v2(ImmutableUri(path_).c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI,
+                        nullptr) != SQLITE_OK)
       return Error("cannot open");
+    warnings_ = WalWarnings(path_);
     sqlite3_stmt* q = nullptr;
     if (sqlite3_prepare_v2(db_, "SELECT id, name, type, serialization_format FROM topics ORDER BY id",
                            -1, &q, nullptr) != SQLITE_OK)
@@ -70,7 +104,7 @@ class SqliteSource final : public RecordingSource {
   std::string storage() const override { return "sqlite3"; }
   std::vector<std::string> compressions() const override { return {}; }
   const std::vector<RecordingTopic>& topics() const override { return topics_; }
-  std::vector<std::string> warnings() const override { return {}; }
+  std::vector<std::string> warnings() const override { return warnings_; }
 
   Status SetTopicFilter(const std::vector<int>& topics) override {
     filter_ = topics;
@@ -180,6 +214,7 @@ class SqliteSource final : public RecordingSource {
   sqlite3* db_ = nullptr;
   sqlite3_stmt* stmt_ = nullptr;
   std::vector<RecordingTopic> topics_;
+  std::vector<std::string> warnings_;
   std::map<int64_t, int> topic_index_;  // topics.id -> index
   std::vector<int> filter_;
   bool filtered_ = false;
@@ -218,6 +253,7 @@ class McapSource final : public RecordingSource {
   }
   const std::vector<RecordingTopic>& topics() const override { return topics_; }
   std::vector<std::string> warnings() const override { return reader_->warnings(); }
+  bool truncated() const override { return reader_->summary().truncated; }
 
   Status SetTopicFilter(const std::vector<int>& topics) override {
     std::vector<uint16_t> ids;
@@ -402,6 +438,9 @@ class FolderSource final : public RecordingSource {
       for (const std::string& w : p->warnings()) out.push_back(w);
     }
     return out;
+  }
+  bool truncated() const override {
+    return std::any_of(parts_.begin(), parts_.end(), [](const auto& p) { return p->truncated(); });
   }
 
   Status SetTopicFilter(const std::vector<int>& topics) override {

@@ -39,22 +39,14 @@ Status RequireCdr(const RecordingSource& source, int topic, const std::string& k
 class Ros2SensorReader final : public SensorBagReader {
  public:
   Ros2SensorReader(std::string path, LidarOptions lidar, ImuOptions imu)
-      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_) {}
+      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_, lidar_, path_) {}
 
   // With `range` the layout comes from the first LiDAR message inside it.
   Status Init(const std::optional<ReceiveTimeRange>& range) {
     StatusOr<std::unique_ptr<RecordingSource>> source = RecordingSource::Open(path_);
     if (!source.ok()) return source.status();
     source_ = std::move(source).value();
-    const auto types = TopicTypes(*source_);
-    const auto lidar_type = types.find(lidar_.topic);
-    livox_ = lidar_type != types.end() && lidar_type->second == kLivoxRos2Type;
-    if (Status s = RequireTopic(path_, types, lidar_.topic,
-                                livox_ ? kLivoxRos2Type : cdr::kPointCloud2Type, "lidar.topic");
-        !s.ok())
-      return s;
-    if (Status s = RequireTopic(path_, types, imu_.topic, cdr::kImuType, "imu.topic"); !s.ok())
-      return s;
+    if (Status s = RequireTopics(); !s.ok()) return TruncationExplains(s);
     lidar_index_ = TopicIndex(*source_, lidar_.topic);
     imu_index_ = TopicIndex(*source_, imu_.topic);
     if (Status s = RequireCdr(*source_, lidar_index_, "lidar.topic"); !s.ok()) return s;
@@ -81,9 +73,31 @@ class Ros2SensorReader final : public SensorBagReader {
     }
   }
 
+  Status RequireTopics() {
+    const auto types = TopicTypes(*source_);
+    const auto lidar_type = types.find(lidar_.topic);
+    livox_ = lidar_type != types.end() && lidar_type->second == kLivoxRos2Type;
+    if (Status s = RequireTopic(path_, types, lidar_.topic,
+                                livox_ ? kLivoxRos2Type : cdr::kPointCloud2Type, "lidar.topic");
+        !s.ok())
+      return s;
+    return RequireTopic(path_, types, imu_.topic, cdr::kImuType, "imu.topic");
+  }
+
+  // A topic missing from a file cut short is missing from the part that was
+  // read (an MCAP file's channels may all sit after the cut): say so first.
+  Status TruncationExplains(const Status& s) const {
+    if (!source_->truncated()) return s;
+    const std::vector<std::string> w = source_->warnings();
+    return Status::InvalidInput("'" + path_ + "' is truncated (" +
+                                (w.empty() ? std::string("cut short") : w.front()) +
+                                "), and its readable part lacks a topic: " + s.message());
+  }
+
   const SensorReaderStats& stats() const override { return gate_.stats(); }
   std::string lidar_layout() const override { return layout_; }
   std::vector<std::string> warnings() const override { return source_->warnings(); }
+  bool truncated() const override { return source_->truncated(); }
 
  private:
   // Bytes of messages PeekLayout may hold before the first LiDAR message

@@ -44,7 +44,7 @@ ros::Time RosTime(TimeNs t_ns) {
 class RosbagSensorReader final : public SensorBagReader {
  public:
   RosbagSensorReader(std::string path, LidarOptions lidar, ImuOptions imu)
-      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_) {}
+      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_, lidar_, path_) {}
 
   Status Init(const std::optional<ReceiveTimeRange>& range) {
     if (Status s = bag_detail::OpenForRead(path_, &bag_); !s.ok()) return s;

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,6 +16,7 @@
 #include "rvlio/common/time.h"
 #include "rvlio/common/types.h"
 #include "rvlio/imu/options.h"
+#include "rvlio/lidar/options.h"
 #include "rvlio/io/pointcloud2.h"
 #include "rvlio/io/sensor_bag.h"
 
@@ -30,21 +32,29 @@ Status RequireTopic(const std::string& path, const std::map<std::string, std::st
 // Applies the reader's acceptance rules and keeps SensorReaderStats.
 class SensorGate {
  public:
-  explicit SensorGate(const ImuOptions& imu) : imu_(imu) {}
+  // `path`: the recording, for messages.
+  SensorGate(const ImuOptions& imu, const LidarOptions& lidar, std::string path)
+      : imu_(imu), lidar_(lidar), path_(std::move(path)) {}
   // An IMU message: acc in imu.accel_unit (scaled to m/s^2 here), gyro in
   // rad/s. True when *out holds a new sample; false when it was dropped
   // (non-finite, duplicate or older stamp).
   bool AcceptImu(TimeNs t_ns, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro,
                  ImuSample* out);
   // A decoded scan: counts the dropped points; true (and moves the scan into
-  // *out) when it has points, false for an empty scan.
-  bool AcceptScan(const DecodeStats& decode, Scan&& scan, Scan* out);
+  // *out) when it has points, false for an empty scan. InvalidInput when the
+  // point times of the first scans span less than lidar.point_time_span_stop
+  // of the scan period (CheckPointTimes).
+  StatusOr<bool> AcceptScan(const DecodeStats& decode, Scan&& scan, Scan* out);
   const SensorReaderStats& stats() const { return stats_; }
 
  private:
   bool AcceptImuStamp(TimeNs t_ns);
+  Status CheckPointTimes(const Scan& scan);
 
   ImuOptions imu_;
+  LidarOptions lidar_;
+  std::string path_;
+  std::vector<TimeNs> first_starts_ns_, first_spans_ns_;  // of the first scans
   SensorReaderStats stats_;
   bool have_imu_ = false;
   TimeNs last_imu_ns_ = 0;

@@ -45,7 +45,10 @@ class WindowedReader final : public SensorBagReader {
         ended_ = true;  // the recording is in time order: nothing later is in the window
         return SensorMessage::kEnd;
       }
-      if (rel < start_ns_ - (is_imu ? lead_in_ns_ : 0)) continue;
+      // Only a --start selects: without one, scans that lidar.time_offset moved
+      // before the recording's first stamp are delivered (and counted where
+      // they are dropped), not skipped here unseen.
+      if (start_ns_ > 0 && rel < start_ns_ - (is_imu ? lead_in_ns_ : 0)) continue;
       ++(is_imu ? imu_delivered_ : scans_delivered_);
       return m;
     }
@@ -59,6 +62,7 @@ class WindowedReader final : public SensorBagReader {
   }
   std::string lidar_layout() const override { return inner_->lidar_layout(); }
   std::vector<std::string> warnings() const override { return inner_->warnings(); }
+  bool truncated() const override { return inner_->truncated(); }
 
  private:
   std::unique_ptr<SensorBagReader> inner_;
@@ -145,6 +149,7 @@ class SkipAheadReader final : public SensorBagReader {
   const SensorReaderStats& stats() const override { return inner_->stats(); }
   std::string lidar_layout() const override { return inner_->lidar_layout(); }
   std::vector<std::string> warnings() const override { return inner_->warnings(); }
+  bool truncated() const override { return inner_->truncated(); }
 
  private:
   struct Held {
@@ -181,7 +186,8 @@ class ThreadedReader final : public SensorBagReader {
         max_bytes_(io.queue_mb * 1e6),
         stats_(inner_->stats()),
         layout_(inner_->lidar_layout()),
-        warnings_(inner_->warnings()) {
+        warnings_(inner_->warnings()),
+        truncated_(inner_->truncated()) {
     thread_ = std::thread([this] { Produce(); });
   }
   ~ThreadedReader() override {
@@ -210,7 +216,10 @@ class ThreadedReader final : public SensorBagReader {
     not_full_.notify_one();
     stats_ = item.stats;
     if (item.kind != SensorMessage::kImu) layout_ = std::move(item.layout);
-    if (item.kind == SensorMessage::kEnd || !item.error.ok()) warnings_ = std::move(item.warnings);
+    if (item.kind == SensorMessage::kEnd || !item.error.ok()) {
+      warnings_ = std::move(item.warnings);
+      truncated_ = item.truncated;
+    }
     if (!item.error.ok()) return error_ = item.error;
     if (item.kind == SensorMessage::kEnd) ended_ = true;
     if (item.kind == SensorMessage::kImu) *imu = item.imu;
@@ -221,6 +230,7 @@ class ThreadedReader final : public SensorBagReader {
   const SensorReaderStats& stats() const override { return stats_; }
   std::string lidar_layout() const override { return layout_; }
   std::vector<std::string> warnings() const override { return warnings_; }
+  bool truncated() const override { return truncated_; }
 
  private:
   struct Item {
@@ -231,6 +241,7 @@ class ThreadedReader final : public SensorBagReader {
     SensorReaderStats stats;
     std::string layout;  // scans, end and errors only
     std::vector<std::string> warnings;  // end and errors only
+    bool truncated = false;             // end and errors only
     double bytes = 0.0;
   };
 
@@ -244,7 +255,10 @@ class ThreadedReader final : public SensorBagReader {
       else item.error = m.status();
       item.stats = inner_->stats();
       if (item.kind != SensorMessage::kImu || !m.ok()) item.layout = inner_->lidar_layout();
-      if (item.kind == SensorMessage::kEnd || !m.ok()) item.warnings = inner_->warnings();
+      if (item.kind == SensorMessage::kEnd || !m.ok()) {
+        item.warnings = inner_->warnings();
+        item.truncated = inner_->truncated();
+      }
       item.bytes = static_cast<double>(item.scan.points.size() * sizeof(LidarPoint));
       const bool last = !m.ok() || *m == SensorMessage::kEnd;
       {
@@ -275,6 +289,7 @@ class ThreadedReader final : public SensorBagReader {
   SensorReaderStats stats_;
   std::string layout_;
   std::vector<std::string> warnings_;
+  bool truncated_ = false;
   Status error_;
   bool ended_ = false;
 };

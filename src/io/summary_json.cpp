@@ -28,7 +28,8 @@ nlohmann::json ReaderStatsJson(const SensorReaderStats& r) {
           {"imu_duplicates", r.imu_duplicates},
           {"imu_non_monotonic", r.imu_non_monotonic},
           {"imu_gaps", r.imu_gaps},
-          {"imu_max_gap_s", r.imu_max_gap_s}};
+          {"imu_max_gap_s", r.imu_max_gap_s},
+          {"point_time_span_ratio", r.point_time_span_ratio}};
 }
 
 std::vector<std::string> ReaderWarnings(const SensorReaderStats& r, const LidarOptions& lidar,
@@ -52,6 +53,15 @@ std::vector<std::string> ReaderWarnings(const SensorReaderStats& r, const LidarO
                   r.imu_max_gap_s);
     w.push_back("IMU gaps longer than imu.max_gap " + Short(imu.max_gap) + " s" + imu_on + ": " +
                 std::to_string(r.imu_gaps) + text);
+  }
+  if (r.point_time_span_ratio >= 0.0 && r.point_time_span_ratio < lidar.point_time_span_warn) {
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "the point times%s span %.3g of the scan period (median of the first scans; "
+                  "below lidar.point_time_span_warn %g): deskewing corrects only that part of "
+                  "the sweep",
+                  scans_on.c_str(), r.point_time_span_ratio, lidar.point_time_span_warn);
+    w.push_back(text);
   }
   return w;
 }

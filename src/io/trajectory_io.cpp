@@ -137,16 +137,20 @@ Status ParseStamp(const std::string& path, const DataLine& line, TimeNs* t_ns) {
   return LineError(path, line.number, "time stamp '" + line.tokens[0] + "' is not a number");
 }
 
-// Stamps must not decrease (evo accepts repeated stamps, and so do we).
 Status CheckOrder(const std::string& path, const std::vector<DataLine>& lines,
                   const Trajectory& trajectory) {
-  for (size_t i = 1; i < trajectory.size(); ++i)
-    if (trajectory[i].t_ns < trajectory[i - 1].t_ns)
-      return LineError(path, lines[i].number,
-                       "time stamp " + lines[i].tokens[0] +
-                           " is earlier than the previous one (line " +
-                           std::to_string(lines[i - 1].number) + "); stamps must not decrease");
-  return Status::Ok();
+  bool earlier = false;
+  const size_t i = FirstStampOrderViolation(trajectory, &earlier);
+  if (i == 0) return Status::Ok();
+  if (earlier)
+    return LineError(path, lines[i].number,
+                     "time stamp " + lines[i].tokens[0] + " is earlier than the previous one (line " +
+                         std::to_string(lines[i - 1].number) + "); stamps must not decrease");
+  return LineError(path, lines[i].number,
+                   "time stamp " + lines[i].tokens[0] + " is the third in a row (lines " +
+                       std::to_string(lines[i - 2].number) + ", " +
+                       std::to_string(lines[i - 1].number) +
+                       "); stamps must increase (written with too few digits?)");
 }
 
 StatusOr<StampedPose> ParseTumLine(const std::string& path, const DataLine& line) {
@@ -418,6 +422,14 @@ Status WriteTum(const std::string& path, const Trajectory& trajectory, const std
   }
   if (Status s = writer.Append(block); !s.ok()) return s;
   return writer.Commit();
+}
+
+size_t FirstStampOrderViolation(const Trajectory& trajectory, bool* earlier) {
+  for (size_t i = 1; i < trajectory.size(); ++i) {
+    *earlier = trajectory[i].t_ns < trajectory[i - 1].t_ns;
+    if (*earlier || (i >= 2 && trajectory[i].t_ns == trajectory[i - 2].t_ns)) return i;
+  }
+  return 0;
 }
 
 }  // namespace rvlio

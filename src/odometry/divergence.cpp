@@ -17,6 +17,7 @@ const char* DivergenceKindName(DivergenceKind k) {
     case DivergenceKind::kResidual: return "residual";
     case DivergenceKind::kInliers: return "inliers";
     case DivergenceKind::kGravity: return "gravity";
+    case DivergenceKind::kRotation: return "rotation";
   }
   return "unknown";
 }
@@ -61,6 +62,12 @@ std::string DivergenceEvent::Describe() const {
       std::snprintf(text, sizeof(text),
                     "mean measured specific force %.2f m/s^2 (window) where imu.gravity is %g m/s^2: "
                     "check imu.accel_unit",
+                    value, threshold);
+      break;
+    case DivergenceKind::kRotation:
+      std::snprintf(text, sizeof(text),
+                    "the scans turn %.2f deg per scan against the gyro (window mean) > "
+                    "divergence.max_lidar_rotation_deg %g: check the extrinsic rotation",
                     value, threshold);
       break;
   }
@@ -154,6 +161,12 @@ uint8_t DivergenceMonitor::Check(const HealthSample& s) {
     if (Full(specific_force_) &&
         std::abs(mean / gravity_mps2_ - 1.0) > options_.max_gravity_error)
       Trip(DivergenceKind::kGravity, s.t_ns, mean, gravity_mps2_, &mask);
+  }
+  if (std::isfinite(s.health.lidar_rotation_deg)) {
+    Push(&lidar_rotation_, s.health.lidar_rotation_deg);
+    const double mean = lidar_rotation_.Mean();
+    if (Full(lidar_rotation_) && mean > options_.max_lidar_rotation_deg)
+      Trip(DivergenceKind::kRotation, s.t_ns, mean, options_.max_lidar_rotation_deg, &mask);
   }
   EndEpisodes(mask);
   if (mask != 0) ++report_.scans_flagged;

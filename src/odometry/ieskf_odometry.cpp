@@ -22,6 +22,7 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {
   if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
+  scans_.NoteImu(imu.t_ns);
   if (!stats_.initialized) {
     TryInitialize(imu);
     return;
@@ -45,6 +46,12 @@ void IeskfOdometry::TryInitialize(const ImuSample& imu) {
   if (a->moving) warnings_.push_back(MovingStartWarning(*a));
 }
 
+std::vector<std::string> IeskfOdometry::warnings() const {
+  std::vector<std::string> w = warnings_;
+  for (std::string& q : QueueWarnings(stats_)) w.push_back(std::move(q));
+  return w;
+}
+
 void IeskfOdometry::AddScan(Scan scan) {
   scans_.Add(std::move(scan), stats_.initialized, filter_.time_ns(), &stats_);
 }
@@ -54,6 +61,7 @@ void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
 }
 
 void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
+  scans_.DropPastImu(SecondsToNs(options_.imu.max_gap), &stats_);
   while (!scans_.empty()) ProcessFrontScan(out);
 }
 
@@ -119,6 +127,7 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   r->iterations = u.iterations;
   r->rv = u.rv;
   r->health.nis_per_dof = u.nis_per_dof;
+  r->health.lidar_rotation_deg = u.lidar_rotation_deg;
   if (u.ok) {
     r->health.residual_median_m = u.residuals.median_abs_m;
     r->health.residual_rms_m = u.residuals.rms_m;

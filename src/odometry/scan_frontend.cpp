@@ -94,11 +94,38 @@ bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, Odomet
 
 void ScanQueue::Add(Scan scan, bool initialized, TimeNs state_time_ns, OdometryStats* stats) {
   ++stats->scans_received;
+  if (initialized && scan.t_end_ns <= last_end_ns_) {
+    ++stats->scans_out_of_order;  // estimating it would step the trajectory back in time
+    return;
+  }
   if (!initialized || scan.t_start_ns < state_time_ns) {
     ++stats->scans_before_imu;  // no IMU state covers this scan
     return;
   }
+  last_end_ns_ = scan.t_end_ns;
   scans_.push_back(std::move(scan));
+}
+
+void ScanQueue::DropPastImu(TimeNs max_gap_ns, OdometryStats* stats) {
+  if (imu_end_ns_ == std::numeric_limits<TimeNs>::min()) return;  // no IMU: nothing was queued
+  while (!scans_.empty() && scans_.back().t_end_ns - imu_end_ns_ > max_gap_ns) {
+    scans_.pop_back();
+    ++stats->scans_after_imu;
+  }
+}
+
+std::vector<std::string> QueueWarnings(const OdometryStats& stats) {
+  std::vector<std::string> w;
+  if (stats.scans_out_of_order > 0)
+    w.push_back(std::to_string(stats.scans_out_of_order) +
+                " scans were skipped: their stamps repeat or go back behind a scan already taken "
+                "(stats.scans_out_of_order)");
+  if (stats.scans_after_imu > 0)
+    w.push_back(std::to_string(stats.scans_after_imu) +
+                " scans at the end were skipped: they end more than imu.max_gap after the last "
+                "IMU sample (the IMU stopped before the LiDAR, or lidar.time_offset is wrong; "
+                "stats.scans_after_imu)");
+  return w;
 }
 
 Scan ScanQueue::PopFront() {

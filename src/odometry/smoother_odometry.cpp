@@ -46,6 +46,7 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
   if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
+  scans_.NoteImu(imu.t_ns);
   if (!stats_.initialized) {
     TryInitialize(imu);
     return;
@@ -80,6 +81,7 @@ void SmootherOdometry::Poll(std::vector<ScanResult>* out) {
 // The remaining scans, then the states still in the window enter the
 // output map at their final estimates.
 void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
+  scans_.DropPastImu(SecondsToNs(options_.imu.max_gap), &stats_);
   while (!scans_.empty()) ProcessFrontScan(out);
   if (flushed_ || !window_) return;
   flushed_ = true;
@@ -255,6 +257,7 @@ void SmootherOdometry::SetNewestFromWindow() {
 
 std::vector<std::string> SmootherOdometry::warnings() const {
   std::vector<std::string> w = warnings_;
+  for (std::string& q : QueueWarnings(stats_)) w.push_back(std::move(q));
   const auto count = [&w](int64_t n, const std::string& what) {
     if (n > 0) w.push_back(std::to_string(n) + " " + what);
   };
@@ -265,7 +268,6 @@ std::vector<std::string> SmootherOdometry::warnings() const {
         "window solves failed or diverged: the last good window state was restored");
   count(stats_.marginalization_failures,
         "marginalizations failed: the window was re-anchored with a prior at its oldest state");
-  count(stats_.scans_out_of_order, "scans ended before the newest window state and were skipped");
   count(stats_.imu_non_finite, "non-finite IMU samples were dropped");
   return w;
 }

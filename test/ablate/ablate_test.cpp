@@ -270,6 +270,37 @@ TEST_F(AblatePlanTest, BadGridsStopWithExit2AndOneLineNamingFileAndKey) {
   EXPECT_NE(jobs.err.find("--jobs"), std::string::npos);
 }
 
+// A grid larger than the cell limit is refused before it is expanded (the
+// product of the ranges is unbounded); --max-cells allows it; a run states
+// the number of cells before it starts.
+TEST_F(AblatePlanTest, GridBeyondTheCellLimitIsRefusedUnlessAllowedAndTheCountIsStated) {
+  const std::string seq = "sequences:\n  - {name: r, bag: rec.bag}\n";
+  const std::string huge = Grid(seq + "parameters:\n  rv.k0: {from: 1, to: 10000, step: 1}\n"
+                                      "  rv.eps0: {from: 1, to: 10000, step: 1}\n",
+                                "huge.yaml");
+  ToolRun r = Plan(huge);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("the grid has 1e+08 cells"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--max-cells"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+
+  const std::string four = Grid(seq + "parameters:\n  rv.k0: [1, 2, 3, 4]\n", "four.yaml");
+  r = RunTool("ablate --grid " + four + " --out " + dir_ + "/o --plan --max-cells 3", dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("the grid has 4 cells"), std::string::npos) << r.err;
+  r = RunTool("ablate --grid " + four + " --out " + dir_ + "/o --plan --max-cells 4", dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out, nullptr, false)["cells"].size(), 4u);
+  r = RunTool("ablate --grid " + four + " --out " + dir_ + "/o --plan --max-cells 0", dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+
+  // rec.bag is not a bag: each cell fails at once (recorded), after the count.
+  const std::string two = Grid(seq + "parameters:\n  rv.k0: [1, 2]\n", "two.yaml");
+  r = RunTool("ablate --grid " + two + " --out " + dir_ + "/run --no-plots", dir_);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("rvlio ablate: the grid has 2 cells", 0), 0u) << r.out;
+}
+
 // ---------------------------------------------------------------------------
 // Real runs: tiny.yaml's tunnel (2 seeds x 2 variants) plus a corrupt bag
 // ---------------------------------------------------------------------------

@@ -141,7 +141,8 @@ class SimulatedSuite : public ::testing::Test {
     return nlohmann::json::parse(ReadFile(out + "/summary.json"), nullptr, false);
   }
 
-  // Writes the simulated messages to `path` through SensorBagWriter.
+  // Writes the simulated messages to `path` through SensorBagWriter (a ROS1
+  // bag, or by the extension a ROS 2 .mcap or .db3 file).
   // `edit_scan` may change a scan; `keep_imu` may drop an IMU sample; the
   // topics can be renamed or left out ("" drops the whole topic).
   static void WriteCopy(const std::string& path,
@@ -149,7 +150,10 @@ class SimulatedSuite : public ::testing::Test {
                         const std::function<bool(const ImuSample&)>& keep_imu = nullptr,
                         const std::string& lidar_topic = kLidarTopic,
                         const std::string& imu_topic = kImuTopic) {
-    auto writer = SensorBagWriter::Create(path);
+    BagWriterOptions format;
+    const std::string ext = std::filesystem::path(path).extension().string();
+    if (ext == ".mcap" || ext == ".db3") format.format = ext.substr(1);
+    auto writer = SensorBagWriter::Create(path, format);
     ASSERT_TRUE(writer.ok()) << writer.status().message();
     int scan_index = 0;
     for (const Message& m : *messages_) {

@@ -144,6 +144,27 @@ TEST(DivergenceMonitor, AccelerometerUnitOffByG) {
   }
 }
 
+// The scans asking the prediction for a persistent rotation (the gyro and the
+// LiDAR disagree: a wrong extrinsic rotation) fire once the window is full;
+// one odd scan in a healthy stream does not.
+TEST(DivergenceMonitor, LidarRotationAgainstTheGyroIsAWindowTest) {
+  DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
+  for (int k = 0; k < 60; ++k) {
+    HealthSample s = Healthy(k);
+    s.health.lidar_rotation_deg = k == 10 ? 5.0 : 0.02;
+    EXPECT_EQ(m.Check(s), 0) << k;
+  }
+  for (int k = 60; k < 120; ++k) {
+    HealthSample s = Healthy(k);
+    s.health.lidar_rotation_deg = 1.5;
+    m.Check(s);
+  }
+  EXPECT_EQ(Episodes(m.report(), DivergenceKind::kRotation), 1);
+  ASSERT_FALSE(m.report().events.empty());
+  EXPECT_NE(m.report().events[0].Describe().find("divergence.max_lidar_rotation_deg"),
+            std::string::npos);
+}
+
 TEST(DivergenceMonitor, UnknownStatisticsAreSkippedAndNonFiniteStateFires) {
   DivergenceMonitor m(DivergenceOptions{}, kNoise, kGravity);
   for (int k = 0; k < 50; ++k) {

@@ -40,13 +40,23 @@ struct Node {
   std::vector<std::string> keys;  // kMap keys, parallel to items
   std::vector<int> key_lines;     // kMap: line of each key
   int line = 0;                   // 1-based line in the source, 0 if unknown (--set)
+  // Root only: the document has more values than a configuration can (an
+  // alias bomb, or a large section); the values past the limit are nulls.
+  std::string over_budget;
 };
 
 // Parses a whole file (top level must be a mapping or empty). Errors name the
-// file, and the line for syntax errors and duplicate keys.
-StatusOr<Node> ParseYamlFile(const std::string& path);
+// file, and the line for syntax errors and duplicate keys. A document over the
+// value limit is an error, unless `keep_over_budget`: then the root carries
+// the error in over_budget for the caller to report after FirstUnknownKey.
+StatusOr<Node> ParseYamlFile(const std::string& path, bool keep_over_budget = false);
 // Parses YAML text; `source` names it in error messages.
-StatusOr<Node> ParseYamlText(const std::string& text, const std::string& source);
+StatusOr<Node> ParseYamlText(const std::string& text, const std::string& source,
+                             bool keep_over_budget = false);
+// The UnknownKey error of the first key of `n` (dotted under `prefix`) that is
+// neither one of `known_keys` nor a section holding some of them.
+Status FirstUnknownKey(const Node& n, const std::string& prefix, const std::string& source,
+                       const std::vector<std::string>& known_keys);
 // "a.b.c=value" -> {a: {b: {c: <value parsed as a YAML scalar or flow sequence>}}}.
 StatusOr<Node> ParseOverride(const std::string& assignment);
 
@@ -338,14 +348,26 @@ std::vector<std::string> ListKeys(const Opts& options) {
   return keys;
 }
 
+namespace config_detail {
+// A document over the value limit: an unknown key it holds is the error to
+// report (a large section under a misspelt name), else the limit itself.
+template <class Opts>
+Status CheckOverBudget(const Opts& options, const Node& root, const std::string& source) {
+  if (root.over_budget.empty()) return Status::Ok();
+  if (Status s = FirstUnknownKey(root, "", source, ListKeys(options)); !s.ok()) return s;
+  return Status::InvalidInput(root.over_budget);
+}
+}  // namespace config_detail
+
 // Overlays one YAML file onto `options` (only the keys it contains). Records
 // in `sources` (if given) where each key came from.
 // Deprecated names used add a warning each to *deprecations (may be null).
 template <class Opts>
 Status ApplyYamlFile(Opts& options, const std::string& path, ConfigSources* sources = nullptr,
                      std::vector<std::string>* deprecations = nullptr) {
-  StatusOr<config_detail::Node> root = config_detail::ParseYamlFile(path);
+  StatusOr<config_detail::Node> root = config_detail::ParseYamlFile(path, true);
   if (!root.ok()) return root.status();
+  if (Status s = config_detail::CheckOverBudget(options, *root, path); !s.ok()) return s;
   return config_detail::ApplyNode(options, *root, path, sources, deprecations);
 }
 
@@ -353,8 +375,9 @@ Status ApplyYamlFile(Opts& options, const std::string& path, ConfigSources* sour
 template <class Opts>
 Status ApplyYamlText(Opts& options, const std::string& text, const std::string& source,
                      ConfigSources* sources = nullptr) {
-  StatusOr<config_detail::Node> root = config_detail::ParseYamlText(text, source);
+  StatusOr<config_detail::Node> root = config_detail::ParseYamlText(text, source, true);
   if (!root.ok()) return root.status();
+  if (Status s = config_detail::CheckOverBudget(options, *root, source); !s.ok()) return s;
   return config_detail::ApplyNode(options, *root, source, sources);
 }
 

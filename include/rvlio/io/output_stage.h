@@ -11,6 +11,25 @@ namespace rvlio {
 // Creates `dir` if needed and proves it writable (InvalidInput naming it if not).
 Status PrepareOutputDir(const std::string& dir);
 
+// The output folder of a command that can still fail before it writes
+// anything: Prepare() creates it at once (an unwritable folder fails before
+// the work), and the destructor removes it again, unless Keep() was called,
+// when Prepare() created it and it is still empty, so that a rejected
+// command leaves no new folder behind.
+class OutputFolder {
+ public:
+  explicit OutputFolder(std::string dir) : dir_(std::move(dir)) {}
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+  Status Prepare();
+  void Keep() { keep_ = true; }
+
+ private:
+  std::string dir_;
+  bool created_ = false, keep_ = false;
+};
+
 // A command's outputs are written (each atomically) into a private folder
 // inside the output folder and moved into place only when every one of them
 // is complete, so a failed write (disk full, file-size limit) leaves the

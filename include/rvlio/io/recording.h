@@ -81,6 +81,9 @@ class RecordingSource {
   virtual StatusOr<RecordingTopicStats> Span() = 0;
   // Problems that did not stop reading (a cut-short MCAP file).
   virtual std::vector<std::string> warnings() const = 0;
+  // The file (or a file of the folder) was cut short: only its complete part
+  // is read (an MCAP file without its footer, read by a linear scan).
+  virtual bool truncated() const { return false; }
 };
 
 }  // namespace rvlio

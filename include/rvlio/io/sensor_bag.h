@@ -30,6 +30,9 @@ struct SensorReaderStats {
   int64_t imu_gaps = 0;               // gaps longer than imu.max_gap
   int64_t scans_before_first_imu = 0;  // scans delivered before any IMU sample (LiDAR started first)
   double imu_max_gap_s = 0.0;
+  // Median span of the point times of the first scans over their median
+  // period (-1 until known): about 1 for a sweeping LiDAR.
+  double point_time_span_ratio = -1.0;
 };
 
 enum class SensorMessage { kImu, kScan, kEnd };
@@ -68,6 +71,9 @@ class SensorBagReader {
   // Problems of the recording that did not stop reading (e.g. an MCAP file
   // cut short: its complete part is read); each names the file.
   virtual std::vector<std::string> warnings() const { return {}; }
+  // The recording was cut short and only its complete part is read (an MCAP
+  // file read by a linear scan); summary.json says "truncated": true.
+  virtual bool truncated() const { return false; }
 };
 
 // How SensorBagWriter::Create writes.

@@ -32,6 +32,14 @@ StatusOr<Trajectory> ReadTrajectory(const std::string& path,
                                     const std::string& kitti_times_path = "",
                                     double kitti_rate_hz = 10.0);
 
+// The stamp order every trajectory reader enforces: stamps must increase; a
+// stamp repeated once is accepted (evo accepts it, and the TUM RGB-D ground
+// truth has one); a third pose at one stamp is refused (stamps written with
+// too few digits, 1.7e+09, collapse into runs of equal values). Returns the
+// index of the first pose breaking it (0: none); *earlier tells whether it
+// goes back in time (else it is the third of equal stamps).
+size_t FirstStampOrderViolation(const Trajectory& trajectory, bool* earlier);
+
 // The same parsers on text in memory (the file readers above read the file
 // and parse it with these); `source` stands for the path in error messages.
 StatusOr<Trajectory> ParseTumText(const std::string& text, const std::string& source);

@@ -15,6 +15,10 @@ struct LidarOptions {
   double voxel_size = 0.5;            // m, scan downsampling before association
   int point_stride = 1;               // keep every n-th raw point before the voxel filter
   double time_offset = 0.0;           // s, t_imu_clock = t_lidar_stamp + time_offset
+  // Point-time sanity check (io/sensor_bag.h): the span of the point times of
+  // a scan against the scan period, median over the first scans.
+  double point_time_span_stop = 0.01;  // below this fraction reading stops (0: never)
+  double point_time_span_warn = 0.5;   // below this fraction a warning
 
   template <class V>
   void Visit(V& v) {
@@ -31,6 +35,15 @@ struct LidarOptions {
             Spec().Unit("s").Range(-10.0, 10.0).Help(
                 "added to every LiDAR time to put it on the IMU clock: t_imu = t_lidar_stamp + "
                 "time_offset (LiDAR stamps 30 ms behind the IMU clock: 0.03)"));
+    v.Field("point_time_span_stop", point_time_span_stop,
+            Spec().Range(0.0, 1.0).Help(
+                "reading stops when the point times of a scan span less than this fraction of "
+                "the scan period (median of the first scans: times all zero, or not in "
+                "nanoseconds); 0: never"));
+    v.Field("point_time_span_warn", point_time_span_warn,
+            Spec().Range(0.0, 1.0).Help(
+                "a warning when the point times of a scan span less than this fraction of the "
+                "scan period (median of the first scans)"));
   }
   Status Validate() {
     Status s = ValidateFields(*this, "lidar");

@@ -15,6 +15,11 @@
 //             above max_residual_ratio * constraints.lidar_noise.
 //   inliers   window mean of constraints / downsampled points below
 //             min_inlier_fraction (the scans stop matching the map).
+//   rotation  window mean of the rotation the LiDAR alone asks of the
+//             IESKF's prediction (first iteration, position held) above
+//             max_lidar_rotation_deg: the gyro and the scans disagree about
+//             how the platform turns (a wrong extrinsic rotation such as an
+//             upside-down mount turns every turn around for the LiDAR).
 //   gravity   window mean of the per-scan mean specific force |f| off
 //             imu.gravity by more than max_gravity_error (relative): over
 //             seconds any vehicle's mean |f| is close to g, so a wrong
@@ -53,6 +58,7 @@ struct DivergenceOptions {
   double max_residual_ratio = 2.5;     // window median of median |r| / lidar_noise (0.075 m; 2.7x normal)
   double min_inlier_fraction = 0.15;   // window mean of constraints / points (normal >= 0.31)
   double max_gravity_error = 0.5;      // relative error of the window mean |f| vs imu.gravity
+  double max_lidar_rotation_deg = 0.15;  // deg, window mean of the LiDAR-only rotation step (IESKF; normal < 0.1)
 
   template <class V>
   void Visit(V& v) {
@@ -71,12 +77,14 @@ struct DivergenceOptions {
         .Help("window mean of constraints per downsampled point below this is divergence (0: off)"));
     v.Field("max_gravity_error", max_gravity_error, Spec().Positive()
         .Help("window mean of the measured specific force off imu.gravity by more than this fraction is divergence (wrong imu.accel_unit)"));
+    v.Field("max_lidar_rotation_deg", max_lidar_rotation_deg, Spec().Unit("deg").Positive()
+        .Help("IESKF: window mean of the rotation the scans alone ask of the gyro's prediction above this is divergence (wrong extrinsic rotation)"));
   }
   Status Validate() { return ValidateFields(*this, "divergence"); }
 };
 
-enum class DivergenceKind : int { kSpeed = 0, kJump, kNis, kResidual, kInliers, kGravity };
-constexpr int kNumDivergenceKinds = 6;
+enum class DivergenceKind : int { kSpeed = 0, kJump, kNis, kResidual, kInliers, kGravity, kRotation };
+constexpr int kNumDivergenceKinds = 7;
 const char* DivergenceKindName(DivergenceKind k);
 // The kinds set in a ScanHealth::divergence_mask, "speed+nis"; "" for none.
 std::string DivergenceKindNames(uint8_t mask);
@@ -87,6 +95,7 @@ struct ScanHealth {
   double nis_per_dof = kUnknown;        // NaN: not computed (smoother, refine, no update)
   double residual_median_m = kUnknown;  // median |r| after the update; NaN: no update
   double residual_rms_m = kUnknown;
+  double lidar_rotation_deg = kUnknown;  // IESKF: LiDAR-only rotation step at the prediction
   uint8_t divergence_mask = 0;          // bit k set: DivergenceKind k tripped on this scan
 };
 
@@ -145,7 +154,7 @@ class DivergenceMonitor {
   DivergenceReport report_;
   bool have_previous_ = false;
   HealthSample previous_;
-  Window nis_, residual_, inliers_, specific_force_;
+  Window nis_, residual_, inliers_, specific_force_, lidar_rotation_;
   std::array<bool, kNumDivergenceKinds> active_{};
   std::array<int, kNumDivergenceKinds> clear_scans_{};
 };

@@ -22,7 +22,7 @@ class IeskfOdometry : public Odometry {
   void Finish(std::vector<ScanResult>* out) override;
 
   const OdometryStats& stats() const override { return stats_; }
-  std::vector<std::string> warnings() const override { return warnings_; }
+  std::vector<std::string> warnings() const override;
   const DivergenceReport& divergence() const override { return monitor_.report(); }
   std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
 

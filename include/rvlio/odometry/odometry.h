@@ -80,7 +80,9 @@ struct OdometryStats {
   // Sliding-window smoother (backend: smoother); zero for the IESKF.
   int64_t imu_factors_skipped = 0;       // window states added without an IMU factor (IMU gap)
   int64_t marginalization_failures = 0;  // replaced by a prior at the next state's estimate
-  int64_t scans_out_of_order = 0;        // ending before the newest window state: skipped
+  int64_t scans_out_of_order = 0;        // stamp repeating or going back (or, window: ending
+                                         // before the newest window state): skipped
+  int64_t scans_after_imu = 0;           // ending more than imu.max_gap after the last IMU sample
   int64_t imu_non_finite = 0;            // non-finite IMU samples dropped
   double association_ms = 0.0;           // CPU ms in association, RV and robust weights (total)
   double solve_ms = 0.0;                 // CPU ms in building and solving the window (total)

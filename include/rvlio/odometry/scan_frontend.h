@@ -2,7 +2,9 @@
 // Pieces of the odometry pipeline shared by its backends (ieskf_odometry.h,
 // smoother_odometry.h): the extrinsics, static initialization and the working
 // map with its periodic trim (the IMU poses for deskew: imu/pose_history.h).
+#include <algorithm>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -102,13 +104,25 @@ class WorkingMap {
 // sample; a gap to the previous sample longer than a scan period is counted.
 bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats);
 
+// Warnings for the scans the queue skipped (out of order, after the IMU's end).
+std::vector<std::string> QueueWarnings(const OdometryStats& stats);
+
 // Scans waiting for the IMU data that covers them: both backends hand a scan
 // to the estimator only once an IMU sample at or after its end has arrived.
 class ScanQueue {
  public:
   // Queues a scan unless no IMU state covers it yet (not initialized, or it
-  // starts before the estimator's current time); counts either way.
+  // starts before the estimator's current time: scans_before_imu) or it does
+  // not end after the previous scan taken (a stamp repeated or going back:
+  // scans_out_of_order), so the estimates come out in increasing time;
+  // counts either way.
   void Add(Scan scan, bool initialized, TimeNs state_time_ns, OdometryStats* stats);
+  // The newest IMU sample received (accepted or used for initialization).
+  void NoteImu(TimeNs t_ns) { imu_end_ns_ = std::max(imu_end_ns_, t_ns); }
+  // At the end of input: drops (and counts in scans_after_imu) the queued
+  // scans that end more than max_gap_ns after the newest IMU sample: the IMU
+  // stopped before the LiDAR, and such a scan would be estimated without IMU.
+  void DropPastImu(TimeNs max_gap_ns, OdometryStats* stats);
   // True when the oldest scan's end is covered by the buffered IMU samples.
   bool FrontReady(const std::deque<ImuSample>& imu_buffer) const {
     return !scans_.empty() && !imu_buffer.empty() &&
@@ -119,6 +133,8 @@ class ScanQueue {
 
  private:
   std::deque<Scan> scans_;
+  TimeNs last_end_ns_ = std::numeric_limits<TimeNs>::min();  // of the newest scan taken
+  TimeNs imu_end_ns_ = std::numeric_limits<TimeNs>::min();
 };
 
 }  // namespace rvlio
