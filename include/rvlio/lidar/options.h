@@ -15,6 +15,7 @@ struct LidarOptions {
   double voxel_size = 0.5;            // m, scan downsampling before association
   int point_stride = 1;               // keep every n-th raw point before the voxel filter
   double time_offset = 0.0;           // s, t_imu_clock = t_lidar_stamp + time_offset
+  std::string ouster_metadata;        // Ouster metadata JSON of a packet recording ("" = find it)
 
   template <class V>
   void Visit(V& v) {
@@ -31,6 +32,10 @@ struct LidarOptions {
             Spec().Unit("s").Range(-10.0, 10.0).Help(
                 "added to every LiDAR time to put it on the IMU clock: t_imu = t_lidar_stamp + "
                 "time_offset (LiDAR stamps 30 ms behind the IMU clock: 0.03)"));
+    v.Field("ouster_metadata", ouster_metadata,
+            Spec().Help("Ouster sensor metadata JSON for a packet recording (pcap capture or "
+                        "packet bag); empty: NAME.json / NAME_0.json next to a capture, the "
+                        "bag's metadata topic (CLI: --ouster-metadata)"));
   }
   Status Validate() {
     Status s = ValidateFields(*this, "lidar");
