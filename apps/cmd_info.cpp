@@ -85,11 +85,12 @@ void Print(const BagInfo& info) {
 
 int CmdInfo(int argc, char** argv) {
   CommandSpec spec{"info",
-                   "Lists the topics of a recording (ROS1 bag, ROS 2 .db3 / .mcap / bag folder, Ouster\n"
-                   ".pcap:\n"
+                   "Lists the topics of a recording (ROS1 bag, ROS 2 .db3 / .mcap / bag folder:\n"
                    "type, count, rate; storage and chunk compression) and, for PointCloud2 and\n"
                    "Livox CustomMsg topics, the detected per-point time layout, the fields and\n"
-                   "the mean number of valid points per scan (from the first few messages).",
+                   "the mean number of valid points per scan (from the first few messages). For\n"
+                   "Ouster packets (.pcap capture, packet bag): sensor, firmware, mode, profile,\n"
+                   "frames, IMU rate and dropped packets, from a pass over every packet.",
                    {{"bag", "PATH", "ROS1 bag, .db3, .mcap, ROS 2 bag folder or Ouster .pcap", true, false},
                     {"lidar-topic", "TOPIC", "analyse only this PointCloud2 or CustomMsg topic", false, false},
                     OusterMetadataOption()}};

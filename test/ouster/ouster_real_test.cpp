@@ -74,17 +74,18 @@ struct Expected {
 };
 
 // Frame and IMU counts: what the files hold (192 lidar packets = 64 per
-// frame x 3 for the low-bandwidth capture, README); a capture of 64 packets
-// that starts mid-rotation gives two partial frames.
+// frame x 3 for the low-bandwidth capture, README). The FUSA capture holds
+// 8 packets (128 of 1024 columns: one incomplete frame); crc_test holds a
+// 512-column frame and the first 2 packets of the next (incomplete).
 const Expected kCaptures[] = {
     {"OS-1-128_v2.3.0_1024x10_lb_n3.pcap", "OS-1-128_v2.3.0_1024x10.json", "RNG15_RFL8_NIR8", 3, 30, 0},
-    {"OS-0-128-U1_v2.3.0_1024x10.pcap", "OS-0-128-U1_v2.3.0_1024x10.json", "RNG15_RFL8_NIR8", -1, 10, -1},
-    {"OS-2-128-U1_v2.3.0_1024x10.pcap", "OS-2-128-U1_v2.3.0_1024x10.json", "RNG19_RFL8_SIG16_NIR16", -1, 10, -1},
+    {"OS-0-128-U1_v2.3.0_1024x10.pcap", "OS-0-128-U1_v2.3.0_1024x10.json", "RNG15_RFL8_NIR8", 1, 10, 0},
+    {"OS-2-128-U1_v2.3.0_1024x10.pcap", "OS-2-128-U1_v2.3.0_1024x10.json", "RNG19_RFL8_SIG16_NIR16", 1, 10, 0},
     {"OS-1-128_767798045_1024x10_20230712_120049.pcap", "OS-1-128_767798045_1024x10_20230712_120049.json",
-     "FUSA_RNG15_RFL8_NIR8_DUAL", -1, 2, -1},
-    {"crc_test.pcap", "crc_test.json", "RNG15_RFL8_NIR8", -1, 10, -1},
-    {"windowed_frame1.pcap", "windowed_frame1_0.json", "RNG15_RFL8_NIR8", -1, 10, -1},
-    {"OS-1-32-G_v2.1.1_1024x10.pcap", "OS-1-32-G_v2.1.1_1024x10.json", "LEGACY", -1, 0, -1},
+     "FUSA_RNG15_RFL8_NIR8_DUAL", 1, 2, 1},
+    {"crc_test.pcap", "crc_test.json", "RNG15_RFL8_NIR8", 2, 10, 1},
+    {"windowed_frame1.pcap", "windowed_frame1_0.json", "RNG15_RFL8_NIR8", 1, 10, 0},
+    {"OS-1-32-G_v2.1.1_1024x10.pcap", "OS-1-32-G_v2.1.1_1024x10.json", "LEGACY", 1, 0, 0},
 };
 
 TEST(OusterRealTest, EveryCaptureDecodesWithItsMetadata) {
@@ -99,6 +100,7 @@ TEST(OusterRealTest, EveryCaptureDecodesWithItsMetadata) {
     if (e.incomplete >= 0) EXPECT_EQ(info->ouster->incomplete_frames, e.incomplete);
     EXPECT_EQ(info->ouster->late_packets, 0);
     EXPECT_EQ(info->ouster->crc_errors, 0);
+    EXPECT_EQ(info->ouster->crc, std::string(e.pcap) == "crc_test.pcap");  // the one with a CRC-64
     // Every lidar packet's columns land in a frame: frames x window columns
     // = packets x 16 columns - missing, up to the columns outside the window.
     const int64_t sent = info->ouster->lidar_packets * 16;
