@@ -47,6 +47,22 @@ std::string Stamp(TimeNs t_ns) {
   return buf;
 }
 
+void PrintOuster(const OusterRecordingInfo& o) {
+  std::cout << "ouster:\n"
+            << "  metadata: " << o.metadata << "\n"
+            << "  sensor:   " << o.prod_line << ", firmware " << o.firmware << "\n"
+            << "  mode:     " << o.lidar_mode << " (" << o.beams << " beams, " << o.window_columns
+            << " of " << o.columns_per_frame << " columns sent)\n"
+            << "  profile:  " << o.lidar_profile << (o.crc ? " (CRC-64 checked)" : "") << "\n"
+            << "  lidar:    " << o.lidar_source << ", " << o.lidar_packets << " packets\n"
+            << "  frames:   " << o.frames << " (" << Fixed(o.frame_rate_hz, 2) << " Hz), "
+            << o.incomplete_frames << " incomplete, " << o.missing_columns << " columns missing\n"
+            << "  imu:      " << o.imu_source << ", " << o.imu_packets << " packets, "
+            << Fixed(o.imu_rate_hz, 1) << " Hz\n"
+            << "  dropped:  " << o.late_packets << " late packets, " << o.crc_errors
+            << " CRC errors\n";
+}
+
 void Print(const BagInfo& info) {
   std::cout << "bag:      " << info.path << "\n"
             << "storage:  " << info.storage << "\n";
@@ -62,6 +78,7 @@ void Print(const BagInfo& info) {
               << Fixed(t.rate_hz, 2) << " Hz\n";
     PrintCloud(t);
   }
+  if (info.ouster) PrintOuster(*info.ouster);
 }
 
 }  // namespace
@@ -71,12 +88,15 @@ int CmdInfo(int argc, char** argv) {
                    "Lists the topics of a recording (ROS1 bag, ROS 2 .db3 / .mcap / bag folder:\n"
                    "type, count, rate; storage and chunk compression) and, for PointCloud2 and\n"
                    "Livox CustomMsg topics, the detected per-point time layout, the fields and\n"
-                   "the mean number of valid points per scan (from the first few messages).",
-                   {{"bag", "PATH", "ROS1 bag, .db3, .mcap or ROS 2 bag folder", true, false},
-                    {"lidar-topic", "TOPIC", "analyse only this PointCloud2 or CustomMsg topic", false, false}}};
+                   "the mean number of valid points per scan (from the first few messages). For\n"
+                   "Ouster packets (.pcap capture, packet bag): sensor, firmware, mode, profile,\n"
+                   "frames, IMU rate and dropped packets, from a pass over every packet.",
+                   {{"bag", "PATH", "ROS1 bag, .db3, .mcap, ROS 2 bag folder or Ouster .pcap", true, false},
+                    {"lidar-topic", "TOPIC", "analyse only this PointCloud2 or CustomMsg topic", false, false},
+                    OusterMetadataOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
-  StatusOr<BagInfo> info = ReadBagInfo(args.Get("bag"), args.Get("lidar-topic"));
+  StatusOr<BagInfo> info = ReadBagInfo(args.Get("bag"), args.Get("lidar-topic"), args.Get("ouster-metadata"));
   if (!info.ok()) return Fail(spec.name, info.status().message(), info.status().exit_code());
   Print(*info);
   for (const std::string& w : info->warnings)

@@ -87,10 +87,11 @@ int CmdRefine(int argc, char** argv) {
                    "(all scans, IMU factors, re-association rounds; sparse Cholesky) and writes "
                    "trajectory.tum, map.pcd and summary.json to the output folder. SIGINT/SIGTERM "
                    "write the last completed round's result and exit 130/143.",
-                   {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
+                   {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder; or Ouster packets (.pcap + metadata JSON, packet bag)", true},
                     {"init", "TUM", "initial trajectory (TUM format), e.g. rvlio run's", true},
                     ConfigOption(),
                     SetOption(),
+                    OusterMetadataOption(),
                     {"out", "DIR", "output folder", true},
                     {"checkpoint", "DIR",
                      "after each round, write the state to continue from to DIR/refine.checkpoint"},
@@ -116,7 +117,7 @@ int CmdRefine(int argc, char** argv) {
   req.out_dir = args.Get("out");
   std::vector<std::string> config_warnings;
   StatusOr<OdometryOptions> options =
-      LoadConfig(args.GetAll("config"), args.GetAll("set"), &config_warnings);
+      LoadConfig(args.GetAll("config"), OverridesOf(args), &config_warnings);
   if (!options.ok()) return Fail("refine", options.status().message());
   for (const auto& w : config_warnings)
     std::fprintf(stderr, "rvlio refine: warning: %s\n", w.c_str());

@@ -14,9 +14,10 @@ int CmdRun(int argc, char** argv) {
                    "map.pcd, scans.csv and summary.json to the output folder (and "
                    "trajectory.partial.tum while it runs). SIGINT/SIGTERM write the outputs of the "
                    "scans done and exit 130/143.",
-                   {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
+                   {{"bag", "PATH", "recording with LiDAR and IMU topics: ROS1 .bag, ROS 2 .db3, .mcap or bag folder; or Ouster packets (.pcap + metadata JSON, packet bag)", true},
                     ConfigOption(),
                     SetOption(),
+                    OusterMetadataOption(),
                     {"out", "DIR", "output folder", true},
                     StartOption(),
                     DurationOption(),
@@ -24,7 +25,7 @@ int CmdRun(int argc, char** argv) {
                     AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
-  RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), args.GetAll("set"),
+  RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), OverridesOf(args),
                  args.Has("quiet"), args.Has("allow-divergence"), ReadWindow()};
   if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("run", err);
   RunOutcome outcome;

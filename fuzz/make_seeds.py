@@ -229,6 +229,34 @@ def trajectory_seeds(gt_tum):
     write("trajectory", "kitti_tiny_rate", trajectory_seed(1, kitti, rate_pick=4))
 
 
+def cut_pcap(path, limit):
+    """The pcap file header and its first records, about `limit` bytes."""
+    data = open(path, "rb").read()
+    off = keep = 24
+    while off + 16 <= len(data):
+        incl = struct.unpack("<I", data[off + 8:off + 12])[0]
+        if off + 16 + incl - 24 > limit and keep > 24:
+            break
+        off += 16 + incl
+        keep = off
+    return data[:keep]
+
+
+def ouster_seeds():
+    """Byte 0 picks the sensor (bits 0-2 profile: 0 RNG15, 1 RNG19, 2 FUSA,
+    3 LEGACY; bits 3-4 beams: 0 -> 128, 1 -> 32), then the first packets of
+    the real captures in test/data/ouster."""
+    src = os.path.join(ROOT, "test", "data", "ouster")
+    seeds = {"lb_rng15_128": (0, "OS-1-128_v2.3.0_1024x10_lb_n3.pcap", 40000),
+             "rng19_128": (1, "OS-2-128-U1_v2.3.0_1024x10.pcap", 60000),
+             "fusa_128": (2, "OS-1-128_767798045_1024x10_20230712_120049.pcap", 40000),
+             "legacy_32": (3 | 1 << 3, "OS-1-32-G_v2.1.1_1024x10.pcap", 30000),
+             "crc_rng15_128": (0, "crc_test.pcap", 30000),
+             "imu_only": (0, "imu_zm_no_lidar.pcap", 6000)}
+    for name, (pick, capture, limit) in seeds.items():
+        write("ouster", name, bytes([pick]) + cut_pcap(os.path.join(src, capture), limit))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bag", required=True)
@@ -238,6 +266,7 @@ def main():
     pointcloud2_seeds(a.bag)
     config_seeds(a.sim_yaml)
     trajectory_seeds(a.gt)
+    ouster_seeds()
 
 
 if __name__ == "__main__":

@@ -35,7 +35,7 @@ while [[ $# -gt 0 ]]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[[ ${#targets[@]} -eq 0 ]] && targets=(pointcloud2 config trajectory mcap cdr)
+[[ ${#targets[@]} -eq 0 ]] && targets=(pointcloud2 config trajectory mcap cdr ouster)
 if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [[ "$seconds" -lt 1 ]]; then
   echo "fuzz.sh: --seconds must be a positive integer (got '$seconds')" >&2
   exit 2
@@ -47,6 +47,9 @@ declare -A max_len=([pointcloud2]=8192 [config]=8192 [trajectory]=4096 [mcap]=81
 declare -A ci_runs=([pointcloud2]=600000 [config]=10000 [trajectory]=500000 [mcap]=200000)
 max_len[cdr]=8192
 ci_runs[cdr]=500000
+# ouster: seeds are real captures cut to a few packets (fuzz/corpus/ouster).
+max_len[ouster]=65536
+ci_runs[ouster]=20000
 for t in "${targets[@]}"; do
   [[ -n "${max_len[$t]:-}" ]] || { echo "fuzz.sh: unknown target '$t'" >&2; exit 2; }
 done

@@ -16,6 +16,7 @@
 #include "rvlio/io/output_stage.h"
 #include "rvlio/io/refine_checkpoint.h"
 #include "rvlio/io/run_outputs.h"
+#include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/summary_json.h"
 #include "rvlio/io/trajectory_io.h"
 #include "rvlio/lidar/preprocess.h"
@@ -297,8 +298,14 @@ Status PrepareCheckpointDir(const RefineArgs& args) {
 
 }  // namespace
 
-StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args) {
+StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   const auto t0 = Clock::now();
+  RefineArgs args = in;  // an Ouster recording may supply the default extrinsic
+  std::vector<std::string> notes;
+  if (Status s = ApplyRecordingExtrinsics(args.bag, args.options.lidar, &args.options.extrinsics,
+                                          &notes);
+      !s.ok())
+    return s;
   RefineInput input;
   if (!args.init.empty()) {
     input.init = args.init;
@@ -351,6 +358,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args) {
                                                             : Status::InvalidInput(what);
   }
   r.refine = std::move(*refined);
+  r.refine.warnings.insert(r.refine.warnings.begin(), notes.begin(), notes.end());
   if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
   if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, r.refine);
   r.stopped = r.refine.stopped;

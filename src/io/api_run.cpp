@@ -12,6 +12,7 @@
 #include "rvlio/io/extrinsic_json.h"
 #include "rvlio/io/output_stage.h"
 #include "rvlio/io/run_outputs.h"
+#include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/summary_json.h"
 #include "rvlio/io/trajectory_io.h"
 #include "rvlio/io/tum_stream.h"
@@ -228,7 +229,13 @@ void Process(const RunArgs& args, SensorBagReader* reader, Odometry* odo, TumStr
 
 }  // namespace
 
-StatusOr<RunResult> RunRecording(const RunArgs& args) {
+StatusOr<RunResult> RunRecording(const RunArgs& in) {
+  RunArgs args = in;  // an Ouster recording may supply the default extrinsic
+  std::vector<std::string> notes;
+  if (Status s = ApplyRecordingExtrinsics(args.bag, args.options.lidar, &args.options.extrinsics,
+                                          &notes);
+      !s.ok())
+    return s;
   StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(args.options);
   if (!odo.ok()) return odo.status();
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
@@ -256,7 +263,9 @@ StatusOr<RunResult> RunRecording(const RunArgs& args) {
   data.truncated = (*reader)->truncated();
 
   const SensorReaderStats& reader_stats = (*reader)->stats();
-  result.warnings = ReaderWarnings(reader_stats, args.options.lidar, args.options.imu);
+  result.warnings = notes;
+  for (const auto& w : ReaderWarnings(reader_stats, args.options.lidar, args.options.imu))
+    result.warnings.push_back(w);
   for (const auto& w : (*odo)->warnings()) result.warnings.push_back(w);
   for (const auto& w : (*reader)->warnings()) result.warnings.push_back(w);
   for (const auto& w : stream_warnings) result.warnings.push_back(w);

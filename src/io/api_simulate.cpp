@@ -1,7 +1,9 @@
 // SimulateRecording (rvlio/api.h): runs the deterministic tunnel simulator
 // (sim/) and writes
 //   DIR/NAME.bag     ROS1 bag: Ouster-layout PointCloud2 + sensor_msgs/Imu
-//                    (format mcap: DIR/NAME.mcap, db3: DIR/NAME.db3, ROS 2 CDR)
+//                    (format mcap: DIR/NAME.mcap, db3: DIR/NAME.db3, ROS 2 CDR;
+//                    ouster-pcap: DIR/NAME.pcap + NAME.json, Ouster packets, and
+//                    DIR/NAME.bag with the same quantized data)
 //   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
 //   DIR/reference_map.pcd  with survey.enabled: a static survey of the world
@@ -17,6 +19,8 @@
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/run_outputs.h"
+#include "rvlio/io/ouster.h"
+#include "rvlio/io/pcap.h"
 #include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/trajectory_io.h"
 #include "rvlio/sim/presets.h"
@@ -67,10 +71,10 @@ Status ResolveOptions(const SimulateArgs& args, SimOptions* options) {
 // The format and MCAP compression -> writer options and the file extension.
 Status ResolveFormat(const SimulateArgs& args, BagWriterOptions* format, std::string* extension) {
   const std::string& name = args.format;
-  if (name != "bag" && name != "mcap" && name != "db3")
-    return Status::InvalidInput("format '" + name + "' is not one of bag, mcap, db3");
-  format->format = name == "bag" ? "ros1" : name;
-  *extension = "." + name;
+  if (name != "bag" && name != "mcap" && name != "db3" && name != "ouster-pcap")
+    return Status::InvalidInput("format '" + name + "' is not one of bag, mcap, db3, ouster-pcap");
+  format->format = name == "bag" || name == "ouster-pcap" ? "ros1" : name;
+  *extension = name == "ouster-pcap" ? ".pcap" : "." + name;
   format->mcap_compression = args.mcap_compression;
   const std::string& c = format->mcap_compression;
   if (c != "zstd" && c != "lz4" && c != "none" && c != "unchunked")
@@ -157,6 +161,70 @@ Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool l
   return error;
 }
 
+// The simulated sensor as Ouster metadata (io/ouster.h), read back from its
+// own JSON text so that the writer uses exactly the values a reader parses.
+StatusOr<OusterMetadata> SimulatedMetadata(const sim::Simulator& simulator, std::string* json) {
+  const sim::LidarModel& lidar = simulator.lidar();
+  std::vector<double> altitude_deg;
+  for (int r = 0; r < lidar.rows(); ++r)
+    altitude_deg.push_back(std::asin(lidar.Direction(r, 0).z()) * 180.0 / M_PI);
+  const int rate_hz = static_cast<int>(std::lround(1e9 / static_cast<double>(lidar.period_ns())));
+  Eigen::Isometry3d imu_T_lidar = Eigen::Isometry3d::Identity();
+  imu_T_lidar.linear() = simulator.T_imu_lidar().R;
+  imu_T_lidar.translation() = simulator.T_imu_lidar().t;
+  StatusOr<OusterMetadata> meta = SimulatedOusterMetadata(altitude_deg, lidar.cols(), rate_hz, imu_T_lidar);
+  if (!meta.ok()) return meta.status();
+  *json = OusterMetadataJson(*meta);
+  return ParseOusterMetadata(*json, "simulated metadata");
+}
+
+// `rvlio simulate --format ouster-pcap`: NAME.pcap (lidar packets on port
+// 7502, IMU packets on 7503, IPv4-fragmented at a 1500-byte MTU), NAME.json
+// (the metadata) and NAME.bag, the same quantized data as PointCloud2 and
+// Imu messages (what the capture must decode to, bit for bit).
+Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pcap_path,
+                          const std::string& json_path, const std::string& bag_path,
+                          const StopFn& stop, std::string* stop_reason) {
+  std::string json;
+  StatusOr<OusterMetadata> meta = SimulatedMetadata(simulator, &json);
+  if (!meta.ok()) return meta.status();
+  PcapWriter pcap;
+  if (Status s = pcap.Open(pcap_path); !s.ok()) return s;
+  StatusOr<std::unique_ptr<SensorBagWriter>> bag = SensorBagWriter::Create(bag_path);
+  if (!bag.ok()) return bag.status();
+  LidarOptions every_return;
+  every_return.min_range = 0.0;
+  every_return.max_range = 1e9;
+  OusterScanAssembler assembler(*meta, every_return);
+  const SimOptions& o = simulator.options();
+  Status error;
+  uint32_t frame_id = 0;
+  auto go_on = [&] { return error.ok() && (!stop || (*stop_reason = stop()).empty()); };
+  simulator.Run(
+      [&](const ImuSample& m) {
+        const OusterImuPacket packet = OusterImuPacketOf(m);
+        error = pcap.Write({m.t_ns, "", 7503, 7503, EncodeOusterImuPacket(packet)});
+        if (error.ok()) error = (*bag)->WriteImu(o.imu.topic, o.imu.frame_id, OusterImuToSample(packet));
+        return go_on();
+      },
+      [&](const Scan& scan, int rows, int cols) {
+        Scan decoded;
+        DecodeStats decode;
+        for (const OusterLidarPacket& p : OusterPacketsOfScan(*meta, scan, frame_id)) {
+          if (!error.ok()) break;
+          error = pcap.Write({p.columns.back().t_ns, "", 7502, 7502, EncodeOusterLidarPacket(*meta, p)});
+          assembler.Add(p, &decoded, &decode);
+        }
+        ++frame_id;
+        if (error.ok()) error = (*bag)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, decoded, rows, cols);
+        return go_on();
+      });
+  if (!error.ok() || !stop_reason->empty()) return error;
+  if (Status s = (*bag)->Close(); !s.ok()) return s;
+  if (Status s = WriteFileAtomically(json_path, json); !s.ok()) return s;
+  return pcap.Close();
+}
+
 std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
   return "ground truth of '" + name + "' (rvlio simulate, seed " + std::to_string(o.seed) +
          FlightSeedNote(o) +
@@ -226,9 +294,12 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
     return r;
   }
   r.bag_path = (dir / (name + extension)).string();
-  if (Status s = WriteBag(**simulator, r.bag_path, livox, format, args.stop, &r.stop_reason);
-      !s.ok())
-    return s;
+  const Status written =
+      args.format == "ouster-pcap"
+          ? WriteOusterCapture(**simulator, r.bag_path, (dir / (name + ".json")).string(),
+                               (dir / (name + ".bag")).string(), args.stop, &r.stop_reason)
+          : WriteBag(**simulator, r.bag_path, livox, format, args.stop, &r.stop_reason);
+  if (!written.ok()) return written;
   if ((r.stopped = !r.stop_reason.empty())) return r;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;

@@ -6,12 +6,15 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include "livox_ros1.h"
+#include "ouster_source.h"
+#include "rvlio/io/pcap.h"
 #include "rosbag_common.h"
 #include "rvlio/io/cdr.h"
 #include "rvlio/io/livox.h"
@@ -320,20 +323,67 @@ StatusOr<BagInfo> ReadRos2Span(const std::string& path) {
   return info;
 }
 
+// A capture: its UDP destination ports as topics ("udp port 7502",
+// "N-byte datagrams"), capture times as receive times.
+StatusOr<BagInfo> ReadPcapInfo(const std::string& path) {
+  StatusOr<PcapReader> reader = PcapReader::Open(path);
+  if (!reader.ok()) return reader.status();
+  BagInfo info;
+  info.path = path;
+  info.storage = "pcap";
+  std::map<std::pair<int, size_t>, RecordingTopicStats> ports;
+  UdpDatagram d;
+  TimeNs first_ns = 0, last_ns = 0;
+  int64_t n = 0;
+  while (true) {
+    StatusOr<bool> got = reader->Next(&d);
+    if (!got.ok()) return got.status();
+    if (!*got) break;
+    first_ns = n == 0 ? d.t_ns : std::min(first_ns, d.t_ns);
+    last_ns = n == 0 ? d.t_ns : std::max(last_ns, d.t_ns);
+    ++n;
+    RecordingTopicStats& s = ports[{d.dst_port, d.payload.size()}];
+    if (s.count++ == 0) s.first_ns = d.t_ns;
+    s.last_ns = d.t_ns;
+  }
+  SetSpan(&info, n, first_ns, last_ns);
+  for (const auto& [key, s] : ports) {
+    BagTopicInfo t;
+    t.topic = "udp port " + std::to_string(key.first);
+    t.type = std::to_string(key.second) + "-byte datagrams";
+    t.count = s.count;
+    SetRate(&t, s.first_ns, s.last_ns);
+    info.topics.push_back(t);
+  }
+  return info;
+}
+
 }  // namespace
 
 StatusOr<BagInfo> ReadBagSpan(const std::string& path) {
   StatusOr<RecordingKind> kind = DetectRecording(path);
   if (!kind.ok()) return kind.status();
+  if (*kind == RecordingKind::kPcap) return ReadPcapInfo(path);
   if (*kind == RecordingKind::kRos1Bag) return ReadRos1Span(path);
   return ReadRos2Span(path);
 }
 
-StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic) {
+StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic,
+                              const std::string& ouster_metadata) {
   StatusOr<RecordingKind> kind = DetectRecording(path);
   if (!kind.ok()) return kind.status();
-  if (*kind == RecordingKind::kRos1Bag) return ReadRos1Info(path, lidar_topic);
-  return ReadRos2Info(path, lidar_topic);
+  StatusOr<BagInfo> info = *kind == RecordingKind::kPcap     ? ReadPcapInfo(path)
+                           : *kind == RecordingKind::kRos1Bag ? ReadRos1Info(path, lidar_topic)
+                                                              : ReadRos2Info(path, lidar_topic);
+  if (!info.ok()) return info;
+  StatusOr<bool> packets = bag_detail::HoldsOusterPackets(path, *kind, lidar_topic);
+  if (!packets.ok()) return packets.status();
+  if (!*packets) return info;
+  StatusOr<OusterRecordingInfo> ouster =
+      bag_detail::ReadOusterRecordingInfo(path, *kind, ouster_metadata);
+  if (!ouster.ok()) return ouster.status();
+  info->ouster = *ouster;
+  return info;
 }
 
 }  // namespace rvlio

@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "rvlio/io/mcap.h"
+#include "rvlio/io/pcap.h"
 
 namespace rvlio {
 namespace {
@@ -558,6 +559,7 @@ const char* RecordingKindName(RecordingKind kind) {
     case RecordingKind::kMcap: return "mcap";
     case RecordingKind::kSqlite3: return "sqlite3";
     case RecordingKind::kRos2Folder: return "ros2 folder";
+    case RecordingKind::kPcap: return "pcap";
   }
   return "unknown";
 }
@@ -575,11 +577,14 @@ StatusOr<RecordingKind> DetectRecording(const std::string& path) {
   if (StartsWith(head, kRos1Magic, sizeof(kRos1Magic) - 1)) return RecordingKind::kRos1Bag;
   if (StartsWith(head, kMcapMagic, sizeof(kMcapMagic) - 1)) return RecordingKind::kMcap;
   if (StartsWith(head, kSqliteMagic, sizeof(kSqliteMagic))) return RecordingKind::kSqlite3;
+  const auto* bytes = reinterpret_cast<const uint8_t*>(head.data());
+  if (IsPcapMagic(bytes, head.size()) || IsPcapngMagic(bytes, head.size()))
+    return RecordingKind::kPcap;  // pcapng: the capture reader says why it cannot read it
   // A .bag of no known kind goes to the ROS1 reader, which says why it is not
   // a bag (empty, truncated header, text).
   if (fs::path(path).extension() == ".bag") return RecordingKind::kRos1Bag;
   return Status::InvalidInput("'" + path + "' is not a recording rvlio reads (neither a ROS1 bag, "
-                              "an MCAP file, a sqlite3 .db3 nor a ROS 2 bag folder)");
+                              "an MCAP file, a sqlite3 .db3, a ROS 2 bag folder nor a pcap capture)");
 }
 
 StatusOr<std::unique_ptr<RecordingSource>> RecordingSource::Open(const std::string& path) {

@@ -11,6 +11,7 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include "livox_ros1.h"
+#include "ouster_source.h"
 #include "rosbag_common.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
@@ -166,6 +167,16 @@ StatusOr<std::unique_ptr<SensorBagReader>> SensorBagReader::Open(
     const std::optional<ReceiveTimeRange>& range) {
   StatusOr<RecordingKind> kind = DetectRecording(path);
   if (!kind.ok()) return kind.status();
+  StatusOr<bool> packets = bag_detail::HoldsOusterPackets(path, *kind, lidar.topic);
+  if (!packets.ok()) return packets.status();
+  if (*packets) {
+    StatusOr<std::unique_ptr<bag_detail::OusterPacketSource>> source =
+        *kind == RecordingKind::kPcap
+            ? bag_detail::OpenOusterPcapSource(path, lidar.ouster_metadata, range)
+            : bag_detail::OpenOusterBagSource(path, *kind, lidar.ouster_metadata, range);
+    if (!source.ok()) return source.status();
+    return bag_detail::OpenOusterReader(std::move(source).value(), lidar, imu);
+  }
   if (*kind != RecordingKind::kRos1Bag)
     return bag_detail::OpenRos2SensorReader(path, lidar, imu, range);
   auto reader = std::make_unique<RosbagSensorReader>(path, lidar, imu);

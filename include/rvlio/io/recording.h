@@ -3,7 +3,8 @@
 // storages: a single sqlite3 `.db3`, a single `.mcap`, or a ROS 2 bag folder
 // (metadata.yaml + its files; several files = a split bag, merged by time).
 // The kind is detected from the content, not from the extension. ROS1 bags
-// are read through rosbag_storage by the sensor reader itself.
+// are read through rosbag_storage by the sensor reader itself, pcap captures
+// by the Ouster packet reader (io/ouster.h, io/pcap.h).
 //
 // Messages are opaque serialized payloads (CDR for ROS 2: io/cdr.h).
 #include <cstdint>
@@ -21,8 +22,9 @@ enum class RecordingKind {
   kMcap,        // "\x89MCAP0\r\n" magic
   kSqlite3,     // "SQLite format 3\0" header
   kRos2Folder,  // a directory with metadata.yaml
+  kPcap,        // a classic pcap capture (Ouster packets + metadata JSON, io/ouster.h)
 };
-// "ros1", "mcap", "sqlite3", "ros2 folder".
+// "ros1", "mcap", "sqlite3", "ros2 folder", "pcap".
 const char* RecordingKindName(RecordingKind kind);
 
 // InvalidInput naming the path when it is missing, unreadable, an empty

@@ -126,6 +126,20 @@ struct BagTopicInfo {
   std::string decode_error;         // PointCloud2 topics: why the layout is unknown
   int64_t scans_sampled = 0;        // PointCloud2 topics: messages decoded for the figures
 };
+// An Ouster packet recording (pcap capture or packet bag), from a pass over
+// all its packets.
+struct OusterRecordingInfo {
+  std::string metadata;          // the JSON file or the bag topic it came from
+  std::string prod_line, firmware, lidar_mode, lidar_profile;
+  int beams = 0, columns_per_frame = 0, window_columns = 0;
+  std::string lidar_source, imu_source;  // "udp 169.254.10.1 port 7502" or the topic
+  int64_t lidar_packets = 0, imu_packets = 0;
+  int64_t frames = 0, incomplete_frames = 0, missing_columns = 0;
+  int64_t late_packets = 0, crc_errors = 0;
+  bool crc = false;              // the packets carry a CRC-64 (checked)
+  double imu_rate_hz = 0.0;      // from the IMU packets' own times
+  double frame_rate_hz = 0.0;    // from the frames' first column times
+};
 struct BagInfo {
   std::string path;
   std::string storage;                    // "ros1", "sqlite3" or "mcap"
@@ -136,12 +150,25 @@ struct BagInfo {
   TimeNs start_ns = 0, end_ns = 0;  // the same, exact
   int64_t messages = 0;
   std::vector<BagTopicInfo> topics;
+  std::optional<OusterRecordingInfo> ouster;  // Ouster packet recordings
 };
 // Lists every topic of any recording SensorBagReader::Open takes (ROS1 bag,
 // .db3, .mcap, ROS 2 bag folder); decodes the first few messages of each
 // PointCloud2 topic (only of `lidar_topic` when it is given; it must then be a
 // PointCloud2 topic).
-StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic = "");
+// For an Ouster packet recording (a pcap capture: storage "pcap", its UDP
+// ports as topics; or a packet bag) also `ouster`, with the metadata
+// `ouster_metadata` names ("": found as SensorBagReader::Open finds it).
+StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_topic = "",
+                              const std::string& ouster_metadata = "");
+// For an Ouster packet recording whose configuration leaves
+// extrinsics.imu_T_lidar at its default (identity), sets it from the
+// metadata (inverse of imu_to_sensor_transform: rvlio's LiDAR frame is the
+// Ouster sensor frame) and appends one line saying so to *notes. Other
+// recordings and configured extrinsics are left as they are.
+Status ApplyRecordingExtrinsics(const std::string& path, const LidarOptions& lidar,
+                                ExtrinsicsSection* extrinsics, std::vector<std::string>* notes);
+
 // Only path, storage, messages and the start/end times of ReadBagInfo, from
 // the recording's index or summary (no pass over an MCAP file's chunks).
 StatusOr<BagInfo> ReadBagSpan(const std::string& path);

@@ -19,6 +19,7 @@ struct LidarOptions {
   // a scan against the scan period, median over the first scans.
   double point_time_span_stop = 0.01;  // below this fraction reading stops (0: never)
   double point_time_span_warn = 0.5;   // below this fraction a warning
+  std::string ouster_metadata;        // Ouster metadata JSON of a packet recording ("" = find it)
 
   template <class V>
   void Visit(V& v) {
@@ -44,6 +45,10 @@ struct LidarOptions {
             Spec().Range(0.0, 1.0).Help(
                 "a warning when the point times of a scan span less than this fraction of the "
                 "scan period (median of the first scans)"));
+    v.Field("ouster_metadata", ouster_metadata,
+            Spec().Help("Ouster sensor metadata JSON for a packet recording (pcap capture or "
+                        "packet bag); empty: NAME.json / NAME_0.json next to a capture, the "
+                        "bag's metadata topic (CLI: --ouster-metadata)"));
   }
   Status Validate() {
     Status s = ValidateFields(*this, "lidar");
