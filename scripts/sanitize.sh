@@ -51,6 +51,8 @@ ex=(
   CompareTest.FullCompareWritesTablesEqualToEvalAndPlots
   CompareTest.EveryVariantFailedIsExitOne
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
+  'PresetsAndBackends/TimeOffsetMatrix\..*'
+  TimeOffsetCliTest.SmootherEstimatesA30MsOffset
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData
   DivergenceCli.LidarTopicOfAnotherRobot
