@@ -13,6 +13,7 @@ int CmdEval(int argc, char** argv);
 int CmdCompare(int argc, char** argv);
 int CmdAblate(int argc, char** argv);
 int CmdInfo(int argc, char** argv);
+int CmdCalibrateTime(int argc, char** argv);
 int CmdDemo(int argc, char** argv);
 int CmdReport(int argc, char** argv);
 

@@ -12,6 +12,21 @@ void WarnDivergence(const std::string& command, const DivergenceReport& r, size_
   }
 }
 
+// When the residuals grew with the motion before the divergence: the likely
+// cause and the command that checks it.
+static std::string ClockHint(const DivergenceReport& r) {
+  if (!r.clock_suspect) return "";
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "; the point-to-plane residuals grew with the motion before it (%.3f m median "
+                "at rest, %.3f m moving), as unsynchronized LiDAR and IMU clocks make them (or "
+                "wrong extrinsics): check the clocks with `rvlio calibrate-time --bag RECORDING "
+                "--config CONFIG` and set lidar.time_offset, or run with --set "
+                "lidar.estimate_time_offset=true",
+                r.residual_at_rest_m, r.residual_moving_m);
+  return text;
+}
+
 int FinishDiverged(const std::string& command, const DivergenceReport& r,
                    const std::string& out_dir, bool allow) {
   char when[64];
@@ -20,7 +35,7 @@ int FinishDiverged(const std::string& command, const DivergenceReport& r,
                            std::to_string(r.events.size()) + " episode(s), " +
                            std::to_string(r.scans_flagged) +
                            " scans flagged; see divergence in summary.json); outputs written to " +
-                           out_dir + " for inspection";
+                           out_dir + " for inspection" + ClockHint(r);
   if (allow) {
     std::fprintf(stderr, "rvlio %s: warning: %s\n", command.c_str(), what.c_str());
     return 0;

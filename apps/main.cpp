@@ -29,6 +29,8 @@ constexpr Subcommand kSubcommands[] = {
      rvlio::cli::CmdCompare},
     {"ablate", "run a grid of sequences x variants x parameters, resumable", rvlio::cli::CmdAblate},
     {"info", "list the topics, rates and point layouts of a ROS1 or ROS 2 bag", rvlio::cli::CmdInfo},
+    {"calibrate-time", "estimate the LiDAR-IMU clock offset of a recording (offline)",
+     rvlio::cli::CmdCalibrateTime},
     {"demo", "simulate the default tunnel and show what rvlio does with it", rvlio::cli::CmdDemo},
     {"report", "one self-contained report.html for a compare, demo, ablate or run folder",
      rvlio::cli::CmdReport},

@@ -55,6 +55,8 @@ ex=(
   CompareTest.RefMapAddsMapColumnsEqualToEvalMap
   MapAccuracyTest.RefineMapIsMoreAccurateThanTheIeskfMapItStartedFrom
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
+  'PresetsAndBackends/TimeOffsetMatrix\..*'
+  TimeOffsetCliTest.SmootherEstimatesA30MsOffset
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData
   DivergenceCli.LidarTopicOfAnotherRobot

@@ -43,6 +43,20 @@ void AddExtrinsicColumns(const std::vector<ScanResult>& scans, Column& column) {
   column("ext_z_m", [&](const ScanResult& r) { return t_m(r, 2); });
 }
 
+// The time-offset columns of scans.csv (NaN for a scan without an
+// estimate), only when some scan carries one.
+template <typename Column>
+void AddTimeOffsetColumns(const std::vector<ScanResult>& scans, Column& column) {
+  if (std::none_of(scans.begin(), scans.end(),
+                   [](const ScanResult& r) { return r.time_offset_s.has_value(); }))
+    return;
+  column("time_offset_s",
+         [](const ScanResult& r) { return r.time_offset_s ? *r.time_offset_s : std::nan(""); });
+  column("time_offset_std_s", [](const ScanResult& r) {
+    return r.time_offset_s ? r.time_offset_std_s : std::nan("");
+  });
+}
+
 // The per-scan table: the columns of scans.csv as numpy arrays (one row per scan).
 py::dict ScanTable(const std::vector<ScanResult>& scans) {
   const auto n = static_cast<py::ssize_t>(scans.size());
@@ -90,6 +104,7 @@ py::dict ScanTable(const std::vector<ScanResult>& scans) {
   column("residual_rms_m", [](const ScanResult& r) { return r.health.residual_rms_m; });
   column("diverged", [](const ScanResult& r) { return r.health.divergence_mask != 0; });
   AddExtrinsicColumns(scans, column);
+  AddTimeOffsetColumns(scans, column);
   return table;
 }
 

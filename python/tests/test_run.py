@@ -160,3 +160,27 @@ def test_run_table_follows_the_extrinsic_estimate_like_scans_csv(tmp_path, rvlio
     final = result.summary["extrinsic"]["T_imu_lidar"]
     np.testing.assert_allclose([result.scans[c][-1] for c in EXTRINSIC_COLUMNS],
                                final["rpy_deg"] + final["translation_m"], rtol=0, atol=1e-12)
+
+
+TIME_OFFSET_COLUMNS = ("time_offset_s", "time_offset_std_s")
+
+
+def test_run_table_follows_the_time_offset_estimate_like_scans_csv(tmp_path, rvlio_bin, tunnel,
+                                                                    py_run):
+    # Without online estimation neither the table nor scans.csv has the columns.
+    assert not set(TIME_OFFSET_COLUMNS) & set(py_run[1].scans)
+    cli_out = tmp_path / "cli"
+    run_cli(rvlio_bin, "run", "--bag", tunnel["bag"], "--config", tunnel["config"], "--out",
+            cli_out, "--quiet", "--set", "lidar.estimate_time_offset=true")
+    config = rvlio.Config.load(tunnel["config"], set={"lidar.estimate_time_offset": True})
+    result = rvlio.run(tunnel["bag"], config)
+    csv = np.genfromtxt(cli_out / "scans.csv", delimiter=",", names=True, dtype=None,
+                        encoding="utf-8")
+    header = (cli_out / "scans.csv").read_text().splitlines()[0].split(",")
+    assert header[-2:] == list(TIME_OFFSET_COLUMNS)
+    # The columns both have come in the same order.
+    assert [c for c in result.scans if c in header] == [c for c in header if c in result.scans]
+    for column in TIME_OFFSET_COLUMNS:
+        assert np.all(np.isfinite(result.scans[column])), column
+        np.testing.assert_allclose(result.scans[column], csv[column], rtol=1e-8, atol=1e-12)
+    assert result.scans["time_offset_s"][-1] == result.summary["time_offset"]["estimate_s"]

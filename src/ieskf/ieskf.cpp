@@ -16,6 +16,11 @@ namespace {
 using Matrix12d = Eigen::Matrix<double, 12, 12>;
 using Vector12d = Eigen::Matrix<double, 12, 1>;
 using Matrix24x12d = Eigen::Matrix<double, 24, 12>;
+using Matrix16d = Eigen::Matrix<double, 16, 16>;
+using Vector16d = Eigen::Matrix<double, 16, 1>;
+using Matrix25d = Eigen::Matrix<double, 25, 25>;
+using Vector25d = Eigen::Matrix<double, 25, 1>;
+constexpr int kTimeOffsetIndex = FilterState::kDim;  // the augmented error-state entry
 
 // Fixed extrinsics: a tiny std keeps P invertible; no update touches the block.
 constexpr double kFixedExtrinsicStd = 1e-5;  // rad and m
@@ -76,6 +81,27 @@ int AccumulateNormalEquations(const ConstraintList& constraints, const FilterSta
   return static_cast<int>(constraints.size());
 }
 
+// The same with the time-offset columns (TimeOffsetJacobian): 16 columns
+// [dtheta, dp, dphi, dt_ext, dv, d(td)], extrinsic columns zero unless estimated.
+void AccumulateNormalEquationsWithTimeOffset(const ConstraintList& constraints,
+                                             const FilterState& x, const ScanTimeMotion& motion,
+                                             double dt_s, bool with_extrinsics, double inv_sigma2,
+                                             Matrix16d* HtRinvH, Vector16d* HtRinvz,
+                                             double* zRinvz) {
+  HtRinvH->setZero();
+  HtRinvz->setZero();
+  *zRinvz = 0.0;
+  TimeOffsetJacobian h;
+  for (const Constraint& c : constraints) {
+    const double r = PointToPlaneResidualWithTimeOffset(c, x, motion, dt_s, &h);
+    if (!with_extrinsics) h.segment<6>(6).setZero();
+    const double w = c.weight * inv_sigma2;
+    *zRinvz += w * r * r;
+    HtRinvH->noalias() += w * h.transpose() * h;
+    HtRinvz->noalias() += w * r * h.transpose();
+  }
+}
+
 void PropagateCovariance(const Matrix24d& F, const ImuOptions& imu, double dt_s, Matrix24d* P) {
   *P = F * *P * F.transpose();
   auto add_diag = [&](int index, double variance) {
@@ -108,12 +134,13 @@ Matrix24d ExcitationCovariance(const Matrix24d& P0, const Vector6d& extrinsic_st
 // The rotation step of the point-to-plane normal equations alone (columns
 // [dtheta, dp, ...]: the first three), position held; NaN when the rotation
 // is not observable from them.
-double LidarOnlyRotationDeg(const Matrix12d& HtRinvH, const Vector12d& HtRinvz) {
-  const Eigen::Matrix3d H_rr = HtRinvH.topLeftCorner<3, 3>();
+template <class MatrixC, class VectorC>
+double LidarOnlyRotationDeg(const MatrixC& HtRinvH, const VectorC& HtRinvz) {
+  const Eigen::Matrix3d H_rr = HtRinvH.template topLeftCorner<3, 3>();
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(H_rr);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0))
     return std::numeric_limits<double>::quiet_NaN();
-  const Eigen::Vector3d dtheta = -ldlt.solve(HtRinvz.head<3>());
+  const Eigen::Vector3d dtheta = -ldlt.solve(HtRinvz.template head<3>());
   return dtheta.allFinite() ? dtheta.norm() * 180.0 / M_PI : std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -129,9 +156,20 @@ Matrix24x12d ErrorStateColumns(const std::array<bool, 6>& free) {
   return E;
 }
 
+// The rows of TimeOffsetJacobian's 16 columns in the 25-dim augmented error
+// state [FilterState, td].
+static Eigen::Matrix<double, 25, 16> TimeOffsetErrorStateColumns(
+    const std::array<bool, 6>& free) {
+  Eigen::Matrix<double, 25, 16> E = Eigen::Matrix<double, 25, 16>::Zero();
+  E.topLeftCorner<24, 12>() = ErrorStateColumns(free);
+  E.block<3, 3>(FilterState::kVel, 12).setIdentity();
+  E(kTimeOffsetIndex, 15) = 1.0;
+  return E;
+}
+
 Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
-             const ConstraintOptions& constraints, const RvOptions& rv)
-    : options_(options), imu_(imu), constraints_(constraints), rv_(rv) {}
+             const ConstraintOptions& constraints, const RvOptions& rv, const LidarOptions& lidar)
+    : options_(options), imu_(imu), constraints_(constraints), rv_(rv), lidar_(lidar) {}
 
 void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu) {
   x_ = x0;
@@ -141,8 +179,16 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
   excitation_ = ExtrinsicExcitation(ExtrinsicPriorStd(options_));
   t_ns_ = t_ns;
   last_imu_ = last_imu;
+  td_s_ = td_lin_s_ = lidar_.time_offset;
+  scan_motion_ = ScanTimeMotion();
+  P_x_td_.setZero();
+  P_td_td_ = lidar_.estimate_time_offset ? lidar_.time_offset_init_std * lidar_.time_offset_init_std
+                                         : 0.0;
+  td_at_bound_ = false;
   ClearPoseHistory();
 }
+
+double Ieskf::time_offset_std_s() const { return std::sqrt(std::max(P_td_td_, 0.0)); }
 
 void Ieskf::ClearPoseHistory() {
   pose_history_.Clear();
@@ -206,6 +252,10 @@ void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu
   x_.R_world_imu = x_.R_world_imu * so3::Exp(w_dt);
 
   PropagateCovariance(F, imu_, dt_s, &P_);
+  if (lidar_.estimate_time_offset) {
+    P_x_td_ = F * P_x_td_;  // the offset itself is constant: identity row
+    P_td_td_ += lidar_.time_offset_random_walk * lidar_.time_offset_random_walk * dt_s;
+  }
   if (options_.estimate_extrinsics) {
     PropagateCovariance(F, imu_, dt_s, &P_all_extrinsic_);
     AddExtrinsicRandomWalk(dt_s);
@@ -228,56 +278,123 @@ void Ieskf::AddExtrinsicRandomWalk(double dt_s) {
 // which equals -K z - (I - K H) e of Eq. (1); the posterior covariance
 // (I - K H) Pv equals (H^T R^-1 H + Pv^-1)^-1.
 IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
+  if (lidar_.estimate_time_offset) return UpdateImpl<true>(associate);
+  return UpdateImpl<false>(associate);
+}
+
+// The motion held at the state's time: the newest pose sample's (the IMU
+// measurement held by the last propagation step).
+ScanTimeMotion Ieskf::MotionAtStateTime() const {
+  ScanTimeMotion m;
+  if (pose_history_.empty()) return m;
+  m.gyro_imu = pose_history_.samples().back().gyro_imu;
+  m.acc_world = pose_history_.samples().back().acc_world;
+  return m;
+}
+
+// kTimeOffset: the error state is augmented with the time offset (index 24),
+// the residuals are taken at the scan's time (PointToPlaneResidualWithTimeOffset)
+// and the normal equations have the 16 columns of TimeOffsetJacobian. Without
+// it the 24-dim filter of paper Eq. (1) as it is.
+template <bool kTimeOffset>
+IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
+  constexpr int N = kTimeOffset ? 25 : 24;  // error-state dimension
+  constexpr int C = kTimeOffset ? 16 : 12;  // Jacobian columns
+  using MatrixN = Eigen::Matrix<double, N, N>;
+  using VectorN = Eigen::Matrix<double, N, 1>;
+  using MatrixC = Eigen::Matrix<double, C, C>;
+  using VectorC = Eigen::Matrix<double, C, 1>;
   IeskfUpdateResult result;
   if (options_.estimate_extrinsics) ReleaseExcitedAxes();
   const FilterState x0 = x_;
-  const Matrix24d P0 = P_;
-  const Matrix24d P0_inv = P0.ldlt().solve(Matrix24d::Identity());
+  MatrixN P0;
+  if constexpr (kTimeOffset) {
+    P0 << P_, P_x_td_, P_x_td_.transpose(), P_td_td_;
+    td_lin_s_ = td_s_;
+    scan_motion_ = MotionAtStateTime();
+  } else {
+    P0 = P_;
+  }
+  const MatrixN P0_inv = P0.ldlt().solve(MatrixN::Identity());
   const bool with_ext = options_.estimate_extrinsics;
   const double inv_sigma2 = 1.0 / (constraints_.lidar_noise * constraints_.lidar_noise);
   const int cols = with_ext ? 12 : 6;
   std::array<bool, 6> free{};
   for (int i = 0; i < 6; ++i) free[i] = with_ext && excitation_.excited(i);
-  const Matrix24x12d E = ErrorStateColumns(free);
+  Eigen::Matrix<double, N, C> E;
+  if constexpr (kTimeOffset) {
+    E = TimeOffsetErrorStateColumns(free);
+  } else {
+    E = ErrorStateColumns(free);
+  }
   Matrix24d J = Matrix24d::Identity();
 
   FilterState x = x0;
-  Matrix24d S = P0;
+  double td_s = td_s_;
+  // The state at the scan's time, as association and RV see it.
+  auto at_scan_time = [&](const FilterState& s) {
+    if constexpr (kTimeOffset) {
+      FilterState moved = s;
+      const Pose3 T = ScanTimePose(s, scan_motion_, td_s - td_lin_s_);
+      moved.R_world_imu = T.R;
+      moved.p_world_imu = T.t;
+      return moved;
+    } else {
+      return s;
+    }
+  };
+  MatrixN S = P0;
   ConstraintList constraints;
-  Matrix12d HtRinvH;
-  Vector12d HtRinvz;
+  MatrixC HtRinvH;
+  VectorC HtRinvz;
   for (int it = 0; it < options_.max_iterations; ++it) {
-    associate(x, &constraints);
+    const FilterState x_scan = at_scan_time(x);
+    associate(x_scan, &constraints);
     // Alg. 3: criterion, reinforcement, repair; a no-op edit when RV is off
     // (the report still carries the localizability figure).
-    result.rv = ApplyRv(rv_, x.T_world_lidar(), &constraints, &rv_workspace_);
+    result.rv = ApplyRv(rv_, x_scan.T_world_lidar(), &constraints, &rv_workspace_);
     result.num_constraints = static_cast<int>(constraints.size());
     if (result.num_constraints < kMinPoseConstraints) break;
     double zRinvz = 0.0;
-    AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
+    if constexpr (kTimeOffset) {
+      AccumulateNormalEquationsWithTimeOffset(constraints, x, scan_motion_, td_s - td_lin_s_,
+                                              with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
+    } else {
+      AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
+    }
 
     const Matrix24d J_inv = BoxminusJacobianInverse(x, x0);
     J = BoxminusJacobian(x, x0);
-    const Vector24d e = J_inv * Boxminus(x, x0);
-    const Matrix24d Pv_inv = J.transpose() * P0_inv * J;
-    Matrix24d A = Pv_inv;
-    Vector24d b = Pv_inv * e;
-    if (with_ext) {
+    VectorN e;
+    MatrixN Jn;
+    if constexpr (kTimeOffset) {
+      e << J_inv * Boxminus(x, x0), td_s - td_s_;
+      Jn.setIdentity();
+      Jn.template topLeftCorner<24, 24>() = J;
+    } else {
+      e = J_inv * Boxminus(x, x0);
+      Jn = J;
+    }
+    const MatrixN Pv_inv = Jn.transpose() * P0_inv * Jn;
+    MatrixN A = Pv_inv;
+    VectorN b = Pv_inv * e;
+    if (with_ext || kTimeOffset) {
       A.noalias() += E * HtRinvH * E.transpose();
       b.noalias() += E * HtRinvz;
     } else {
       A.topLeftCorner(cols, cols) += HtRinvH.topLeftCorner(cols, cols);
       b.head(cols) += HtRinvz.head(cols);
     }
-    const Eigen::LDLT<Matrix24d> ldlt(A);
-    const Vector24d dx = -ldlt.solve(b);
-    S = ldlt.solve(Matrix24d::Identity());
+    const Eigen::LDLT<MatrixN> ldlt(A);
+    const VectorN dx = -ldlt.solve(b);
+    S = ldlt.solve(MatrixN::Identity());
     // At x = x0 (e = 0): z^T (H P0 H^T + R)^-1 z = z^T R^-1 z - b^T A^-1 b = z^T R^-1 z + b^T dx.
     if (it == 0) {
       result.nis_per_dof = (zRinvz + b.dot(dx)) / result.num_constraints;
       result.lidar_rotation_deg = LidarOnlyRotationDeg(HtRinvH, HtRinvz);
     }
-    x = Boxplus(x, dx);
+    x = Boxplus(x, dx.template head<24>());
+    if constexpr (kTimeOffset) td_s += dx(kTimeOffsetIndex);
     result.iterations = it + 1;
     result.last_step_norm = dx.norm();
     if (!dx.allFinite()) break;
@@ -285,16 +402,32 @@ IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
   }
   if (result.iterations == 0) return result;  // too few constraints: prediction only
   S = 0.5 * (S + S.transpose());
-  if (!IsHealthy(x, S)) {
+  if (!IsHealthy(x, S.template topLeftCorner<24, 24>()) || !std::isfinite(td_s)) {
     result.diverged = true;  // keep the prior (x0, P0): the last good state
     return result;
   }
   x_ = x;
-  P_ = S;
-  if (with_ext) UpdateExcitation(HtRinvH, J);
+  P_ = S.template topLeftCorner<24, 24>();
+  if constexpr (kTimeOffset) {
+    P_x_td_ = S.col(kTimeOffsetIndex).template head<24>();
+    P_td_td_ = S(kTimeOffsetIndex, kTimeOffsetIndex);
+    td_s_ = td_s;
+    HoldTimeOffsetInBound();
+  }
+  if (with_ext) UpdateExcitation(HtRinvH.template topLeftCorner<12, 12>(), J);
   result.ok = true;
-  result.residuals = ComputeResidualStats(constraints, x.T_world_imu(), x.T_imu_lidar());
+  const FilterState x_scan = at_scan_time(x_);
+  result.residuals = ComputeResidualStats(constraints, x_scan.T_world_imu(), x_scan.T_imu_lidar());
   return result;
+}
+
+// An estimate past +-time_offset_max is held at the bound (and reported:
+// time_offset_at_bound()); the state's pose is left as the update made it.
+void Ieskf::HoldTimeOffsetInBound() {
+  const double bound_s = lidar_.time_offset_max;
+  if (std::abs(td_s_) <= bound_s) return;
+  td_s_ = std::copysign(bound_s, td_s_);
+  td_at_bound_ = true;
 }
 
 // A held extrinsic axis carries the tiny kFixedExtrinsicStd in P (a loose

@@ -15,18 +15,17 @@ size_t SampleIndexAt(const std::vector<ImuPoseSample>& samples, TimeNs t_ns) {
   return it == samples.begin() ? 0 : static_cast<size_t>(it - samples.begin()) - 1;
 }
 
-// Constant angular rate and world acceleration over dt (may be negative).
-Pose3 Advance(const ImuPoseSample& s, double dt_s) {
+}  // namespace
+
+Pose3 AdvanceImuPose(const ImuPoseSample& s, double dt_s) {
   return Pose3(s.R_world_imu * so3::Exp(s.gyro_imu * dt_s),
                s.p_world_imu + s.v_world_imu * dt_s + 0.5 * s.acc_world * dt_s * dt_s);
 }
 
-}  // namespace
-
 Pose3 InterpolateImuPose(const std::vector<ImuPoseSample>& samples, TimeNs t_ns) {
   RVLIO_CHECK(!samples.empty());
   const ImuPoseSample& s = samples[SampleIndexAt(samples, t_ns)];
-  return Advance(s, NsToSeconds(t_ns - s.t_ns));
+  return AdvanceImuPose(s, NsToSeconds(t_ns - s.t_ns));
 }
 
 ImuPoseHistory ImuPoseHistory::Integrate(const ImuKinematics& start,

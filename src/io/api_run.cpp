@@ -84,6 +84,7 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   j["stats"] = StatsJson(odo.stats(), reader_stats);
   j["divergence"] = DivergenceJson(odo.divergence());
   if (odo.stats().extrinsic.enabled) j["extrinsic"] = ExtrinsicJson(odo.stats().extrinsic);
+  if (odo.stats().time_offset.enabled) j["time_offset"] = TimeOffsetJson(odo.stats().time_offset);
   j["warnings"] = result.warnings;
   j["truncated"] = data.truncated;
   j["interrupted"] = result.stopped;

@@ -47,4 +47,22 @@ nlohmann::json ExtrinsicJson(const ExtrinsicReport& r) {
             {"translation_delta_m", ToList(dt)}}}};
 }
 
+nlohmann::json TimeOffsetJson(const TimeOffsetReport& r) {
+  return {{"estimate_s", r.estimate_s},
+          {"std_s", r.std_s},
+          {"prior_s", r.prior_s},
+          {"at_bound", r.at_bound},
+          {"bound_s", r.bound_s},
+          {"excited", r.excited},
+          {"excited_s", r.excited_s},
+          {"max_rotation_rate_spread_rad_s", r.max_rate_spread_rad_s},
+          {"max_velocity_spread_m_s", r.max_velocity_spread_m_s},
+          {"trustworthy", r.trustworthy},
+          {"note", r.trustworthy ? "put estimate_s in lidar.time_offset"
+                   : r.excited   ? "not trustworthy: the estimate is not settled (1-sigma above "
+                                   "lidar.time_offset_excited_std, or at the bound)"
+                                 : "not trustworthy: the motion never excited the time offset "
+                                   "(hover or constant velocity); keep lidar.time_offset"}};
+}
+
 }  // namespace rvlio

@@ -106,6 +106,11 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
   const bool extrinsic = std::any_of(results.begin(), results.end(),
                                      [](const ScanResult& r) { return r.T_imu_lidar.has_value(); });
   if (extrinsic) os << ",ext_roll_deg,ext_pitch_deg,ext_yaw_deg,ext_x_m,ext_y_m,ext_z_m";
+  // Online time-offset estimation: its estimate and 1-sigma after each scan (s).
+  const bool time_offset = std::any_of(results.begin(), results.end(), [](const ScanResult& r) {
+    return r.time_offset_s.has_value();
+  });
+  if (time_offset) os << ",time_offset_s,time_offset_std_s";
   os << '\n';
   for (size_t i = 0; i < results.size(); ++i) {
     const ScanResult& r = results[i];
@@ -122,6 +127,12 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
        << Optional(r.health.nis_per_dof) << ',' << Optional(r.health.residual_median_m) << ','
        << Optional(r.health.residual_rms_m) << ',' << DivergenceKindNames(r.health.divergence_mask);
     if (extrinsic) WriteExtrinsicColumns(r.T_imu_lidar, os);
+    if (time_offset) {
+      if (r.time_offset_s)
+        os << ',' << *r.time_offset_s << ',' << r.time_offset_std_s;
+      else
+        os << ",,";
+    }
     os << '\n';
   }
   return WriteFileAtomically(path, os.str());

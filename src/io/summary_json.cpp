@@ -76,11 +76,16 @@ nlohmann::json DivergenceJson(const DivergenceReport& r) {
                         {"time_s", NsToSeconds(e.t_ns)},
                         {"value", e.value},
                         {"threshold", e.threshold}});
-  return {{"detected", r.detected},
-          {"first_time_s", r.detected ? nlohmann::json(NsToSeconds(r.first_t_ns)) : nlohmann::json()},
-          {"scans_flagged", r.scans_flagged},
-          {"events", events},
-          {"episodes", episodes}};
+  nlohmann::json j = {
+      {"detected", r.detected},
+      {"first_time_s", r.detected ? nlohmann::json(NsToSeconds(r.first_t_ns)) : nlohmann::json()},
+      {"scans_flagged", r.scans_flagged},
+      {"events", events},
+      {"episodes", episodes}};
+  // Residuals grown with the motion before the divergence: unsynchronized
+  // clocks (or wrong extrinsics) are the likely cause (`rvlio calibrate-time`).
+  if (r.detected) j["clock_suspect"] = r.clock_suspect;
+  return j;
 }
 
 double PeakMemoryMb() {

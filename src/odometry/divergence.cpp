@@ -122,9 +122,29 @@ void DivergenceMonitor::EndEpisodes(uint8_t mask) {
   }
 }
 
+// Residuals by motion up to (and with) the scan of the first divergence.
+void DivergenceMonitor::CountMotionResidual(const HealthSample& s, bool detected_before) {
+  if (detected_before || !s.associated || !std::isfinite(s.health.residual_median_m)) return;
+  const double speed = s.v_world_imu.norm();
+  if (speed < DivergenceReport::kRestSpeed) {
+    rest_sum_m_ += s.health.residual_median_m;
+    ++rest_scans_;
+  } else if (speed > DivergenceReport::kMovingSpeed) {
+    moving_sum_m_ += s.health.residual_median_m;
+    ++moving_scans_;
+  }
+  if (rest_scans_ > 0) report_.residual_at_rest_m = rest_sum_m_ / rest_scans_;
+  if (moving_scans_ > 0) report_.residual_moving_m = moving_sum_m_ / moving_scans_;
+  report_.clock_suspect = rest_scans_ >= DivergenceReport::kClockSuspectMinScans &&
+                          moving_scans_ >= DivergenceReport::kClockSuspectMinScans &&
+                          report_.residual_moving_m >
+                              DivergenceReport::kClockSuspectRatio * report_.residual_at_rest_m;
+}
+
 uint8_t DivergenceMonitor::Check(const HealthSample& s) {
   uint8_t mask = 0;
   if (!options_.enabled) return mask;
+  CountMotionResidual(s, report_.detected);
   const double speed = s.v_world_imu.norm();
   if (!std::isfinite(speed) || speed > options_.max_speed)
     Trip(DivergenceKind::kSpeed, s.t_ns, speed, options_.max_speed, &mask);

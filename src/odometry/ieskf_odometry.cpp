@@ -12,7 +12,7 @@ namespace rvlio {
 
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
     : options_(options),
-      filter_(options.ieskf, options.imu, options.constraints, options.rv),
+      filter_(options.ieskf, options.imu, options.constraints, options.rv, options.lidar),
       map_(options.map, options.ieskf.estimate_extrinsics),
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
@@ -53,11 +53,13 @@ std::vector<std::string> IeskfOdometry::warnings() const {
 }
 
 void IeskfOdometry::AddScan(Scan scan) {
-  scans_.Add(std::move(scan), stats_.initialized, filter_.time_ns(), &stats_);
+  // The filter's time is on the IMU clock, the queued scans' on the reader's
+  // (before the estimated shift).
+  scans_.Add(std::move(scan), stats_.initialized, filter_.time_ns() - ScanTimeShiftNs(), &stats_);
 }
 
 void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
-  while (scans_.FrontReady(imu_buffer_)) ProcessFrontScan(out);
+  while (scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) ProcessFrontScan(out);
 }
 
 void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
@@ -65,9 +67,14 @@ void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
   while (!scans_.empty()) ProcessFrontScan(out);
 }
 
+// The scan is moved onto the IMU clock by the current estimate (prediction
+// and deskew at the moved times); the update then refines the estimate
+// (Ieskf::Update, ScanTimeMotion). The result's stamp and pose are the
+// filter's: the IMU at the moved scan end.
 void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   Scan scan = scans_.PopFront();
   const double start_ms = ThreadCpuMs();
+  if (options_.lidar.estimate_time_offset) ShiftScanTime(ScanTimeShiftNs(), &scan);
   const Eigen::Vector3d mean_acc_imu = Predict(scan.t_end_ns);
   preprocessor_.Downsample(scan, &downsampled_);
   if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {
@@ -84,6 +91,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.status = map_.Empty() ? ScanStatus::kMapInit : Correct(&r);
   InsertIntoMap(scan.t_end_ns);
   ReportExtrinsic(&r);
+  ReportTimeOffset(&r);
   filter_.ClearPoseHistory();
   r.t_ns = scan.t_end_ns;
   r.T_world_imu = filter_.state().T_world_imu();
@@ -152,9 +160,33 @@ void IeskfOdometry::ReportExtrinsic(ScanResult* r) {
   stats_.extrinsic.map_rebuilds = map_.rebuilds();
 }
 
+TimeNs IeskfOdometry::ScanTimeShiftNs() const {
+  if (!options_.lidar.estimate_time_offset) return 0;
+  return SecondsToNs(filter_.time_offset_s() - options_.lidar.time_offset);
+}
+
+void IeskfOdometry::ReportTimeOffset(ScanResult* r) {
+  if (!options_.lidar.estimate_time_offset) return;
+  const bool was_at_bound = stats_.time_offset.at_bound;
+  if (!filter_.pose_history().empty())
+    time_offset_excitation_.CountScan(filter_.time_ns(), filter_.pose_history().back().gyro_imu,
+                                      filter_.state().v_world_imu);
+  r->time_offset_s = filter_.time_offset_s();
+  r->time_offset_std_s = filter_.time_offset_std_s();
+  stats_.time_offset =
+      MakeTimeOffsetReport(time_offset_excitation_, options_.lidar, filter_.time_offset_s(),
+                           filter_.time_offset_std_s(), filter_.time_offset_at_bound());
+  if (stats_.time_offset.at_bound && !was_at_bound)
+    warnings_.push_back(TimeOffsetAtBoundWarning(options_.lidar, filter_.time_ns()));
+}
+
+// The scan's points were deskewed to its end on the LiDAR clock, which the
+// estimated offset puts at the filter's ScanTimeImuPose().
 void IeskfOdometry::InsertIntoMap(TimeNs t_ns) {
   const FilterState& x = filter_.state();
-  output_map_.Insert(map_.InsertScan(t_ns, x.T_world_imu(), x.T_imu_lidar(), p_lidar_end_));
+  const Pose3 T_world_imu =
+      options_.lidar.estimate_time_offset ? filter_.ScanTimeImuPose() : x.T_world_imu();
+  output_map_.Insert(map_.InsertScan(t_ns, T_world_imu, x.T_imu_lidar(), p_lidar_end_));
 }
 
 }  // namespace rvlio

@@ -41,6 +41,24 @@ ExtrinsicReport MakeExtrinsicReport(const ExtrinsicExcitation& excitation,
   return r;
 }
 
+TimeOffsetReport MakeTimeOffsetReport(const TimeOffsetExcitation& excitation,
+                                      const LidarOptions& lidar, double estimate_s, double std_s,
+                                      bool at_bound) {
+  TimeOffsetReport r;
+  r.enabled = true;
+  r.prior_s = lidar.time_offset;
+  r.estimate_s = estimate_s;
+  r.std_s = std_s;
+  r.at_bound = at_bound;
+  r.bound_s = lidar.time_offset_max;
+  r.excited = excitation.excited();
+  r.excited_s = excitation.excited_seconds();
+  r.max_rate_spread_rad_s = excitation.max_rate_spread();
+  r.max_velocity_spread_m_s = excitation.max_velocity_spread();
+  r.trustworthy = r.excited && std_s < lidar.time_offset_excited_std && !at_bound;
+  return r;
+}
+
 StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& options) {
   OdometryOptions checked = options;
   if (Status s = checked.Validate(); !s.ok()) return s;

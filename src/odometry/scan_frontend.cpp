@@ -82,6 +82,13 @@ void WorkingMap::Rebuild(const Pose3& T_imu_lidar) {
   ++rebuilds_;
 }
 
+std::string TimeOffsetAtBoundWarning(const LidarOptions& lidar, TimeNs t_ns) {
+  return "the estimated LiDAR-IMU time offset reached lidar.time_offset_max (" +
+         std::to_string(lidar.time_offset_max) + " s) at t=" + std::to_string(NsToSeconds(t_ns)) +
+         " s and is held there: the clocks differ by more, or the estimate is lost; check the "
+         "recording with `rvlio calibrate-time` and set lidar.time_offset";
+}
+
 bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats) {
   if (!imu.acc_imu.allFinite() || !imu.gyro_imu.allFinite()) {
     ++stats->imu_non_finite;

@@ -21,6 +21,15 @@ WindowOptions MakeWindowOptions(const OdometryOptions& o) {
   return w;
 }
 
+// The IMU motion held at the end of a predicted interval (the last knot's).
+ScanTimeMotion MotionAtEnd(const ImuPoseHistory& history) {
+  ScanTimeMotion m;
+  if (history.empty()) return m;
+  m.gyro_imu = history.samples().back().gyro_imu;
+  m.acc_world = history.samples().back().acc_world;
+  return m;
+}
+
 Eigen::Vector3d MeanAcc(const std::vector<ImuSample>& samples, TimeNs t0_ns, TimeNs t1_ns) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int n = 0;
@@ -71,11 +80,13 @@ void SmootherOdometry::TryInitialize(const ImuSample& imu) {
 }
 
 void SmootherOdometry::AddScan(Scan scan) {
-  scans_.Add(std::move(scan), stats_.initialized, newest_.t_ns, &stats_);
+  // newest_ is on the IMU clock, the queued scans on the reader's (before the
+  // estimated shift).
+  scans_.Add(std::move(scan), stats_.initialized, newest_.t_ns - ScanTimeShiftNs(), &stats_);
 }
 
 void SmootherOdometry::Poll(std::vector<ScanResult>* out) {
-  while (scans_.FrontReady(imu_buffer_)) ProcessFrontScan(out);
+  while (scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) ProcessFrontScan(out);
 }
 
 // The remaining scans, then the states still in the window enter the
@@ -86,16 +97,19 @@ void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
   if (flushed_ || !window_) return;
   flushed_ = true;
   for (int k = 0; k < window_->size(); ++k) {
-    const WindowState s = window_->state(k);
-    TransformPoints(s.pose.ToPose3() * CurrentTImuLidar(), window_->points(k), &p_world_);
+    TransformPoints(window_->ScanTimeImuPose(k) * CurrentTImuLidar(), window_->points(k),
+                    &p_world_);
     output_map_.Insert(p_world_);
   }
 }
 
 // Predict -> Downsample -> Deskew -> Add + Optimize -> Insert -> Marginalize.
+// With lidar.estimate_time_offset the scan is first moved onto the IMU clock
+// by the current estimate (the window then refines it).
 void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   Scan scan = scans_.PopFront();
   const double start_ms = ThreadCpuMs();
+  if (options_.lidar.estimate_time_offset) ShiftScanTime(ScanTimeShiftNs(), &scan);
   if (scan.t_end_ns < newest_.t_ns) {
     ++stats_.scans_out_of_order;
     return;
@@ -117,10 +131,11 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
   const ImuKinematics predicted = history.Newest();
   r.status = window_->empty() ? StartWindow(scan.t_end_ns, predicted)
-                              : UpdateWindow(scan.t_end_ns, predicted, samples, &r);
+                              : UpdateWindow(scan.t_end_ns, history, samples, &r);
   SetNewestFromWindow();
   MarginalizeIfFull();
   ReportExtrinsic(&r);
+  ReportTimeOffset(&r, history);
   DropImuBefore(scan.t_end_ns);
   r.t_ns = scan.t_end_ns;
   r.T_world_imu = Pose3(newest_.R_world_imu, newest_.p_world_imu);
@@ -164,20 +179,22 @@ void SmootherOdometry::DropImuBefore(TimeNs t_ns) {
 ScanStatus SmootherOdometry::StartWindow(TimeNs t_ns, const ImuKinematics& predicted) {
   window_->Start(t_ns, PoseBlock(Eigen::Quaterniond(predicted.R_world_imu), predicted.p_world_imu),
                  SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, p_lidar_end_);
-  InsertIntoWorkingMap(window_->state(0), p_lidar_end_);
+  InsertIntoWorkingMap(0, p_lidar_end_);
   return ScanStatus::kMapInit;
 }
 
 // Adds the scan's state (IMU factor from the newest state unless the interval
 // is empty or has a gap) and optimizes the window.
-ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& predicted,
+ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuPoseHistory& history,
                                           const std::vector<ImuSample>& samples, ScanResult* r) {
+  const ImuKinematics predicted = history.Newest();
   std::optional<ImuPreintegration> imu;
   if (t_ns > newest_.t_ns && !HasImuGap(samples, newest_.t_ns, t_ns))
     imu = ImuPreintegration::FromSamples(samples, newest_.t_ns, t_ns,
                                          ImuNoise::FromOptions(options_.imu), bg_, ba_);
   window_->Add(t_ns, PoseBlock(Eigen::Quaterniond(predicted.R_world_imu), predicted.p_world_imu),
-               SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, std::move(imu), p_lidar_end_);
+               SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, std::move(imu), p_lidar_end_,
+               MotionAtEnd(history));
   const ScanAssociateFn associate = [this](const std::vector<Eigen::Vector3d>& p_lidar,
                                            const Pose3& T_world_imu, ConstraintList* out) {
     Associate(p_lidar, T_world_imu, CurrentTImuLidar(), map_.map(), options_.constraints, out,
@@ -191,7 +208,7 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
   r->iterations = report.iterations;
   r->rv = report.newest_rv;
   if (options_.smoother.map_update == "newest" || !window_filled_)
-    InsertIntoWorkingMap(window_->state(window_->size() - 1), p_lidar_end_);
+    InsertIntoWorkingMap(window_->size() - 1, p_lidar_end_);
   stats_.diverged_resets += report.failures;  // each failed round was restored
   if (!report.ok) return ScanStatus::kDiverged;
   // What the newest state's constraints leave after the solve (divergence monitor).
@@ -209,9 +226,8 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuKinematics& pred
   return ScanStatus::kUpdated;
 }
 
-void SmootherOdometry::InsertIntoWorkingMap(const WindowState& s,
-                                            const std::vector<Eigen::Vector3d>& p_lidar) {
-  map_.InsertScan(s.t_ns, s.pose.ToPose3(), CurrentTImuLidar(), p_lidar);
+void SmootherOdometry::InsertIntoWorkingMap(int k, const std::vector<Eigen::Vector3d>& p_lidar) {
+  map_.InsertScan(window_->state(k).t_ns, window_->ScanTimeImuPose(k), CurrentTImuLidar(), p_lidar);
 }
 
 // The oldest state leaves the window: its points enter the output map (and,
@@ -223,10 +239,10 @@ void SmootherOdometry::MarginalizeIfFull() {
   stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   window_filled_ = true;
   if (options_.smoother.map_update == "marginalized") {
-    output_map_.Insert(map_.InsertScan(m->state.t_ns, m->state.pose.ToPose3(), CurrentTImuLidar(),
-                                       m->p_lidar));
+    output_map_.Insert(
+        map_.InsertScan(m->state.t_ns, m->scan_T_world_imu, CurrentTImuLidar(), m->p_lidar));
   } else {
-    TransformPoints(m->state.pose.ToPose3() * CurrentTImuLidar(), m->p_lidar, &p_world_);
+    TransformPoints(m->scan_T_world_imu * CurrentTImuLidar(), m->p_lidar, &p_world_);
     output_map_.Insert(p_world_);
   }
   stats_.marginalization_failures = window_->stats().marginalization_failures;
@@ -243,6 +259,25 @@ void SmootherOdometry::ReportExtrinsic(ScanResult* r) {
   stats_.extrinsic =
       MakeExtrinsicReport(window_->extrinsic_excitation(), T_imu_lidar_, window_->T_imu_lidar());
   stats_.extrinsic.map_rebuilds = map_.rebuilds();
+}
+
+TimeNs SmootherOdometry::ScanTimeShiftNs() const {
+  if (!options_.lidar.estimate_time_offset || !window_) return 0;
+  return SecondsToNs(window_->time_offset_s() - options_.lidar.time_offset);
+}
+
+void SmootherOdometry::ReportTimeOffset(ScanResult* r, const ImuPoseHistory& history) {
+  if (!options_.lidar.estimate_time_offset || !window_) return;
+  const bool was_at_bound = stats_.time_offset.at_bound;
+  time_offset_excitation_.CountScan(newest_.t_ns, MotionAtEnd(history).gyro_imu,
+                                    newest_.v_world_imu);
+  r->time_offset_s = window_->time_offset_s();
+  r->time_offset_std_s = window_->time_offset_std_s();
+  stats_.time_offset =
+      MakeTimeOffsetReport(time_offset_excitation_, options_.lidar, window_->time_offset_s(),
+                           window_->time_offset_std_s(), window_->time_offset_at_bound());
+  if (stats_.time_offset.at_bound && !was_at_bound)
+    warnings_.push_back(TimeOffsetAtBoundWarning(options_.lidar, newest_.t_ns));
 }
 
 void SmootherOdometry::SetNewestFromWindow() {

@@ -70,10 +70,18 @@ bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan) cons
   for (int64_t k = 0; k < scan_count_; ++k) {
     if (!emit_imu_until(ScanStartTime(k) + lidar_.period_ns())) return false;
     Scan scan = SimulateScan(k);
-    ShiftScanTime(-SecondsToNs(options_.lidar.time_offset), &scan);
+    ShiftScanTime(-LidarClockOffsetNs(scan.t_start_ns), &scan);
     if (!on_scan(scan, lidar_.rows(), lidar_.cols())) return false;
   }
   return emit_imu_until(t_end_ns_);
+}
+
+// The LiDAR clock's offset at true time t_ns: constant plus a linear drift
+// (one value per scan: the drift over a sweep is far below a nanosecond's
+// worth of motion for any realistic rate).
+TimeNs Simulator::LidarClockOffsetNs(TimeNs t_ns) const {
+  const double drift_s = options_.lidar.time_offset_drift * NsToSeconds(t_ns - t0_ns_);
+  return SecondsToNs(options_.lidar.time_offset + drift_s);
 }
 
 Trajectory Simulator::GroundTruth(double rate_hz) const {

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <Eigen/Eigenvalues>
+#include <ceres/normal_prior.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
@@ -16,6 +17,7 @@
 #include "rvlio/math/so3.h"
 #include "rvlio/smoother/imu_factor.h"
 #include "rvlio/smoother/plane_extrinsic_factor.h"
+#include "rvlio/smoother/plane_time_offset_factor.h"
 #include "rvlio/smoother/plane_summary_factor.h"
 
 namespace rvlio {
@@ -31,6 +33,9 @@ struct SlidingWindow::Node {
   bool associated = false;
   std::unique_ptr<PlaneSummaryFactor> plane;         // null: too few constraints
   std::unique_ptr<PlaneExtrinsicFactor> plane_ext;   // instead of plane: estimate_extrinsics
+  std::unique_ptr<PlaneTimeOffsetFactor> plane_td;   // instead of plane: estimate_time_offset
+  ScanTimeMotion motion;   // held at t_ns (estimate_time_offset)
+  double td_lin_s = 0.0;   // the time offset the scan was deskewed with
   std::unique_ptr<ImuFactor> imu;                    // from the previous node, or null
   std::unique_ptr<SpeedBiasContinuityFactor> gap;    // from the previous node when imu is null
 
@@ -127,6 +132,45 @@ SlidingWindow::SlidingWindow(const WindowOptions& options)
   prior_std << Eigen::Vector3d::Constant(options_.smoother.extrinsic_rot_std),
       Eigen::Vector3d::Constant(options_.smoother.extrinsic_pos_std);
   excitation_ = ExtrinsicExcitation(prior_std);
+  time_offset_[0] = options_.lidar.time_offset;
+  RVLIO_CHECK_MSG(!(estimate_time_offset() && estimate_extrinsics()),
+                  "the smoother estimates the extrinsic or the time offset, not both");
+}
+
+namespace {
+
+// A 1-d Gaussian prior on the time offset at td_s.
+std::unique_ptr<ceres::CostFunction> TimeOffsetPrior(double td_s, double std_s) {
+  ceres::Matrix A(1, 1);
+  A(0, 0) = 1.0 / std_s;
+  ceres::Vector b(1);
+  b(0) = td_s;
+  return std::make_unique<ceres::NormalPrior>(A, b);
+}
+
+}  // namespace
+
+Pose3 SlidingWindow::ScanPose(const Node& node) const {
+  if (!estimate_time_offset()) return node.T_world_imu();
+  FilterState x;
+  const Pose3 T = node.T_world_imu();
+  x.R_world_imu = T.R;
+  x.p_world_imu = T.t;
+  x.v_world_imu = SpeedBiasBlock::FromArray(node.sb).v_world_imu;
+  return ScanTimePose(x, node.motion, time_offset_[0] - node.td_lin_s);
+}
+
+Pose3 SlidingWindow::ScanTimeImuPose(int k) const {
+  RVLIO_CHECK(k >= 0 && k < size());
+  return ScanPose(*nodes_[k]);
+}
+
+// An estimate past +-lidar.time_offset_max is held at the bound (reported).
+void SlidingWindow::HoldTimeOffsetInBound() {
+  if (!estimate_time_offset() || std::abs(time_offset_[0]) <= options_.lidar.time_offset_max)
+    return;
+  time_offset_[0] = std::copysign(options_.lidar.time_offset_max, time_offset_[0]);
+  time_offset_at_bound_ = true;
 }
 
 Pose3 SlidingWindow::T_imu_lidar() const {
@@ -155,15 +199,22 @@ void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlo
     extrinsic_prior_ = std::make_unique<PosePriorFactor>(
         PoseBlock::FromArray(extrinsic_), options_.smoother.extrinsic_rot_std,
         options_.smoother.extrinsic_pos_std);
+  if (estimate_time_offset()) {
+    time_offset_prior_ = TimeOffsetPrior(time_offset_[0], options_.lidar.time_offset_init_std);
+    time_offset_std_s_ = options_.lidar.time_offset_init_std;
+  }
   nodes_.push_back(MakeNode(t_ns, pose, speed_bias, std::move(p_lidar)));
+  nodes_.back()->td_lin_s = time_offset_[0];
 }
 
 void SlidingWindow::Add(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
                         std::optional<ImuPreintegration> imu,
-                        std::vector<Eigen::Vector3d> p_lidar) {
+                        std::vector<Eigen::Vector3d> p_lidar, const ScanTimeMotion& motion) {
   RVLIO_CHECK_MSG(!nodes_.empty(), "SlidingWindow::Start() first");
   RVLIO_CHECK_MSG(t_ns >= nodes_.back()->t_ns, "window states must be added in time order");
   std::unique_ptr<Node> node = MakeNode(t_ns, pose, speed_bias, std::move(p_lidar));
+  node->motion = motion;
+  node->td_lin_s = time_offset_[0];
   if (imu && imu->dt() > 0.0 && IsFinite(*imu)) {
     node->imu = std::make_unique<ImuFactor>(std::move(*imu), options_.g_world);
   } else {
@@ -257,18 +308,25 @@ int SlidingWindow::AssociateRound(const ScanAssociateFn& associate, WindowSolveR
 
 // Associate -> RV (Alg. 1-3 on this scan's list) -> Huber weights -> factor.
 void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) {
-  const Pose3 T_world_imu = node->T_world_imu();
+  const Pose3 T_world_imu = ScanPose(*node);  // the state's pose unless estimate_time_offset
   const Pose3 T_imu_lidar = this->T_imu_lidar();
   associate(node->p_lidar, T_world_imu, &node->constraints);
   RemoveNonFinite(&node->constraints);
   node->rv = ApplyRv(options_.rv, T_world_imu * T_imu_lidar, &node->constraints, &rv_workspace_);
   RefreshResiduals(T_world_imu, T_imu_lidar, &node->constraints);
   ApplyHuberWeights(options_.smoother.sliding_window_huber_delta, &node->constraints);
-  node->associated_at = T_world_imu;
+  node->associated_at = node->T_world_imu();
   node->associated = true;
   node->plane.reset();
   node->plane_ext.reset();
+  node->plane_td.reset();
   if (static_cast<int>(node->constraints.size()) < kMinPoseConstraints) return;
+  if (estimate_time_offset()) {
+    node->plane_td = std::make_unique<PlaneTimeOffsetFactor>(
+        node->constraints, options_.constraints.lidar_noise, T_imu_lidar_config_, node->motion,
+        node->td_lin_s);
+    return;
+  }
   if (estimate_extrinsics()) {
     node->plane_ext = std::make_unique<PlaneExtrinsicFactor>(node->constraints, options_.constraints.lidar_noise);
     return;
@@ -322,6 +380,9 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
     } else if (n.plane_ext) {
       problem.AddResidualBlock(n.plane_ext.get(), nullptr, n.pose, extrinsic_);
       pose_used[k] = true;
+    } else if (n.plane_td) {
+      problem.AddResidualBlock(n.plane_td.get(), nullptr, n.pose, n.sb, time_offset_);
+      pose_used[k] = true;
     }
     if (k == 0) continue;
     Node& p = *nodes_[k - 1];
@@ -343,6 +404,8 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
     if (std::find(blocks.begin(), blocks.end(), first.pose) != blocks.end()) pose_used[0] = true;
   }
   if (extrinsic_prior_) problem.AddResidualBlock(extrinsic_prior_.get(), nullptr, extrinsic_);
+  if (time_offset_prior_)
+    problem.AddResidualBlock(time_offset_prior_.get(), nullptr, time_offset_);
   // A pose no factor touches (IMU gap and no scan constraints) keeps its
   // prediction.
   for (size_t k = 0; k < nodes_.size(); ++k)
@@ -357,7 +420,10 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   report->iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
-  if (summary.IsSolutionUsable() && Healthy()) return true;
+  if (summary.IsSolutionUsable() && Healthy()) {
+    HoldTimeOffsetInBound();
+    return true;
+  }
   Restore();
   ++stats_.solve_failures;
   // This round's associations may be what broke the solve, and the restored
@@ -385,6 +451,7 @@ void SlidingWindow::AddExtrinsicBlock(ceres::Problem* problem) {
 bool SlidingWindow::Healthy() const {
   const Eigen::Map<const Eigen::Matrix<double, 7, 1>> extrinsic(extrinsic_);
   if (!extrinsic.allFinite() || std::abs(extrinsic.head<4>().norm() - 1.0) > 1e-3) return false;
+  if (!std::isfinite(time_offset_[0])) return false;
   for (const auto& n : nodes_) {
     const Eigen::Map<const Eigen::Matrix<double, 7, 1>> pose(n->pose);
     const Eigen::Map<const Eigen::Matrix<double, 9, 1>> sb(n->sb);
@@ -396,8 +463,9 @@ bool SlidingWindow::Healthy() const {
 }
 
 void SlidingWindow::Backup() {
-  backup_.resize(nodes_.size() * kBlockSize + PoseBlock::kNumParams);
+  backup_.resize(nodes_.size() * kBlockSize + PoseBlock::kNumParams + 1);
   double* out = std::copy(extrinsic_, extrinsic_ + PoseBlock::kNumParams, backup_.data());
+  *out++ = time_offset_[0];
   for (const auto& n : nodes_) {
     out = std::copy(n->pose, n->pose + PoseBlock::kNumParams, out);
     out = std::copy(n->sb, n->sb + SpeedBiasBlock::kNumParams, out);
@@ -405,10 +473,11 @@ void SlidingWindow::Backup() {
 }
 
 void SlidingWindow::Restore() {
-  RVLIO_CHECK(backup_.size() == nodes_.size() * kBlockSize + PoseBlock::kNumParams);
+  RVLIO_CHECK(backup_.size() == nodes_.size() * kBlockSize + PoseBlock::kNumParams + 1);
   const double* in = backup_.data();
   std::copy(in, in + PoseBlock::kNumParams, extrinsic_);
   in += PoseBlock::kNumParams;
+  time_offset_[0] = *in++;
   for (auto& n : nodes_) {
     std::copy(in, in + PoseBlock::kNumParams, n->pose);
     in += PoseBlock::kNumParams;
@@ -444,19 +513,25 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   if (old.plane_ext)
     info.AddResidualBlock(old.plane_ext.get(), nullptr, {old.pose, extrinsic_}, {0});
   if (extrinsic_prior_) info.AddResidualBlock(extrinsic_prior_.get(), nullptr, {extrinsic_}, {});
+  if (old.plane_td)
+    info.AddResidualBlock(old.plane_td.get(), nullptr, {old.pose, old.sb, time_offset_}, {0, 1});
+  if (time_offset_prior_)
+    info.AddResidualBlock(time_offset_prior_.get(), nullptr, {time_offset_}, {});
   if (next.imu)
     info.AddResidualBlock(next.imu.get(), nullptr, {old.pose, old.sb, next.pose, next.sb}, {0, 1});
   else
     info.AddResidualBlock(next.gap.get(), nullptr, {old.sb, next.sb}, {0});
   const Status status = info.Marginalize();
 
-  MarginalizedScan out{state(0), std::move(old.p_lidar)};
+  MarginalizedScan out{state(0), ScanPose(old), std::move(old.p_lidar)};
   state_prior_.reset();
   marginal_prior_.reset();
   if (status.ok() && info.prior()->rank > 0) {
     marginal_prior_ = std::make_unique<MarginalizationFactor>(info.prior());
     extrinsic_prior_.reset();  // now inside the marginalization prior
+    time_offset_prior_.reset();
     if (estimate_extrinsics()) ObserveExtrinsicExcitation();
+    if (estimate_time_offset()) ObserveTimeOffsetStd();
   } else {
     // Keep the window anchored: a prior at the next state's estimate.
     ++stats_.marginalization_failures;
@@ -468,6 +543,10 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
       extrinsic_prior_ = std::make_unique<PosePriorFactor>(
           PoseBlock::FromArray(extrinsic_), options_.smoother.extrinsic_rot_std,
           options_.smoother.extrinsic_pos_std);
+    if (estimate_time_offset()) {
+      time_offset_prior_ = TimeOffsetPrior(time_offset_[0], options_.lidar.time_offset_init_std);
+      time_offset_std_s_ = options_.lidar.time_offset_init_std;
+    }
   }
   ++stats_.marginalizations;
   next.imu.reset();
@@ -484,6 +563,29 @@ void SlidingWindow::CountExcitationScan() {
   if (nodes_.empty()) return;
   const Node& newest = *nodes_.back();
   excitation_.CountScan(newest.t_ns, newest.T_world_imu().R, T_imu_lidar().R);
+}
+
+// The marginal variance of the time offset under the marginalization prior
+// (pseudo-inverse of H* = S^T S with the marginalization's relative floor;
+// no information: infinite).
+void SlidingWindow::ObserveTimeOffsetStd() {
+  const MarginalizationPrior& prior = marginal_prior_->prior();
+  const auto it = std::find(prior.blocks.begin(), prior.blocks.end(), time_offset_);
+  if (it == prior.blocks.end()) return;
+  const int offset = prior.tangent_offsets[it - prior.blocks.begin()];
+  const Eigen::MatrixXd H = prior.S.transpose() * prior.S;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  if (eig.info() != Eigen::Success) return;
+  const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 0.0);
+  double variance = 0.0;
+  for (int k = 0; k < eig.eigenvalues().size(); ++k) {
+    const double v = eig.eigenvectors()(offset, k);
+    if (eig.eigenvalues()(k) > floor)
+      variance += v * v / eig.eigenvalues()(k);
+    else if (std::abs(v) > 1e-6)
+      variance = std::numeric_limits<double>::infinity();
+  }
+  time_offset_std_s_ = std::sqrt(variance);
 }
 
 // Marginal covariance of the extrinsic block under the marginalization

@@ -12,9 +12,11 @@
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/constraints/options.h"
 #include "rvlio/constraints/point_to_plane.h"
+#include "rvlio/constraints/time_offset_residual.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/pose_history.h"
+#include "rvlio/lidar/options.h"
 #include "rvlio/math/extrinsic_excitation.h"
 #include "rvlio/math/state.h"
 #include "rvlio/rv/options.h"
@@ -54,8 +56,9 @@ Eigen::Matrix<double, 24, 12> ErrorStateColumns(const std::array<bool, 6>& free_
 
 class Ieskf {
  public:
+  // `lidar`: the time-offset keys (estimate_time_offset and its noise, bound).
   Ieskf(const IeskfOptions& options, const ImuOptions& imu, const ConstraintOptions& constraints,
-        const RvOptions& rv);
+        const RvOptions& rv, const LidarOptions& lidar = LidarOptions());
 
   // Starts the filter at t_ns from a static alignment; P from the init stds.
   void Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu);
@@ -86,7 +89,21 @@ class Ieskf {
   }
   TimeNs time_ns() const { return t_ns_; }
 
+  // The LiDAR-IMU time offset (lidar.time_offset, or its online estimate), s.
+  double time_offset_s() const { return td_s_; }
+  // Its 1-sigma (0 when not estimated).
+  double time_offset_std_s() const;
+  // True once an update pushed the estimate to +-lidar.time_offset_max (held there).
+  bool time_offset_at_bound() const { return td_at_bound_; }
+  // The IMU pose at the time of the last updated scan (the state's pose when
+  // the offset is not estimated; see ScanTimeMotion).
+  Pose3 ScanTimeImuPose() const { return ScanTimePose(x_, scan_motion_, td_s_ - td_lin_s_); }
+
  private:
+  template <bool kTimeOffset>
+  IeskfUpdateResult UpdateImpl(const AssociateFn& associate);
+  ScanTimeMotion MotionAtStateTime() const;
+  void HoldTimeOffsetInBound();
   void Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s);
   void RecordPose(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu);
   void ReleaseExcitedAxes();
@@ -106,6 +123,15 @@ class Ieskf {
   ImuSample last_imu_;
   ImuPoseHistory pose_history_;
   RvWorkspace rv_workspace_;
+  // Time offset (augmented state, estimate_time_offset): value, cross
+  // covariance with the 24-dim error state, variance.
+  LidarOptions lidar_;
+  double td_s_ = 0.0;
+  double td_lin_s_ = 0.0;  // the offset the last scan was predicted and deskewed with
+  ScanTimeMotion scan_motion_;
+  Vector24d P_x_td_ = Vector24d::Zero();
+  double P_td_td_ = 0.0;
+  bool td_at_bound_ = false;
 };
 
 }  // namespace rvlio

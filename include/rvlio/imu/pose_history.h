@@ -33,6 +33,10 @@ struct ImuPoseSample {
   Eigen::Vector3d gyro_imu = Eigen::Vector3d::Zero();   // rad/s, bias removed
 };
 
+// The pose dt_s (may be negative) after the sample's time by its constant
+// angular rate and world acceleration.
+Pose3 AdvanceImuPose(const ImuPoseSample& s, double dt_s);
+
 // Pose of the IMU at t_ns by constant-acceleration / constant-rate motion
 // from the latest sample at or before t_ns (or the first one, backwards).
 // samples: non-empty, sorted by time.

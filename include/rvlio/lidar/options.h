@@ -1,5 +1,6 @@
 #pragma once
 // LiDAR input and preprocessing options.
+#include <cmath>
 #include <string>
 
 #include "rvlio/common/options.h"
@@ -20,6 +21,13 @@ struct LidarOptions {
   double point_time_span_stop = 0.01;  // below this fraction reading stops (0: never)
   double point_time_span_warn = 0.5;   // below this fraction a warning
   std::string ouster_metadata;        // Ouster metadata JSON of a packet recording ("" = find it)
+  // Online estimation of time_offset (docs/time_offset.md): an augmented state
+  // of the IESKF, one parameter of the smoother's window.
+  bool estimate_time_offset = false;
+  double time_offset_max = 0.2;            // s, |estimate| bound (reported when reached)
+  double time_offset_init_std = 0.05;      // s, prior std around time_offset
+  double time_offset_random_walk = 1e-4;   // s/sqrt(s), process noise of the estimate
+  double time_offset_excited_std = 0.002;  // s, 1-sigma under which an excited estimate is trusted
 
   template <class V>
   void Visit(V& v) {
@@ -49,11 +57,30 @@ struct LidarOptions {
             Spec().Help("Ouster sensor metadata JSON for a packet recording (pcap capture or "
                         "packet bag); empty: NAME.json / NAME_0.json next to a capture, the "
                         "bag's metadata topic (CLI: --ouster-metadata)"));
+    v.Field("estimate_time_offset", estimate_time_offset,
+            Spec().Help("estimate the LiDAR-IMU time offset online, starting from time_offset "
+                        "(scans.csv time_offset_s, summary.json time_offset)"));
+    v.Field("time_offset_max", time_offset_max,
+            Spec().Unit("s").Range(0.001, 10.0).Help(
+                "bound of the estimated time offset; an estimate reaching it is held there and "
+                "reported (warning, summary.json time_offset.at_bound)"));
+    v.Field("time_offset_init_std", time_offset_init_std,
+            Spec().Unit("s").Range(1e-6, 10.0).Help("prior std of the estimated time offset"));
+    v.Field("time_offset_random_walk", time_offset_random_walk,
+            Spec().Unit("s/sqrt(s)").Range(0.0, 1.0).Help(
+                "process noise of the estimated time offset (clock drift)"));
+    v.Field("time_offset_excited_std", time_offset_excited_std,
+            Spec().Unit("s").Range(1e-6, 1.0).Help(
+                "the estimate counts as trustworthy once excited and its 1-sigma is below this"));
   }
   Status Validate() {
     Status s = ValidateFields(*this, "lidar");
     if (s.ok() && !(max_range > min_range))
       return Status::InvalidInput("lidar.max_range must be greater than lidar.min_range");
+    if (s.ok() && estimate_time_offset && std::abs(time_offset) > time_offset_max)
+      return Status::InvalidInput("lidar.time_offset (" + std::to_string(time_offset) +
+                                  " s) is outside lidar.time_offset_max (" +
+                                  std::to_string(time_offset_max) + " s)");
     return s;
   }
 };

@@ -114,6 +114,19 @@ struct DivergenceReport {
   std::array<int64_t, kNumDivergenceKinds> episodes{};  // per kind
   int64_t scans_flagged = 0;                            // scans with any kind tripped
   std::vector<DivergenceEvent> events;                  // every episode start, in time order
+  // The scans up to the first divergence, split by motion: mean of the
+  // per-scan median residuals at rest (speed < kRestSpeed) and moving
+  // (speed > kMovingSpeed); NaN without such scans. A LiDAR-IMU clock offset
+  // leaves the scans at rest exact and grows the residuals with the motion:
+  // clock_suspect when moving > kClockSuspectRatio x at rest (both with at
+  // least kClockSuspectMinScans scans). Wrong extrinsics look the same.
+  double residual_at_rest_m = std::numeric_limits<double>::quiet_NaN();
+  double residual_moving_m = std::numeric_limits<double>::quiet_NaN();
+  bool clock_suspect = false;
+  static constexpr double kRestSpeed = 0.05;          // m/s
+  static constexpr double kMovingSpeed = 0.3;         // m/s
+  static constexpr double kClockSuspectRatio = 2.5;
+  static constexpr int kClockSuspectMinScans = 5;
 };
 
 // One scan as the monitor sees it.
@@ -147,6 +160,7 @@ class DivergenceMonitor {
   bool Full(const Window& w) const;
   void Trip(DivergenceKind k, TimeNs t_ns, double value, double threshold, uint8_t* mask);
   void EndEpisodes(uint8_t mask);
+  void CountMotionResidual(const HealthSample& s, bool detected_before);
 
   DivergenceOptions options_;
   double lidar_noise_m_;
@@ -155,6 +169,8 @@ class DivergenceMonitor {
   bool have_previous_ = false;
   HealthSample previous_;
   Window nis_, residual_, inliers_, specific_force_, lidar_rotation_;
+  double rest_sum_m_ = 0.0, moving_sum_m_ = 0.0;  // CountMotionResidual
+  int rest_scans_ = 0, moving_scans_ = 0;
   std::array<bool, kNumDivergenceKinds> active_{};
   std::array<int, kNumDivergenceKinds> clear_scans_{};
 };

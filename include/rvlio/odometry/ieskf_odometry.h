@@ -36,6 +36,10 @@ class IeskfOdometry : public Odometry {
   ScanStatus Correct(ScanResult* r);
   void InsertIntoMap(TimeNs t_ns);
   void ReportExtrinsic(ScanResult* r);  // ieskf.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
+  // lidar.estimate_time_offset: how far the scans are moved beyond
+  // lidar.time_offset (the reader's shift) onto the IMU clock (0 when off).
+  TimeNs ScanTimeShiftNs() const;
+  void ReportTimeOffset(ScanResult* r);  // stats_.time_offset, r->time_offset_s, bound warning
 
   OdometryOptions options_;
   Ieskf filter_;
@@ -47,6 +51,7 @@ class IeskfOdometry : public Odometry {
   std::vector<std::string> warnings_;
   DivergenceMonitor monitor_;
   StaticInitializer initializer_;
+  TimeOffsetExcitation time_offset_excitation_;
   std::deque<ImuSample> imu_buffer_;
   ScanQueue scans_;
   // Per-scan workspaces, reused to avoid allocation in the hot path.

@@ -12,7 +12,9 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/lidar/options.h"
 #include "rvlio/math/extrinsic_excitation.h"
+#include "rvlio/math/time_offset_excitation.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/options.h"
@@ -44,6 +46,11 @@ struct ScanResult {
   // The backend's LiDAR-IMU extrinsic after this scan; set only while it is
   // estimated online (ieskf/smoother.estimate_extrinsics), to follow its convergence.
   std::optional<Pose3> T_imu_lidar;
+  // The LiDAR-IMU time offset after this scan (s, t_imu = t_lidar_stamp +
+  // offset) and its 1-sigma; set only while it is estimated online
+  // (lidar.estimate_time_offset).
+  std::optional<double> time_offset_s;
+  double time_offset_std_s = 0.0;
 };
 
 // The monitor's view of a scan result (odometry/divergence.h).
@@ -65,6 +72,28 @@ struct ExtrinsicReport {
 // The report of a backend's excitation monitor and its current estimate.
 ExtrinsicReport MakeExtrinsicReport(const ExtrinsicExcitation& excitation,
                                     const Pose3& T_imu_lidar_prior, const Pose3& T_imu_lidar);
+
+// Online time-offset estimation (lidar.estimate_time_offset), reported in
+// summary.json ("time_offset"; math/time_offset_excitation.h).
+struct TimeOffsetReport {
+  bool enabled = false;
+  double prior_s = 0.0;     // lidar.time_offset
+  double estimate_s = 0.0;  // final estimate
+  double std_s = 0.0;       // its 1-sigma
+  bool at_bound = false;    // the estimate reached lidar.time_offset_max (held there)
+  double bound_s = 0.0;     // lidar.time_offset_max
+  bool excited = false;     // the motion excited it (TimeOffsetExcitation::excited)
+  double excited_s = 0.0;   // seconds of excited scans
+  double max_rate_spread_rad_s = 0.0;
+  double max_velocity_spread_m_s = 0.0;
+  bool trustworthy = false;  // excited, 1-sigma under time_offset_excited_std, not at the bound
+};
+
+// The report of a backend's time-offset estimate (estimate_s, std_s) and
+// excitation monitor under the lidar options.
+TimeOffsetReport MakeTimeOffsetReport(const TimeOffsetExcitation& excitation,
+                                      const LidarOptions& lidar, double estimate_s, double std_s,
+                                      bool at_bound);
 
 // Counts of what was skipped or repaired, reported in summary.json.
 struct OdometryStats {
@@ -88,6 +117,7 @@ struct OdometryStats {
   double solve_ms = 0.0;                 // CPU ms in building and solving the window (total)
   double marginalization_ms = 0.0;       // CPU ms in marginalization (total)
   ExtrinsicReport extrinsic;
+  TimeOffsetReport time_offset;
 };
 
 class Odometry {

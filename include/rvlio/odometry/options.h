@@ -62,6 +62,10 @@ struct OdometryOptions {
                      constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate(),
                      divergence.Validate(), io.Validate()})
       if (!m.ok()) return m;
+    if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
+      return Status::InvalidInput(
+          "lidar.estimate_time_offset and smoother.estimate_extrinsics: the smoother estimates "
+          "one of them at a time (the IESKF both)");
     return Status::Ok();
   }
 };

@@ -16,6 +16,7 @@
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/static_init.h"
 #include "rvlio/lidar/deskew.h"
+#include "rvlio/lidar/options.h"
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/map/options.h"
 #include "rvlio/map/voxel_map.h"
@@ -100,6 +101,10 @@ class WorkingMap {
   std::vector<Eigen::Vector3d> p_world_;
 };
 
+// The warning for an estimated time offset that reached lidar.time_offset_max
+// (at the estimator's time t_ns).
+std::string TimeOffsetAtBoundWarning(const LidarOptions& lidar, TimeNs t_ns);
+
 // Screens one IMU sample for the buffer: false (and counted) for a non-finite
 // sample; a gap to the previous sample longer than a scan period is counted.
 bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats);
@@ -123,10 +128,11 @@ class ScanQueue {
   // scans that end more than max_gap_ns after the newest IMU sample: the IMU
   // stopped before the LiDAR, and such a scan would be estimated without IMU.
   void DropPastImu(TimeNs max_gap_ns, OdometryStats* stats);
-  // True when the oldest scan's end is covered by the buffered IMU samples.
-  bool FrontReady(const std::deque<ImuSample>& imu_buffer) const {
+  // True when the oldest scan's end, moved by shift_ns (an estimated time
+  // offset), is covered by the buffered IMU samples.
+  bool FrontReady(const std::deque<ImuSample>& imu_buffer, TimeNs shift_ns = 0) const {
     return !scans_.empty() && !imu_buffer.empty() &&
-           imu_buffer.back().t_ns >= scans_.front().t_end_ns;
+           imu_buffer.back().t_ns >= scans_.front().t_end_ns + shift_ns;
   }
   bool empty() const { return scans_.empty(); }
   Scan PopFront();

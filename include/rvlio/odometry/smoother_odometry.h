@@ -88,13 +88,19 @@ class SmootherOdometry : public Odometry {
   bool HasImuGap(const std::vector<ImuSample>& samples, TimeNs t0_ns, TimeNs t1_ns) const;
   void DropImuBefore(TimeNs t_ns);
   ScanStatus StartWindow(TimeNs t_ns, const ImuKinematics& predicted);
-  ScanStatus UpdateWindow(TimeNs t_ns, const ImuKinematics& predicted,
+  ScanStatus UpdateWindow(TimeNs t_ns, const ImuPoseHistory& history,
                           const std::vector<ImuSample>& samples, ScanResult* r);
-  void InsertIntoWorkingMap(const WindowState& s, const std::vector<Eigen::Vector3d>& p_lidar);
+  // State k's scan at its IMU pose of the scan time (SlidingWindow::ScanTimeImuPose).
+  void InsertIntoWorkingMap(int k, const std::vector<Eigen::Vector3d>& p_lidar);
   void MarginalizeIfFull();
   void SetNewestFromWindow();
   Pose3 CurrentTImuLidar() const;  // the window's extrinsic (estimate or configured)
   void ReportExtrinsic(ScanResult* r);  // smoother.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
+  // lidar.estimate_time_offset: how far the scans are moved beyond
+  // lidar.time_offset onto the IMU clock (0 when off).
+  TimeNs ScanTimeShiftNs() const;
+  // stats_.time_offset, r->time_offset_s, bound warning; history: the scan's prediction.
+  void ReportTimeOffset(ScanResult* r, const ImuPoseHistory& history);
 
   OdometryOptions options_;
   WindowOptions window_options_;
@@ -107,6 +113,7 @@ class SmootherOdometry : public Odometry {
   OdometryStats stats_;
   std::vector<std::string> warnings_;
   DivergenceMonitor monitor_;
+  TimeOffsetExcitation time_offset_excitation_;
   std::deque<ImuSample> imu_buffer_;
   ScanQueue scans_;
   // The newest estimate: where the next prediction starts.

@@ -130,7 +130,8 @@ struct SimLidarOptions {
   double min_range = 0.5;     // m, closer returns are dropped
   double max_range = 100.0;   // m, farther returns are dropped
   double dropout = 0.0;       // probability of a random missing return
-  double time_offset = 0.0;   // s, written LiDAR stamps = true time - time_offset
+  double time_offset = 0.0;   // s, written LiDAR stamps = true time - clock offset
+  double time_offset_drift = 0.0;  // s/s, clock offset = time_offset + drift * (t - start)
 
   template <class V>
   void Visit(V& v) {
@@ -148,7 +149,12 @@ struct SimLidarOptions {
     v.Field("time_offset", time_offset,
             Spec().Unit("s").Range(-1.0, 1.0).Help(
                 "LiDAR clock error: scan stamps are written as true time - time_offset "
-                "(`rvlio run --set lidar.time_offset=` the same value undoes it)"));
+                "(`rvlio run --set lidar.time_offset=` the same value undoes it); not "
+                "written to the emitted configuration"));
+    v.Field("time_offset_drift", time_offset_drift,
+            Spec().Unit("s/s").Range(-1e-3, 1e-3).Help(
+                "LiDAR clock drift: the clock offset grows by this many seconds per second "
+                "from time_offset at the first sample (1e-5: 10 ppm)"));
   }
 };
 

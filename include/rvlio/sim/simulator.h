@@ -60,6 +60,10 @@ class Simulator {
   TimeNs ScanStartTime(int64_t k) const { return t0_ns_ + k * lidar_.period_ns(); }
   int64_t scan_count() const { return scan_count_; }
   int64_t imu_count() const { return imu_count_; }
+  // The LiDAR clock's offset at true time t_ns (lidar.time_offset plus
+  // lidar.time_offset_drift since the first sample): Run() writes a scan's
+  // stamps as true time minus this value at the scan start.
+  TimeNs LidarClockOffsetNs(TimeNs t_ns) const;
 
  private:
   explicit Simulator(const SimOptions& options);

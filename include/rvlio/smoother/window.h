@@ -45,6 +45,15 @@
 // covariance of the extrinsic block: an axis not yet excited is held fixed
 // (PoseSubsetManifold; all fixed: a constant block).
 //
+// With lidar.estimate_time_offset the LiDAR-IMU time offset is one more
+// parameter block (1, s), shared by every scan's plane factor
+// (PlaneTimeOffsetFactor: the scan's pose is its state's carried over
+// td - td_lin by the motion held at the state, plane_time_offset_factor.h).
+// As with the extrinsic, its prior (lidar.time_offset, time_offset_init_std)
+// enters the first marginalization and the offset is then a kept block of the
+// marginalization prior. An estimate past lidar.time_offset_max is held at the
+// bound and reported (time_offset_at_bound()).
+//
 // The window owns no map: association is a callback, so the window can be
 // driven by the odometry's voxel map or by an exact synthetic world.
 #include <deque>
@@ -65,6 +74,8 @@
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/noise.h"
 #include "rvlio/imu/preintegration.h"
+#include "rvlio/lidar/options.h"
+#include "rvlio/constraints/time_offset_residual.h"
 #include "rvlio/math/extrinsic_excitation.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/math/smoother_blocks.h"
@@ -84,6 +95,7 @@ namespace rvlio {
 class ImuFactor;
 class PlaneExtrinsicFactor;
 class PlaneSummaryFactor;
+class PlaneTimeOffsetFactor;
 
 // The window's configuration: the option sections it reads, with the names
 // and types they have in the whole configuration (OdometryOptions), listed in
@@ -98,6 +110,7 @@ struct WindowOptions {
   IeskfOptions ieskf;             // init_*_std: prior of the run's first state (the same static
                                   // initialization as the filter)
   ExtrinsicsSection extrinsics;   // T_imu_lidar: fixed, or the prior (smoother.estimate_extrinsics)
+  LidarOptions lidar;             // time_offset: fixed, or the prior (estimate_time_offset)
   Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);  // m/s^2, static initialization
 
   template <class V>
@@ -108,6 +121,7 @@ struct WindowOptions {
     v.Section("constraints", constraints);
     v.Section("ieskf", ieskf);
     v.Section("extrinsics", extrinsics);
+    v.Section("lidar", lidar);
   }
   Status Validate() { return ValidateFields(*this); }
 };
@@ -153,6 +167,7 @@ struct WindowStats {
 // The oldest state leaving the window, at its final estimate.
 struct MarginalizedScan {
   WindowState state;
+  Pose3 scan_T_world_imu;  // the IMU pose at the scan's time (ScanTimeImuPose)
   std::vector<Eigen::Vector3d> p_lidar;  // the scan's deskewed points
 };
 
@@ -172,8 +187,11 @@ class SlidingWindow {
   // (pose, speed_bias) (the IMU prediction). imu: the preintegration from
   // the newest state's time to t_ns; nullopt, dt = 0 or non-finite values
   // add the state without an IMU factor (weak continuity prior, counted).
+  // motion: the IMU motion held at t_ns (used with an estimated time offset:
+  // the scan was deskewed with the current time_offset_s()).
   void Add(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
-           std::optional<ImuPreintegration> imu, std::vector<Eigen::Vector3d> p_lidar);
+           std::optional<ImuPreintegration> imu, std::vector<Eigen::Vector3d> p_lidar,
+           const ScanTimeMotion& motion = ScanTimeMotion());
 
   // Association rounds and solves (see the header comment).
   WindowSolveReport Optimize(const ScanAssociateFn& associate);
@@ -192,6 +210,16 @@ class SlidingWindow {
   // The extrinsic in use: the estimate (estimate_extrinsics) or the configured one.
   Pose3 T_imu_lidar() const;
   const ExtrinsicExcitation& extrinsic_excitation() const { return excitation_; }
+  // The time offset in use (s): the estimate (lidar.estimate_time_offset) or
+  // lidar.time_offset; whether an estimate reached lidar.time_offset_max.
+  double time_offset_s() const { return time_offset_[0]; }
+  bool time_offset_at_bound() const { return time_offset_at_bound_; }
+  // The marginal 1-sigma of the offset under the marginalization prior (s;
+  // the prior's std before the first marginalization, 0 when not estimated).
+  double time_offset_std_s() const { return time_offset_std_s_; }
+  // The IMU pose at the scan time of state k (its own pose unless the time
+  // offset is estimated).
+  Pose3 ScanTimeImuPose(int k) const;
   // One processed scan: the newest state's attitude feeds the rotational excitation.
   void CountExcitationScan();
   const WindowOptions& options() const { return options_; }
@@ -209,6 +237,10 @@ class SlidingWindow {
   bool SolveRound(WindowSolveReport* report);
   bool Healthy() const;
   bool estimate_extrinsics() const { return options_.smoother.estimate_extrinsics; }
+  bool estimate_time_offset() const { return options_.lidar.estimate_time_offset; }
+  Pose3 ScanPose(const Node& node) const;
+  void HoldTimeOffsetInBound();
+  void ObserveTimeOffsetStd();
   void AddExtrinsicBlock(ceres::Problem* problem);
   void ObserveExtrinsicExcitation();
   void Backup();
@@ -226,6 +258,10 @@ class SlidingWindow {
   std::unique_ptr<PosePriorFactor> extrinsic_prior_;  // until the first marginalization
   std::unique_ptr<PoseSubsetManifold> extrinsic_manifold_;  // partly excited extrinsic
   ExtrinsicExcitation excitation_;
+  double time_offset_[1] = {0.0};                      // s
+  std::unique_ptr<ceres::CostFunction> time_offset_prior_;  // until the first marginalization
+  bool time_offset_at_bound_ = false;
+  double time_offset_std_s_ = 0.0;
   RvWorkspace rv_workspace_;
   WindowStats stats_;
 };

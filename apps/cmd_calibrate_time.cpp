@@ -1,0 +1,127 @@
+// rvlio calibrate-time --bag PATH [--config FILE] [--set K=V]: the LiDAR-IMU
+// clock offset of a recording, offline (odometry/clock_check.h), and what the
+// stamps alone tell (scan period, jitter, drops, header stamp, IMU rate).
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "common_options.h"
+#include "rvlio/io/config.h"
+#include "rvlio/io/sensor_bag.h"
+#include "rvlio/io/sensor_stream.h"
+#include "rvlio/odometry/clock_check.h"
+
+namespace rvlio::cli {
+namespace {
+
+constexpr const char* kName = "calibrate-time";
+// A lag below this (and within 3 sigma of zero) counts as synchronized.
+constexpr double kSynchronizedS = 0.002;
+
+struct Recording {
+  std::vector<ImuSample> imu;
+  std::vector<LidarRateSample> rates;
+  std::vector<TimeNs> scan_start_ns, scan_end_ns, imu_ns;
+};
+
+Status Read(const std::string& bag, const OdometryOptions& o, Recording* rec) {
+  StatusOr<std::unique_ptr<SensorBagReader>> reader =
+      OpenSensorStream(bag, o.lidar, o.imu, ReadWindow(), o.io);
+  if (!reader.ok()) return reader.status();
+  ScanRotationTracker tracker(o);
+  ImuSample imu;
+  Scan scan;
+  for (;;) {
+    StatusOr<SensorMessage> m = (*reader)->Next(&imu, &scan);
+    if (!m.ok()) return m.status();
+    if (*m == SensorMessage::kEnd) return Status::Ok();
+    if (*m == SensorMessage::kImu) {
+      rec->imu.push_back(imu);
+      rec->imu_ns.push_back(imu.t_ns);
+      continue;
+    }
+    rec->scan_start_ns.push_back(scan.t_start_ns);
+    rec->scan_end_ns.push_back(scan.t_end_ns);
+    if (std::optional<LidarRateSample> r = tracker.Add(scan)) rec->rates.push_back(*r);
+  }
+}
+
+std::string HeaderStampLine(const std::string& bag, const std::string& topic) {
+  StatusOr<BagInfo> info = ReadBagInfo(bag, topic);
+  if (!info.ok()) return "unknown";
+  for (const BagTopicInfo& t : info->topics)
+    if (t.topic == topic && !t.header_stamp.empty()) return "marks the scan " + t.header_stamp;
+  return "not applicable (no PointCloud2 header time layout)";
+}
+
+void PrintStamps(const StampReport& s, const std::string& header_stamp) {
+  std::printf(
+      "stamps (no estimation):\n"
+      "  lidar: %d scans, period %.2f ms (median), jitter %.3f ms RMS, %d dropped; sweep %.2f ms; "
+      "header stamp %s\n"
+      "  imu:   %d samples, %.1f Hz, jitter %.3f ms RMS, %d gaps over 2 periods (longest %.2f ms)\n",
+      s.scans, 1e3 * s.scan_period_s, 1e3 * s.scan_jitter_s, s.dropped_scans,
+      1e3 * s.scan_duration_s, header_stamp.c_str(), s.imu_samples, s.imu_rate_hz,
+      1e3 * s.imu_jitter_s, s.imu_gaps, 1e3 * s.imu_max_gap_s);
+}
+
+void PrintOffset(const ClockCheckResult& r, const OdometryOptions& o, const ClockCheckOptions& c) {
+  std::printf(
+      "clock offset (scan-to-scan rotation rate vs gyroscope, %d intervals, lag searched +-%.0f "
+      "ms):\n"
+      "  rotation excitation: gyro rate spread %.3f rad/s RMS (needed: %.3f)\n",
+      r.intervals, 1e3 * c.max_lag_s, r.rate_spread_rad_s, c.min_rate_spread);
+  const double offset_s = o.lidar.time_offset + r.lag_s;
+  if (!r.enough_rotation) {
+    std::printf(
+        "  not enough rotation: the best lag %.1f ms has a 1-sigma of %.1f ms (needed: %.1f ms); "
+        "record a few seconds of turning about all axes (or keep lidar.time_offset %.4f s)\n",
+        1e3 * r.lag_s, 1e3 * r.std_s, 1e3 * c.max_std_s, o.lidar.time_offset);
+    return;
+  }
+  std::printf(
+      "  offset: %.4f s (lidar.time_offset %.4f s + lag %.2f ms), 1-sigma %.2f ms, gyro explains "
+      "%.0f %% of the LiDAR rotation rate\n"
+      "  -> set lidar.time_offset: %.4f   (t_imu = t_lidar_stamp + time_offset)\n",
+      offset_s, o.lidar.time_offset, 1e3 * r.lag_s, 1e3 * r.std_s, 100.0 * r.explained, offset_s);
+  if (std::abs(r.lag_s) > 3.0 * r.std_s && std::abs(r.lag_s) > kSynchronizedS)
+    std::printf("  the LiDAR and IMU clocks are not synchronized as configured\n");
+}
+
+}  // namespace
+
+int CmdCalibrateTime(int argc, char** argv) {
+  CommandSpec spec{kName,
+                   "Estimates the LiDAR-IMU clock offset of a recording offline: the rotation rate "
+                   "from registering consecutive scans is correlated with the gyroscope over a "
+                   "range of lags (coarse, then refined). Prints the offset to put in "
+                   "lidar.time_offset, its 1-sigma and the rotation excitation seen (or \"not "
+                   "enough rotation\"), and what the stamps alone tell: scan period, jitter, "
+                   "dropped scans, header stamp at scan start or end, IMU rate and gaps.",
+                   {{"bag", "PATH", "ROS1 .bag, ROS 2 .db3, .mcap or bag folder", true},
+                    ConfigOption(),
+                    SetOption()}};
+  Args args;
+  if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  std::vector<std::string> warnings;
+  StatusOr<OdometryOptions> o = LoadConfig(args.GetAll("config"), args.GetAll("set"), &warnings);
+  if (!o.ok()) return Fail(kName, o.status().message());
+  for (const auto& w : warnings) std::fprintf(stderr, "rvlio %s: warning: %s\n", kName, w.c_str());
+  Recording rec;
+  if (Status s = Read(args.Get("bag"), *o, &rec); !s.ok())
+    return Fail(kName, s.message(), s.exit_code());
+  if (rec.scan_start_ns.empty() || rec.imu.empty())
+    return Fail(kName, args.Get("bag") + ": no scans on lidar.topic '" + o->lidar.topic +
+                           "' or no IMU samples on imu.topic '" + o->imu.topic + "'");
+  std::printf("rvlio %s: %s\n", kName, args.Get("bag").c_str());
+  PrintStamps(AnalyzeStamps(rec.scan_start_ns, rec.scan_end_ns, rec.imu_ns),
+              HeaderStampLine(args.Get("bag"), o->lidar.topic));
+  ClockCheckOptions c;
+  c.max_lag_s = o->lidar.time_offset_max;
+  PrintOffset(EstimateClockLag(rec.rates, rec.imu, c), *o, c);
+  return 0;
+}
+
+}  // namespace rvlio::cli

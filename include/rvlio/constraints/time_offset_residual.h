@@ -1,0 +1,37 @@
+#pragma once
+// The point-to-plane residual of a scan whose LiDAR clock is off by an
+// estimated time offset (lidar.estimate_time_offset), shared by the IESKF
+// (augmented state) and the smoother (one window parameter).
+#include <Eigen/Core>
+
+#include "rvlio/constraints/constraint.h"
+#include "rvlio/math/pose.h"
+#include "rvlio/math/state.h"
+
+namespace rvlio {
+
+// Online LiDAR-IMU time offset (lidar.estimate_time_offset): the scan is
+// taken dt = td - td_lin after the state's time, where td_lin is the offset
+// the prediction and deskew used. Its pose is the state's IMU pose carried
+// over dt by the motion held at the state's time (AdvanceImuPose): to first
+// order the rotation moves by w dt and the position by v dt.
+struct ScanTimeMotion {
+  Eigen::Vector3d gyro_imu = Eigen::Vector3d::Zero();   // rad/s, bias removed
+  Eigen::Vector3d acc_world = Eigen::Vector3d::Zero();  // m/s^2, gravity included
+};
+
+// The IMU pose at the scan's time: x's pose advanced by dt_s along `motion`.
+Pose3 ScanTimePose(const FilterState& x, const ScanTimeMotion& motion, double dt_s);
+
+// Jacobian columns of a residual with the time offset estimated:
+// [dtheta, dp, dphi, dt_ext, dv, d(td)] (FilterState perturbations of x, and
+// the offset in seconds).
+using TimeOffsetJacobian = Eigen::Matrix<double, 1, 16>;
+
+// r of Eq. (3) at ScanTimePose(x, motion, dt_s); J (optional) = dr / the
+// columns above (the pose and velocity columns perturb x at its own time).
+double PointToPlaneResidualWithTimeOffset(const Constraint& c, const FilterState& x,
+                                          const ScanTimeMotion& motion, double dt_s,
+                                          TimeOffsetJacobian* J = nullptr);
+
+}  // namespace rvlio
