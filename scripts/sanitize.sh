@@ -51,6 +51,7 @@ ex=(
   CompareTest.FullCompareWritesTablesEqualToEvalAndPlots
   CompareTest.EveryVariantFailedIsExitOne
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
+  DivergenceCli.UpsideDownLidarIsCaughtOnAShortFlight
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData
   DivergenceCli.LidarTopicOfAnotherRobot
