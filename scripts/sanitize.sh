@@ -57,6 +57,7 @@ ex=(
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   'PresetsAndBackends/TimeOffsetMatrix\..*'
   TimeOffsetCliTest.SmootherEstimatesA30MsOffset
+  DivergenceCli.UpsideDownLidarIsCaughtOnAShortFlight
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData
   DivergenceCli.LidarTopicOfAnotherRobot
