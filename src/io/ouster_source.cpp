@@ -191,7 +191,7 @@ class Ros1Source final : public OusterPacketSource {
   StatusOr<bool> Next(OusterRawPacket* out) override {
     try {
       while (it_ != view_->end()) {
-        const rosbag::MessageInstance& m = *it_;
+        const rosbag::MessageInstance m = *it_;  // a copy: the iterator owns *it_
         ++it_;
         const TimeNs t = ToNs(m.getTime());
         if (!InRange(range_, t)) continue;
