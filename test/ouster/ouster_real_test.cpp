@@ -15,6 +15,7 @@
 
 #include "rvlio/constraints/plane_fit.h"
 #include "rvlio/io/ouster.h"
+#include "ouster_test_util.h"
 #include "rvlio/io/sensor_bag.h"
 
 namespace rvlio {
@@ -22,11 +23,7 @@ namespace {
 
 std::string Data(const std::string& name) { return std::string(RVLIO_TEST_DATA) + "/ouster/" + name; }
 
-struct Decoded {
-  std::vector<Scan> scans;
-  std::vector<ImuSample> imu;
-  std::vector<std::string> warnings;
-};
+using testing_ouster::Decoded;
 
 // Every return (no range crop), every IMU sample.
 LidarOptions AllReturns() {
@@ -37,22 +34,7 @@ LidarOptions AllReturns() {
 }
 
 Decoded ReadAll(const std::string& path, const LidarOptions& lidar = AllReturns()) {
-  Decoded out;
-  ImuOptions imu;
-  StatusOr<std::unique_ptr<SensorBagReader>> reader = SensorBagReader::Open(path, lidar, imu);
-  EXPECT_TRUE(reader.ok()) << reader.status().message();
-  if (!reader.ok()) return out;
-  ImuSample s;
-  Scan scan;
-  while (true) {
-    StatusOr<SensorMessage> m = (*reader)->Next(&s, &scan);
-    EXPECT_TRUE(m.ok()) << m.status().message();
-    if (!m.ok() || *m == SensorMessage::kEnd) break;
-    if (*m == SensorMessage::kImu) out.imu.push_back(s);
-    else out.scans.push_back(scan);
-  }
-  out.warnings = (*reader)->warnings();
-  return out;
+  return testing_ouster::ReadAll(path, lidar, ImuOptions());
 }
 
 // Distinct column times of a scan (one per column with a return).
