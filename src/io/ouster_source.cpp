@@ -146,6 +146,15 @@ Status NoMetadata(const std::string& path) {
                               "--ouster-metadata FILE");
 }
 
+// The metadata a bag's reader was given (--ouster-metadata) instead of its topic.
+Status LoadMetadataFile(const std::string& path, OusterMetadata* meta, std::string* origin) {
+  *origin = path;
+  StatusOr<OusterMetadata> m = ReadOusterMetadataFile(path);
+  if (!m.ok()) return m.status();
+  *meta = *m;
+  return Status::Ok();
+}
+
 // Strips the driver's extra trailing byte (ouster_ros buffers are one byte
 // longer than the packet) when the rest is exactly a lidar packet.
 void TrimDriverByte(const OusterMetadata& meta, OusterRawPacket* p) {
@@ -191,7 +200,7 @@ class Ros1Source final : public OusterPacketSource {
   StatusOr<bool> Next(OusterRawPacket* out) override {
     try {
       while (it_ != view_->end()) {
-        const rosbag::MessageInstance& m = *it_;
+        const rosbag::MessageInstance m = *it_;  // a copy: the iterator owns *it_
         ++it_;
         const TimeNs t = ToNs(m.getTime());
         if (!InRange(range_, t)) continue;
@@ -223,13 +232,7 @@ class Ros1Source final : public OusterPacketSource {
   }
 
   Status LoadMetadata(const std::string& metadata_path) {
-    if (!metadata_path.empty()) {
-      meta_origin_ = metadata_path;
-      StatusOr<OusterMetadata> m = ReadOusterMetadataFile(metadata_path);
-      if (!m.ok()) return m.status();
-      meta_ = *m;
-      return Status::Ok();
-    }
+    if (!metadata_path.empty()) return LoadMetadataFile(metadata_path, &meta_, &meta_origin_);
     if (topics_.metadata.empty()) return NoMetadata(path_);
     meta_origin_ = "topic " + topics_.metadata;
     rosbag::View view(bag_, rosbag::TopicQuery(topics_.metadata));
@@ -313,13 +316,7 @@ class Ros2Source final : public OusterPacketSource {
 
  private:
   Status LoadMetadata(const std::string& metadata_path) {
-    if (!metadata_path.empty()) {
-      meta_origin_ = metadata_path;
-      StatusOr<OusterMetadata> m = ReadOusterMetadataFile(metadata_path);
-      if (!m.ok()) return m.status();
-      meta_ = *m;
-      return Status::Ok();
-    }
+    if (!metadata_path.empty()) return LoadMetadataFile(metadata_path, &meta_, &meta_origin_);
     if (meta_index_ < 0) return NoMetadata(path_);
     meta_origin_ = "topic " + topics_.metadata;
     if (Status s = source_->SetTopicFilter({meta_index_}); !s.ok()) return s;

@@ -48,7 +48,9 @@ void Rewrite(const std::string& from, const std::string& to, Edit edit) {
     StatusOr<bool> got = in->Next(&d);
     ASSERT_TRUE(got.ok());
     if (!*got) break;
-    if (edit(index++, &d)) ASSERT_TRUE(out.Write(d).ok());
+    if (edit(index++, &d)) {
+      ASSERT_TRUE(out.Write(d).ok());
+    }
   }
   ASSERT_TRUE(out.Close().ok());
 }

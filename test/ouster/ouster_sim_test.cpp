@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "ouster_test_util.h"
 #include "rvlio/api.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/pcap.h"
@@ -24,28 +25,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Stream {
-  std::vector<Scan> scans;
-  std::vector<ImuSample> imu;
-  SensorReaderStats stats;
-};
+using Stream = testing_ouster::Decoded;
 
 Stream ReadAll(const std::string& path, const OdometryOptions& o) {
-  Stream out;
-  StatusOr<std::unique_ptr<SensorBagReader>> reader = SensorBagReader::Open(path, o.lidar, o.imu);
-  EXPECT_TRUE(reader.ok()) << reader.status().message();
-  if (!reader.ok()) return out;
-  ImuSample s;
-  Scan scan;
-  while (true) {
-    StatusOr<SensorMessage> m = (*reader)->Next(&s, &scan);
-    EXPECT_TRUE(m.ok()) << m.status().message();
-    if (!m.ok() || *m == SensorMessage::kEnd) break;
-    if (*m == SensorMessage::kImu) out.imu.push_back(s);
-    else out.scans.push_back(scan);
-  }
-  out.stats = (*reader)->stats();
-  return out;
+  return testing_ouster::ReadAll(path, o.lidar, o.imu);
 }
 
 void SortPoints(Scan* scan) {

@@ -110,7 +110,7 @@ Alignment Align(const std::vector<Eigen::Vector3d>& source, const VoxelMap& targ
       b += c.weight * J.transpose() * r;
     }
     const Eigen::Matrix<double, 6, 1> dx = H.ldlt().solve(-b);
-    T = Pose3(T.R * Exp(dx.head<3>()), T.t + dx.tail<3>());
+    T = Pose3(T.R * so3::Exp(dx.head<3>()), T.t + dx.tail<3>());
     out.constraints = static_cast<int>(constraints.size());
     if (dx.norm() < 1e-7) break;
   }
@@ -143,7 +143,7 @@ TEST_F(RealScanPairTest, PointToPlaneAgreesWithSmallGicp) {
   const Alignment a = Align(*source_, *target_, 0.0);
   EXPECT_GT(a.constraints, 3000);
   const double dt_m = (a.T_target_source.t - peer.t).norm();
-  const double dr_deg = Log(peer.R.transpose() * a.T_target_source.R).norm() * 180.0 / M_PI;
+  const double dr_deg = so3::Log(peer.R.transpose() * a.T_target_source.R).norm() * 180.0 / M_PI;
   EXPECT_LT(dt_m, 0.02) << a.T_target_source.t.transpose() << " vs " << peer.t.transpose();
   EXPECT_LT(dr_deg, 0.1);
   std::printf("small_gicp pair: translation %.4f m and rotation %.4f deg from small_gicp's, %d constraints\n",
@@ -154,7 +154,7 @@ TEST_F(RealScanPairTest, AWrongPlaneModelFails) {
   const Pose3 peer = ReadTransform(Data("T_target_source.txt"));
   const Alignment a = Align(*source_, *target_, 0.10);
   const double dt_m = (a.T_target_source.t - peer.t).norm();
-  const double dr_deg = Log(peer.R.transpose() * a.T_target_source.R).norm() * 180.0 / M_PI;
+  const double dr_deg = so3::Log(peer.R.transpose() * a.T_target_source.R).norm() * 180.0 / M_PI;
   EXPECT_TRUE(dt_m > 0.02 || dr_deg > 0.1) << dt_m << " m, " << dr_deg << " deg";
   std::printf("planes moved 10 cm along their normals: %.4f m, %.4f deg from small_gicp's\n", dt_m, dr_deg);
 }
