@@ -54,8 +54,10 @@ std::vector<std::string> IeskfOdometry::warnings() const {
 
 void IeskfOdometry::AddScan(Scan scan) {
   // The filter's time is on the IMU clock, the queued scans' on the reader's
-  // (before the estimated shift).
-  scans_.Add(std::move(scan), stats_.initialized, filter_.time_ns() - ScanTimeShiftNs(), &stats_);
+  // (before the estimated shift): the state is at the last processed scan's end
+  // moved by that scan's shift.
+  scans_.Add(std::move(scan), stats_.initialized, filter_.time_ns() - applied_shift_ns_,
+             &stats_);
 }
 
 void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
@@ -74,7 +76,10 @@ void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
 void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   Scan scan = scans_.PopFront();
   const double start_ms = ThreadCpuMs();
-  if (options_.lidar.estimate_time_offset) ShiftScanTime(ScanTimeShiftNs(), &scan);
+  if (options_.lidar.estimate_time_offset) {
+    applied_shift_ns_ = ScanTimeShiftNs();
+    ShiftScanTime(applied_shift_ns_, &scan);
+  }
   const Eigen::Vector3d mean_acc_imu = Predict(scan.t_end_ns);
   preprocessor_.Downsample(scan, &downsampled_);
   if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {

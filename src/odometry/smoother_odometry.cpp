@@ -81,8 +81,8 @@ void SmootherOdometry::TryInitialize(const ImuSample& imu) {
 
 void SmootherOdometry::AddScan(Scan scan) {
   // newest_ is on the IMU clock, the queued scans on the reader's (before the
-  // estimated shift).
-  scans_.Add(std::move(scan), stats_.initialized, newest_.t_ns - ScanTimeShiftNs(), &stats_);
+  // estimated shift): newest_ is at the last processed scan's end moved by its shift.
+  scans_.Add(std::move(scan), stats_.initialized, newest_.t_ns - applied_shift_ns_, &stats_);
 }
 
 void SmootherOdometry::Poll(std::vector<ScanResult>* out) {
@@ -109,7 +109,10 @@ void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
 void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   Scan scan = scans_.PopFront();
   const double start_ms = ThreadCpuMs();
-  if (options_.lidar.estimate_time_offset) ShiftScanTime(ScanTimeShiftNs(), &scan);
+  if (options_.lidar.estimate_time_offset) {
+    applied_shift_ns_ = ScanTimeShiftNs();
+    ShiftScanTime(applied_shift_ns_, &scan);
+  }
   if (scan.t_end_ns < newest_.t_ns) {
     ++stats_.scans_out_of_order;
     return;

@@ -565,53 +565,50 @@ void SlidingWindow::CountExcitationScan() {
   excitation_.CountScan(newest.t_ns, newest.T_world_imu().R, T_imu_lidar().R);
 }
 
-// The marginal variance of the time offset under the marginalization prior
-// (pseudo-inverse of H* = S^T S with the marginalization's relative floor;
-// no information: infinite).
-void SlidingWindow::ObserveTimeOffsetStd() {
-  const MarginalizationPrior& prior = marginal_prior_->prior();
-  const auto it = std::find(prior.blocks.begin(), prior.blocks.end(), time_offset_);
-  if (it == prior.blocks.end()) return;
-  const int offset = prior.tangent_offsets[it - prior.blocks.begin()];
-  const Eigen::MatrixXd H = prior.S.transpose() * prior.S;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
-  if (eig.info() != Eigen::Success) return;
-  const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 0.0);
-  double variance = 0.0;
-  for (int k = 0; k < eig.eigenvalues().size(); ++k) {
-    const double v = eig.eigenvectors()(offset, k);
-    if (eig.eigenvalues()(k) > floor)
-      variance += v * v / eig.eigenvalues()(k);
-    else if (std::abs(v) > 1e-6)
-      variance = std::numeric_limits<double>::infinity();
-  }
-  time_offset_std_s_ = std::sqrt(variance);
-}
+namespace {
 
-// Marginal covariance of the extrinsic block under the marginalization
-// prior (H* = S^T S over the kept blocks; pseudo-inverse with the
-// marginalization's relative eigenvalue floor): the information of every scan
-// that left the window, judged as if all six axes were estimated.
-void SlidingWindow::ObserveExtrinsicExcitation() {
-  const MarginalizationPrior& prior = marginal_prior_->prior();
-  const auto it = std::find(prior.blocks.begin(), prior.blocks.end(), extrinsic_);
-  if (it == prior.blocks.end()) return;
+// Marginal covariance of the `size` tangent entries of `block` under the
+// marginalization prior (H* = S^T S over the kept blocks; pseudo-inverse with
+// the marginalization's relative eigenvalue floor); an entry with no
+// information (zero eigenvalue) gets an infinite variance, not zero. False
+// when the block is not in the prior or the decomposition fails.
+bool PriorMarginalCovariance(const MarginalizationPrior& prior, const double* block, int size,
+                             Eigen::MatrixXd* C_block) {
+  const auto it = std::find(prior.blocks.begin(), prior.blocks.end(), block);
+  if (it == prior.blocks.end()) return false;
   const int offset = prior.tangent_offsets[it - prior.blocks.begin()];
   const Eigen::MatrixXd H = prior.S.transpose() * prior.S;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
-  if (eig.info() != Eigen::Success) return;
+  if (eig.info() != Eigen::Success) return false;
   const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 0.0);
   const Eigen::VectorXd inv = eig.eigenvalues().unaryExpr(
       [floor](double l) { return l > floor ? 1.0 / l : 0.0; });
   const Eigen::MatrixXd C = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
-  // An axis with no information (zero eigenvalue) has infinite variance, not zero.
-  Matrix6d C_ext = C.block<6, 6>(offset, offset);
-  const Eigen::MatrixXd V_ext = eig.eigenvectors().middleRows(offset, 6);
+  *C_block = C.block(offset, offset, size, size);
+  const Eigen::MatrixXd V = eig.eigenvectors().middleRows(offset, size);
   for (int k = 0; k < eig.eigenvalues().size(); ++k)
     if (eig.eigenvalues()(k) <= floor)
-      for (int i = 0; i < 6; ++i)
-        if (std::abs(V_ext(i, k)) > 1e-6) C_ext(i, i) = std::numeric_limits<double>::infinity();
-  excitation_.Observe(C_ext);
+      for (int i = 0; i < size; ++i)
+        if (std::abs(V(i, k)) > 1e-6) (*C_block)(i, i) = std::numeric_limits<double>::infinity();
+  return true;
+}
+
+}  // namespace
+
+// The marginal 1-sigma of the time offset under the marginalization prior.
+void SlidingWindow::ObserveTimeOffsetStd() {
+  Eigen::MatrixXd C;
+  if (PriorMarginalCovariance(marginal_prior_->prior(), time_offset_, 1, &C))
+    time_offset_std_s_ = std::sqrt(C(0, 0));
+}
+
+// The marginal covariance of the extrinsic block under the marginalization
+// prior: the information of every scan that left the window, judged as if all
+// six axes were estimated.
+void SlidingWindow::ObserveExtrinsicExcitation() {
+  Eigen::MatrixXd C;
+  if (PriorMarginalCovariance(marginal_prior_->prior(), extrinsic_, 6, &C))
+    excitation_.Observe(Matrix6d(C));
 }
 
 }  // namespace rvlio

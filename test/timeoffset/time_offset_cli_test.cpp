@@ -95,7 +95,9 @@ class TimeOffsetCliTest : public ::testing::Test {
 TEST_F(TimeOffsetCliTest, SimulateKeepsTheClockOffsetOutOfTheConfiguration) {
   std::istringstream yaml(ReadFile(dir_ + "/off30/tunnel.yaml"));
   for (std::string line; std::getline(yaml, line);)
-    if (line.find("time_offset") != std::string::npos) EXPECT_EQ(line.rfind('#', 0), 0u) << line;
+    if (line.find("time_offset") != std::string::npos) {
+      EXPECT_EQ(line.rfind('#', 0), 0u) << line;
+    }
   EXPECT_NE(ReadFile(dir_ + "/off30/tunnel.bag"), ReadFile(dir_ + "/sync/tunnel.bag"));
 }
 

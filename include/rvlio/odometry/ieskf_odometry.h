@@ -39,6 +39,7 @@ class IeskfOdometry : public Odometry {
   // lidar.estimate_time_offset: how far the scans are moved beyond
   // lidar.time_offset (the reader's shift) onto the IMU clock (0 when off).
   TimeNs ScanTimeShiftNs() const;
+  TimeNs applied_shift_ns_ = 0;  // the shift of the last processed scan (the state's time)
   void ReportTimeOffset(ScanResult* r);  // stats_.time_offset, r->time_offset_s, bound warning
 
   OdometryOptions options_;

@@ -99,6 +99,7 @@ class SmootherOdometry : public Odometry {
   // lidar.estimate_time_offset: how far the scans are moved beyond
   // lidar.time_offset onto the IMU clock (0 when off).
   TimeNs ScanTimeShiftNs() const;
+  TimeNs applied_shift_ns_ = 0;  // the shift of the last processed scan (the state's time)
   // stats_.time_offset, r->time_offset_s, bound warning; history: the scan's prediction.
   void ReportTimeOffset(ScanResult* r, const ImuPoseHistory& history);
 
