@@ -1,8 +1,7 @@
 // A default `rvlio simulate` gives the same bytes as the simulator gave before
 // the flight seed, the reference survey and the deformation existed: the
 // checksums below are those of the files written by the earlier binary,
-//   rvlio simulate --preset tunnel --seed 1 --duration 1.5 \
-//     --set lidar.columns=256 --out DIR
+//   rvlio simulate --preset tunnel --seed 1 --duration 1.5 --set lidar.columns=256 --out DIR
 // (FNV-1a 64 of NAME.bag and NAME_gt.tum; NAME.yaml is left out: its comment
 // block lists every simulator key, the new ones too).
 #include <unistd.h>
