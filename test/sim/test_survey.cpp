@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 #include <unordered_set>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -46,7 +47,11 @@ SurveyResult Survey(const Simulator& sim) {
 
 TEST(Survey, PointsLieOnTheWorldSurfacesWithinTheRangeNoise) {
   for (const std::string& preset : PresetNames()) {
-    for (const double noise : {0.0, 0.002}) {
+    // Noise-free on every preset (points on the surfaces to float rounding),
+    // with the default noise on the tunnel.
+    const std::vector<double> noises =
+        preset == "tunnel" ? std::vector<double>{0.0, 0.002} : std::vector<double>{0.0};
+    for (const double noise : noises) {
       SimOptions o = CheapSurvey(preset, -3.0, 9.0);
       o.survey.range_noise = noise;
       const auto sim = Make(o);
