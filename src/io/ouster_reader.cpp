@@ -20,7 +20,7 @@ class OusterSensorReader final : public SensorBagReader {
  public:
   OusterSensorReader(std::unique_ptr<OusterPacketSource> source, const LidarOptions& lidar,
                      const ImuOptions& imu)
-      : source_(std::move(source)), gate_(SiImu(imu)),
+      : source_(std::move(source)), gate_(SiImu(imu), lidar, source_->path()),
         assembler_(source_->metadata(), lidar) {}
 
   // Reads ahead to the first lidar packet and decodes it, so that metadata
@@ -77,7 +77,9 @@ class OusterSensorReader final : public SensorBagReader {
         DecodeStats decode;
         Scan last;
         while (assembler_.Flush(&last, &decode)) {
-          if (gate_.AcceptScan(decode, std::move(last), scan)) return SensorMessage::kScan;
+          StatusOr<bool> accepted = gate_.AcceptScan(decode, std::move(last), scan);
+          if (!accepted.ok()) return accepted.status();
+          if (*accepted) return SensorMessage::kScan;
         }
         return SensorMessage::kEnd;
       }
@@ -98,9 +100,10 @@ class OusterSensorReader final : public SensorBagReader {
       }
       DecodeStats decode;
       Scan done;
-      if (assembler_.Add(*packet, &done, &decode) &&
-          gate_.AcceptScan(decode, std::move(done), scan))
-        return SensorMessage::kScan;
+      if (!assembler_.Add(*packet, &done, &decode)) continue;
+      StatusOr<bool> accepted = gate_.AcceptScan(decode, std::move(done), scan);
+      if (!accepted.ok()) return accepted.status();
+      if (*accepted) return SensorMessage::kScan;
     }
   }
 
