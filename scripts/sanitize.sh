@@ -50,8 +50,7 @@ ex=(
   SmootherCliTest.AnImuGapInsideTheWindowIsBridged
   CompareTest.FullCompareWritesTablesEqualToEvalAndPlots
   CompareTest.EveryVariantFailedIsExitOne
-  CompareTest.RefMapAddsMapColumnsEqualToEvalMap
-  MapAccuracyTest.RefineMapIsMoreAccurateThanTheIeskfMapItStartedFrom
+  CompareTest.RefMapAddsMapColumnsInTheGroundTruthFrame
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData
