@@ -273,12 +273,14 @@ std::string Describe(int status, int* exit_code) {
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 // map_rms and map_completeness of run/map.pcd against the cell's reference
-// cloud (as `rvlio eval --map`); "" or why it failed.
-std::string CollectMapMetrics(const Cell& cell, json* metrics) {
+// cloud (as `rvlio eval --map`), the map moved by T_ref_est (the trajectory's
+// alignment to the ground truth, as `compare` does); "" or why it failed.
+std::string CollectMapMetrics(const Cell& cell, const Similarity3& T_ref_est, json* metrics) {
   if (cell.ref_map.empty()) return "";
   const PointCloudReadOptions xyz_only{false};
   StatusOr<PointCloudFile> map = ReadPointCloud(cell.RunDir() + "/map.pcd", xyz_only);
   if (!map.ok()) return "map eval: " + map.status().message();
+  for (Eigen::Vector3d& p : map->points) p = T_ref_est * p;
   StatusOr<PointCloudFile> ref = ReadPointCloud(cell.ref_map, xyz_only);
   if (!ref.ok()) return "map eval: " + ref.status().message();
   StatusOr<MapEvalResult> r = EvaluateMap(map->points, ref->points, MapEvalOptions());
@@ -305,8 +307,7 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point"})
     (*metrics)[m] = nullptr;
   if (!cell.ref_map.empty()) (*metrics)["map_rms"] = (*metrics)["map_completeness"] = nullptr;
-  if (std::string error = CollectMapMetrics(cell, metrics); !error.empty()) return error;
-  if (cell.gt.empty()) return "";
+  if (cell.gt.empty()) return CollectMapMetrics(cell, Similarity3(), metrics);
   StatusOr<Trajectory> gt = ReadTrajectory(cell.gt);
   if (!gt.ok()) return "eval: " + gt.status().message();
   StatusOr<Trajectory> est = ReadTrajectory(cell.RunDir() + "/trajectory.tum");
@@ -319,7 +320,7 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   (*metrics)["axis_max"] = Number(r->along_axis.max_abs_m);
   (*metrics)["end_point"] = Number(r->end_point_error_m);
   *warnings = r->warnings;
-  return "";
+  return CollectMapMetrics(cell, r->T_ref_est, metrics);
 }
 
 json CellHeader(const Cell& cell) {

@@ -52,8 +52,7 @@ ex=(
   SmootherCliTest.AnImuGapInsideTheWindowIsBridged
   CompareTest.FullCompareWritesTablesEqualToEvalAndPlots
   CompareTest.EveryVariantFailedIsExitOne
-  CompareTest.RefMapAddsMapColumnsEqualToEvalMap
-  MapAccuracyTest.RefineMapIsMoreAccurateThanTheIeskfMapItStartedFrom
+  CompareTest.RefMapAddsMapColumnsInTheGroundTruthFrame
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   'PresetsAndBackends/TimeOffsetMatrix\..*'
   TimeOffsetCliTest.SmootherEstimatesA30MsOffset

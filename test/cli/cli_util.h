@@ -38,6 +38,17 @@ inline ToolRun RunTool(const std::string& args, const std::string& scratch) {
   return r;
 }
 
+// Bad input: exit 2, exactly one stderr line "rvlio COMMAND: error: ..."
+// containing `part`, nothing on stdout.
+inline void ExpectOneErrorLine(const ToolRun& r, const std::string& command,
+                               const std::string& part) {
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("rvlio " + command + ": error: ", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "more than one line: " << r.err;
+  EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 inline std::string MakeTempDir(const std::string& stem) {
   std::string tmpl = std::filesystem::temp_directory_path().string() + "/" + stem + "_XXXXXX";
   if (::mkdtemp(tmpl.data()) == nullptr) return "";

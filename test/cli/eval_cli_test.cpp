@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_util.h"
+
 namespace rvlio {
 namespace {
 
@@ -57,11 +59,7 @@ class EvalCliTest : public ::testing::Test {
   // Exit 2 and exactly one stderr line "rvlio eval: error: ..." containing `part`.
   void ExpectBadInput(const std::string& args, const std::string& part) {
     const EvalRun r = Eval(args);
-    EXPECT_EQ(r.exit_code, 2) << args;
-    EXPECT_EQ(r.err.rfind("rvlio eval: error: ", 0), 0u) << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "more than one line: " << r.err;
-    EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+    testing_cli::ExpectOneErrorLine({r.exit_code, r.out, r.err}, "eval", part);
   }
 
   std::string dir_;

@@ -55,12 +55,7 @@ class EvalMapCliTest : public ::testing::Test {
 
   ToolRun Eval(const std::string& args) { return RunTool("eval " + args, dir_); }
   void ExpectBadInput(const std::string& args, const std::string& part) {
-    const ToolRun r = Eval(args);
-    EXPECT_EQ(r.exit_code, 2) << args;
-    EXPECT_EQ(r.err.rfind("rvlio eval: error: ", 0), 0u) << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "more than one line: " << r.err;
-    EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
+    ExpectOneErrorLine(Eval(args), "eval", part);
   }
   std::string dir_;
 };

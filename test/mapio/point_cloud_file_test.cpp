@@ -61,7 +61,9 @@ class PointCloudFileTest : public ::testing::Test {
       EXPECT_NEAR(f.points[i].y(), c[i].y, 1e-6);
       EXPECT_NEAR(f.points[i].z(), c[i].z, 1e-6);
       EXPECT_EQ(intensity->values[i], c[i].intensity);
-      if (f.format.find("ascii") == std::string::npos) EXPECT_EQ(f.points[i].y(), c[i].y);
+      if (f.format.find("ascii") == std::string::npos) {
+        EXPECT_EQ(f.points[i].y(), c[i].y);
+      }
     }
   }
   fs::path dir_;
