@@ -73,6 +73,7 @@ ex=(
   RefineSignalsTest.KilledAfterARoundThenResumedEqualsTheUninterruptedResult
   RefineMemory.PeakPerScanOfA400ScanRefineStaysBounded
   RefineChunksCliTest.MergedChunksAgreeWithTheWholeRefineHaveNoBorderStepsAndRefuseBadSets
+  'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

@@ -131,6 +131,19 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
   ClearPoseHistory();
 }
 
+void Ieskf::ChangeWorldFrame(const Pose3& T_new_old) {
+  x_.R_world_imu = T_new_old.R * x_.R_world_imu;
+  x_.p_world_imu = T_new_old * x_.p_world_imu;
+  x_.v_world_imu = T_new_old.R * x_.v_world_imu;
+  x_.g_world = T_new_old.R * x_.g_world;
+  Matrix24d J = Matrix24d::Identity();
+  for (int k : {FilterState::kPos, FilterState::kVel, FilterState::kGrav})
+    J.block<3, 3>(k, k) = T_new_old.R;
+  P_ = J * P_ * J.transpose();
+  P_all_extrinsic_ = J * P_all_extrinsic_ * J.transpose();
+  ClearPoseHistory();
+}
+
 void Ieskf::ClearPoseHistory() {
   pose_history_.Clear();
   RecordPose(last_imu_.gyro_imu, last_imu_.acc_imu);
