@@ -114,7 +114,8 @@ TEST(AlignToReference, FeaturelessTunnelLeavesTheAxisUninformed) {
   EXPECT_LT(info_p(0, 0), 1e-3 * info_p(1, 1));
   EXPECT_LT(info_p(0, 0), 1e-3 * info_p(2, 2));
   EXPECT_GT(std::abs(a.weakest_axis.x()), 0.99);
-  EXPECT_LT(a.weakest_axis_constraints, LocalizationOptions().min_start_axis_constraints);
+  EXPECT_LT(a.weakest_axis_constraints, 0.2 * LocalizationOptions().min_start_axis_constraints)
+      << a.weakest_axis_constraints;
 }
 
 TEST(AlignToReference, FeaturesFixEveryAxis) {
@@ -122,7 +123,7 @@ TEST(AlignToReference, FeaturesFixEveryAxis) {
   const ReferenceAlignment a = AlignToReference(s.p_lidar, s.T_imu_lidar, *s.reference,
                                                 s.T_ref_imu_true, ConstraintOptions(),
                                                 LocalizationOptions());
-  EXPECT_GT(a.weakest_axis_constraints, 3.0 * LocalizationOptions().min_start_axis_constraints);
+  EXPECT_GT(a.weakest_axis_constraints, 2.0 * LocalizationOptions().min_start_axis_constraints);
 }
 
 TEST(AlignToReference, FarFromTheReferenceThereIsNoOverlap) {

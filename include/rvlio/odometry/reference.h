@@ -46,7 +46,7 @@ struct LocalizationOptions {
   int align_iterations = 6;        // Gauss-Newton iterations per radius
   double min_start_overlap = 0.3;  // the aligned first scan must overlap the reference this much
   double max_start_distance = 10.0;  // m, a reference point must lie this close to the initial position
-  double min_start_axis_constraints = 30.0;  // the aligned first scan must fix every translation axis this well
+  double min_start_axis_constraints = 5.0;   // the aligned first scan must fix every translation axis this well
   bool trust_initial_pose = false;  // take the initial pose along an axis the first scan does not fix
   double search_step = 2.0;         // m, position grid of the global search (no initial pose)
   double search_yaw_step = 15.0;    // deg, yaw step of the global search
