@@ -103,6 +103,7 @@ int CmdRefine(int argc, char** argv) {
                      "trajectory's span (smoother.refine_job_overlap_s); writes chunk.json too, "
                      "for `rvlio merge`"},
                     {"of", "N", "the number of chunks (with --chunk)"},
+                    {"map", "REF", "reference map (PCD or PLY, metres) in the --init trajectory's frame: every scan is also held to it (docs/survey.md)"},
                     AllowDivergenceOption(),
                     StartOption(),
                     DurationOption()}};
@@ -115,6 +116,7 @@ int CmdRefine(int argc, char** argv) {
   req.bag = args.Get("bag");
   req.init_path = args.Get("init");
   req.out_dir = args.Get("out");
+  req.map = args.Get("map");
   std::vector<std::string> config_warnings;
   StatusOr<OdometryOptions> options =
       LoadConfig(args.GetAll("config"), OverridesOf(args), &config_warnings);

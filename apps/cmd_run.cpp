@@ -21,12 +21,18 @@ int CmdRun(int argc, char** argv) {
                     {"out", "DIR", "output folder", true},
                     StartOption(),
                     DurationOption(),
+                    {"map", "REF", "reference map (PCD or PLY, metres): localize in it; outputs in its frame (docs/survey.md)"},
+                    {"initial-pose", "X,Y,Z,R,P,Y", "with --map: IMU pose in the map's frame at the first scan (m, deg; R = Rz Ry Rx)"},
+                    {"initial-pose-tum", "FILE", "with --map: initial pose from a TUM file (one line, or interpolated at the first scan)"},
                     {"quiet", "", "no progress line"},
                     AllowDivergenceOption()}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
-  RunRequest req{args.Get("bag"), args.Get("out"), args.GetAll("config"), OverridesOf(args),
-                 args.Has("quiet"), args.Has("allow-divergence"), ReadWindow()};
+  RunRequest req{args.Get("bag"),     args.Get("out"),
+                 args.GetAll("config"), OverridesOf(args),
+                 args.Has("quiet"),   args.Has("allow-divergence"),
+                 ReadWindow(),        args.Get("map"),
+                 args.Get("initial-pose"), args.Get("initial-pose-tum")};
   if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("run", err);
   RunOutcome outcome;
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: write what is done, exit 130/143

@@ -74,6 +74,9 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   args.options = *options;
   args.out_dir = req.out_dir;
   args.window = req.window;
+  args.map = req.map;
+  args.initial_pose = req.initial_pose;
+  args.initial_pose_tum = req.initial_pose_tum;
   args.stop = [] { return InterruptSignalName(); };
   Progress progress(!req.quiet);
   size_t divergence_warned = 0;

@@ -21,6 +21,9 @@ struct RunRequest {
   bool quiet = false;                  // no progress line even on a terminal
   bool allow_divergence = false;       // exit 0 even if the divergence monitor fired
   ReadWindow window;                   // --start / --duration
+  std::string map;                     // --map: localize in this reference map
+  std::string initial_pose;            // --initial-pose x,y,z,roll_deg,pitch_deg,yaw_deg
+  std::string initial_pose_tum;        // --initial-pose-tum FILE
 };
 
 struct RunOutcome {

@@ -80,6 +80,7 @@ ex=(
   RefineMemory.PeakPerScanOfA400ScanRefineStaysBounded
   RefineChunksCliTest.MergedChunksAgreeWithTheWholeRefineHaveNoBorderStepsAndRefuseBadSets
   'ReportBrowserTest\..*'
+  'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

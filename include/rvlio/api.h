@@ -62,6 +62,13 @@ struct RunArgs {
   // goes, trajectory.partial.tum. Empty: nothing is written.
   std::string out_dir;
   ReadWindow window;  // part of the recording (default: all of it)
+  // Localization in a reference map (docs/survey.md): when map is not empty,
+  // the run is in that map's frame, starting from initial_pose
+  // ("x,y,z,roll_deg,pitch_deg,yaw_deg") or initial_pose_tum (a TUM file);
+  // scans.csv gains map_overlap and localized, summary.json "localization".
+  std::string map;
+  std::string initial_pose;
+  std::string initial_pose_tum;
   StopFn stop;
   // Called after every message read and once after the end of the input.
   std::function<void(const RunProgress&)> progress;
@@ -114,6 +121,9 @@ struct RefineArgs {
   // chunk.json, which MergeRefineChunks reads.
   int chunk = 0;
   int chunk_count = 0;
+  // A reference map (PCD or PLY, metres) in the initial trajectory's frame:
+  // every scan is also held to it (`refine --map`, docs/survey.md).
+  std::string map;
 };
 
 struct RefineRunResult {

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "config_py.h"
 #include "odometry_py.h"
@@ -105,6 +106,12 @@ py::dict ScanTable(const std::vector<ScanResult>& scans) {
   column("diverged", [](const ScanResult& r) { return r.health.divergence_mask != 0; });
   AddExtrinsicColumns(scans, column);
   AddTimeOffsetColumns(scans, column);
+  if (std::any_of(scans.begin(), scans.end(),
+                  [](const ScanResult& r) { return r.map_overlap.has_value(); })) {
+    column("map_overlap",
+           [](const ScanResult& r) { return r.map_overlap ? *r.map_overlap : std::nan(""); });
+    column("localized", [](const ScanResult& r) { return r.localized; });
+  }
   return table;
 }
 
@@ -163,8 +170,23 @@ struct RunOutput {
   std::string out;
 };
 
+// initial_pose: None, "x,y,z,roll_deg,pitch_deg,yaw_deg", or six numbers.
+std::string InitialPoseText(const py::handle& pose) {
+  if (pose.is_none()) return "";
+  if (py::isinstance<py::str>(pose)) return pose.cast<std::string>();
+  std::string text;
+  for (const py::handle& v : pose) {
+    char number[64];
+    std::snprintf(number, sizeof(number), "%.17g", v.cast<double>());
+    text += (text.empty() ? "" : ",") + std::string(number);
+  }
+  return text;
+}
+
 RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::handle& out,
-              double start, double duration, const py::object& progress) {
+              double start, double duration, const py::object& progress,
+              const py::handle& map, const py::handle& initial_pose,
+              const py::handle& initial_pose_tum) {
   const std::string bag = PathText(bag_obj);
   RequireExisting(bag, "recording");
   Config defaults;
@@ -173,6 +195,9 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
   args.options = ConfigArg(config, &defaults).options;
   args.out_dir = OutDir(out);
   args.window = Window(start, duration);
+  if (!map.is_none()) args.map = PathText(map);
+  args.initial_pose = InitialPoseText(initial_pose);
+  if (!initial_pose_tum.is_none()) args.initial_pose_tum = PathText(initial_pose_tum);
   SignalCheck signals;
   args.stop = StopOn(&signals);
   auto last_progress = std::chrono::steady_clock::now();
@@ -225,7 +250,7 @@ void SetChunk(const py::handle& chunk, const py::handle& of, RefineArgs* args) {
 
 RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py::handle& config,
                     const py::handle& out, double start, double duration, const py::handle& chunk,
-                    const py::handle& of) {
+                    const py::handle& of, const py::handle& map) {
   const std::string bag = PathText(bag_obj);
   RequireExisting(bag, "recording");
   Config defaults;
@@ -235,6 +260,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   args.out_dir = OutDir(out);
   args.window = Window(start, duration);
   SetChunk(chunk, of, &args);
+  if (!map.is_none()) args.map = PathText(map);
   if (py::isinstance<RunOutput>(init)) {
     args.init = init.cast<const RunOutput&>().poses;
   } else if (py::isinstance<py::str>(init) || py::hasattr(init, "__fspath__")) {
@@ -352,17 +378,23 @@ void BindRun(py::module_& m) {
 
   m.def("run", &Run, py::arg("bag"), py::arg("config") = py::none(), py::arg("out") = py::none(),
         py::kw_only(), py::arg("start") = 0.0, py::arg("duration") = 0.0,
-        py::arg("progress") = py::none(),
+        py::arg("progress") = py::none(), py::arg("map") = py::none(),
+        py::arg("initial_pose") = py::none(), py::arg("initial_pose_tum") = py::none(),
         "`rvlio run`: the odometry over a recording. With `out`, writes trajectory.tum, map.pcd, "
-        "scans.csv and summary.json there, as the command does. progress(scans, fraction) is "
+        "scans.csv and summary.json there, as the command does. map (a PCD/PLY path) with "
+        "initial_pose (x, y, z, roll_deg, pitch_deg, yaw_deg: six numbers or that text) or "
+        "initial_pose_tum (a TUM path): localize in that reference map, as `rvlio run --map` "
+        "(the table gains map_overlap and localized). progress(scans, fraction) is "
         "called after each new scan result (and every 0.2 s while reading without one); an "
         "exception it raises stops the run and is raised. Ctrl-C "
         "raises KeyboardInterrupt (with `out`, the outputs of the scans done are written first).");
   m.def("refine", &Refine, py::arg("bag"), py::arg("init"), py::arg("config") = py::none(),
         py::arg("out") = py::none(), py::kw_only(), py::arg("start") = 0.0,
         py::arg("duration") = 0.0, py::arg("chunk") = py::none(), py::arg("of") = py::none(),
+        py::arg("map") = py::none(),
         "`rvlio refine`: offline batch refinement from `init` (a TUM path or an rvlio.run "
         "result). With `out`, writes trajectory.tum, map.pcd and summary.json there. "
+        "map: a reference map (PCD/PLY) every scan is also held to (`refine --map`). "
         "chunk=K, of=N: the chunk job `rvlio refine --chunk K --of N` (also writes chunk.json; "
         "join the N output folders with rvlio.merge).");
   m.def("merge", &Merge, py::arg("chunks"), py::arg("out") = py::none(),

@@ -189,6 +189,18 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
 }
 
 double Ieskf::time_offset_std_s() const { return std::sqrt(std::max(P_td_td_, 0.0)); }
+void Ieskf::ChangeWorldFrame(const Pose3& T_new_old) {
+  x_.R_world_imu = T_new_old.R * x_.R_world_imu;
+  x_.p_world_imu = T_new_old * x_.p_world_imu;
+  x_.v_world_imu = T_new_old.R * x_.v_world_imu;
+  x_.g_world = T_new_old.R * x_.g_world;
+  Matrix24d J = Matrix24d::Identity();
+  for (int k : {FilterState::kPos, FilterState::kVel, FilterState::kGrav})
+    J.block<3, 3>(k, k) = T_new_old.R;
+  P_ = J * P_ * J.transpose();
+  P_all_extrinsic_ = J * P_all_extrinsic_ * J.transpose();
+  ClearPoseHistory();
+}
 
 void Ieskf::ClearPoseHistory() {
   pose_history_.Clear();

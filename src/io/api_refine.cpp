@@ -14,6 +14,7 @@
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/output_stage.h"
+#include "rvlio/io/reference_map.h"
 #include "rvlio/io/refine_checkpoint.h"
 #include "rvlio/io/run_outputs.h"
 #include "rvlio/io/sensor_bag.h"
@@ -31,8 +32,10 @@ double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-RefineConfig ToRefineConfig(const OdometryOptions& o) {
+RefineConfig ToRefineConfig(const OdometryOptions& o,
+                            std::shared_ptr<const VoxelMap> reference) {
   RefineConfig c;
+  c.reference = std::move(reference);
   c.imu = o.imu;
   const auto& e = o.extrinsics.imu_T_lidar;
   c.T_imu_lidar = Pose3(Eigen::Quaterniond(e.rotation_xyzw[3], e.rotation_xyzw[0],
@@ -218,6 +221,7 @@ nlohmann::json Summary(const RefineArgs& args, const RefineRunResult& r,
   j["command"] = "refine";
   j["bag"] = args.bag;
   j["init"] = args.init_path;
+  if (!args.map.empty()) j["map"] = args.map;
   j["config"] = ToJson(args.options);
   j["linear_solver"] = res.linear_solver;
   j["threads"] = res.threads;
@@ -262,6 +266,7 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r) {
 // The refinement with its hooks: rounds, checkpoints, the stop flag.
 // *checkpoint_s: wall time of the fingerprint and the checkpoint writes.
 StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input,
+                                       std::shared_ptr<const VoxelMap> reference,
                                        std::string* stop_reason, double* checkpoint_s) {
   RefineHooks hooks;
   hooks.on_round = args.on_round;
@@ -277,12 +282,13 @@ StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input
       *checkpoint_s += SecondsSince(t_write);
       return s;
     };
-  if (!args.resume) return Refine(ToRefineConfig(args.options), std::move(input), hooks);
+  if (!args.resume)
+    return Refine(ToRefineConfig(args.options, std::move(reference)), std::move(input), hooks);
   StatusOr<RefineRoundState> resume = ReadRefineCheckpoint(args.checkpoint_dir, fingerprint);
   if (!resume.ok()) return resume.status();
   hooks.resume = &*resume;
   if (args.on_resume) args.on_resume(resume->rounds_done);
-  return Refine(ToRefineConfig(args.options), std::move(input), hooks);
+  return Refine(ToRefineConfig(args.options, std::move(reference)), std::move(input), hooks);
 }
 
 // The checkpoint folder: one to resume from must hold a checkpoint; a new
@@ -324,6 +330,13 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   }
   const uint64_t init_hash = job ? TrajectoryHash(input.init) : 0;
   const Trajectory init_span = {input.init.front(), input.init.back()};
+  std::shared_ptr<const VoxelMap> reference;
+  if (!args.map.empty()) {  // read before anything is written
+    StatusOr<std::shared_ptr<const VoxelMap>> loaded =
+        LoadReferenceMap(args.map, args.options.localization);
+    if (!loaded.ok()) return loaded.status();
+    reference = std::move(*loaded);
+  }
   if (Status s = PrepareCheckpointDir(args); !s.ok()) return s;
   StatusOr<std::unique_ptr<SensorBagReader>> reader = OpenSensorStream(
       args.bag, args.options.lidar, args.options.imu, args.window, args.options.io);
@@ -350,7 +363,8 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   Times times;
   times.read_s = SecondsSince(t0);
   StatusOr<RefineResult> refined =
-      RefineWithHooks(args, std::move(input), &r.stop_reason, &times.checkpoint_s);
+      RefineWithHooks(args, std::move(input), std::move(reference), &r.stop_reason,
+                      &times.checkpoint_s);
   if (!refined.ok()) {
     const std::string what =
         refined.status().message() + " (bag " + args.bag + ", init " + args.init_path + ")";

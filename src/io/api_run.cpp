@@ -2,15 +2,18 @@
 // of docs/design.md section 7 when an output folder is given. `rvlio run` is this
 // call plus argument parsing, signals and the terminal lines.
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/extrinsic_json.h"
 #include "rvlio/io/output_stage.h"
+#include "rvlio/io/reference_map.h"
 #include "rvlio/io/run_outputs.h"
 #include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/summary_json.h"
@@ -54,6 +57,39 @@ int RvActiveScans(const std::vector<ScanResult>& results) {
   return n;
 }
 
+// With a reference map: where the run left it (scans not localized), as
+// spans of consecutive such scans with their length along the trajectory.
+nlohmann::json LocalizationJson(const RunArgs& args, const std::vector<ScanResult>& scans) {
+  nlohmann::json spans = nlohmann::json::array();
+  int localized = 0;
+  double longest_m = 0.0, longest_s = 0.0;
+  for (size_t i = 0; i < scans.size();) {
+    if (scans[i].localized || !scans[i].map_overlap) {
+      localized += scans[i].localized ? 1 : 0;
+      ++i;
+      continue;
+    }
+    size_t j = i;
+    double length_m = 0.0;
+    while (j + 1 < scans.size() && !scans[j + 1].localized) {
+      length_m += (scans[j + 1].T_world_imu.t - scans[j].T_world_imu.t).norm();
+      ++j;
+    }
+    const double t0 = NsToSeconds(scans[i].t_ns), t1 = NsToSeconds(scans[j].t_ns);
+    spans.push_back({{"t_start", t0}, {"t_end", t1}, {"scans", j - i + 1}, {"length_m", length_m}});
+    longest_m = std::max(longest_m, length_m);
+    longest_s = std::max(longest_s, t1 - t0);
+    i = j + 1;
+  }
+  return {{"map", args.map},
+          {"initial_pose", args.initial_pose},
+          {"initial_pose_tum", args.initial_pose_tum},
+          {"localized_scans", localized},
+          {"out_of_map_spans", spans},
+          {"longest_out_of_map_m", longest_m},
+          {"longest_out_of_map_s", longest_s}};
+}
+
 struct RunData {
   TimeNs first_ns = -1, last_ns = -1;
   double wall_s = 0.0;
@@ -85,6 +121,7 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   j["divergence"] = DivergenceJson(odo.divergence());
   if (odo.stats().extrinsic.enabled) j["extrinsic"] = ExtrinsicJson(odo.stats().extrinsic);
   if (odo.stats().time_offset.enabled) j["time_offset"] = TimeOffsetJson(odo.stats().time_offset);
+  if (!args.map.empty()) j["localization"] = LocalizationJson(args, result.scans);
   j["warnings"] = result.warnings;
   j["truncated"] = data.truncated;
   j["interrupted"] = result.stopped;
@@ -95,13 +132,54 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   return j;
 }
 
-Status WriteOutputs(const std::string& out_dir, const Odometry& odo, const RunResult& result) {
+// With a reference map: each map point's deviation from it, and per chainage bin.
+struct Deviation {
+  std::vector<Eigen::Vector3d> p_map;
+  PointDeviations points;
+  std::vector<DeviationBin> bins;
+};
+
+Deviation ComputeRunDeviation(const Odometry& odo, const ReferenceMap& reference,
+                              const Trajectory& trajectory, const DeviationOptions& options) {
+  Deviation d;
+  d.p_map = odo.MapPoints();
+  d.points = ComputeDeviations(d.p_map, reference, trajectory, options.surface);
+  d.bins = BinByChainage(d.points, options.chainage_step);
+  return d;
+}
+
+nlohmann::json DeviationJson(const Deviation& d) {
+  std::vector<double> abs_m;
+  for (double v : d.points.deviation_m)
+    if (std::isfinite(v)) abs_m.push_back(std::abs(v));
+  std::sort(abs_m.begin(), abs_m.end());
+  const auto at = [&abs_m](double q) {
+    return abs_m.empty() ? nlohmann::json(nullptr)
+                         : nlohmann::json(abs_m[std::min(abs_m.size() - 1,
+                                                         static_cast<size_t>(q * abs_m.size()))]);
+  };
+  return {{"map_points", d.p_map.size()},
+          {"with_surface", abs_m.size()},
+          {"median_abs_m", at(0.5)},
+          {"p95_abs_m", at(0.95)},
+          {"max_abs_m", abs_m.empty() ? nlohmann::json(nullptr) : nlohmann::json(abs_m.back())}};
+}
+
+Status WriteOutputs(const std::string& out_dir, const Odometry& odo, const RunResult& result,
+                    const Deviation* deviation) {
   OutputStage stage(out_dir);
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), result.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteMapPcd(stage.Path("map.pcd"), odo.MapPoints()); !s.ok())
+  if (Status s = deviation != nullptr
+                     ? WriteMapPcd(stage.Path("map.pcd"), deviation->p_map,
+                                   &deviation->points.deviation_m)
+                     : WriteMapPcd(stage.Path("map.pcd"), odo.MapPoints());
+      !s.ok())
     return stage.Explain(s);
+  if (deviation != nullptr)
+    if (Status s = WriteDeviationCsv(stage.Path("deviation.csv"), deviation->bins); !s.ok())
+      return stage.Explain(s);
   if (Status s = WriteScansCsv(stage.Path("scans.csv"), result.scans, result.rss_mb); !s.ok())
     return stage.Explain(s);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(result.summary) + "\n");
@@ -215,6 +293,7 @@ void Process(const RunArgs& args, SensorBagReader* reader, Odometry* odo, TumStr
     if (*m == SensorMessage::kImu) odo->AddImu(imu);
     else odo->AddScan(std::move(scan));
     odo->Poll(&result->scans);
+    if (!odo->status().ok()) return;  // the reference map did not fit: nothing is written
     StreamNewPoses(result->scans, &streamed, partial, stream_warnings);
     (void)partial->SyncIfDue();  // a failure surfaces at the next Append
     if (result->rss_mb.size() < result->scans.size())
@@ -237,7 +316,17 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
                                           &notes);
       !s.ok())
     return s;
-  StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(args.options);
+  Localization localization;
+  std::shared_ptr<const ReferenceMap> reference;  // the full cloud, for the deviation
+  if (!args.map.empty()) {
+    StatusOr<Localization> loaded = LoadLocalization(args.map, args.initial_pose,
+                                                     args.initial_pose_tum, args.options, &reference);
+    if (!loaded.ok()) return loaded.status();
+    localization = std::move(*loaded);
+  } else if (!args.initial_pose.empty() || !args.initial_pose_tum.empty()) {
+    return Status::InvalidInput("--initial-pose and --initial-pose-tum need --map");
+  }
+  StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(args.options, std::move(localization));
   if (!odo.ok()) return odo.status();
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(args.bag, args.options.lidar, args.options.imu, args.window,
@@ -262,6 +351,13 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   Process(args, reader->get(), odo->get(), &partial, &stream_warnings, &data, &result);
   data.wall_s = SecondsSince(t0);
   data.truncated = (*reader)->truncated();
+  if (!(*odo)->status().ok()) {  // nothing new in the output folder
+    if (write) {
+      partial.Remove();
+      if (!out_dir_existed) std::filesystem::remove(args.out_dir, ec);  // only if empty
+    }
+    return Status::InvalidInput("--map " + args.map + ": " + (*odo)->status().message());
+  }
 
   const SensorReaderStats& reader_stats = (*reader)->stats();
   result.warnings = notes;
@@ -284,8 +380,15 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   }
   result.trajectory = ToTrajectory(result.scans);
   result.summary = Summary(args, **odo, reader_stats, data, result);
+  std::optional<Deviation> deviation;
+  if (reference != nullptr) {
+    deviation = ComputeRunDeviation(**odo, *reference, result.trajectory,
+                                    args.options.localization.deviation);
+    result.summary["localization"]["deviation"] = DeviationJson(*deviation);
+  }
   if (!write) return result;
-  const Status written = WriteOutputs(args.out_dir, **odo, result);
+  const Status written =
+      WriteOutputs(args.out_dir, **odo, result, deviation ? &*deviation : nullptr);
   partial.Remove();  // the complete outputs (or the folder as it was) replace it
   if (!written.ok()) return written;
   result.written = true;

@@ -47,25 +47,46 @@ void WriteExtrinsicColumns(const std::optional<Pose3>& T_imu_lidar, std::ostream
 }  // namespace
 
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world) {
+  return WriteMapPcd(path, p_world, nullptr);
+}
+
+namespace {
+
+// The header of a binary PCD of n points with fields x y z and `field` (float32).
+std::string PcdHeaderWithField(size_t n, const std::string& field) {
+  const std::string count = std::to_string(n);
+  return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z " + field +
+         "\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " + count +
+         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + count + "\nDATA binary\n";
+}
+
+}  // namespace
+
+Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world,
+                   const std::vector<double>* deviation_m) {
   // PCL's own writer maps the file into memory after fallocate and throws on
   // failure; a full disk must instead be a clean error that leaves no half
   // file. So PCL only makes the header and the points go through the atomic
   // writer, byte for byte what PCDWriter::writeBinary produces.
   const pcl::PointCloud<pcl::PointXYZ> no_points;  // the header needs only the fields
   const std::string header =
-      p_world.empty() ? EmptyPcd()
-                      : pcl::PCDWriter::generateHeader(no_points, static_cast<int>(p_world.size())) +
-                            "DATA binary\n";
+      deviation_m != nullptr ? PcdHeaderWithField(p_world.size(), "deviation_m")
+      : p_world.empty()
+          ? EmptyPcd()
+          : pcl::PCDWriter::generateHeader(no_points, static_cast<int>(p_world.size())) +
+                "DATA binary\n";
+  const size_t fields = deviation_m != nullptr ? 4 : 3;
   AtomicFileWriter writer;
   if (Status s = writer.Open(path); !s.ok()) return s;
   if (Status s = writer.Append(header); !s.ok()) return s;
   std::string block;
-  block.reserve(kPcdBlockPoints * 3 * sizeof(float));
+  block.reserve(kPcdBlockPoints * fields * sizeof(float));
   for (size_t i = 0; i < p_world.size(); ++i) {
-    const float xyz[3] = {static_cast<float>(p_world[i].x()), static_cast<float>(p_world[i].y()),
-                          static_cast<float>(p_world[i].z())};
-    block.append(reinterpret_cast<const char*>(xyz), sizeof(xyz));
-    if (block.size() >= kPcdBlockPoints * sizeof(xyz) || i + 1 == p_world.size()) {
+    const float row[4] = {static_cast<float>(p_world[i].x()), static_cast<float>(p_world[i].y()),
+                          static_cast<float>(p_world[i].z()),
+                          deviation_m != nullptr ? static_cast<float>((*deviation_m)[i]) : 0.0f};
+    block.append(reinterpret_cast<const char*>(row), fields * sizeof(float));
+    if (block.size() >= kPcdBlockPoints * fields * sizeof(float) || i + 1 == p_world.size()) {
       if (Status s = writer.Append(block); !s.ok()) return s;
       block.clear();
     }
@@ -111,6 +132,10 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
     return r.time_offset_s.has_value();
   });
   if (time_offset) os << ",time_offset_s,time_offset_std_s";
+  // Localization in a reference map (run --map).
+  const bool reference = std::any_of(results.begin(), results.end(),
+                                     [](const ScanResult& r) { return r.map_overlap.has_value(); });
+  if (reference) os << ",map_overlap,localized";
   os << '\n';
   for (size_t i = 0; i < results.size(); ++i) {
     const ScanResult& r = results[i];
@@ -133,8 +158,21 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
       else
         os << ",,";
     }
+    if (reference)
+      os << ',' << (r.map_overlap ? Optional(*r.map_overlap) : "") << ',' << (r.localized ? 1 : 0);
     os << '\n';
   }
+  return WriteFileAtomically(path, os.str());
+}
+
+Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin>& bins) {
+  std::ostringstream os;
+  os.precision(6);
+  os << "chainage_m,count,median_m,median_abs_m,p95_abs_m,max_abs_m\n";
+  for (const DeviationBin& b : bins)
+    os << b.chainage_m << ',' << b.count << ',' << Optional(b.median_m) << ','
+       << Optional(b.median_abs_m) << ',' << Optional(b.p95_abs_m) << ',' << Optional(b.max_abs_m)
+       << '\n';
   return WriteFileAtomically(path, os.str());
 }
 

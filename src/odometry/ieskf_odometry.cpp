@@ -10,7 +10,7 @@
 
 namespace rvlio {
 
-IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
+IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization localization)
     : options_(options),
       filter_(options.ieskf, options.imu, options.constraints, options.rv, options.lidar),
       map_(options.map, options.ieskf.estimate_extrinsics),
@@ -18,7 +18,8 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options)
       preprocessor_(options.lidar),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
       monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity),
-      initializer_(options.imu.init_duration) {}
+      initializer_(options.imu.init_duration),
+      localizer_(std::move(localization), options.localization, options.constraints) {}
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {
   if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
@@ -61,12 +62,12 @@ void IeskfOdometry::AddScan(Scan scan) {
 }
 
 void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
-  while (scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) ProcessFrontScan(out);
+  while (status_.ok() && scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) ProcessFrontScan(out);
 }
 
 void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
   scans_.DropPastImu(SecondsToNs(options_.imu.max_gap), &stats_);
-  while (!scans_.empty()) ProcessFrontScan(out);
+  while (status_.ok() && !scans_.empty()) ProcessFrontScan(out);
 }
 
 // The scan is moved onto the IMU clock by the current estimate (prediction
@@ -89,11 +90,12 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   }
   DeskewToScanEnd(filter_.pose_history(), filter_.state().T_imu_lidar(), downsampled_.points,
                   scan.t_end_ns, &p_lidar_end_);
+  if (localizer_.enabled() && !localizer_.started() && !StartInReference()) return;
   ScanResult r;
   r.raw_points = static_cast<int>(scan.points.size());
   r.mean_acc_imu = mean_acc_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
-  r.status = map_.Empty() ? ScanStatus::kMapInit : Correct(&r);
+  r.status = map_.Empty() && !localizer_.enabled() ? ScanStatus::kMapInit : Correct(&r);
   InsertIntoMap(scan.t_end_ns);
   ReportExtrinsic(&r);
   ReportTimeOffset(&r);
@@ -128,11 +130,17 @@ Eigen::Vector3d IeskfOdometry::Predict(TimeNs t_end_ns) {
 // search keeps that plane (with a fresh residual), so the later iterations,
 // which move the pose by millimetres, mostly skip the search (the dominant
 // cost, bench/RESULTS.md). A new cache per scan: the map changed since.
+// With a reference map, the scan is matched with the reference, or with the
+// working map when it overlaps the reference too little at the prediction
+// (ReferenceLocalizer::Associate; its search fills the cache, which the
+// first iteration then reuses).
 ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   AssociationCache cache(options_.constraints.reuse_distance);
-  const AssociateFn associate = [this, &cache](const FilterState& x, ConstraintList* constraints) {
+  const VoxelMap& search = localizer_.enabled() ? ChooseMap(&cache, r) : map_.map();
+  const AssociateFn associate = [this, &cache, &search](const FilterState& x,
+                                                        ConstraintList* constraints) {
     AssociationStats stats;
-    Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_.map(), options_.constraints,
+    Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), search, options_.constraints,
               constraints, &stats, &cache, ResolveThreads(options_.constraints.threads));
   };
   const IeskfUpdateResult u = filter_.Update(associate);
@@ -154,6 +162,27 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
     return ScanStatus::kPredictOnly;
   }
   return ScanStatus::kUpdated;
+}
+
+const VoxelMap& IeskfOdometry::ChooseMap(AssociationCache* cache, ScanResult* r) {
+  const FilterState& x = filter_.state();
+  return localizer_.Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_.map(), cache,
+                              ResolveThreads(options_.constraints.threads), &choice_, r);
+}
+
+// The first scan aligned to the reference from the initial pose; the whole
+// state follows into the reference frame. False (status_ set) when it does
+// not align.
+bool IeskfOdometry::StartInReference() {
+  const FilterState& x = filter_.state();
+  StatusOr<Pose3> T_ref_world =
+      localizer_.Start(filter_.time_ns(), p_lidar_end_, x.T_world_imu(), x.T_imu_lidar());
+  if (!T_ref_world.ok()) {
+    status_ = T_ref_world.status();
+    return false;
+  }
+  filter_.ChangeWorldFrame(*T_ref_world);
+  return true;
 }
 
 void IeskfOdometry::ReportExtrinsic(ScanResult* r) {

@@ -3,6 +3,8 @@
 #include "rvlio/odometry/ieskf_odometry.h"
 #include "rvlio/odometry/smoother_odometry.h"
 
+#include <utility>
+
 namespace rvlio {
 
 const char* ScanStatusName(ScanStatus s) {
@@ -59,14 +61,15 @@ TimeOffsetReport MakeTimeOffsetReport(const TimeOffsetExcitation& excitation,
   return r;
 }
 
-StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& options) {
+StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& options,
+                                                     Localization localization) {
   OdometryOptions checked = options;
   if (Status s = checked.Validate(); !s.ok()) return s;
   switch (options.backend) {
     case Backend::kIeskf:
-      return std::unique_ptr<Odometry>(new IeskfOdometry(options));
+      return std::unique_ptr<Odometry>(new IeskfOdometry(options, std::move(localization)));
     case Backend::kSmoother:
-      return std::unique_ptr<Odometry>(new SmootherOdometry(options));
+      return std::unique_ptr<Odometry>(new SmootherOdometry(options, std::move(localization)));
   }
   return Status::InvalidInput("backend " + std::to_string(static_cast<int>(options.backend)) +
                               " is not a backend");

@@ -43,7 +43,7 @@ Eigen::Vector3d MeanAcc(const std::vector<ImuSample>& samples, TimeNs t0_ns, Tim
 
 }  // namespace
 
-SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
+SmootherOdometry::SmootherOdometry(const OdometryOptions& options, Localization localization)
     : options_(options),
       window_options_(MakeWindowOptions(options)),
       map_(options.map, options.smoother.estimate_extrinsics),
@@ -51,7 +51,8 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options)
       preprocessor_(options.lidar),
       initializer_(options.imu.init_duration),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
-      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity) {}
+      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity),
+      localizer_(std::move(localization), options.localization, options.constraints) {}
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
   if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
@@ -86,15 +87,15 @@ void SmootherOdometry::AddScan(Scan scan) {
 }
 
 void SmootherOdometry::Poll(std::vector<ScanResult>* out) {
-  while (scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) ProcessFrontScan(out);
+  while (status_.ok() && scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) ProcessFrontScan(out);
 }
 
 // The remaining scans, then the states still in the window enter the
 // output map at their final estimates.
 void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
   scans_.DropPastImu(SecondsToNs(options_.imu.max_gap), &stats_);
-  while (!scans_.empty()) ProcessFrontScan(out);
-  if (flushed_ || !window_) return;
+  while (status_.ok() && !scans_.empty()) ProcessFrontScan(out);
+  if (flushed_ || !window_ || !status_.ok()) return;
   flushed_ = true;
   for (int k = 0; k < window_->size(); ++k) {
     TransformPoints(window_->ScanTimeImuPose(k) * CurrentTImuLidar(), window_->points(k),
@@ -132,9 +133,14 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.raw_points = static_cast<int>(scan.points.size());
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
-  const ImuKinematics predicted = history.Newest();
+  ImuKinematics predicted = history.Newest();
+  if (localizer_.enabled() && !localizer_.started() && !StartInReference(&predicted)) return;
   r.status = window_->empty() ? StartWindow(scan.t_end_ns, predicted)
                               : UpdateWindow(scan.t_end_ns, history, samples, &r);
+  if (localizer_.enabled() && r.status == ScanStatus::kMapInit) {  // aligned to the reference
+    r.map_overlap = localizer_.start_overlap();
+    r.localized = true;
+  }
   SetNewestFromWindow();
   MarginalizeIfFull();
   ReportExtrinsic(&r);
@@ -198,10 +204,20 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuPoseHistory& his
   window_->Add(t_ns, PoseBlock(Eigen::Quaterniond(predicted.R_world_imu), predicted.p_world_imu),
                SpeedBiasBlock{predicted.v_world_imu, bg_, ba_}, std::move(imu), p_lidar_end_,
                MotionAtEnd(history));
-  const ScanAssociateFn associate = [this](const std::vector<Eigen::Vector3d>& p_lidar,
-                                           const Pose3& T_world_imu, ConstraintList* out) {
-    Associate(p_lidar, T_world_imu, CurrentTImuLidar(), map_.map(), options_.constraints, out,
-              nullptr, nullptr, ResolveThreads(options_.constraints.threads));
+  const std::vector<Eigen::Vector3d>* newest_points = &window_->points(window_->size() - 1);
+  const ScanAssociateFn associate = [this, newest_points, r](
+                                        const std::vector<Eigen::Vector3d>& p_lidar,
+                                        const Pose3& T_world_imu, ConstraintList* out) {
+    const int threads = ResolveThreads(options_.constraints.threads);
+    if (!localizer_.enabled()) {
+      Associate(p_lidar, T_world_imu, CurrentTImuLidar(), map_.map(), options_.constraints, out,
+                nullptr, nullptr, threads);
+      return;
+    }
+    // The newest scan's overlap and choice are reported as they were at its last association.
+    ScanResult choice;
+    localizer_.Associate(p_lidar, T_world_imu, CurrentTImuLidar(), map_.map(), nullptr, threads,
+                         out, &p_lidar == newest_points ? r : &choice);
   };
   const WindowSolveReport report = window_->Optimize(associate);
   stats_.association_ms += report.association_ms;
@@ -227,6 +243,23 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuPoseHistory& his
     return ScanStatus::kPredictOnly;
   }
   return ScanStatus::kUpdated;
+}
+
+bool SmootherOdometry::StartInReference(ImuKinematics* predicted) {
+  const Pose3 T_world_imu(predicted->R_world_imu, predicted->p_world_imu);
+  StatusOr<Pose3> T_ref_world =
+      localizer_.Start(predicted->t_ns, p_lidar_end_, T_world_imu, CurrentTImuLidar());
+  if (!T_ref_world.ok()) {
+    status_ = T_ref_world.status();
+    return false;
+  }
+  const Pose3& T = *T_ref_world;
+  predicted->R_world_imu = T.R * predicted->R_world_imu;
+  predicted->p_world_imu = T * predicted->p_world_imu;
+  predicted->v_world_imu = T.R * predicted->v_world_imu;
+  window_options_.g_world = T.R * window_options_.g_world;
+  window_ = std::make_unique<SlidingWindow>(window_options_);  // still empty: gravity of the new frame
+  return true;
 }
 
 void SmootherOdometry::InsertIntoWorkingMap(int k, const std::vector<Eigen::Vector3d>& p_lidar) {

@@ -99,8 +99,9 @@ void BatchRefiner::SolveChunk(const ScanRange& chunk, int next_begin, RefineRoun
 
   t0 = Clock::now();
   ceres::Problem problem(RefineProblemOptions());
-  BuildRefineChunkProblem(sequence_, noise_, result_.g_world, chunk, &a.factors, &pose_manifold_,
-                          &states_, &problem);
+  const bool hold_first_pose = chunk.begin > 0 || config_.reference == nullptr;
+  BuildRefineChunkProblem(sequence_, noise_, result_.g_world, chunk, hold_first_pose, &a.factors,
+                          &pose_manifold_, &states_, &problem);
   const RefineSolveReport r = SolveRefineProblem(
       &problem, solver_.Options(config_.smoother.refine_solver_iterations), chunk, stop_, &states_);
   if (!r.accepted) {

@@ -125,6 +125,17 @@ ScanFactors MakeScanFactors(const RefineAssociationWorkspace& w,
   return f;
 }
 
+// With a reference map: the scan's planes in it, world-fixed, appended to
+// w->fixed (Huber weights as the scans' own planes).
+void AddReferencePlanes(const RefineConfig& config, const std::vector<Eigen::Vector3d>& p_lidar,
+                        const Pose3& T_world_lidar, RefineAssociationWorkspace* w) {
+  if (config.reference == nullptr) return;
+  AssociateWith(p_lidar, T_world_lidar, *config.reference, config.constraints, &w->reference,
+                nullptr);
+  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->reference);
+  w->fixed.insert(w->fixed.end(), w->reference.begin(), w->reference.end());
+}
+
 }  // namespace
 
 ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap& round,
@@ -135,12 +146,17 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
   AssociateScan(round.p_lidar_end[k], T_world_lidar, k, round.map, config.constraints, &w->list,
                 stats, &w->sources);
   *rv_active = false;
-  if (w->list.empty()) return ScanFactors();
-  *rv_active = ApplyRv(config.rv, T_world_lidar, &w->list, &w->rv).active;
-  // Huber weights at the association estimate (constraints/robust_kernel.h).
-  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->list);
-  SplitScanConstraints(k, chunk, config.smoother.refine_plane_window, w->list, w->sources, states,
-                       round.map_poses, &w->fixed, &w->attached);
+  w->fixed.clear();
+  w->attached.clear();
+  if (!w->list.empty()) {
+    *rv_active = ApplyRv(config.rv, T_world_lidar, &w->list, &w->rv).active;
+    // Huber weights at the association estimate (constraints/robust_kernel.h).
+    ApplyHuberWeights(config.smoother.refine_huber_delta, &w->list);
+    SplitScanConstraints(k, chunk, config.smoother.refine_plane_window, w->list, w->sources,
+                         states, round.map_poses, &w->fixed, &w->attached);
+  }
+  AddReferencePlanes(config, round.p_lidar_end[k], T_world_lidar, w);
+  if (w->fixed.empty() && w->attached.empty()) return ScanFactors();
   return MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise,
                          config.smoother.refine_summarize_pairs, states[k].T_world_imu().t);
 }

@@ -62,8 +62,9 @@ void AddRefineImuFactors(const RefineSequence& sequence, const ImuNoise& noise,
 
 void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noise,
                              const Eigen::Vector3d& g_world, const ScanRange& chunk,
-                             std::vector<ScanFactors>* factors, PoseManifold* pose_manifold,
-                             std::vector<RefineState>* states, ceres::Problem* problem) {
+                             bool hold_first_pose, std::vector<ScanFactors>* factors,
+                             PoseManifold* pose_manifold, std::vector<RefineState>* states,
+                             ceres::Problem* problem) {
   AddRefineStateBlocks(chunk, false, pose_manifold, states, problem);
   for (int k = chunk.begin; k < chunk.end; ++k) {
     ScanFactors& f = (*factors)[k - chunk.begin];
@@ -73,7 +74,8 @@ void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noi
       problem->AddResidualBlock(pair.release(), nullptr, pose_k, (*states)[j].pose.data());
   }
   AddRefineImuFactors(sequence, noise, g_world, chunk, states, problem);
-  problem->SetParameterBlockConstant((*states)[chunk.begin].pose.data());  // gauge / previous chunk
+  if (hold_first_pose)  // gauge / previous chunk
+    problem->SetParameterBlockConstant((*states)[chunk.begin].pose.data());
 }
 
 RefineSolver RefineSolver::Make(int threads) {

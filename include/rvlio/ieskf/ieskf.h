@@ -74,6 +74,12 @@ class Ieskf {
   const std::vector<ImuPoseSample>& pose_history() const { return pose_history_.samples(); }
   void ClearPoseHistory();
 
+  // A rigid change of world frame (localization in a reference map,
+  // odometry/reference.h): pose, velocity and gravity are carried into the
+  // new frame by T_new_old, and the world-frame blocks of P (position,
+  // velocity, gravity) rotate with them; the pose history is cleared.
+  void ChangeWorldFrame(const Pose3& T_new_old);
+
   // Iterated update, paper Eq. (1): re-associates, applies RV, solves.
   IeskfUpdateResult Update(const AssociateFn& associate);
 

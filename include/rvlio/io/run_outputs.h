@@ -8,12 +8,20 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/odometry/deviation.h"
 #include "rvlio/odometry/odometry.h"
 
 namespace rvlio {
 
 // Binary PCD (x y z float32; header made by PCL), written atomically.
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
+// The same with a fourth float32 field deviation_m (one per point; NaN
+// allowed) when deviation_m is not null: what PCL viewers and CloudCompare
+// show as a scalar field (run --map, docs/survey.md).
+Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world,
+                   const std::vector<double>* deviation_m);
+// deviation.csv: one row per chainage bin (odometry/deviation.h).
+Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin>& bins);
 // Reads the points of a map.pcd (any PCD or PLY, point_cloud_file.h: the one
 // point-cloud reader; an empty cloud is allowed). InvalidInput naming the
 // file for an unreadable, malformed, truncated or non-finite cloud.

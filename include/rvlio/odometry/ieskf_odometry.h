@@ -14,7 +14,7 @@ namespace rvlio {
 
 class IeskfOdometry : public Odometry {
  public:
-  explicit IeskfOdometry(const OdometryOptions& options);
+  IeskfOdometry(const OdometryOptions& options, Localization localization = {});
 
   void AddImu(const ImuSample& imu) override;
   void AddScan(Scan scan) override;
@@ -25,6 +25,7 @@ class IeskfOdometry : public Odometry {
   std::vector<std::string> warnings() const override;
   const DivergenceReport& divergence() const override { return monitor_.report(); }
   std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
+  const Status& status() const override { return status_; }
 
   const FilterState& state() const { return filter_.state(); }
 
@@ -34,6 +35,10 @@ class IeskfOdometry : public Odometry {
   // Returns the mean specific force of the samples used (IMU frame).
   Eigen::Vector3d Predict(TimeNs t_end_ns);
   ScanStatus Correct(ScanResult* r);
+  // Reference map: moves the state into the reference frame at the first scan.
+  bool StartInReference();
+  // Reference map: the map this scan is matched with, at the prediction.
+  const VoxelMap& ChooseMap(AssociationCache* cache, ScanResult* r);
   void InsertIntoMap(TimeNs t_ns);
   void ReportExtrinsic(ScanResult* r);  // ieskf.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
   // lidar.estimate_time_offset: how far the scans are moved beyond
@@ -53,11 +58,14 @@ class IeskfOdometry : public Odometry {
   DivergenceMonitor monitor_;
   StaticInitializer initializer_;
   TimeOffsetExcitation time_offset_excitation_;
+  ReferenceLocalizer localizer_;
+  Status status_;
   std::deque<ImuSample> imu_buffer_;
   ScanQueue scans_;
   // Per-scan workspaces, reused to avoid allocation in the hot path.
   Scan downsampled_;
   std::vector<Eigen::Vector3d> p_lidar_end_;
+  ConstraintList choice_;  // the association that chose the map (reference runs)
 };
 
 }  // namespace rvlio

@@ -51,6 +51,11 @@ struct ScanResult {
   // (lidar.estimate_time_offset).
   std::optional<double> time_offset_s;
   double time_offset_std_s = 0.0;
+  // With a reference map (odometry/reference.h): share of the scan's points
+  // with an accepted reference plane, and whether the scan was matched to
+  // the reference (else to the working map: out of the reference).
+  std::optional<double> map_overlap;
+  bool localized = false;
 };
 
 // The monitor's view of a scan result (odometry/divergence.h).
@@ -123,7 +128,10 @@ struct OdometryStats {
 class Odometry {
  public:
   // Validates the options; fails for a backend this build does not have.
-  static StatusOr<std::unique_ptr<Odometry>> Create(const OdometryOptions& options);
+  // With localization.reference set, the odometry localizes in that map
+  // from localization.T_ref_imu_initial (odometry/reference.h).
+  static StatusOr<std::unique_ptr<Odometry>> Create(const OdometryOptions& options,
+                                                    Localization localization = {});
   virtual ~Odometry() = default;
 
   virtual void AddImu(const ImuSample& imu) = 0;
@@ -139,6 +147,9 @@ class Odometry {
   virtual const DivergenceReport& divergence() const = 0;
   // The full map for output (coarse resolution), world frame.
   virtual std::vector<Eigen::Vector3d> MapPoints() const = 0;
+  // Not ok once the run cannot go on: with a reference map, the first scan
+  // did not align to it (InvalidInput naming the cause). Poll/Finish then do nothing.
+  virtual const Status& status() const = 0;
 };
 
 }  // namespace rvlio

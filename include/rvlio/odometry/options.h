@@ -12,6 +12,7 @@
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/options.h"
 #include "rvlio/odometry/divergence.h"
+#include "rvlio/odometry/reference.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/smoother/options.h"
 
@@ -37,6 +38,7 @@ struct OdometryOptions {
   IeskfOptions ieskf;
   SmootherOptions smoother;
   DivergenceOptions divergence;
+  LocalizationOptions localization;  // used only with a reference map (`run --map`)
   ReaderOptions io;
 
   template <class V>
@@ -51,6 +53,7 @@ struct OdometryOptions {
     v.Section("ieskf", ieskf);
     v.Section("smoother", smoother);
     v.Section("divergence", divergence);
+    v.Section("localization", localization);
     v.Section("io", io);
   }
 
@@ -60,7 +63,7 @@ struct OdometryOptions {
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate(),
-                     divergence.Validate(), io.Validate()})
+                     divergence.Validate(), localization.Validate(), io.Validate()})
       if (!m.ok()) return m;
     if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
       return Status::InvalidInput(

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "rvlio/common/types.h"
+#include "rvlio/constraints/associate.h"
 #include "rvlio/imu/integrator.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/static_init.h"
@@ -22,6 +23,7 @@
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/odometry/odometry.h"
+#include "rvlio/odometry/reference.h"
 
 namespace rvlio {
 
@@ -104,6 +106,49 @@ class WorkingMap {
 // The warning for an estimated time offset that reached lidar.time_offset_max
 // (at the estimator's time t_ns).
 std::string TimeOffsetAtBoundWarning(const LidarOptions& lidar, TimeNs t_ns);
+// The reference-map side of both backends (odometry/reference.h): the start
+// alignment and, per scan, the choice between the reference and the working
+// map. Disabled (and never consulted) without a reference.
+class ReferenceLocalizer {
+ public:
+  ReferenceLocalizer(Localization localization, const LocalizationOptions& options,
+                     const ConstraintOptions& constraints);
+
+  bool enabled() const { return localization_.reference != nullptr; }
+  bool started() const { return started_; }
+  double start_overlap() const { return start_overlap_; }  // of the aligned first scan
+  // The first scan, ending at t_ns: aligns p_lidar (deskewed, LiDAR frame)
+  // to the reference from the initial pose, or by the global search without
+  // one (SearchReference). Returns T_ref_world, the change of world frame
+  // that takes the estimator's current T_world_imu to the aligned pose, or
+  // InvalidInput when the initial poses do not cover t_ns, the aligned scan
+  // overlaps the reference too little, the search finds two places, or the
+  // scan leaves a translation direction unfixed (a featureless axis).
+  StatusOr<Pose3> Start(TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_lidar,
+                        const Pose3& T_world_imu, const Pose3& T_imu_lidar);
+  // Associates a scan at T_world_imu (threads as AssociateWith's): with the
+  // reference when its overlap there reaches localization.min_overlap, else
+  // with `working`. Returns the map used; sets r->map_overlap and
+  // r->localized. With a cache (may be null), a later association at the
+  // same pose reuses the planes of the map used.
+  const VoxelMap& Associate(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
+                            const Pose3& T_imu_lidar, const VoxelMap& working,
+                            AssociationCache* cache, int threads, ConstraintList* out,
+                            ScanResult* r) const;
+
+ private:
+  StatusOr<ReferenceAlignment> AlignFromInitialPose(TimeNs t_ns,
+                                                    const std::vector<Eigen::Vector3d>& p_lidar,
+                                                    const Pose3& T_imu_lidar) const;
+  StatusOr<ReferenceAlignment> SearchStart(const std::vector<Eigen::Vector3d>& p_lidar,
+                                           const Pose3& T_world_imu, const Pose3& T_imu_lidar) const;
+
+  Localization localization_;
+  LocalizationOptions options_;
+  ConstraintOptions constraints_;
+  bool started_ = false;
+  double start_overlap_ = 0.0;
+};
 
 // Screens one IMU sample for the buffer: false (and counted) for a non-finite
 // sample; a gap to the previous sample longer than a scan period is counted.

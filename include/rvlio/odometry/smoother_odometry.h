@@ -64,7 +64,7 @@ namespace rvlio {
 
 class SmootherOdometry : public Odometry {
  public:
-  explicit SmootherOdometry(const OdometryOptions& options);
+  SmootherOdometry(const OdometryOptions& options, Localization localization = {});
 
   void AddImu(const ImuSample& imu) override;
   void AddScan(Scan scan) override;
@@ -75,6 +75,7 @@ class SmootherOdometry : public Odometry {
   const DivergenceReport& divergence() const override { return monitor_.report(); }
   std::vector<std::string> warnings() const override;
   std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
+  const Status& status() const override { return status_; }
 
   // Null before static initialization.
   const SlidingWindow* window() const { return window_.get(); }
@@ -88,6 +89,10 @@ class SmootherOdometry : public Odometry {
   bool HasImuGap(const std::vector<ImuSample>& samples, TimeNs t0_ns, TimeNs t1_ns) const;
   void DropImuBefore(TimeNs t_ns);
   ScanStatus StartWindow(TimeNs t_ns, const ImuKinematics& predicted);
+  // Reference map: the first scan's predicted kinematics carried into the
+  // reference frame (gravity and the window with it); false (status_ set)
+  // when the scan does not align.
+  bool StartInReference(ImuKinematics* predicted);
   ScanStatus UpdateWindow(TimeNs t_ns, const ImuPoseHistory& history,
                           const std::vector<ImuSample>& samples, ScanResult* r);
   // State k's scan at its IMU pose of the scan time (SlidingWindow::ScanTimeImuPose).
@@ -115,6 +120,8 @@ class SmootherOdometry : public Odometry {
   std::vector<std::string> warnings_;
   DivergenceMonitor monitor_;
   TimeOffsetExcitation time_offset_excitation_;
+  ReferenceLocalizer localizer_;
+  Status status_;
   std::deque<ImuSample> imu_buffer_;
   ScanQueue scans_;
   // The newest estimate: where the next prediction starts.

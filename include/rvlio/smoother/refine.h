@@ -63,6 +63,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,7 @@
 #include "rvlio/imu/options.h"
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/map/options.h"
+#include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/smoother/options.h"
@@ -88,6 +90,12 @@ struct RefineConfig {
   ConstraintOptions constraints;
   RvOptions rv;
   SmootherOptions smoother;
+  // A fixed reference map (`refine --map`, docs/survey.md), or null. Each
+  // scan is then also associated with it every round (the same association
+  // and Huber weights), its planes world-fixed, so the result is held to the
+  // reference's frame; the first scan's pose is then not held (no gauge
+  // freedom is left).
+  std::shared_ptr<const VoxelMap> reference;
 };
 
 struct RefineInput {

@@ -89,7 +89,7 @@ void SplitScanConstraints(int k, const ScanRange& chunk, int plane_window,
 
 // Per-slot scratch of the association.
 struct RefineAssociationWorkspace {
-  ConstraintList list, fixed;
+  ConstraintList list, fixed, reference;
   std::vector<int32_t> sources;
   std::vector<std::pair<int32_t, int>> attached;  // source scan, constraint index
   RvWorkspace rv;

@@ -42,11 +42,13 @@ void AddRefineImuFactors(const RefineSequence& sequence, const ImuNoise& noise,
 
 // The chunk's problem: state blocks, each scan's plane factors (taken from
 // *factors, one per scan of the chunk; the problem owns them), the IMU
-// factors, and the chunk's first pose held.
+// factors, and the chunk's first pose held unless hold_first_pose is false
+// (the first chunk with a reference map: the reference fixes the gauge).
 void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noise,
                              const Eigen::Vector3d& g_world, const ScanRange& chunk,
-                             std::vector<ScanFactors>* factors, PoseManifold* pose_manifold,
-                             std::vector<RefineState>* states, ceres::Problem* problem);
+                             bool hold_first_pose, std::vector<ScanFactors>* factors,
+                             PoseManifold* pose_manifold, std::vector<RefineState>* states,
+                             ceres::Problem* problem);
 
 // The linear solver the refine problems use, and the Ceres threads.
 struct RefineSolver {

@@ -1,0 +1,208 @@
+// Localization in a fixed reference map: the reference's search structure
+// and the coarse-to-fine alignment of the first scan (odometry/reference.h).
+#include "rvlio/odometry/reference.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+#include <unordered_set>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/point_to_plane.h"
+#include "rvlio/constraints/robust_kernel.h"
+#include "rvlio/map/voxel_key.h"
+#include "rvlio/math/so3.h"
+
+namespace rvlio {
+namespace {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+// The association of one alignment stage: residuals up to radius_m, and
+// neighbours searched at least that far.
+ConstraintOptions StageOptions(const ConstraintOptions& base, double radius_m) {
+  ConstraintOptions o = base;
+  o.max_residual = radius_m;
+  o.max_neighbor_distance = std::max(base.max_neighbor_distance, radius_m);
+  return o;
+}
+
+// Normal equations of the weighted point-to-plane residuals at T_ref_imu.
+void Accumulate(const ConstraintList& constraints, const Pose3& T_ref_imu,
+                const Pose3& T_imu_lidar, bool weighted, Matrix6d* H, Vector6* b) {
+  H->setZero();
+  b->setZero();
+  Eigen::Matrix<double, 1, 6> J;
+  for (const Constraint& c : constraints) {
+    const double r = PointToPlaneResidual(c, T_ref_imu, T_imu_lidar, &J);
+    const double w = weighted ? c.weight : 1.0;
+    *H += w * J.transpose() * J;
+    *b += w * J.transpose() * r;
+  }
+}
+
+// One Gauss-Newton step with Huber weights (delta: a quarter of the radius).
+// False when the scan has too few constraints to fix a pose.
+bool GaussNewtonStep(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_imu_lidar,
+                     const VoxelMap& reference, const ConstraintOptions& stage, double radius_m,
+                     ConstraintList* constraints, Pose3* T_ref_imu) {
+  AssociateWith(p_lidar, *T_ref_imu * T_imu_lidar, reference, stage, constraints, nullptr);
+  if (static_cast<int>(constraints->size()) < kMinPoseConstraints) return false;
+  ApplyHuberWeights(0.25 * radius_m, constraints);
+  Matrix6d H;
+  Vector6 b;
+  Accumulate(*constraints, *T_ref_imu, T_imu_lidar, true, &H, &b);
+  H.diagonal().array() += 1e-6 * std::max(1.0, H.diagonal().maxCoeff());  // gauge along unseen axes
+  const Vector6 dx = -H.ldlt().solve(b);
+  if (!dx.allFinite()) return false;
+  T_ref_imu->R = T_ref_imu->R * so3::Exp(dx.head<3>());
+  T_ref_imu->t += dx.tail<3>();
+  return true;
+}
+
+// The position block of the covariance (the information's inverse, with a
+// tiny ridge so that an unfixed axis gives a huge but finite variance).
+void WeakestAxis(const Matrix6d& information, double lidar_noise_m, ReferenceAlignment* a) {
+  Matrix6d info = information;
+  info.diagonal().array() += 1e-9 * std::max(1.0, info.diagonal().maxCoeff());
+  const Eigen::Matrix3d cov_p = info.ldlt().solve(Matrix6d::Identity()).block<3, 3>(3, 3);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov_p);
+  a->weakest_axis = eig.eigenvectors().col(2);
+  const double var_m2 = eig.eigenvalues()(2);
+  a->weakest_axis_constraints = var_m2 > 0.0 ? lidar_noise_m * lidar_noise_m / var_m2 : 0.0;
+}
+
+// Grid cells (edge step_m) holding points of `coarse`.
+std::unordered_set<VoxelKey, VoxelKeyHash> OccupiedCells(const VoxelMap& coarse, double step_m) {
+  std::unordered_set<VoxelKey, VoxelKeyHash> cells;
+  coarse.ForEachPoint([&](const Eigen::Vector3d& p) { cells.insert(KeyOf(p, 1.0 / step_m)); });
+  return cells;
+}
+
+// Share of p_lidar's points with an accepted plane of `search` at T_ref_imu.
+template <class Search>
+double OverlapWith(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_ref_imu,
+                   const Pose3& T_imu_lidar, const Search& search,
+                   const ConstraintOptions& constraints) {
+  if (p_lidar.empty()) return 0.0;
+  ConstraintList list;
+  AssociationStats stats;
+  AssociateWith(p_lidar, T_ref_imu * T_imu_lidar, search, constraints, &list, &stats);
+  return static_cast<double>(stats.num_accepted) / static_cast<double>(p_lidar.size());
+}
+
+// Centres of the empty cells next to an occupied one: where a sensor that
+// sees the reference's surfaces can be.
+std::vector<Eigen::Vector3d> FreeCellsNearSurfaces(
+    const std::unordered_set<VoxelKey, VoxelKeyHash>& occupied, double step_m) {
+  std::unordered_set<VoxelKey, VoxelKeyHash> free;
+  for (const VoxelKey& c : occupied)
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const VoxelKey n{c.x + dx, c.y + dy, c.z + dz};
+          if (!occupied.count(n)) free.insert(n);
+        }
+  std::vector<VoxelKey> keys(free.begin(), free.end());
+  std::sort(keys.begin(), keys.end(), [](const VoxelKey& a, const VoxelKey& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  });
+  std::vector<Eigen::Vector3d> centres;
+  centres.reserve(keys.size());
+  for (const VoxelKey& k : keys)
+    centres.emplace_back((k.x + 0.5) * step_m, (k.y + 0.5) * step_m, (k.z + 0.5) * step_m);
+  return centres;
+}
+
+// Every n-th point, about `count` in all.
+std::vector<Eigen::Vector3d> Subsample(const std::vector<Eigen::Vector3d>& p, size_t count) {
+  const size_t stride = std::max<size_t>(1, p.size() / std::max<size_t>(1, count));
+  std::vector<Eigen::Vector3d> out;
+  for (size_t i = 0; i < p.size(); i += stride) out.push_back(p[i]);
+  return out;
+}
+
+}  // namespace
+
+std::vector<ReferenceAlignment> SearchReference(const std::vector<Eigen::Vector3d>& p_lidar,
+                                                const Pose3& T_imu_lidar,
+                                                const VoxelMap& reference,
+                                                const Eigen::Matrix3d& R_tilt,
+                                                const ConstraintOptions& constraints,
+                                                const LocalizationOptions& options) {
+  constexpr size_t kScorePoints = 256;
+  const std::vector<Eigen::Vector3d> sample = Subsample(p_lidar, kScorePoints);
+  const std::vector<Eigen::Vector3d> positions =
+      FreeCellsNearSurfaces(OccupiedCells(reference, options.search_step), options.search_step);
+  const int yaws = std::max(1, static_cast<int>(std::lround(360.0 / options.search_yaw_step)));
+  std::vector<std::pair<double, Pose3>> scored;
+  scored.reserve(positions.size() * yaws);
+  const ConstraintOptions stage = StageOptions(constraints, options.align_radius_max);
+  for (const Eigen::Vector3d& p : positions)
+    for (int i = 0; i < yaws; ++i) {
+      const Eigen::Matrix3d R =
+          Eigen::AngleAxisd(2.0 * M_PI * i / yaws, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+          R_tilt;
+      const Pose3 T(R, p);
+      scored.emplace_back(OverlapWith(sample, T, T_imu_lidar, reference, stage), T);
+    }
+  const size_t keep = std::min(scored.size(), static_cast<size_t>(options.search_keep));
+  std::partial_sort(scored.begin(), scored.begin() + keep, scored.end(),
+                    [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<ReferenceAlignment> aligned;
+  for (size_t i = 0; i < keep; ++i)
+    aligned.push_back(
+        AlignToReference(p_lidar, T_imu_lidar, reference, scored[i].second, constraints, options));
+  std::stable_sort(aligned.begin(), aligned.end(),
+                   [](const ReferenceAlignment& a, const ReferenceAlignment& b) {
+                     return a.overlap > b.overlap;
+                   });
+  return aligned;
+}
+
+std::shared_ptr<const VoxelMap> MakeReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
+                                                 const LocalizationOptions& options) {
+  MapOptions o;  // the working map's thinning
+  o.voxel_size = options.reference_voxel_size;
+  auto map = std::make_shared<VoxelMap>(o);
+  map->Insert(p_ref);
+  return map;
+}
+
+double ReferenceOverlap(const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_ref_imu,
+                        const Pose3& T_imu_lidar, const VoxelMap& reference,
+                        const ConstraintOptions& constraints) {
+  return OverlapWith(p_lidar, T_ref_imu, T_imu_lidar, reference, constraints);
+}
+
+ReferenceAlignment AlignToReference(const std::vector<Eigen::Vector3d>& p_lidar,
+                                    const Pose3& T_imu_lidar, const VoxelMap& reference,
+                                    const Pose3& T_ref_imu_guess,
+                                    const ConstraintOptions& constraints,
+                                    const LocalizationOptions& options) {
+  ReferenceAlignment a;
+  a.T_ref_imu = T_ref_imu_guess;
+  ConstraintList list;
+  for (double radius = options.align_radius_max;; radius = std::max(0.5 * radius, options.align_radius_min)) {
+    const ConstraintOptions stage = StageOptions(constraints, radius);
+    for (int i = 0; i < options.align_iterations; ++i)
+      if (!GaussNewtonStep(p_lidar, T_imu_lidar, reference, stage, radius, &list, &a.T_ref_imu))
+        break;
+    if (radius <= options.align_radius_min) break;
+  }
+  AssociateWith(p_lidar, a.T_ref_imu * T_imu_lidar, reference,
+                StageOptions(constraints, options.align_radius_min), &list, nullptr);
+  Vector6 b;
+  Accumulate(list, a.T_ref_imu, T_imu_lidar, false, &a.information, &b);
+  a.information /= constraints.lidar_noise * constraints.lidar_noise;
+  WeakestAxis(a.information, constraints.lidar_noise, &a);
+  a.constraints = static_cast<int>(list.size());
+  a.overlap = ReferenceOverlap(p_lidar, a.T_ref_imu, T_imu_lidar, reference, constraints);
+  return a;
+}
+
+}  // namespace rvlio

@@ -1,0 +1,70 @@
+// Deviation of a map from the reference (odometry/deviation.h).
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "rvlio/odometry/deviation.h"
+
+namespace rvlio {
+namespace {
+
+// A wall at y = 3 m (x 0..20 m, z 0..4 m) every step_m; with `bulge_m`, the
+// part 8 <= x < 12 is moved that far towards y = 0 (a convergence).
+std::vector<Eigen::Vector3d> Wall(double step_m, double bulge_m) {
+  std::vector<Eigen::Vector3d> p;
+  for (double x = 0.0; x < 20.0; x += step_m)
+    for (double z = 0.0; z <= 4.0; z += step_m)
+      p.emplace_back(x, 3.0 - (x >= 8.0 && x < 12.0 ? bulge_m : 0.0), z);
+  return p;
+}
+
+Trajectory AlongX() {
+  Trajectory t;
+  for (int i = 0; i <= 20; ++i) {
+    StampedPose s;
+    s.t_ns = i * 100000000LL;
+    s.p_world_imu = Eigen::Vector3d(i, 0.0, 1.5);
+    t.push_back(s);
+  }
+  return t;
+}
+
+TEST(Deviation, AConvergenceShowsAtItsChainageWithItsSign) {
+  const ReferenceMap reference(Wall(0.05, 0.0));
+  const std::vector<Eigen::Vector3d> p_map = Wall(0.2, 0.05);
+  const PointDeviations d = ComputeDeviations(p_map, reference, AlongX(), SurfaceQueryOptions());
+  ASSERT_EQ(d.deviation_m.size(), p_map.size());
+  const std::vector<DeviationBin> bins = BinByChainage(d, 1.0);
+  ASSERT_GE(bins.size(), 19u);
+  for (const DeviationBin& b : bins) {
+    if (b.count == 0) continue;
+    // Bins wholly inside / outside the convergence (its edges are at 8 and 12 m).
+    if (b.chainage_m >= 8.0 && b.chainage_m < 11.0) {
+      EXPECT_NEAR(b.median_m, 0.05, 0.002) << b.chainage_m;
+    }
+    if (b.chainage_m < 7.0 || b.chainage_m >= 13.0) {
+      EXPECT_LT(b.median_abs_m, 0.002) << b.chainage_m;
+    }
+    EXPECT_GE(b.max_abs_m, b.p95_abs_m);
+    EXPECT_GE(b.p95_abs_m, b.median_abs_m);
+  }
+}
+
+TEST(Deviation, NoReferenceSurfaceGivesNaN) {
+  const ReferenceMap reference(Wall(0.05, 0.0));
+  const std::vector<Eigen::Vector3d> p_map = {Eigen::Vector3d(5.0, 3.0, 2.0),
+                                              Eigen::Vector3d(5.0, -3.0, 2.0)};  // no wall there
+  const PointDeviations d = ComputeDeviations(p_map, reference, AlongX(), SurfaceQueryOptions());
+  EXPECT_NEAR(d.deviation_m[0], 0.0, 1e-3);
+  EXPECT_TRUE(std::isnan(d.deviation_m[1]));
+  EXPECT_NEAR(d.chainage_m[1], 5.0, 0.3);
+  const std::vector<DeviationBin> bins = BinByChainage(d, 1.0);
+  ASSERT_EQ(bins.size(), 6u);
+  EXPECT_EQ(bins[5].count, 1);
+  EXPECT_EQ(bins[0].count, 0);
+  EXPECT_TRUE(std::isnan(bins[0].median_m));
+}
+
+}  // namespace
+}  // namespace rvlio
