@@ -290,7 +290,7 @@ TEST(RefineProblem, ChunkProblemHoldsItsFirstPoseAndLinksEveryScan) {
   PoseManifold manifold;
   ceres::Problem problem(RefineProblemOptions());
   const ImuNoise noise = ImuNoise::FromOptions(config.imu);
-  BuildRefineChunkProblem(r.sequence, noise, test::Gravity(), chunk, &a.factors, &manifold,
+  BuildRefineChunkProblem(r.sequence, noise, test::Gravity(), chunk, /*hold_first_pose=*/true, &a.factors, &manifold,
                           &r.states, &problem);
   EXPECT_EQ(problem.NumResidualBlocks(), plane_blocks + chunk.size() - 1);
   EXPECT_EQ(problem.NumParameterBlocks(), 2 * chunk.size());
