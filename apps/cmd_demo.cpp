@@ -46,13 +46,14 @@ int CmdDemo(int argc, char** argv) {
   compare.total_steps = 1 + CompareSteps(compare);
 
   std::vector<std::string> sim_args = {"rvlio", "simulate", "--preset", preset, "--seed",
-                                       args.Get("seed", "1"), "--out", data_dir};
+                                       args.Get("seed", "1"), "--reference-map", "--out",
+                                       data_dir};
   if (args.Has("duration")) sim_args.insert(sim_args.end(), {"--duration", args.Get("duration")});
   std::printf("[1/%d] simulating preset '%s' into %s\n", compare.total_steps, preset.c_str(),
               data_dir.c_str());
   std::fflush(stdout);
   if (int rc = Invoke(CmdSimulate, sim_args); rc != 0) return rc;
-  // The simulator's survey of the world, where it writes one: map columns.
+  // The simulator's survey of the world (reference_map.pcd): the map columns.
   const std::string reference = data_dir + "/reference_map.pcd";
   if (std::filesystem::is_regular_file(reference)) compare.ref_map = reference;
   return RunCompare(compare);
