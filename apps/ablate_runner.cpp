@@ -273,8 +273,8 @@ std::string Describe(int status, int* exit_code) {
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 // map_rms and map_completeness of run/map.pcd against the cell's reference
-// cloud (as `rvlio eval --map`), the map moved by T_ref_est (the trajectory's
-// alignment to the ground truth, as `compare` does); "" or why it failed.
+// cloud (as `rvlio eval --map`), the map moved by T_ref_est_poses (the run's
+// poses aligned to the ground truth, as `compare` does); "" or why it failed.
 std::string CollectMapMetrics(const Cell& cell, const Similarity3& T_ref_est, json* metrics) {
   if (cell.ref_map.empty()) return "";
   const PointCloudReadOptions xyz_only{false};
@@ -320,7 +320,7 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   (*metrics)["axis_max"] = Number(r->along_axis.max_abs_m);
   (*metrics)["end_point"] = Number(r->end_point_error_m);
   *warnings = r->warnings;
-  return CollectMapMetrics(cell, r->T_ref_est, metrics);
+  return CollectMapMetrics(cell, r->T_ref_est_poses, metrics);
 }
 
 json CellHeader(const Cell& cell) {

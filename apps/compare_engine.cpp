@@ -199,16 +199,17 @@ int CheckInputs(const CompareRequest& req, Truth* truth) {
 // ---------------------------------------------------------------------------
 
 // The run's map.pcd against the reference cloud, as `rvlio eval --map`,
-// after moving it into the ground truth's frame with the trajectory's
-// alignment (row->eval->T_ref_est: the estimate's world frame is its own, and
-// a small initial tilt moves far walls by centimetres). A failure is a
+// after moving it into the ground truth's frame by the alignment of the
+// run's poses (row->eval->T_ref_est_poses: the estimate's world frame is its
+// own, and a small initial tilt moves far walls by centimetres; the ATE's
+// Umeyama alignment of positions leaves the roll about a straight path free). A failure is a
 // warning and leaves the row's map columns empty.
 void EvaluateRowMap(const Truth& truth, const std::string& dir, Row* row) {
   if (truth.ref_map.empty() || !row->eval) return;
   const std::string map_path = dir + "/map.pcd";
   StatusOr<PointCloudFile> map = ReadPointCloud(map_path, PointCloudReadOptions{false});
   if (map.ok())
-    for (Eigen::Vector3d& p : map->points) p = row->eval->T_ref_est * p;
+    for (Eigen::Vector3d& p : map->points) p = row->eval->T_ref_est_poses * p;
   StatusOr<MapEvalResult> m = map.ok() ? EvaluateMap(map->points, truth.ref_map, MapEvalOptions())
                                        : StatusOr<MapEvalResult>(map.status());
   if (!m.ok()) {

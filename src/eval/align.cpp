@@ -120,6 +120,25 @@ Similarity3 OriginAlignment(const StampedPose& ref0, const StampedPose& est0) {
   return T;
 }
 
+Similarity3 PoseAlignment(const Trajectory& ref_matched, const Trajectory& est_matched) {
+  Similarity3 T;
+  const size_t n = std::min(ref_matched.size(), est_matched.size());
+  if (n == 0) return T;
+  Eigen::Matrix3d sum_R = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < n; ++i)
+    sum_R += ref_matched[i].q_world_imu.normalized().toRotationMatrix() *
+             est_matched[i].q_world_imu.normalized().toRotationMatrix().transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum_R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  T.R_ref_est = svd.matrixU() * D * svd.matrixV().transpose();
+  Eigen::Vector3d sum_t = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i)
+    sum_t += ref_matched[i].p_world_imu - T.R_ref_est * est_matched[i].p_world_imu;
+  T.t_ref_est = sum_t / static_cast<double>(n);
+  return T;
+}
+
 double LateralRatio(const Trajectory& trajectory) {
   if (trajectory.size() < 2) return 0.0;
   const Eigen::Matrix3Xd p = Positions(trajectory);

@@ -30,6 +30,7 @@ StatusOr<EvalResult> Evaluate(const Trajectory& ref, const Trajectory& est, Eval
   r.matched = association->size();
   r.align = alignment.used;
   r.T_ref_est = alignment.T_ref_est;
+  r.T_ref_est_poses = PoseAlignment(ref_m, est_m);
   r.warnings = std::move(alignment.warnings);
   r.ape_m = ComputeStats(ApeTranslationErrors(ref_m, est_aligned));
   r.ape_rot_deg = ComputeStats(ApeRotationErrorsDeg(ref_m, est_aligned));

@@ -44,6 +44,13 @@ StatusOr<Similarity3> Umeyama(const Eigen::Matrix3Xd& x_est, const Eigen::Matrix
 
 // T = T_ref_0 * T_est_0^-1 from the first pose of each trajectory.
 Similarity3 OriginAlignment(const StampedPose& ref0, const StampedPose& est0);
+// The rigid alignment of whole poses: R_ref_est the chordal mean of
+// R_ref_i R_est_i^T over the matched poses, t_ref_est the mean of
+// p_ref_i - R_ref_est p_est_i. Unlike Umeyama on positions it is well
+// conditioned on a straight path (the roll about the path comes from the
+// orientations): what a map is moved by before it is compared with a
+// reference cloud (compare and ablate with a reference map).
+Similarity3 PoseAlignment(const Trajectory& ref_matched, const Trajectory& est_matched);
 
 struct AlignOptions {
   double min_lateral_ratio = 1e-3;  // see EvalOptions (eval/options.h)

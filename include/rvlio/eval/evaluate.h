@@ -18,6 +18,7 @@ struct EvalResult {
   size_t matched = 0;
   AlignMode align = AlignMode::kSe3;  // the alignment used (origin after a fallback)
   Similarity3 T_ref_est;
+  Similarity3 T_ref_est_poses;  // PoseAlignment of the matched poses (for maps)
   ErrorStats ape_m;        // APE translation
   ErrorStats ape_rot_deg;  // APE rotation angle
   RpeResult rpe;           // on the aligned estimate (Sim3 scale applies)
