@@ -11,6 +11,7 @@
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/metrics.h"
 #include "rvlio/eval/stats.h"
+#include "rvlio/math/so3.h"
 
 namespace rvlio {
 namespace {
@@ -340,6 +341,31 @@ TEST(Align, CollinearReferenceFallsBackToOriginWithWarning) {
   // A real 3D trajectory keeps Umeyama.
   const Trajectory curve = RandomTrajectory(rng, 100);
   EXPECT_EQ(Align(curve, curve, AlignMode::kSe3).used, AlignMode::kSe3);
+}
+
+// On a straight path with noisy positions, Umeyama leaves the roll about the
+// path to the noise; the alignment of whole poses takes it from the
+// orientations and recovers a rigid transform of the estimate.
+TEST(Align, PoseAlignmentRecoversTheRollAboutAStraightPath) {
+  std::mt19937 rng(11);
+  Trajectory ref = StraightLine(100, 0.002, rng);
+  for (StampedPose& p : ref)
+    p.q_world_imu = Eigen::Quaterniond(so3::Exp(RandomVector(rng, 0.05)));
+  Similarity3 T;  // est = T^-1 ref: a roll of 3 degrees about the path and a shift
+  T.R_ref_est = so3::Exp(Eigen::Vector3d(3.0 * M_PI / 180.0, 0.01, -0.02));
+  T.t_ref_est = Eigen::Vector3d(0.4, -1.0, 0.3);
+  Similarity3 T_inv;
+  T_inv.R_ref_est = T.R_ref_est.transpose();
+  T_inv.t_ref_est = -(T_inv.R_ref_est * T.t_ref_est);
+  const Trajectory est = T_inv.Apply(ref);
+  ExpectSimilarityNear(PoseAlignment(ref, est), T, 1e-9);
+  // Rotation noise on the estimate's orientations leaves it close.
+  Trajectory noisy = est;
+  for (StampedPose& p : noisy)
+    p.q_world_imu = Eigen::Quaterniond(p.q_world_imu.toRotationMatrix() *
+                                       so3::Exp(RandomVector(rng, 0.002)));
+  const Similarity3 A = PoseAlignment(ref, noisy);
+  EXPECT_LT(so3::Log(A.R_ref_est.transpose() * T.R_ref_est).norm(), 1e-3);
 }
 
 TEST(Align, TooFewPosesFallBackToOrigin) {
