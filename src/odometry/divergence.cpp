@@ -33,7 +33,7 @@ std::string DivergenceKindNames(uint8_t mask) {
 }
 
 std::string DivergenceEvent::Describe() const {
-  char text[160];
+  char text[256];
   switch (kind) {
     case DivergenceKind::kSpeed:
       std::snprintf(text, sizeof(text), "speed %.1f m/s > divergence.max_speed %g m/s", value,
@@ -67,7 +67,8 @@ std::string DivergenceEvent::Describe() const {
     case DivergenceKind::kRotation:
       std::snprintf(text, sizeof(text),
                     "the scans turn %.2f deg per scan against the gyro (window mean) > "
-                    "divergence.max_lidar_rotation_deg %g: check the extrinsic rotation",
+                    "divergence.max_lidar_rotation_deg %g: check the extrinsic rotation, or "
+                    "the LiDAR-IMU time offset (rvlio calibrate-time)",
                     value, threshold);
       break;
   }

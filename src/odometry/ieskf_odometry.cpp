@@ -1,6 +1,7 @@
 // The IESKF backend of the odometry pipeline (paper-exact mode).
 #include "rvlio/odometry/ieskf_odometry.h"
 
+#include <limits>
 #include <utility>
 
 #include "rvlio/common/cpu_time.h"
@@ -10,6 +11,21 @@
 
 namespace rvlio {
 
+namespace {
+
+// The divergence monitor's options. With lidar.estimate_time_offset the
+// rotation check (scans against the gyro) is off: until the offset's estimate
+// has converged, that disagreement is what the estimate absorbs, not a wrong
+// extrinsic rotation.
+DivergenceOptions MonitorOptions(const OdometryOptions& options) {
+  DivergenceOptions divergence = options.divergence;
+  if (options.lidar.estimate_time_offset)
+    divergence.max_lidar_rotation_deg = std::numeric_limits<double>::infinity();
+  return divergence;
+}
+
+}  // namespace
+
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization localization)
     : options_(options),
       filter_(options.ieskf, options.imu, options.constraints, options.rv, options.lidar),
@@ -17,7 +33,7 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization locali
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
-      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity),
+      monitor_(MonitorOptions(options), options.constraints.lidar_noise, options.imu.gravity),
       initializer_(options.imu.init_duration),
       localizer_(std::move(localization), options.localization, options.constraints) {}
 
