@@ -1,5 +1,5 @@
 #pragma once
-// IMU measurements along a FlightTrajectory (issue 3):
+// IMU measurements along a FlightTrajectory:
 //   gyro_imu = w_imu + b_g + n_g,   acc_imu = R_world_imu^T (a_world - g_world) + b_a + n_a
 // with g_world = (0, 0, -gravity), discrete white noise n ~ N(0, sigma_c^2 rate),
 // biases starting at the configured constants and walking as

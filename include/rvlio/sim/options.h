@@ -1,5 +1,5 @@
 #pragma once
-// Options of the deterministic tunnel simulator (issue 3). Presets
+// Options of the deterministic tunnel simulator. Presets
 // (sim/presets.h) fill a SimOptions; `rvlio simulate --set key=value` edits
 // it through the same Visit() list as every other options struct.
 //

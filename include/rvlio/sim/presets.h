@@ -1,5 +1,5 @@
 #pragma once
-// Named simulator configurations (issue 3):
+// Named simulator configurations:
 //   tunnel      the paper's Gazebo tunnel: 10.45 x 7.8 x 100.5 m, OS1-32,
 //               waypoints [0,0,0] -> [0,0,2.5] -> [30,0,2.5] -> [30,0,4.5] -> [50,0,4.5]
 //   corridor    narrow and long like the paper's real tunnel (5.8 x 5.0 x 225.5 m), OS0-32 (+-45

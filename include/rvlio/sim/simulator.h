@@ -1,5 +1,5 @@
 #pragma once
-// The deterministic simulator (issue 3): world + flight + LiDAR + IMU. Data
+// The deterministic simulator: world + flight + LiDAR + IMU. Data
 // is generated in time order through callbacks (a 60 s OS1-32 sequence does
 // not fit in memory as a whole). Same options and seed -> identical output.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Multirotor-like flight (issue 3): rest at the first waypoint for
+// Multirotor-like flight: rest at the first waypoint for
 // static_duration, then straight segments between waypoints, each with a
 // jerk-limited speed ramp up ("shock": hover to forward acceleration), a
 // cruise and a ramp down, and a hover at each waypoint; rest after the last.

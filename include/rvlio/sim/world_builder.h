@@ -1,5 +1,5 @@
 #pragma once
-// Builds the simulated world from SimOptions (issue 3): the tunnel (or hall)
+// Builds the simulated world from SimOptions: the tunnel (or hall)
 // shell with rough surfaces placed relative to the start pose, the
 // feature-rich entrance region, sparse features, and for the hall pillars,
 // stairs and doorways. Every random choice comes from the seed; features keep
