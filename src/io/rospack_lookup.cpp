@@ -23,7 +23,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -64,6 +63,46 @@ std::string FindPackage(const std::string& name) {
   return "";
 }
 
+bool IsSpace(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+bool IsWordChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_'; }
+
+// The value of `attribute="..."` inside one tag's text (between the tag name
+// and its '>'), or false when the tag has no such attribute.
+bool AttributeValue(const std::string& tag, const std::string& attribute, std::string* value) {
+  for (size_t at = tag.find(attribute); at != std::string::npos;
+       at = tag.find(attribute, at + 1)) {
+    if (at > 0 && IsWordChar(tag[at - 1])) continue;  // a longer name ending in it
+    size_t i = at + attribute.size();
+    while (i < tag.size() && IsSpace(tag[i])) ++i;
+    if (i >= tag.size() || tag[i] != '=') continue;
+    for (++i; i < tag.size() && IsSpace(tag[i]);) ++i;
+    if (i >= tag.size() || tag[i] != '"') continue;
+    const size_t end = tag.find('"', i + 1);
+    if (end == std::string::npos) return false;
+    *value = tag.substr(i + 1, end - i - 1);
+    return true;
+  }
+  return false;
+}
+
+// The `attribute` values of every <package ...> tag of the XML text (the
+// export tags of package.xml are named after the exporting package).
+std::vector<std::string> ExportValues(const std::string& xml, const std::string& package,
+                                      const std::string& attribute) {
+  std::vector<std::string> values;
+  const std::string open = "<" + package;
+  for (size_t at = xml.find(open); at != std::string::npos; at = xml.find(open, at + 1)) {
+    const size_t name_end = at + open.size();
+    if (name_end >= xml.size() || !IsSpace(xml[name_end])) continue;
+    const size_t close = xml.find('>', name_end);
+    if (close == std::string::npos) break;
+    std::string value;
+    if (AttributeValue(xml.substr(name_end, close - name_end), attribute, &value))
+      values.push_back(value);
+  }
+  return values;
+}
+
 }  // namespace
 }  // namespace rvlio::bag_detail
 
@@ -81,9 +120,7 @@ __attribute__((visibility("default"))) void getPlugins(const std::string& packag
   if (dir.empty()) return;
   std::ifstream in(dir + "/package.xml");
   const std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::regex tag("<" + package + R"re(\s[^>]*\b)re" + attribute + R"re(\s*=\s*"([^"]*)")re");
-  for (std::sregex_iterator it(xml.begin(), xml.end(), tag), end; it != end; ++it) {
-    std::string value = (*it)[1].str();
+  for (std::string value : rvlio::bag_detail::ExportValues(xml, package, attribute)) {
     const std::string prefix = "${prefix}";
     for (size_t p = value.find(prefix); p != std::string::npos; p = value.find(prefix))
       value.replace(p, prefix.size(), dir);
