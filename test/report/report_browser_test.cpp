@@ -21,7 +21,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -174,19 +173,26 @@ bool DecodePng(const std::string& png, Image* image) {
   return true;
 }
 
+// The quoted text that follows the first `prefix` in a DOM dump, or "".
+// (Plain string search, not <regex>: gcc 12's std::regex trips
+// -Werror=maybe-uninitialized in the sanitizer build.)
+std::string QuotedAfter(const std::string& dom, const std::string& prefix) {
+  const size_t at = dom.find(prefix + "\"");
+  if (at == std::string::npos) return "";
+  const size_t begin = at + prefix.size() + 1, end = dom.find('"', begin);
+  return end == std::string::npos ? "" : dom.substr(begin, end - begin);
+}
+
 // The value of `attribute` on the first element carrying it in a DOM dump.
 std::string Attribute(const std::string& dom, const std::string& attribute) {
-  std::smatch m;
-  if (!std::regex_search(dom, m, std::regex(attribute + "=\"([^\"]*)\""))) return "";
-  return m[1];
+  return QuotedAfter(dom, attribute + "=");
 }
 
 // data-value of the metrics table cell of `column`, or NaN.
 double TableValue(const std::string& dom, const std::string& column) {
-  std::smatch m;
-  const std::regex cell("<td data-column=\"" + column + "\" data-value=\"([^\"]+)\"");
-  if (!std::regex_search(dom, m, cell)) return std::nan("");
-  return std::strtod(m.str(1).c_str(), nullptr);
+  const std::string value =
+      QuotedAfter(dom, "<td data-column=\"" + column + "\" data-value=");
+  return value.empty() ? std::nan("") : std::strtod(value.c_str(), nullptr);
 }
 
 TEST(ReportBrowserTest, PageLoadsWithoutConsoleErrorsDrawsTheMapAndHoldsTheRunsFigures) {
