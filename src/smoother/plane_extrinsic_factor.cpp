@@ -9,15 +9,13 @@
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/math/smoother_blocks.h"
 #include "rvlio/smoother/manifolds.h"
+#include "rvlio/smoother/plane_factor.h"
 
 namespace rvlio {
 
 PlaneExtrinsicFactor::PlaneExtrinsicFactor(ConstraintList constraints, double sigma_m)
     : constraints_(std::move(constraints)) {
-  RVLIO_CHECK_MSG(!constraints_.empty(), "a plane factor needs at least one constraint");
-  RVLIO_CHECK(sigma_m > 0.0);
-  for (const Constraint& c : constraints_) RVLIO_CHECK(c.weight >= 0.0);
-  inv_sigma_ = 1.0 / sigma_m;
+  inv_sigma_ = CheckedPlaneInvSigma(constraints_, sigma_m);
   set_num_residuals(num_constraints());
   mutable_parameter_block_sizes()->push_back(PoseBlock::kNumParams);
   mutable_parameter_block_sizes()->push_back(PoseBlock::kNumParams);

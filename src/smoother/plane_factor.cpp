@@ -56,4 +56,11 @@ bool PlaneFactor::Evaluate(double const* const* parameters, double* residuals,
   return true;
 }
 
+double CheckedPlaneInvSigma(const ConstraintList& constraints, double sigma_m) {
+  RVLIO_CHECK_MSG(!constraints.empty(), "a plane factor needs at least one constraint");
+  RVLIO_CHECK(sigma_m > 0.0);
+  for (const Constraint& c : constraints) RVLIO_CHECK(c.weight >= 0.0);
+  return 1.0 / sigma_m;
+}
+
 }  // namespace rvlio

@@ -8,6 +8,7 @@
 #include "rvlio/common/check.h"
 #include "rvlio/math/smoother_blocks.h"
 #include "rvlio/smoother/manifolds.h"
+#include "rvlio/smoother/plane_factor.h"
 
 namespace rvlio {
 
@@ -18,10 +19,7 @@ PlaneTimeOffsetFactor::PlaneTimeOffsetFactor(ConstraintList constraints, double 
       T_imu_lidar_(T_imu_lidar),
       motion_(motion),
       td_lin_s_(td_lin_s) {
-  RVLIO_CHECK_MSG(!constraints_.empty(), "a plane factor needs at least one constraint");
-  RVLIO_CHECK(sigma_m > 0.0);
-  for (const Constraint& c : constraints_) RVLIO_CHECK(c.weight >= 0.0);
-  inv_sigma_ = 1.0 / sigma_m;
+  inv_sigma_ = CheckedPlaneInvSigma(constraints_, sigma_m);
   set_num_residuals(num_constraints());
   mutable_parameter_block_sizes()->push_back(PoseBlock::kNumParams);
   mutable_parameter_block_sizes()->push_back(SpeedBiasBlock::kNumParams);

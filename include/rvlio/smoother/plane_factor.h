@@ -40,4 +40,9 @@ class PlaneFactor final : public ceres::CostFunction {
   Eigen::VectorXd scale_;    // sqrt(weight) / sigma, 1/m
 };
 
+// The checks of a plane factor that keeps its constraints (the extrinsic and
+// time-offset factors): non-empty, sigma_m > 0, weights >= 0. Returns
+// 1 / sigma_m.
+double CheckedPlaneInvSigma(const ConstraintList& constraints, double sigma_m);
+
 }  // namespace rvlio
