@@ -10,11 +10,11 @@
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/PointCloud2.h>
 
 #include "livox_ros1.h"
 #include "ouster_source.h"
 #include "rvlio/io/pcap.h"
+#include "ros1_messages.h"
 #include "rosbag_common.h"
 #include "rvlio/io/cdr.h"
 #include "rvlio/io/livox.h"
@@ -92,16 +92,17 @@ void SetRate(BagTopicInfo* info, TimeNs first_ns, TimeNs last_ns) {
 void DescribeCloudTopic(const rosbag::Bag& bag, BagTopicInfo* info) {
   CloudSampler sampler(info);
   rosbag::View view(bag, rosbag::TopicQuery(info->topic));
+  std::vector<uint8_t> bytes;
   for (const rosbag::MessageInstance& m : view) {
     if (sampler.Full()) break;
-    if (m.getDataType() == kLivoxRos1Type) {
-      const std::vector<uint8_t> bytes = bag_detail::RawMessageBytes(m);
-      sampler.Add(ParseLivoxRos1(bytes.data(), bytes.size(), info->topic));
-      continue;
-    }
-    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
-    if (!msg) break;
-    sampler.Add(bag_detail::ToView(*msg, info->topic));
+    const bool livox = m.getDataType() == kLivoxRos1Type;
+    if (!livox && m.getMD5Sum() != bag_detail::kPointCloud2Md5) break;
+    const size_t size = bag_detail::ReadRawMessage(m, &bytes);
+    if (livox)
+      sampler.Add(ParseLivoxRos1(bytes.data(), size, info->topic));
+    else
+      sampler.Add(bag_detail::ParseRos1PointCloud2(bytes.data(), size, info->topic,
+                                                    "topic '" + info->topic + "'"));
   }
   sampler.Finish();
 }

@@ -2,6 +2,8 @@
 // rules and the driver's .msg files) and the conversion to and from Scans.
 #include "rvlio/io/livox.h"
 
+#include "ros1_wire.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -67,63 +69,10 @@ constexpr size_t kPointBytes = 19;
 // the PointCloud2 decoder).
 constexpr uint64_t kMaxAbsoluteNs = 2000000000000000000ull;
 
-// Little-endian reader over a byte range; every read checks the bounds.
-class WireReader {
- public:
-  WireReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
-  template <typename T>
-  bool Read(T* value) {
-    if (size_ - pos_ < sizeof(T)) return false;
-    uint8_t bytes[sizeof(T)];
-    std::memcpy(bytes, data_ + pos_, sizeof(T));
-    if (BigEndianHost()) std::reverse(bytes, bytes + sizeof(T));
-    std::memcpy(value, bytes, sizeof(T));
-    pos_ += sizeof(T);
-    return true;
-  }
-  bool ReadString(std::string* s) {
-    uint32_t n = 0;
-    if (!Read(&n) || size_ - pos_ < n) return false;
-    s->assign(reinterpret_cast<const char*>(data_ + pos_), n);
-    pos_ += n;
-    return true;
-  }
-  size_t remaining() const { return size_ - pos_; }
+using bag_detail::Ros1WireReader;
+using bag_detail::Ros1WireWriter;
 
-  static bool BigEndianHost() {
-    const uint16_t one = 1;
-    uint8_t first = 0;
-    std::memcpy(&first, &one, 1);
-    return first == 0;
-  }
-
- private:
-  const uint8_t* data_;
-  size_t size_;
-  size_t pos_ = 0;
-};
-
-class WireWriter {
- public:
-  template <typename T>
-  void Write(T value) {
-    uint8_t bytes[sizeof(T)];
-    std::memcpy(bytes, &value, sizeof(T));
-    if (WireReader::BigEndianHost()) std::reverse(bytes, bytes + sizeof(T));
-    out_.insert(out_.end(), bytes, bytes + sizeof(T));
-  }
-  void WriteString(const std::string& s) {
-    Write(static_cast<uint32_t>(s.size()));
-    out_.insert(out_.end(), s.begin(), s.end());
-  }
-  std::vector<uint8_t> Take() { return std::move(out_); }
-  void Reserve(size_t n) { out_.reserve(n); }
-
- private:
-  std::vector<uint8_t> out_;
-};
-
-bool ReadPoint(WireReader& r, LivoxCustomPoint* p) {
+bool ReadPoint(Ros1WireReader& r, LivoxCustomPoint* p) {
   return r.Read(&p->offset_time) && r.Read(&p->x) && r.Read(&p->y) && r.Read(&p->z) &&
          r.Read(&p->reflectivity) && r.Read(&p->tag) && r.Read(&p->line);
 }
@@ -132,19 +81,17 @@ bool ReadPoint(WireReader& r, LivoxCustomPoint* p) {
 
 StatusOr<LivoxCustomMsg> ParseLivoxRos1(const uint8_t* data, size_t size,
                                         const std::string& what) {
-  WireReader r(data, size);
+  Ros1WireReader r(data, size);
   LivoxCustomMsg msg;
-  uint32_t seq = 0, sec = 0, nsec = 0, count = 0;
-  if (!r.Read(&seq) || !r.Read(&sec) || !r.Read(&nsec) || !r.ReadString(&msg.frame_id) ||
-      !r.Read(&msg.timebase) || !r.Read(&msg.point_num) || !r.Read(&msg.lidar_id) ||
-      !r.Read(&msg.rsvd[0]) || !r.Read(&msg.rsvd[1]) || !r.Read(&msg.rsvd[2]) || !r.Read(&count))
+  uint32_t count = 0;
+  if (!r.ReadHeader(&msg.header_stamp_ns, &msg.frame_id) || !r.Read(&msg.timebase) ||
+      !r.Read(&msg.point_num) || !r.Read(&msg.lidar_id) || !r.Read(&msg.rsvd[0]) || !r.Read(&msg.rsvd[1]) || !r.Read(&msg.rsvd[2]) || !r.Read(&count))
     return Status::InvalidInput(what + ": message of " + std::to_string(size) +
                                 " bytes is too short for a livox_ros_driver/CustomMsg header");
   if (r.remaining() / kPointBytes < count)
     return Status::InvalidInput(what + ": " + std::to_string(count) + " points need " +
                                 std::to_string(uint64_t{count} * kPointBytes) + " bytes, " +
                                 std::to_string(r.remaining()) + " left");
-  msg.header_stamp_ns = static_cast<TimeNs>(sec) * kNsPerSecond + nsec;
   msg.points.resize(count);
   for (LivoxCustomPoint& p : msg.points) ReadPoint(r, &p);
   if (r.remaining() != 0)
@@ -154,7 +101,7 @@ StatusOr<LivoxCustomMsg> ParseLivoxRos1(const uint8_t* data, size_t size,
 }
 
 std::vector<uint8_t> SerializeLivoxRos1(const LivoxCustomMsg& msg) {
-  WireWriter w;
+  Ros1WireWriter w;
   w.Reserve(40 + msg.frame_id.size() + msg.points.size() * kPointBytes);
   const TimeNs stamp = std::max<TimeNs>(msg.header_stamp_ns, 0);
   w.Write(uint32_t{0});  // seq

@@ -19,14 +19,6 @@ struct LivoxRos1Bytes {
   std::vector<uint8_t> bytes;
 };
 
-// The serialized bytes of a bag message of any type.
-inline std::vector<uint8_t> RawMessageBytes(const rosbag::MessageInstance& m) {
-  std::vector<uint8_t> bytes(m.size());
-  ros::serialization::OStream stream(bytes.data(), static_cast<uint32_t>(bytes.size()));
-  m.write(stream);
-  return bytes;
-}
-
 }  // namespace rvlio::bag_detail
 
 namespace ros {

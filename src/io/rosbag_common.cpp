@@ -4,6 +4,7 @@
 
 #include <exception>
 
+#include <ros/serialization.h>
 #include <rosbag/view.h>
 
 namespace rvlio::bag_detail {
@@ -36,20 +37,12 @@ ros::Time RecordTime(TimeNs t_ns) {
   return t;
 }
 
-PointCloud2View ToView(const sensor_msgs::PointCloud2& msg, const std::string& topic) {
-  PointCloud2View v;
-  v.header_stamp_ns = ToNs(msg.header.stamp);
-  v.height = msg.height;
-  v.width = msg.width;
-  v.point_step = msg.point_step;
-  v.row_step = msg.row_step;
-  v.is_bigendian = msg.is_bigendian;
-  v.fields.reserve(msg.fields.size());
-  for (const auto& f : msg.fields) v.fields.push_back({f.name, f.offset, f.datatype, f.count});
-  v.data = msg.data.data();
-  v.data_size = msg.data.size();
-  v.topic = topic;
-  return v;
+size_t ReadRawMessage(const rosbag::MessageInstance& m, std::vector<uint8_t>* buffer) {
+  const uint32_t size = m.size();
+  if (buffer->size() < size) buffer->resize(size);
+  ros::serialization::OStream stream(buffer->data(), size);
+  m.write(stream);
+  return size;
 }
 
 }  // namespace rvlio::bag_detail

@@ -7,11 +7,10 @@
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/Imu.h>
-#include <sensor_msgs/PointCloud2.h>
 
 #include "livox_ros1.h"
 #include "ouster_source.h"
+#include "ros1_messages.h"
 #include "rosbag_common.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
@@ -19,17 +18,18 @@
 namespace rvlio {
 namespace {
 
-using bag_detail::ToNs;
-using bag_detail::ToView;
 
 // Reads the first message of the LiDAR topic so that a cloud without a
 // usable time field fails at Open, not minutes into a run.
 StatusOr<std::string> PeekLayout(const rosbag::Bag& bag, const LidarOptions& lidar) {
   rosbag::View view(bag, rosbag::TopicQuery(lidar.topic));
   for (const rosbag::MessageInstance& m : view) {
-    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
-    if (!msg) break;
-    return DetectPointCloud2Layout(ToView(*msg, lidar.topic), lidar.type);
+    if (m.getMD5Sum() != bag_detail::kPointCloud2Md5) break;
+    const std::vector<uint8_t> bytes = bag_detail::RawMessageBytes(m);
+    StatusOr<PointCloud2View> cloud = bag_detail::ParseRos1PointCloud2(
+        bytes.data(), bytes.size(), lidar.topic, "lidar.topic '" + lidar.topic + "'");
+    if (!cloud.ok()) return cloud.status();
+    return DetectPointCloud2Layout(*cloud, lidar.type);
   }
   return std::string();
 }
@@ -108,13 +108,17 @@ class RosbagSensorReader final : public SensorBagReader {
 
   // True when *out holds a new sample; false when it was dropped.
   StatusOr<bool> ReadImu(const rosbag::MessageInstance& m, ImuSample* out) {
-    auto msg = m.instantiate<sensor_msgs::Imu>();
-    if (!msg) return Status::InvalidInput("imu.topic '" + imu_.topic + "' in '" + path_ +
-                                          "' does not hold sensor_msgs/Imu");
+    if (m.getMD5Sum() != bag_detail::kImuMd5)
+      return Status::InvalidInput("imu.topic '" + imu_.topic + "' in '" + path_ +
+                                  "' does not hold sensor_msgs/Imu");
+    const size_t size = bag_detail::ReadRawMessage(m, &bytes_);
+    StatusOr<bag_detail::Ros1Imu> msg = bag_detail::ParseRos1Imu(
+        bytes_.data(), size, "imu.topic '" + imu_.topic + "' in '" + path_ + "'");
+    if (!msg.ok()) return msg.status();
     const auto& a = msg->linear_acceleration;
     const auto& w = msg->angular_velocity;
-    return gate_.AcceptImu(ToNs(msg->header.stamp), Eigen::Vector3d(a.x, a.y, a.z),
-                           Eigen::Vector3d(w.x, w.y, w.z), out);
+    return gate_.AcceptImu(msg->header_stamp_ns, Eigen::Vector3d(a[0], a[1], a[2]),
+                           Eigen::Vector3d(w[0], w[1], w[2]), out);
   }
 
   // True when *out holds a scan with points; false for an empty scan.
@@ -126,22 +130,28 @@ class RosbagSensorReader final : public SensorBagReader {
     return gate_.AcceptScan(decode, std::move(scan).value(), out);
   }
 
-  StatusOr<Scan> DecodeCloud(const rosbag::MessageInstance& m, DecodeStats* decode) const {
-    auto msg = m.instantiate<sensor_msgs::PointCloud2>();
-    if (!msg) return Status::InvalidInput("lidar.topic '" + lidar_.topic + "' in '" + path_ +
-                                          "' does not hold sensor_msgs/PointCloud2");
-    return DecodePointCloud2(ToView(*msg, lidar_.topic), lidar_, decode);
+  // The cloud parsed in place from the message bytes (bytes_ is reused:
+  // no allocation or zero-filled copy per message).
+  StatusOr<Scan> DecodeCloud(const rosbag::MessageInstance& m, DecodeStats* decode) {
+    const std::string where = "lidar.topic '" + lidar_.topic + "' in '" + path_ + "'";
+    if (m.getMD5Sum() != bag_detail::kPointCloud2Md5)
+      return Status::InvalidInput(where + " does not hold sensor_msgs/PointCloud2");
+    const size_t size = bag_detail::ReadRawMessage(m, &bytes_);
+    StatusOr<PointCloud2View> cloud =
+        bag_detail::ParseRos1PointCloud2(bytes_.data(), size, lidar_.topic, where);
+    if (!cloud.ok()) return cloud.status();
+    return DecodePointCloud2(*cloud, lidar_, decode);
   }
 
   // Raw message bytes through the ROS-free parser (io/livox.h).
-  StatusOr<Scan> DecodeLivox(const rosbag::MessageInstance& m, DecodeStats* decode) const {
+  StatusOr<Scan> DecodeLivox(const rosbag::MessageInstance& m, DecodeStats* decode) {
     const std::string where = "lidar.topic '" + lidar_.topic + "' in '" + path_ + "'";
     if (m.getMD5Sum() != kLivoxRos1Md5)
       return Status::InvalidInput(where + " holds " + kLivoxRos1Type + " with md5 " +
                                   m.getMD5Sum() + ", not the driver's " + kLivoxRos1Md5 +
                                   " (a different message layout)");
-    const std::vector<uint8_t> bytes = bag_detail::RawMessageBytes(m);
-    StatusOr<LivoxCustomMsg> msg = ParseLivoxRos1(bytes.data(), bytes.size(), where);
+    const size_t size = bag_detail::ReadRawMessage(m, &bytes_);
+    StatusOr<LivoxCustomMsg> msg = ParseLivoxRos1(bytes_.data(), size, where);
     if (!msg.ok()) return msg.status();
     StatusOr<Scan> scan = DecodeLivoxCustomMsg(*msg, lidar_, decode);
     if (!scan.ok()) return Status::InvalidInput(where + ": " + scan.status().message());
@@ -156,6 +166,7 @@ class RosbagSensorReader final : public SensorBagReader {
   std::unique_ptr<rosbag::View> view_;
   rosbag::View::iterator it_;
   std::string layout_;
+  std::vector<uint8_t> bytes_;  // holds the current message's bytes; reused
   bag_detail::SensorGate gate_;
   Status error_;
 };
