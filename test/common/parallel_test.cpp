@@ -1,7 +1,10 @@
 // ParallelFor: every index once, slots within bounds and never shared by two
 // running calls, and per-index results independent of the thread count.
 #include <atomic>
+#include <cstdio>
 #include <cmath>
+#include <mutex>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -58,6 +61,41 @@ TEST(ParallelFor, PerIndexResultsDoNotDependOnTheThreadCount) {
   const std::vector<double> one = run(1);
   EXPECT_EQ(run(2), one);
   EXPECT_EQ(run(4), one);
+}
+
+// Busy CPU work of about `ms` milliseconds on the calling thread.
+double Spin(double ms) {
+  const double until = ThreadCpuMs() + ms;
+  double x = 1.0;
+  while (ThreadCpuMs() < until) x = std::sqrt(x + 1.0);
+  return x;
+}
+
+// WorkCpuMs counts the items that ran on helper threads: its difference over
+// a loop is at least the CPU the items used wherever they ran, and the helper
+// counter grows by at least the items that ran on another thread.
+TEST(ParallelFor, WorkCpuCountsTheHelperThreads) {
+  const std::thread::id caller = std::this_thread::get_id();
+  std::mutex mutex;
+  double items_ms = 0.0, helper_items_ms = 0.0;
+  const double work_before = WorkCpuMs(), helper_before = ParallelWorkerCpuMs();
+  ParallelFor(0, 16, 2, [&](int, int) {
+    const double t0 = ThreadCpuMs();
+    volatile double sink = Spin(5.0);
+    (void)sink;
+    const double used = ThreadCpuMs() - t0;
+    std::lock_guard<std::mutex> lock(mutex);
+    items_ms += used;
+    if (std::this_thread::get_id() != caller) helper_items_ms += used;
+  });
+  EXPECT_GE(WorkCpuMs() - work_before, 0.99 * items_ms);
+  EXPECT_GE(ParallelWorkerCpuMs() - helper_before, 0.99 * helper_items_ms);
+  std::printf("[ cpu ] items %.1f ms, %.1f ms of them on a helper thread\n", items_ms,
+              helper_items_ms);
+  // One thread: everything on the caller, the helper counter unchanged.
+  const double helper_mid = ParallelWorkerCpuMs();
+  ParallelFor(0, 4, 1, [&](int, int) { Spin(1.0); });
+  EXPECT_EQ(ParallelWorkerCpuMs(), helper_mid);
 }
 
 TEST(ParallelFor, EmptyRangeAndThreadResolution) {

@@ -9,6 +9,8 @@
 // gives the same output for any thread count and any schedule.
 #include <functional>
 
+#include "rvlio/common/cpu_time.h"
+
 namespace rvlio {
 
 // The thread count a `threads` option means: itself when > 0, else the
@@ -25,5 +27,16 @@ void ParallelFor(int begin, int end, int threads,
 
 // The number of slots ParallelFor uses for `count` indices on `threads`.
 int ParallelSlots(int threads, int count);
+
+// Milliseconds of CPU time that other threads have spent so far running the
+// calling thread's ParallelFor loops (a per-thread counter, only ever
+// increased). With ThreadCpuMs it gives the cost of a piece of work that
+// ran part of itself on helper threads: WorkCpuMs below.
+double ParallelWorkerCpuMs();
+
+// CPU time of the calling thread plus that of the helper threads its
+// ParallelFor loops used, in ms: differences of it are a computation's whole
+// CPU cost for any thread count (ThreadCpuMs alone misses the helpers').
+inline double WorkCpuMs() { return ThreadCpuMs() + ParallelWorkerCpuMs(); }
 
 }  // namespace rvlio
