@@ -1,5 +1,6 @@
 // rvlio: LiDAR-inertial odometry for weak-feature environments.
 // This file only dispatches to the subcommands (apps/cmd_*.cpp).
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <iostream>
@@ -41,13 +42,15 @@ void PrintHelp() {
             << " - LiDAR-inertial odometry for weak-feature environments (RV-LIO)\n\n"
                "usage: rvlio <command> [options]    (rvlio <command> --help for its options)\n\n"
                "commands:\n";
+  size_t width = 0;  // the longest command name, then two spaces
+  for (const auto& c : kSubcommands) width = std::max(width, std::strlen(c.name));
   for (const auto& c : kSubcommands) {
-    std::cout << "  " << c.name;
-    for (size_t i = std::strlen(c.name); i < 10; ++i) std::cout << ' ';
-    std::cout << c.summary << "\n";
+    std::cout << "  " << c.name << std::string(width + 2 - std::strlen(c.name), ' ') << c.summary
+              << "\n";
   }
-  std::cout << "\nexit status: 0 success, 2 bad input or configuration, 1 internal failure,\n"
-               "130 / 143 stopped by SIGINT / SIGTERM (run, refine, compare, ablate, simulate)\n";
+  std::cout << "\nexit status: 0 success, 2 bad input or configuration, 3 divergence detected\n"
+               "(run, refine; outputs written), 1 internal failure, 130 / 143 stopped by\n"
+               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate)\n";
 }
 
 }  // namespace
