@@ -153,6 +153,8 @@ VoxelMap::VoxelMap(const MapOptions& options) : options_(options) {
   inv_voxel_size_ = 1.0 / options.voxel_size;
   min_d2_ = static_cast<float>(options.min_point_distance * options.min_point_distance);
   max_points_ = options.max_points_per_voxel;
+  if (options.neighbor_search == "nearby") max_search_shell_ = 1;
+  else RVLIO_CHECK(options.neighbor_search == "exact");
   free_blocks_.resize(CapacityClass(max_points_) + 1);
   const double s2 = options.voxel_size * options.voxel_size;  // as VisitShell's bound test had it
   for (int r = 0; r <= kPrecomputedShells; ++r) {
@@ -453,7 +455,8 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
 
   // Shell r lies at least (r - 1) s from any point of the home voxel, so
   // shells up to floor(max_d / s) + 1 can hold points within max_d.
-  const int max_shell = static_cast<int>(std::floor(max_d / s)) + 1;
+  const int max_shell =
+      std::min(static_cast<int>(std::floor(max_d / s)) + 1, max_search_shell_);
   const double width = 2.0 * max_shell + 1.0;
   if (width * width * width > static_cast<double>(slots_.size())) {
     ScanAllVoxels(q_world, q, &c);

@@ -86,6 +86,60 @@ TEST(VoxelMap, KNearestMatchesBruteForce) {
   EXPECT_GT(empty, 100);
 }
 
+// Brute force restricted to the points of the 27 voxels around q's voxel
+// (what the nearby search sees).
+std::vector<double> BruteForceNearby(const std::vector<Eigen::Vector3d>& pts,
+                                     const Eigen::Vector3d& q, int k, double max_dist,
+                                     double voxel) {
+  std::vector<Eigen::Vector3d> near;
+  const Eigen::Vector3d home = (q / voxel).array().floor();
+  for (const auto& p : pts) {
+    const Eigen::Vector3d key = (p / voxel).array().floor();
+    if ((key - home).cwiseAbs().maxCoeff() <= 1.0) near.push_back(p);
+  }
+  return BruteForce(near, q, k, max_dist);
+}
+
+// The nearby search gives the k nearest among the 27 voxels around the
+// query's, exactly; it misses farther points by design.
+TEST(VoxelMap, NearbySearchIsExactWithinTheTwentySevenVoxels) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int checked = 0, missed_farther = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    MapOptions options;
+    options.voxel_size = 0.2 + 0.8 * unit(rng);
+    options.neighbor_search = "nearby";
+    VoxelMap map(options);
+    MapOptions exact_options = options;
+    exact_options.neighbor_search = "exact";
+    VoxelMap exact(exact_options);
+    const std::vector<Eigen::Vector3d> cloud = RandomCloud(&rng, 300 + trial * 20, 4.0);
+    map.Insert(cloud);
+    exact.Insert(cloud);
+    const std::vector<Eigen::Vector3d> stored = map.Points();
+    for (int query = 0; query < 30; ++query) {
+      std::uniform_real_distribution<double> uq(-4.5, 4.5);
+      const Eigen::Vector3d q(uq(rng), uq(rng), uq(rng));
+      const int k = 1 + static_cast<int>(8 * unit(rng));
+      const double max_dist = 3.0;
+      if (NearBoundary(stored, q, max_dist)) continue;
+      NeighborBuffer nb, nb_exact;
+      const int found = map.KNearest(q, k, max_dist, &nb);
+      const std::vector<double> expected =
+          BruteForceNearby(stored, q, k, max_dist, options.voxel_size);
+      ASSERT_EQ(found, static_cast<int>(expected.size())) << trial << " " << query;
+      for (int i = 0; i < found; ++i) EXPECT_NEAR(nb.dist2[i], expected[i], 1e-6);
+      exact.KNearest(q, k, max_dist, &nb_exact);
+      if (nb_exact.size > found || (found > 0 && nb_exact.dist2[found - 1] < nb.dist2[found - 1]))
+        ++missed_farther;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1500);
+  EXPECT_GT(missed_farther, 10);  // the setup reaches beyond the 27 voxels
+}
+
 // Small voxels, many of them: the shell-by-shell search (not the scan over
 // all voxels) has to go beyond the precomputed shells.
 TEST(VoxelMap, DeepShellSearchMatchesBruteForce) {

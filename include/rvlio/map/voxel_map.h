@@ -15,6 +15,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -48,6 +49,9 @@ class VoxelMap {
   // Exact k nearest stored points of q_world among those within max_dist (m),
   // sorted by distance into *out. Returns out->size (< k when fewer points are
   // within max_dist). 1 <= k <= kMaxNeighbors. No heap allocation.
+  // With MapOptions::neighbor_search "nearby" only the query's voxel and the
+  // 26 around it are searched: the k nearest of their points within
+  // max_dist (the same as the exact search whenever those are the k nearest).
   int KNearest(const Eigen::Vector3d& q_world, int k, double max_dist, NeighborBuffer* out) const;
 
   // Removes every voxel whose centre is farther than radius (m) from
@@ -117,6 +121,7 @@ class VoxelMap {
   double inv_voxel_size_ = 1.0;
   float min_d2_ = 0.0f;
   int max_points_ = 1;  // max_points_per_voxel
+  int max_search_shell_ = std::numeric_limits<int>::max();  // 1 for the nearby search
 
   std::vector<Slot> slots_;
   size_t mask_ = 0;
