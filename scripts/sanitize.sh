@@ -41,7 +41,12 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # memory bound measures a Release build's peak (ASan's shadow memory is not
 # ours); the chunk jobs' bad-input and partial-init cases stay. The report's
 # browser test runs chromium, not our code, once the page is written (its data
-# extraction stays here: ReportDataTest, ReportArrayTest, ...).
+# extraction stays here: ReportDataTest, ReportArrayTest, ...). The time-offset
+# suite simulates and runs a 20 s flight in every test process (several
+# minutes each under ASan); its math runs here in TimeOffsetResidual and the
+# IESKF and smoother unit tests, and the reader's offset in InputStreamTest
+# and QuietFailureTest. Two of the three survey bad-input cases run a whole
+# IESKF flight first; SurveyBadInput.MalformedOrMissingInitialPose stays.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -81,6 +86,8 @@ ex=(
   RefineChunksCliTest.MergedChunksAgreeWithTheWholeRefineHaveNoBorderStepsAndRefuseBadSets
   'ReportBrowserTest\..*'
   'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
+  SurveyBadInput.MissingEmptyTruncatedOrNonFiniteMap SurveyBadInput.MapInMillimetresOrFarFromTheStart
+  'TimeOffsetCliTest\..*'
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}
