@@ -44,8 +44,8 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # extraction stays here: ReportDataTest, ReportArrayTest, ...). The time-offset
 # suite simulates and runs a 20 s flight in every test process (several
 # minutes each under ASan); its math runs here in TimeOffsetResidual and the
-# IESKF and smoother unit tests, and the reader's offset in InputStreamTest
-# and QuietFailureTest. Two of the three survey bad-input cases run a whole
+# IESKF and smoother unit tests, and a scan moved by the offset in
+# QuietFailureTest. Two of the three survey bad-input cases run a whole
 # IESKF flight first; SurveyBadInput.MalformedOrMissingInitialPose stays.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
