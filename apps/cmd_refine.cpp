@@ -18,6 +18,7 @@
 #include "interrupt.h"
 #include "run_pipeline.h"
 #include "window_options.h"
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/api.h"
 #include "rvlio/io/refine_checkpoint.h"
 #include "rvlio/io/trajectory_io.h"
@@ -26,10 +27,6 @@ namespace rvlio::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 void PrintRound(const RefineRound& r, int rounds) {
   std::printf(

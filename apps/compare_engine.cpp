@@ -1,6 +1,4 @@
 #include "compare_engine.h"
-#include "rvlio/version.h"
-#include "rvlio//io/summary_json.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -25,13 +23,16 @@
 #include "run_pipeline.h"
 #include "window_options.h"
 #include "rvlio/api.h"
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/config.h"
 #include "rvlio/io/point_cloud_file.h"
+#include "rvlio/io/summary_json.h"
 #include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/trajectory_io.h"
+#include "rvlio/version.h"
 
 namespace rvlio::cli {
 namespace {
@@ -75,10 +76,6 @@ struct Row {
     return interrupted ? "interrupted" : ok() ? "ok" : (measured() ? "diverged" : "failed");
   }
 };
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // Calls another subcommand in-process with the given arguments.
 int Invoke(int (*command)(int, char**), std::vector<std::string> args) {

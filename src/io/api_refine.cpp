@@ -11,6 +11,7 @@
 #include <optional>
 #include <utility>
 
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/output_stage.h"
@@ -27,10 +28,6 @@ namespace rvlio {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 RefineConfig ToRefineConfig(const OdometryOptions& o,
                             std::shared_ptr<const VoxelMap> reference) {

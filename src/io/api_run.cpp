@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/extrinsic_json.h"
@@ -25,10 +26,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr const char* kPartialTrajectory = "trajectory.partial.tum";
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 nlohmann::json StatsJson(const OdometryStats& o, const SensorReaderStats& r) {
   return {{"scans_received", o.scans_received},

@@ -11,6 +11,7 @@
 #include <functional>
 #include <utility>
 
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/common/parallel.h"
 #include "rvlio/imu/noise.h"
 #include "rvlio/map/output_map.h"
@@ -26,10 +27,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kConvergedTranslationM = 5e-4;  // rounds stop below both changes
 constexpr double kConvergedRotationDeg = 5e-3;
-
-double SecondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // The rounds over one sequence: owns the states and the round's map; each
 // step is a function of refine_*.h.
