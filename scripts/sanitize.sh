@@ -81,6 +81,7 @@ ex=(
   RefineChunksCliTest.MergedChunksAgreeWithTheWholeRefineHaveNoBorderStepsAndRefuseBadSets
   'ReportBrowserTest\..*'
   'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
+  'SurveyFlights\..*' SurveyFeatureless.StartTwentyMetresOffAlongTheAxisIsRefused
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}
