@@ -229,6 +229,62 @@ TEST_F(SurveyFlights, FlightBeyondTheSurveysEndIsFlaggedAndContinuous) {
   }
 }
 
+// `refine --map` in chunk jobs merges (chunk.json records the map's content
+// hash, so chunks held to another map are refused), and a checkpoint resumes
+// only with the map it was written with. On the first 12 s of the flight
+// (chunks overlapping by 3 s).
+TEST_F(SurveyFlights, RefineMapInChunksMergesAndResumesOnlyWithItsMap) {
+  const std::string run = dir_ + "/chunks_run";
+  ToolRun r = RunB(run, Survey(), "ieskf");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Trajectory est = Tum(run + "/trajectory.tum");
+  ASSERT_FALSE(est.empty());
+  Trajectory head;
+  for (const StampedPose& p : est)
+    if (p.t_ns < est.front().t_ns + 12'000'000'000LL) head.push_back(p);
+  const std::string init = dir_ + "/head.tum";
+  ASSERT_TRUE(WriteTum(init, head).ok());
+  const std::string short_map = dir_ + "/short/reference_map.pcd";
+  const ToolRun sim = CachedSimulate(kWorld + " --reference-map-only --set survey.x_min=-10"
+                                     " --set survey.x_max=" + std::to_string(kShortSurveyEndX),
+                                     dir_ + "/short", dir_);
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const auto refine = [&](const std::string& map, const std::string& extra) {
+    return RunTool("refine --bag " + dir_ + "/b/tunnel.bag --config " + dir_ +
+                       "/b/tunnel.yaml --init " + init + " --map " + map +
+                       " --set smoother.refine_job_overlap_s=3 " + extra,
+                   dir_);
+  };
+  for (int k = 1; k <= 2; ++k) {
+    r = refine(Survey(), "--chunk " + std::to_string(k) + " --of 2 --out " + dir_ + "/chunk" +
+                             std::to_string(k));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  r = RunTool("merge --chunks " + dir_ + "/chunk2 " + dir_ + "/chunk1 --out " + dir_ + "/merged", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double ate = AteNoAlign(Truth(), dir_ + "/merged/trajectory.tum", dir_);
+  EXPECT_LT(ate, 0.05);
+  std::printf("[ survey ] refine --map in 2 chunks, merged: ATE (no alignment) %.4f m\n", ate);
+
+  r = refine(short_map, "--chunk 2 --of 2 --out " + dir_ + "/chunk2_short");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunTool("merge --chunks " + dir_ + "/chunk1 " + dir_ + "/chunk2_short --out " + dir_ +
+                  "/merged_mixed",
+              dir_);
+  testing_cli::ExpectOneErrorLine(r, "merge", "map_hash");
+  EXPECT_NE(r.err.find("another --map"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/merged_mixed"));
+
+  const std::string checkpoint = dir_ + "/checkpoint";
+  r = refine(Survey(), "--checkpoint " + checkpoint + " --set smoother.refine_rounds=1 --out " +
+                           dir_ + "/round1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = refine(short_map, "--resume " + checkpoint + " --out " + dir_ + "/resumed_other_map");
+  testing_cli::ExpectOneErrorLine(r, "refine", "--map");
+  EXPECT_NE(r.err.find(checkpoint), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/resumed_other_map"));
+}
+
 // A featureless tunnel cannot check a start 20 m off along its axis: exit 2,
 // one line, nothing written (not a run placed 20 m off).
 TEST(SurveyFeatureless, StartTwentyMetresOffAlongTheAxisIsRefused) {
