@@ -780,7 +780,7 @@ def CmdDeviation(args):
     raise PlotError("%s: no rows" % path)
   col = {c: np.array([ToFloat(r.get(c)) for r in rows]) for c in needed}
   plt = Pyplot()
-  fig, ax = plt.subplots(figsize=(8, 3.2))
+  fig, ax = plt.subplots(figsize=(8, 3.5))
   cm = 100.0
   ax.plot(col["chainage_m"], cm * col["p95_abs_m"], label="p95 |deviation|", color="tab:red")
   ax.plot(col["chainage_m"], cm * col["median_abs_m"], label="median |deviation|",
