@@ -232,7 +232,8 @@ TEST_F(SurveyFlights, FlightBeyondTheSurveysEndIsFlaggedAndContinuous) {
 // `refine --map` in chunk jobs merges (chunk.json records the map's content
 // hash, so chunks held to another map are refused), and a checkpoint resumes
 // only with the map it was written with. On the first 12 s of the flight
-// (chunks overlapping by 3 s).
+// (chunks overlapping by 3 s, two rounds: the initial trajectory is already
+// localized).
 TEST_F(SurveyFlights, RefineMapInChunksMergesAndResumesOnlyWithItsMap) {
   const std::string run = dir_ + "/chunks_run";
   ToolRun r = RunB(run, Survey(), "ieskf");
@@ -252,7 +253,7 @@ TEST_F(SurveyFlights, RefineMapInChunksMergesAndResumesOnlyWithItsMap) {
   const auto refine = [&](const std::string& map, const std::string& extra) {
     return RunTool("refine --bag " + dir_ + "/b/tunnel.bag --config " + dir_ +
                        "/b/tunnel.yaml --init " + init + " --map " + map +
-                       " --set smoother.refine_job_overlap_s=3 " + extra,
+                       " --set smoother.refine_job_overlap_s=3 --set smoother.refine_rounds=2 " + extra,
                    dir_);
   };
   for (int k = 1; k <= 2; ++k) {
