@@ -93,7 +93,7 @@ int CmdRefine(int argc, char** argv) {
                     {"checkpoint", "DIR",
                      "after each round, write the state to continue from to DIR/refine.checkpoint"},
                     {"resume", "DIR",
-                     "continue from DIR/refine.checkpoint (same --bag, --init, --config and --set; "
+                     "continue from DIR/refine.checkpoint (same --bag, --init, --map, --config and --set; "
                      "smoother.refine_rounds may differ) and go on checkpointing there"},
                     {"chunk", "K",
                      "refine only chunk K (1-based) of --of N overlapping chunks of the initial "

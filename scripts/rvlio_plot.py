@@ -8,6 +8,7 @@ Usage:
   rvlio_plot.py ablation     --table CSV --out PREFIX [--metric NAME ...]
                              [--yscale auto|linear|log]
   rvlio_plot.py compare-bars --table CSV --out PREFIX [--metric NAME ...]
+  rvlio_plot.py deviation    --run DIR --out PREFIX [--title TEXT]
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
 
 Inputs follow the run-directory contract of `rvlio run` (docs/design.md section 7):
@@ -764,6 +765,43 @@ def CmdCompareBars(args):
 
 
 # --------------------------------------------------------------------------
+# deviation
+# --------------------------------------------------------------------------
+
+def CmdDeviation(args):
+  """DIR/deviation.csv of `rvlio run --map`: deviation per metre of chainage."""
+  path = os.path.join(args.run, "deviation.csv")
+  header, rows = ReadCsvTable(path)
+  needed = ("chainage_m", "count", "median_m", "median_abs_m", "p95_abs_m")
+  missing = [c for c in needed if c not in header]
+  if missing:
+    raise PlotError("%s: missing column(s) %s" % (path, ", ".join(missing)))
+  if not rows:
+    raise PlotError("%s: no rows" % path)
+  col = {c: np.array([ToFloat(r.get(c)) for r in rows]) for c in needed}
+  plt = Pyplot()
+  fig, ax = plt.subplots(figsize=(8, 3.5))
+  cm = 100.0
+  ax.plot(col["chainage_m"], cm * col["p95_abs_m"], label="p95 |deviation|", color="tab:red")
+  ax.plot(col["chainage_m"], cm * col["median_abs_m"], label="median |deviation|",
+          color="tab:blue")
+  ax.plot(col["chainage_m"], cm * col["median_m"], label="median (signed)", color="tab:green",
+          linestyle="--")
+  ax.axhline(0.0, color="0.6", linewidth=0.8)
+  ax.set_xlabel("chainage [m]")
+  ax.set_ylabel("deviation from the reference [cm]")
+  ax.set_title(args.title or "deviation of %s from its reference map" %
+               os.path.basename(os.path.normpath(args.run)))
+  ax.grid(True, alpha=0.3)
+  ax.legend(loc="upper right", fontsize=8)
+  fig.tight_layout()
+  peak = int(np.nanargmax(col["p95_abs_m"]))
+  print("peak p95 |deviation| %.4f m at chainage %.1f m; median |deviation| median %.4f m" %
+        (col["p95_abs_m"][peak], col["chainage_m"][peak], float(np.nanmedian(col["median_abs_m"]))))
+  SaveFigure(fig, args.out, "deviation")
+
+
+# --------------------------------------------------------------------------
 # Command line
 # --------------------------------------------------------------------------
 
@@ -811,6 +849,11 @@ def BuildParser():
   p.add_argument("--metric", action="append",
                  help="metric column (repeatable; default ATE, RPE, along-axis max)")
   p.set_defaults(func=CmdCompareBars)
+  p = sub.add_parser("deviation", help="deviation.csv of run --map along the chainage")
+  p.add_argument("--run", required=True, help="run directory of rvlio run --map")
+  p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
+  p.add_argument("--title", help="figure title (default: from summary.json)")
+  p.set_defaults(func=CmdDeviation)
   p = sub.add_parser("check", help="exit 0 when matplotlib is usable")
   p.set_defaults(func=None)
   return parser

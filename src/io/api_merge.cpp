@@ -123,14 +123,17 @@ Status CheckChunks(std::vector<ChunkFolder>* chunks) {
             [](const ChunkFolder& a, const ChunkFolder& b) { return a.job.span.chunk < b.job.span.chunk; });
   const ChunkFolder& first = chunks->front();
   const int n = first.job.span.count;
-  for (const char* key : {"of", "options_hash", "init_hash", "overlap_s"})
+  // map_hash: "" without --map (and in chunks written before it was recorded).
+  for (const char* key : {"of", "options_hash", "init_hash", "overlap_s", "map_hash"})
     for (const ChunkFolder& c : *chunks)
-      if (c.manifest[key] != first.manifest[key])
+      if (c.manifest.value(key, json("")) != first.manifest.value(key, json("")))
         return Status::InvalidInput(
             "chunks of different refinements: " + FilePath(c.dir, "chunk.json") + " has " + key +
-            " " + c.manifest[key].dump() + ", " + FilePath(first.dir, "chunk.json") + " " +
-            first.manifest[key].dump() +
-            (std::string(key) == "options_hash" ? " (other --config/--set)" : ""));
+            " " + c.manifest.value(key, json("")).dump() + ", " + FilePath(first.dir, "chunk.json") +
+            " " + first.manifest.value(key, json("")).dump() +
+            (std::string(key) == "options_hash" ? " (other --config/--set)"
+             : std::string(key) == "map_hash"   ? " (another --map)"
+                                                : ""));
   std::set<int> have;
   for (const ChunkFolder& c : *chunks)
     if (!have.insert(c.job.span.chunk).second)

@@ -160,7 +160,7 @@ std::string HashText(uint64_t h) {
 
 // chunk.json of a chunk job: what `rvlio merge` needs to check and merge it.
 nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const ScansSeen& seen,
-                         uint64_t init_hash, const RefineResult& res) {
+                         uint64_t init_hash, uint64_t map_hash, const RefineResult& res) {
   return {{"format", 1},
           {"chunk", job.chunk},
           {"of", job.count},
@@ -177,6 +177,8 @@ nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const
           {"map_output_resolution", args.options.map.output_resolution},
           {"options_hash", HashText(RefineOptionsHash(args.options))},
           {"init_hash", HashText(init_hash)},
+          {"map_hash", args.map.empty() ? std::string() : HashText(map_hash)},
+          {"map", args.map},
           {"interrupted", res.stopped},
           {"bag", args.bag},
           {"init", args.init_path}};
@@ -262,15 +264,16 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r) {
 
 // The refinement with its hooks: rounds, checkpoints, the stop flag.
 // *checkpoint_s: wall time of the fingerprint and the checkpoint writes.
+// map_hash: FileContentHash of --map (0 without one).
 StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input,
-                                       std::shared_ptr<const VoxelMap> reference,
+                                       std::shared_ptr<const VoxelMap> reference, uint64_t map_hash,
                                        std::string* stop_reason, double* checkpoint_s) {
   RefineHooks hooks;
   hooks.on_round = args.on_round;
   hooks.stop = [&args, stop_reason] { return !(*stop_reason = StopReason(args)).empty(); };
   const bool checkpoints = !args.checkpoint_dir.empty();
   const auto t0 = Clock::now();
-  const uint64_t fingerprint = checkpoints ? RefineFingerprint(args.options, input) : 0;
+  const uint64_t fingerprint = checkpoints ? RefineFingerprint(args.options, input, map_hash) : 0;
   *checkpoint_s = checkpoints ? SecondsSince(t0) : 0.0;
   if (checkpoints)
     hooks.on_state = [&args, fingerprint, checkpoint_s](const RefineRoundState& state) {
@@ -334,6 +337,12 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     if (!loaded.ok()) return loaded.status();
     reference = std::move(*loaded);
   }
+  uint64_t map_hash = 0;  // what a checkpoint and chunk.json know the map by
+  if (!args.map.empty() && (job || !args.checkpoint_dir.empty())) {
+    StatusOr<uint64_t> hash = FileContentHash(args.map);
+    if (!hash.ok()) return Status::InvalidInput("--map " + hash.status().message());
+    map_hash = *hash;
+  }
   if (Status s = PrepareCheckpointDir(args); !s.ok()) return s;
   StatusOr<std::unique_ptr<SensorBagReader>> reader = OpenSensorStream(
       args.bag, args.options.lidar, args.options.imu, args.window, args.options.io);
@@ -360,7 +369,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   Times times;
   times.read_s = SecondsSince(t0);
   StatusOr<RefineResult> refined =
-      RefineWithHooks(args, std::move(input), std::move(reference), &r.stop_reason,
+      RefineWithHooks(args, std::move(input), std::move(reference), map_hash, &r.stop_reason,
                       &times.checkpoint_s);
   if (!refined.ok()) {
     const std::string what =
@@ -371,7 +380,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   r.refine = std::move(*refined);
   r.refine.warnings.insert(r.refine.warnings.begin(), notes.begin(), notes.end());
   if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
-  if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, r.refine);
+  if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
   r.stopped = r.refine.stopped;
   if (!r.stopped) r.stop_reason.clear();
   r.divergence = CheckRefineResult(r.refine, args.options.divergence,

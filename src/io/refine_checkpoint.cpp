@@ -25,6 +25,10 @@ class Fnv1a {
     const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
     for (size_t i = 0; i < sizeof(T); ++i) hash_ = (hash_ ^ bytes[i]) * 0x100000001b3ULL;
   }
+  void AddBytes(const char* bytes, size_t n) {
+    for (size_t i = 0; i < n; ++i)
+      hash_ = (hash_ ^ static_cast<unsigned char>(bytes[i])) * 0x100000001b3ULL;
+  }
   void AddText(const std::string& text) {
     Add(text.size());
     for (unsigned char c : text) hash_ = (hash_ ^ c) * 0x100000001b3ULL;
@@ -147,12 +151,31 @@ uint64_t TrajectoryHash(const Trajectory& trajectory) {
   return h.value();
 }
 
-uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input) {
+StatusOr<uint64_t> FileContentHash(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::InvalidInput(path + ": cannot be read (" + std::strerror(errno) + ")");
+  Fnv1a h;
+  std::vector<char> block(1 << 20);
+  uint64_t size = 0;
+  while (in) {
+    in.read(block.data(), static_cast<std::streamsize>(block.size()));
+    const std::streamsize n = in.gcount();
+    h.AddBytes(block.data(), static_cast<size_t>(n));
+    size += static_cast<uint64_t>(n);
+  }
+  if (in.bad()) return Status::InvalidInput(path + ": read error after " + std::to_string(size) + " bytes");
+  h.Add(size);
+  return h.value();
+}
+
+uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input,
+                           uint64_t reference_hash) {
   OdometryOptions config = options;
   config.smoother.refine_rounds = 0;  // resuming may go on for more rounds
   Fnv1a h;
   h.Add(kFormat);
   h.AddText(ToJson(config).dump());
+  h.Add(reference_hash);
   for (const StampedPose& p : input.init) {
     h.Add(p.t_ns);
     for (int i = 0; i < 3; ++i) h.Add(p.p_world_imu[i]);
@@ -206,7 +229,7 @@ StatusOr<RefineRoundState> ReadRefineCheckpoint(const std::string& dir, uint64_t
     return Status::InvalidInput(what + " is not an rvlio refine checkpoint (format " +
                                 std::to_string(kFormat) + ")");
   if (j.value("fingerprint", uint64_t{0}) != fingerprint)
-    return Status::InvalidInput(what + " was written for another bag, initial trajectory or "
+    return Status::InvalidInput(what + " was written for another bag, initial trajectory, --map or "
                                 "configuration (only smoother.refine_rounds may differ)");
   try {
     return StateFrom(j);

@@ -4,16 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
-
-#include "rvlio/map/voxel_key.h"
 
 namespace rvlio {
 namespace {
 
 constexpr double kSampleStepM = 0.25;  // trajectory resampling along its length
-constexpr double kCellM = 2.0;         // hash cell of the samples
-constexpr int kMaxRings = 25;          // search up to ~50 m from a point
+constexpr double kMaxSampleDistanceM = 50.0;  // a point farther from the trajectory has no chainage
 
 struct Sample {
   Eigen::Vector3d p;
@@ -35,45 +31,54 @@ std::vector<Sample> Resample(const Trajectory& t) {
   return s;
 }
 
-// The samples in hash cells, searched ring by ring around a point.
-class SampleGrid {
+// The samples in an implicit k-d tree (the median of each range splits it
+// along the axis of the range's largest extent), so the nearest sample costs
+// O(log n) wherever the point is. A grid of cells searched ring by ring
+// costs (2r+1)^3 cells for a point r cells away: map points tens of metres
+// ahead of the flight's end made that the run's dominant cost.
+class SampleTree {
  public:
-  explicit SampleGrid(std::vector<Sample> samples) : samples_(std::move(samples)) {
-    for (size_t i = 0; i < samples_.size(); ++i)
-      cells_[KeyOf(samples_[i].p, 1.0 / kCellM)].push_back(static_cast<int>(i));
+  explicit SampleTree(std::vector<Sample> samples)
+      : samples_(std::move(samples)), axis_(samples_.size(), 0) {
+    Build(0, samples_.size());
   }
-  // The nearest sample within kMaxRings cells, or null.
+  // The nearest sample within kMaxSampleDistanceM, or null.
   const Sample* Nearest(const Eigen::Vector3d& q) const {
-    const VoxelKey home = KeyOf(q, 1.0 / kCellM);
     const Sample* best = nullptr;
-    double best2 = std::numeric_limits<double>::infinity();
-    for (int r = 0; r <= kMaxRings; ++r) {
-      // Every sample in ring r is at least (r - 1) cells away.
-      const double bound = std::max(0, r - 1) * kCellM;
-      if (best != nullptr && bound * bound > best2) break;
-      VisitRing(home, r, [&](int i) {
-        const double d2 = (samples_[i].p - q).squaredNorm();
-        if (d2 < best2) best2 = d2, best = &samples_[i];
-      });
-    }
+    double best2 = kMaxSampleDistanceM * kMaxSampleDistanceM;
+    Search(0, samples_.size(), q, &best2, &best);
     return best;
   }
 
  private:
-  template <class F>
-  void VisitRing(const VoxelKey& home, int r, F&& f) const {
-    for (int dx = -r; dx <= r; ++dx)
-      for (int dy = -r; dy <= r; ++dy)
-        for (int dz = -r; dz <= r; ++dz) {
-          if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
-          const auto it = cells_.find(VoxelKey{home.x + dx, home.y + dy, home.z + dz});
-          if (it == cells_.end()) continue;
-          for (int i : it->second) f(i);
-        }
+  void Build(size_t lo, size_t hi) {
+    if (hi - lo < 2) return;
+    Eigen::Vector3d lo_p = samples_[lo].p, hi_p = samples_[lo].p;
+    for (size_t i = lo; i < hi; ++i) lo_p = lo_p.cwiseMin(samples_[i].p), hi_p = hi_p.cwiseMax(samples_[i].p);
+    int axis = 0;
+    (hi_p - lo_p).maxCoeff(&axis);
+    const size_t mid = lo + (hi - lo) / 2;
+    std::nth_element(samples_.begin() + lo, samples_.begin() + mid, samples_.begin() + hi,
+                     [axis](const Sample& a, const Sample& b) { return a.p[axis] < b.p[axis]; });
+    axis_[mid] = axis;
+    Build(lo, mid);
+    Build(mid + 1, hi);
+  }
+  void Search(size_t lo, size_t hi, const Eigen::Vector3d& q, double* best2,
+              const Sample** best) const {
+    if (lo >= hi) return;
+    const size_t mid = lo + (hi - lo) / 2;
+    const Sample& s = samples_[mid];
+    const double d2 = (s.p - q).squaredNorm();
+    if (d2 < *best2) *best2 = d2, *best = &s;
+    const double diff = q[axis_[mid]] - s.p[axis_[mid]];
+    const bool below = diff < 0.0;
+    Search(below ? lo : mid + 1, below ? mid : hi, q, best2, best);
+    if (diff * diff < *best2) Search(below ? mid + 1 : lo, below ? hi : mid, q, best2, best);
   }
 
   std::vector<Sample> samples_;
-  std::unordered_map<VoxelKey, std::vector<int>, VoxelKeyHash> cells_;
+  std::vector<int> axis_;  // split axis of the node at each index
 };
 
 double Quantile(std::vector<double>* v, double q) {
@@ -93,13 +98,13 @@ double Median(std::vector<double> v) {
 PointDeviations ComputeDeviations(const std::vector<Eigen::Vector3d>& p_map,
                                   const ReferenceMap& reference, const Trajectory& trajectory,
                                   const SurfaceQueryOptions& options) {
-  const SampleGrid grid(Resample(trajectory));
+  const SampleTree samples(Resample(trajectory));
   PointDeviations d;
   d.deviation_m.resize(p_map.size(), std::numeric_limits<double>::quiet_NaN());
   d.chainage_m.resize(p_map.size(), std::numeric_limits<double>::quiet_NaN());
   NeighborBuffer neighbors;
   for (size_t i = 0; i < p_map.size(); ++i) {
-    const Sample* view = grid.Nearest(p_map[i]);
+    const Sample* view = samples.Nearest(p_map[i]);
     if (view == nullptr) continue;
     d.chainage_m[i] = view->chainage_m;
     const SurfaceDistance s =

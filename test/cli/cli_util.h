@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -61,6 +62,15 @@ inline nlohmann::json EvalJson(const std::string& gt, const std::string& est,
   const ToolRun r = RunTool("eval --gt " + gt + " --est " + est + " --json", scratch);
   if (r.exit_code != 0) return nlohmann::json();
   return nlohmann::json::parse(r.out, nullptr, false);
+}
+
+// ATE (m) of an estimate against ground truth in the ground truth's frame
+// (`eval --align none`: a run localized in a reference map); NaN on failure.
+inline double AteNoAlign(const std::string& gt, const std::string& est, const std::string& scratch) {
+  const ToolRun r = RunTool("eval --gt " + gt + " --est " + est + " --align none --json", scratch);
+  if (r.exit_code != 0) return NAN;
+  const nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
+  return j.is_discarded() ? NAN : j["ape"]["rmse"].get<double>();
 }
 
 // Simulates a 10 s, 512-column hall without sensor noise, wall roughness or

@@ -19,18 +19,11 @@
 namespace rvlio {
 namespace {
 
+using testing_cli::AteNoAlign;
 using testing_cli::IeskfTunnelSuite;
 using testing_cli::ReadFile;
 using testing_cli::RunTool;
 using testing_cli::ToolRun;
-
-// ATE (m) of est against gt in the reference frame: no alignment.
-double AteNoAlign(const std::string& gt, const std::string& est, const std::string& scratch) {
-  const ToolRun r = RunTool("eval --gt " + gt + " --est " + est + " --align none --json", scratch);
-  if (r.exit_code != 0) return NAN;
-  const nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
-  return j.is_discarded() ? NAN : j["ape"]["rmse"].get<double>();
-}
 
 // "x,y,z,roll,pitch,yaw" of `pose` moved by dp_m (world) and rotated by
 // drot_deg about yaw, pitch and roll each (so the text's angles are off).

@@ -3,6 +3,7 @@
 // hand-written files for the cases PCL does not write (big-endian PLY, an
 // element before the vertices); and every refusal, one line naming the file.
 #include "rvlio/io/point_cloud_file.h"
+#include "rvlio/io/run_outputs.h"
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
@@ -85,6 +86,26 @@ TEST_F(PointCloudFileTest, ReadsPclPcdInEveryEncoding) {
   StatusOr<PointCloudFile> xyz_only = ReadPointCloud(Path("b.pcd"), PointCloudReadOptions{false});
   ASSERT_TRUE(xyz_only.ok());
   EXPECT_TRUE(xyz_only->fields.empty());
+}
+
+// A map.pcd of `run --map` carries deviation_m, NaN where the reference has
+// no surface: the map readers (ReadMapPcd: merge, eval, --map) take its
+// points, and the field reads back with its NaNs.
+TEST_F(PointCloudFileTest, MapWithADeviationFieldReadsAsPointsAndField) {
+  const std::vector<Eigen::Vector3d> points = {{1, 2, 3}, {-4.5, 0.25, 7}, {0, 0, -1}};
+  const std::vector<double> deviation_m = {0.012, std::numeric_limits<double>::quiet_NaN(), -0.03};
+  ASSERT_TRUE(WriteMapPcd(Path("map.pcd"), points, &deviation_m).ok());
+  StatusOr<std::vector<Eigen::Vector3d>> xyz = ReadMapPcd(Path("map.pcd"));
+  ASSERT_TRUE(xyz.ok()) << xyz.status().message();
+  ASSERT_EQ(xyz->size(), points.size());
+  for (size_t i = 0; i < points.size(); ++i) EXPECT_TRUE(xyz->at(i).isApprox(points[i], 1e-6));
+  StatusOr<PointCloudFile> cloud = ReadPointCloud(Path("map.pcd"), PointCloudReadOptions());
+  ASSERT_TRUE(cloud.ok()) << cloud.status().message();
+  const PointCloudField* field = cloud->Field("deviation_m");
+  ASSERT_NE(field, nullptr);
+  EXPECT_FLOAT_EQ(field->values[0], 0.012f);
+  EXPECT_TRUE(std::isnan(field->values[1]));
+  EXPECT_FLOAT_EQ(field->values[2], -0.03f);
 }
 
 TEST_F(PointCloudFileTest, ReadsPclPlyAsciiAndBinary) {

@@ -422,6 +422,26 @@ TEST_F(PlotScriptTest, CompareBarsFromACompareTable) {
   ExpectFigures("compare_bars");
 }
 
+// deviation.csv of `rvlio run --map`: the peak printed is the table's
+// largest p95 |deviation| at its chainage; a table without the columns is
+// refused.
+TEST_F(PlotScriptTest, DeviationAlongTheChainage) {
+  const std::string run = dir_ + "/survey";
+  fs::create_directories(run);
+  WriteText(run + "/deviation.csv",
+            "chainage_m,count,median_m,median_abs_m,p95_abs_m,max_abs_m\n"
+            "0,100,0.001,0.002,0.01,0.02\n1,120,0.02,0.021,0.048,0.06\n"
+            "2,90,,,,\n3,110,-0.001,0.003,0.012,0.03\n");
+  const Result r = Plot("deviation --run " + run + " " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("peak p95 |deviation| 0.0480 m at chainage 1.0 m"), std::string::npos)
+      << r.out;
+  ExpectFigures("deviation");
+  for (const auto& entry : fs::directory_iterator(dir_ + "/out")) fs::remove(entry.path());
+  WriteText(run + "/deviation.csv", "chainage_m,count\n0,1\n");
+  ExpectBadInput("deviation --run " + run + " " + Out(), "missing column(s) median_m");
+}
+
 // An --out ending in '/' is a folder: FOLDER/<kind>.png and .pdf.
 TEST_F(PlotScriptTest, OutputPrefixEndingInSlashIsAFolder) {
   WriteText(dir_ + "/compare.csv", "variant,status,ate_rmse_m,rpe_rmse_m,axis_max_m\n"

@@ -147,7 +147,7 @@ TEST_F(RefineSignalsTest, BadCheckpointsAreRefusedInOneLine) {
                                "--set constraints.lidar_noise=0.05 --resume " + dir_ + "/ref_ckpt");
   EXPECT_EQ(other.exit_code, 2);
   EXPECT_EQ(std::count(other.err.begin(), other.err.end(), '\n'), 1) << other.err;
-  EXPECT_NE(other.err.find("was written for another bag, initial trajectory or configuration"),
+  EXPECT_NE(other.err.find("was written for another bag, initial trajectory, --map or configuration"),
             std::string::npos) << other.err;
   EXPECT_FALSE(Exists(dir_ + "/bad2/trajectory.tum"));
 

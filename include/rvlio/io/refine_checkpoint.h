@@ -3,7 +3,8 @@
 // round (smoother/refine.h RefineRoundState) in DIR/refine.checkpoint, CBOR
 // with every double bit for bit, written atomically. A checkpoint carries the
 // fingerprint of what the refinement depends on (the input read from the bag,
-// the initial trajectory and the configuration except smoother.refine_rounds,
+// the initial trajectory, the --map file's content and the configuration
+// except smoother.refine_rounds,
 // so a resumed run may also go on for more rounds); resuming with another
 // input is refused.
 #include <cstdint>
@@ -19,7 +20,13 @@ namespace rvlio {
 
 constexpr const char* kCheckpointFile = "refine.checkpoint";
 
-uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input);
+// reference_hash: FileContentHash of the --map file (0 without one).
+uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input,
+                           uint64_t reference_hash);
+// FNV-1a 64 over a file's bytes and its size: the --map file's identity in a
+// checkpoint and in chunk.json (the content, so a map rewritten in place, or
+// another map at the same path, is another map). InvalidInput naming the file.
+StatusOr<uint64_t> FileContentHash(const std::string& path);
 // The same hash (FNV-1a 64) over the configuration alone (its JSON, except
 // smoother.refine_threads: refine's result is bit-identical on any thread
 // count) and over a trajectory's stamps and poses: what chunk.json records so
