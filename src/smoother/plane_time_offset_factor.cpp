@@ -33,9 +33,7 @@ bool PlaneTimeOffsetFactor::Evaluate(double const* const* parameters, double* re
   x.R_world_imu = T_world_imu.R;
   x.p_world_imu = T_world_imu.t;
   x.v_world_imu = SpeedBiasBlock::FromArray(parameters[1]).v_world_imu;
-  x.R_imu_lidar = T_imu_lidar_.R;
-  x.t_imu_lidar = T_imu_lidar_.t;
-  const double dt_s = parameters[2][0] - td_lin_s_;
+  const ScanTimeLinearization lin = LinearizeAtScanTime(x, motion_, parameters[2][0] - td_lin_s_);
   const int n = num_constraints();
   const bool want_pose = jacobians != nullptr && jacobians[0] != nullptr;
   const bool want_sb = jacobians != nullptr && jacobians[1] != nullptr;
@@ -51,7 +49,7 @@ bool PlaneTimeOffsetFactor::Evaluate(double const* const* parameters, double* re
     const Constraint& c = constraints_[i];
     const double s = std::sqrt(c.weight) * inv_sigma_;
     const double r =
-        PointToPlaneResidualWithTimeOffset(c, x, motion_, dt_s, want_any ? &h : nullptr);
+        PointToPlaneResidualWithTimeOffset(c, lin, T_imu_lidar_, want_any ? &h : nullptr);
     residuals[i] = s * r;
     if (want_pose) J_pose.row(i) = s * h.head<6>();
     if (want_sb) J_sb.row(i).segment<3>(SpeedBiasBlock::kVel) = s * h.segment<3>(12);
