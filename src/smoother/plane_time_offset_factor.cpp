@@ -59,4 +59,19 @@ bool PlaneTimeOffsetFactor::Evaluate(double const* const* parameters, double* re
   return true;
 }
 
+TimeOffsetRandomWalkFactor::TimeOffsetRandomWalkFactor(double random_walk, double dt_s) {
+  RVLIO_CHECK(random_walk > 0.0 && dt_s > 0.0);
+  inv_sigma_ = 1.0 / (random_walk * std::sqrt(dt_s));
+}
+
+bool TimeOffsetRandomWalkFactor::Evaluate(double const* const* parameters, double* residuals,
+                                          double** jacobians) const {
+  residuals[0] = inv_sigma_ * (parameters[1][0] - parameters[0][0]);
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) jacobians[0][0] = -inv_sigma_;
+    if (jacobians[1] != nullptr) jacobians[1][0] = inv_sigma_;
+  }
+  return true;
+}
+
 }  // namespace rvlio

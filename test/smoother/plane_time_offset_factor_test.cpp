@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <ceres/gradient_checker.h>
+#include <ceres/normal_prior.h>
 #include <gtest/gtest.h>
 
 #include "rvlio/constraints/time_offset_residual.h"
 #include "rvlio/smoother/manifolds.h"
+#include "rvlio/smoother/marginalization.h"
 #include "rvlio/smoother/plane_time_offset_factor.h"
 #include "smoother_test_util.h"
 
@@ -64,6 +67,39 @@ TEST(PlaneTimeOffsetFactor, JacobiansMatchNumericDifferences) {
     ceres::GradientChecker::ProbeResults results;
     EXPECT_TRUE(checker.Probe(params, 1e-7, &results)) << "td " << td << ": " << results.error_log;
   }
+}
+
+TEST(TimeOffsetRandomWalkFactor, ResidualAndJacobiansMatchNumericDifferences) {
+  const TimeOffsetRandomWalkFactor f(1e-3, 0.25);  // sigma = 1e-3 * 0.5 s
+  EXPECT_NEAR(test::EvaluateCost(f, {{0.031}, {0.032}})(0), (0.032 - 0.031) / 5e-4, 1e-9);
+  const std::vector<const ceres::Manifold*> euclidean = {nullptr, nullptr};
+  ceres::GradientChecker checker(&f, &euclidean, ceres::NumericDiffOptions());
+  for (const auto& [td_prev, td] : {std::pair{0.03, 0.031}, std::pair{-0.1, 0.05}}) {
+    const double* params[] = {&td_prev, &td};
+    ceres::GradientChecker::ProbeResults results;
+    EXPECT_TRUE(checker.Probe(params, 1e-9, &results)) << results.error_log;
+  }
+}
+
+// Marginalizing the previous offset through the random walk leaves the
+// window's offset with the prior's variance grown by q^2 dt.
+TEST(TimeOffsetRandomWalkFactor, MarginalizedPriorGrowsByTheWalk) {
+  const double prior_std = 2e-3, q = 1e-3, dt = 0.5;
+  ceres::Matrix A(1, 1);
+  A(0, 0) = 1.0 / prior_std;
+  ceres::Vector b(1);
+  b(0) = 0.03;
+  const ceres::NormalPrior prior(A, b);
+  const TimeOffsetRandomWalkFactor walk(q, dt);
+  double td_prev = 0.03, td = 0.03;
+  MarginalizationInfo info;
+  info.AddResidualBlock(&prior, nullptr, {&td_prev}, {0});
+  info.AddResidualBlock(&walk, nullptr, {&td_prev, &td}, {0});
+  ASSERT_TRUE(info.Marginalize().ok());
+  const MarginalizationPrior& p = *info.prior();
+  ASSERT_EQ(p.tangent_dim, 1);
+  const double information = (p.S.transpose() * p.S)(0, 0);
+  EXPECT_NEAR(1.0 / information, prior_std * prior_std + q * q * dt, 1e-12);
 }
 
 }  // namespace

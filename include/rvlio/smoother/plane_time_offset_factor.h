@@ -14,6 +14,7 @@
 // smoother/manifolds.h), [dv, 0, 0] for the speed-bias block, d(td).
 // The extrinsic is held at the given value.
 #include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/constraints/time_offset_residual.h"
@@ -38,6 +39,23 @@ class PlaneTimeOffsetFactor final : public ceres::CostFunction {
   Pose3 T_imu_lidar_;
   ScanTimeMotion motion_;
   double td_lin_s_ = 0.0;
+};
+
+// The random walk of the time offset between the offset of the scans that
+// leave the window (td_prev) and the window's (td), over dt_s of the
+// recording (lidar.time_offset_random_walk q, s/sqrt(s)):
+//   r = (td - td_prev) / (q sqrt(dt)),   dr/dtd = -dr/dtd_prev = 1 / (q sqrt(dt)).
+// Blocks: td_prev (1), td (1), both s.
+class TimeOffsetRandomWalkFactor final : public ceres::SizedCostFunction<1, 1, 1> {
+ public:
+  // random_walk > 0, dt_s > 0.
+  TimeOffsetRandomWalkFactor(double random_walk, double dt_s);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  double inv_sigma_ = 1.0;  // 1 / (q sqrt(dt))
 };
 
 }  // namespace rvlio
