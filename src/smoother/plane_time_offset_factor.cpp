@@ -12,18 +12,17 @@
 
 namespace rvlio {
 
-PlaneTimeOffsetFactor::PlaneTimeOffsetFactor(ConstraintList constraints, double sigma_m,
+using plane_summary::Matrix13d;
+using plane_summary::Vector13d;
+
+PlaneTimeOffsetFactor::PlaneTimeOffsetFactor(const ConstraintList& constraints, double sigma_m,
                                              const Pose3& T_imu_lidar,
-                                             const ScanTimeMotion& motion, double td_lin_s)
-    : constraints_(std::move(constraints)),
-      T_imu_lidar_(T_imu_lidar),
+                                             const ScanTimeMotion& motion, double td_lin_s,
+                                             const Eigen::Vector3d& center_world)
+    : summary_(constraints, T_imu_lidar, sigma_m, center_world),
       motion_(motion),
       td_lin_s_(td_lin_s) {
-  inv_sigma_ = CheckedPlaneInvSigma(constraints_, sigma_m);
-  set_num_residuals(num_constraints());
-  mutable_parameter_block_sizes()->push_back(PoseBlock::kNumParams);
-  mutable_parameter_block_sizes()->push_back(SpeedBiasBlock::kNumParams);
-  mutable_parameter_block_sizes()->push_back(1);
+  CheckedPlaneInvSigma(constraints, sigma_m);
 }
 
 bool PlaneTimeOffsetFactor::Evaluate(double const* const* parameters, double* residuals,
@@ -34,28 +33,24 @@ bool PlaneTimeOffsetFactor::Evaluate(double const* const* parameters, double* re
   x.p_world_imu = T_world_imu.t;
   x.v_world_imu = SpeedBiasBlock::FromArray(parameters[1]).v_world_imu;
   const ScanTimeLinearization lin = LinearizeAtScanTime(x, motion_, parameters[2][0] - td_lin_s_);
-  const int n = num_constraints();
-  const bool want_pose = jacobians != nullptr && jacobians[0] != nullptr;
-  const bool want_sb = jacobians != nullptr && jacobians[1] != nullptr;
-  const bool want_td = jacobians != nullptr && jacobians[2] != nullptr;
-  const bool want_any = want_pose || want_sb || want_td;
-  using RowMajorX6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>;
-  RowMajorX6 J_pose(want_pose ? n : 0, 6);
-  using RowMajorX9 = Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor>;
-  Eigen::Map<RowMajorX9> J_sb(want_sb ? jacobians[1] : nullptr, want_sb ? n : 0, 9);
-  if (want_sb) J_sb.setZero();
-  TimeOffsetJacobian h;
-  for (int i = 0; i < n; ++i) {
-    const Constraint& c = constraints_[i];
-    const double s = std::sqrt(c.weight) * inv_sigma_;
-    const double r =
-        PointToPlaneResidualWithTimeOffset(c, lin, T_imu_lidar_, want_any ? &h : nullptr);
-    residuals[i] = s * r;
-    if (want_pose) J_pose.row(i) = s * h.head<6>();
-    if (want_sb) J_sb.row(i).segment<3>(SpeedBiasBlock::kVel) = s * h.segment<3>(12);
-    if (want_td) jacobians[2][i] = s * h(15);
+  const Matrix13d& sqrt_M = summary_.sqrt_information();
+  Eigen::Map<Vector13d> r(residuals);
+  r.noalias() =
+      sqrt_M * plane_summary::PoseVector(lin.T_world_imu.R, lin.T_world_imu.t, summary_.center());
+  if (jacobians == nullptr) return true;
+  // d r / d[dtheta, dp, dphi, dt_ext, dv, d(td)]; the extrinsic columns unused.
+  const Eigen::Matrix<double, 13, 16> J =
+      sqrt_M * plane_summary::PoseVectorJacobian(lin.T_world_imu.R) * lin.h_to_J.topRows<6>();
+  if (jacobians[0] != nullptr) {
+    const Eigen::Matrix<double, 13, 6, Eigen::RowMajor> J_pose = J.leftCols<6>();
+    PoseTangentToAmbientJacobian(parameters[0], J_pose, jacobians[0]);
   }
-  if (want_pose) PoseTangentToAmbientJacobian(parameters[0], J_pose, jacobians[0]);
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 13, 9, Eigen::RowMajor>> J_sb(jacobians[1]);
+    J_sb.setZero();
+    J_sb.middleCols<3>(SpeedBiasBlock::kVel) = J.middleCols<3>(12);
+  }
+  if (jacobians[2] != nullptr) Eigen::Map<Vector13d>{jacobians[2]} = J.col(15);
   return true;
 }
 

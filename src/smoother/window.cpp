@@ -324,7 +324,8 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   if (estimate_time_offset()) {
     node->plane_td = std::make_unique<PlaneTimeOffsetFactor>(
         node->constraints, options_.constraints.lidar_noise, T_imu_lidar_config_, node->motion,
-        node->td_lin_s);
+        node->td_lin_s, T_world_imu.t);
+    if (!node->plane_td->finite()) RejectOverflowingScan(node);
     return;
   }
   if (estimate_extrinsics()) {
@@ -333,15 +334,18 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   }
   node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, T_imu_lidar_config_,
                                                      options_.constraints.lidar_noise, T_world_imu.t);
-  // Finite but absurd records (a plane 1e300 m away) overflow the summary:
-  // such a scan contributes nothing (and is associated again next round)
-  // rather than a cost Ceres cannot evaluate.
-  if (!node->plane->information().allFinite()) {
-    node->plane.reset();
-    node->constraints.clear();
-    node->associated = false;
-    ++stats_.rejected_scans;
-  }
+  if (!node->plane->information().allFinite()) RejectOverflowingScan(node);
+}
+
+// Finite but absurd records (a plane 1e300 m away) overflow the summary:
+// such a scan contributes nothing (and is associated again next round)
+// rather than a cost Ceres cannot evaluate.
+void SlidingWindow::RejectOverflowingScan(Node* node) {
+  node->plane.reset();
+  node->plane_td.reset();
+  node->constraints.clear();
+  node->associated = false;
+  ++stats_.rejected_scans;
 }
 
 // Re-integrates a preintegration whose linearization biases are far from the

@@ -232,6 +232,7 @@ class SlidingWindow {
                                         std::vector<Eigen::Vector3d> p_lidar);
   int AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
   void AssociateNode(const ScanAssociateFn& associate, Node* node);
+  void RejectOverflowingScan(Node* node);
   void RefreshImuFactors();
   bool DropNewestImuFactor();
   bool SolveRound(WindowSolveReport* report);
