@@ -155,6 +155,15 @@ double LidarOnlyRotationDeg(const MatrixC& HtRinvH, const VectorC& HtRinvz) {
   return dtheta.allFinite() ? dtheta.norm() * 180.0 / M_PI : std::numeric_limits<double>::quiet_NaN();
 }
 
+// The motion a scan's time offset is observed through (its Jacobian column
+// h_theta w + h_p v): below these, at rest within the IMU noise.
+constexpr double kTimeOffsetMinRate = 0.05;   // rad/s
+constexpr double kTimeOffsetMinSpeed = 0.05;  // m/s
+
+bool TimeOffsetObservable(const Eigen::Vector3d& v_world_imu, const ScanTimeMotion& motion) {
+  return motion.gyro_imu.norm() >= kTimeOffsetMinRate || v_world_imu.norm() >= kTimeOffsetMinSpeed;
+}
+
 }  // namespace
 
 // The extrinsic block is not adjacent to the pose block in the error state
@@ -353,6 +362,10 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
   [[maybe_unused]] Matrix24x12d E;
   if constexpr (kTimeOffset) {
     td_rows = TimeOffsetErrorStateRows(free);
+    // At rest the offset's column (w, v) is IMU noise alone: no update of
+    // the offset (it would fit the noise and leave a confident wrong value
+    // for the motion to undo).
+    if (!TimeOffsetObservable(x0.v_world_imu, scan_motion_)) td_rows[15] = -1;
   } else {
     E = ErrorStateColumns(free);
   }
