@@ -61,6 +61,7 @@ ex=(
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   'PresetsAndBackends/TimeOffsetMatrix\..*'
   TimeOffsetCliTest.SmootherEstimatesA30MsOffset
+  TimeOffsetCliTest.EstimateFollowsADriftingOffset
   DivergenceCli.UpsideDownLidarIsCaughtOnAShortFlight
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData

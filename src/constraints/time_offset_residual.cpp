@@ -21,22 +21,36 @@ Pose3 ScanTimePose(const FilterState& x, const ScanTimeMotion& motion, double dt
 //   R Exp(dtheta) Exp(w dt) = R Exp(w dt) Exp(Exp(-w dt) dtheta)
 //     => dr/dtheta = h_theta Exp(w dt)^T;  dr/dp = h_p;  dr/dv = h_p dt;
 //   R Exp(w (dt + e)) = R Exp(w dt) Exp(w e)
-//     => dr/d(td) = h_theta w + h_p (v + a dt).
+//     => dr/d(td) = h_theta w + h_p (v + a dt);
+// the extrinsic columns pass through.
+ScanTimeLinearization LinearizeAtScanTime(const FilterState& x, const ScanTimeMotion& motion,
+                                          double dt_s) {
+  ScanTimeLinearization lin;
+  lin.T_world_imu = ScanTimePose(x, motion, dt_s);
+  Eigen::Matrix<double, 12, 16>& M = lin.h_to_J;
+  M.setZero();
+  M.block<3, 3>(0, 0) = so3::Exp(motion.gyro_imu * dt_s).transpose();
+  M.block<9, 9>(3, 3).setIdentity();
+  M.block<3, 3>(3, 12) = Eigen::Matrix3d::Identity() * dt_s;
+  M.block<3, 1>(0, 15) = motion.gyro_imu;
+  M.block<3, 1>(3, 15) = x.v_world_imu + motion.acc_world * dt_s;
+  return lin;
+}
+
+double PointToPlaneResidualWithTimeOffset(const Constraint& c, const ScanTimeLinearization& lin,
+                                          const Pose3& T_imu_lidar, TimeOffsetJacobian* J) {
+  if (J == nullptr) return PointToPlaneResidual(c, lin.T_world_imu, T_imu_lidar);
+  Eigen::Matrix<double, 1, 12> h;
+  const double r = PointToPlaneResidualWithExtrinsics(c, lin.T_world_imu, T_imu_lidar, &h);
+  J->noalias() = h * lin.h_to_J;
+  return r;
+}
+
 double PointToPlaneResidualWithTimeOffset(const Constraint& c, const FilterState& x,
                                           const ScanTimeMotion& motion, double dt_s,
                                           TimeOffsetJacobian* J) {
-  const Pose3 T_world_imu = ScanTimePose(x, motion, dt_s);
-  if (J == nullptr) return PointToPlaneResidual(c, T_world_imu, x.T_imu_lidar());
-  Eigen::Matrix<double, 1, 12> h;
-  const double r = PointToPlaneResidualWithExtrinsics(c, T_world_imu, x.T_imu_lidar(), &h);
-  const Eigen::Matrix3d R_step = so3::Exp(motion.gyro_imu * dt_s);
-  const Eigen::RowVector3d h_rot = h.head<3>(), h_pos = h.segment<3>(3);
-  J->head<3>() = h_rot * R_step.transpose();
-  J->segment<9>(3) = h.segment<9>(3);
-  J->segment<3>(12) = h_pos * dt_s;
-  (*J)(15) = h_rot.dot(motion.gyro_imu) +
-             h_pos.dot(x.v_world_imu + motion.acc_world * dt_s);
-  return r;
+  return PointToPlaneResidualWithTimeOffset(c, LinearizeAtScanTime(x, motion, dt_s),
+                                            x.T_imu_lidar(), J);
 }
 
 }  // namespace rvlio

@@ -81,24 +81,35 @@ int AccumulateNormalEquations(const ConstraintList& constraints, const FilterSta
   return static_cast<int>(constraints.size());
 }
 
-// The same with the time-offset columns (TimeOffsetJacobian): 16 columns
-// [dtheta, dp, dphi, dt_ext, dv, d(td)], extrinsic columns zero unless estimated.
+// The same with the time-offset columns (TimeOffsetJacobian): the sums of
+// the 12 columns at the scan-time pose (AccumulateNormalEquations, the same
+// per-constraint work as without the offset) mapped once to the 16 columns
+// [dtheta, dp, dphi, dt_ext, dv, d(td)] (ScanTimeLinearization::h_to_J);
+// extrinsic columns zero unless estimated.
 void AccumulateNormalEquationsWithTimeOffset(const ConstraintList& constraints,
-                                             const FilterState& x, const ScanTimeMotion& motion,
-                                             double dt_s, bool with_extrinsics, double inv_sigma2,
+                                             const FilterState& x_scan,
+                                             const ScanTimeLinearization& lin,
+                                             bool with_extrinsics, double inv_sigma2,
                                              Matrix16d* HtRinvH, Vector16d* HtRinvz,
                                              double* zRinvz) {
-  HtRinvH->setZero();
-  HtRinvz->setZero();
-  *zRinvz = 0.0;
-  TimeOffsetJacobian h;
-  for (const Constraint& c : constraints) {
-    const double r = PointToPlaneResidualWithTimeOffset(c, x, motion, dt_s, &h);
-    if (!with_extrinsics) h.segment<6>(6).setZero();
-    const double w = c.weight * inv_sigma2;
-    *zRinvz += w * r * r;
-    HtRinvH->noalias() += w * h.transpose() * h;
-    HtRinvz->noalias() += w * r * h.transpose();
+  Matrix12d H12;
+  Vector12d b12;
+  AccumulateNormalEquations(constraints, x_scan, with_extrinsics, inv_sigma2, &H12, &b12, zRinvz);
+  HtRinvH->noalias() = lin.h_to_J.transpose() * H12 * lin.h_to_J;
+  HtRinvz->noalias() = lin.h_to_J.transpose() * b12;
+}
+
+// A += E H E^T, b += E g for a column map E with one 1 per used column:
+// index[c] is the error-state row of column c, -1 for an unused column.
+template <int N, int C>
+void ScatterNormalEquations(const std::array<int, C>& index, const Eigen::Matrix<double, C, C>& H,
+                            const Eigen::Matrix<double, C, 1>& g,
+                            Eigen::Matrix<double, N, N>* A, Eigen::Matrix<double, N, 1>* b) {
+  for (int i = 0; i < C; ++i) {
+    if (index[i] < 0) continue;
+    (*b)(index[i]) += g(i);
+    for (int j = 0; j < C; ++j)
+      if (index[j] >= 0) (*A)(index[i], index[j]) += H(i, j);
   }
 }
 
@@ -144,6 +155,15 @@ double LidarOnlyRotationDeg(const MatrixC& HtRinvH, const VectorC& HtRinvz) {
   return dtheta.allFinite() ? dtheta.norm() * 180.0 / M_PI : std::numeric_limits<double>::quiet_NaN();
 }
 
+// The motion a scan's time offset is observed through (its Jacobian column
+// h_theta w + h_p v): below these, at rest within the IMU noise.
+constexpr double kTimeOffsetMinRate = 0.05;   // rad/s
+constexpr double kTimeOffsetMinSpeed = 0.05;  // m/s
+
+bool TimeOffsetObservable(const Eigen::Vector3d& v_world_imu, const ScanTimeMotion& motion) {
+  return motion.gyro_imu.norm() >= kTimeOffsetMinRate || v_world_imu.norm() >= kTimeOffsetMinSpeed;
+}
+
 }  // namespace
 
 // The extrinsic block is not adjacent to the pose block in the error state
@@ -157,14 +177,17 @@ Matrix24x12d ErrorStateColumns(const std::array<bool, 6>& free) {
 }
 
 // The rows of TimeOffsetJacobian's 16 columns in the 25-dim augmented error
-// state [FilterState, td].
-static Eigen::Matrix<double, 25, 16> TimeOffsetErrorStateColumns(
-    const std::array<bool, 6>& free) {
-  Eigen::Matrix<double, 25, 16> E = Eigen::Matrix<double, 25, 16>::Zero();
-  E.topLeftCorner<24, 12>() = ErrorStateColumns(free);
-  E.block<3, 3>(FilterState::kVel, 12).setIdentity();
-  E(kTimeOffsetIndex, 15) = 1.0;
-  return E;
+// state [FilterState, td]; -1 for an extrinsic axis held fixed.
+static std::array<int, 16> TimeOffsetErrorStateRows(const std::array<bool, 6>& free) {
+  std::array<int, 16> rows{};
+  for (int i = 0; i < 3; ++i) {
+    rows[i] = FilterState::kRot + i;
+    rows[3 + i] = FilterState::kPos + i;
+    rows[12 + i] = FilterState::kVel + i;
+  }
+  for (int i = 0; i < 6; ++i) rows[6 + i] = free[i] ? FilterState::kExtRot + i : -1;
+  rows[15] = kTimeOffsetIndex;
+  return rows;
 }
 
 Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
@@ -333,9 +356,16 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
   const int cols = with_ext ? 12 : 6;
   std::array<bool, 6> free{};
   for (int i = 0; i < 6; ++i) free[i] = with_ext && excitation_.excited(i);
-  Eigen::Matrix<double, N, C> E;
+  // Where the Jacobian columns go: ErrorStateColumns (24) or
+  // TimeOffsetErrorStateRows (25).
+  [[maybe_unused]] std::array<int, 16> td_rows{};
+  [[maybe_unused]] Matrix24x12d E;
   if constexpr (kTimeOffset) {
-    E = TimeOffsetErrorStateColumns(free);
+    td_rows = TimeOffsetErrorStateRows(free);
+    // At rest the offset's column (w, v) is IMU noise alone: no update of
+    // the offset (it would fit the noise and leave a confident wrong value
+    // for the motion to undo).
+    if (!TimeOffsetObservable(x0.v_world_imu, scan_motion_)) td_rows[15] = -1;
   } else {
     E = ErrorStateColumns(free);
   }
@@ -343,13 +373,15 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
 
   FilterState x = x0;
   double td_s = td_s_;
-  // The state at the scan's time, as association and RV see it.
+  // The state at the scan's time, as association, RV and the residuals see
+  // it; lin: the scan-time linearization of the iteration (kTimeOffset).
+  [[maybe_unused]] ScanTimeLinearization lin;
   auto at_scan_time = [&](const FilterState& s) {
     if constexpr (kTimeOffset) {
+      lin = LinearizeAtScanTime(s, scan_motion_, td_s - td_lin_s_);
       FilterState moved = s;
-      const Pose3 T = ScanTimePose(s, scan_motion_, td_s - td_lin_s_);
-      moved.R_world_imu = T.R;
-      moved.p_world_imu = T.t;
+      moved.R_world_imu = lin.T_world_imu.R;
+      moved.p_world_imu = lin.T_world_imu.t;
       return moved;
     } else {
       return s;
@@ -369,8 +401,8 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
     if (result.num_constraints < kMinPoseConstraints) break;
     double zRinvz = 0.0;
     if constexpr (kTimeOffset) {
-      AccumulateNormalEquationsWithTimeOffset(constraints, x, scan_motion_, td_s - td_lin_s_,
-                                              with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
+      AccumulateNormalEquationsWithTimeOffset(constraints, x_scan, lin, with_ext, inv_sigma2,
+                                              &HtRinvH, &HtRinvz, &zRinvz);
     } else {
       AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
     }
@@ -390,7 +422,9 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
     const MatrixN Pv_inv = Jn.transpose() * P0_inv * Jn;
     MatrixN A = Pv_inv;
     VectorN b = Pv_inv * e;
-    if (with_ext || kTimeOffset) {
+    if constexpr (kTimeOffset) {
+      ScatterNormalEquations<N, C>(td_rows, HtRinvH, HtRinvz, &A, &b);
+    } else if (with_ext) {
       A.noalias() += E * HtRinvH * E.transpose();
       b.noalias() += E * HtRinvz;
     } else {

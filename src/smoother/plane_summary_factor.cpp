@@ -44,6 +44,22 @@ Eigen::Matrix<double, 9, 1> RightRotationColumn(const Eigen::Matrix3d& R, int k)
   return Eigen::Map<const Eigen::Matrix<double, 9, 1>>(dR.data());  // column-major vec
 }
 
+Vector13d PoseVector(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                     const Eigen::Vector3d& center) {
+  Vector13d z;
+  z.head<9>() = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R.data());  // column-major vec
+  z.segment<3>(9) = t - center;
+  z(12) = 1.0;
+  return z;
+}
+
+Eigen::Matrix<double, 13, 6> PoseVectorJacobian(const Eigen::Matrix3d& R) {
+  Eigen::Matrix<double, 13, 6> dz = Eigen::Matrix<double, 13, 6>::Zero();
+  for (int k = 0; k < 3; ++k) dz.block<9, 1>(0, k) = RightRotationColumn(R, k);
+  dz.block<3, 3>(9, 3).setIdentity();
+  return dz;
+}
+
 }  // namespace plane_summary
 
 // M = sum_i a_i a_i^T, then its square root.
@@ -68,18 +84,13 @@ bool PlaneSummaryFactor::Evaluate(double const* const* parameters, double* resid
                                   double** jacobians) const {
   const PoseBlock pose = PoseBlock::FromArray(parameters[0]);
   const Eigen::Matrix3d R = pose.q_world_imu.normalized().toRotationMatrix();
-  Vector13d z;
-  z.head<9>() = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R.data());  // column-major vec
-  z.segment<3>(9) = pose.p_world_imu - center_;
-  z(12) = 1.0;
+  const Vector13d z = plane_summary::PoseVector(R, pose.p_world_imu, center_);
   Eigen::Map<Vector13d> r(residuals);
   r.noalias() = sqrt_M_ * z;
   if (jacobians == nullptr || jacobians[0] == nullptr) return true;
-  Eigen::Matrix<double, 13, 6> dz = Eigen::Matrix<double, 13, 6>::Zero();
-  for (int k = 0; k < 3; ++k)
-    dz.block<9, 1>(0, PoseBlock::kRot + k) = plane_summary::RightRotationColumn(R, k);
-  dz.block<3, 3>(9, PoseBlock::kTrans).setIdentity();
-  const Eigen::Matrix<double, 13, 6, Eigen::RowMajor> J_t = sqrt_M_ * dz;
+  static_assert(PoseBlock::kRot == 0 && PoseBlock::kTrans == 3, "tangent order [d_rot, d_pos]");
+  const Eigen::Matrix<double, 13, 6, Eigen::RowMajor> J_t =
+      sqrt_M_ * plane_summary::PoseVectorJacobian(R);
   PoseTangentToAmbientJacobian(parameters[0], J_t, jacobians[0]);
   return true;
 }

@@ -324,7 +324,8 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   if (estimate_time_offset()) {
     node->plane_td = std::make_unique<PlaneTimeOffsetFactor>(
         node->constraints, options_.constraints.lidar_noise, T_imu_lidar_config_, node->motion,
-        node->td_lin_s);
+        node->td_lin_s, T_world_imu.t);
+    if (!node->plane_td->finite()) RejectOverflowingScan(node);
     return;
   }
   if (estimate_extrinsics()) {
@@ -333,15 +334,18 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   }
   node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, T_imu_lidar_config_,
                                                      options_.constraints.lidar_noise, T_world_imu.t);
-  // Finite but absurd records (a plane 1e300 m away) overflow the summary:
-  // such a scan contributes nothing (and is associated again next round)
-  // rather than a cost Ceres cannot evaluate.
-  if (!node->plane->information().allFinite()) {
-    node->plane.reset();
-    node->constraints.clear();
-    node->associated = false;
-    ++stats_.rejected_scans;
-  }
+  if (!node->plane->information().allFinite()) RejectOverflowingScan(node);
+}
+
+// Finite but absurd records (a plane 1e300 m away) overflow the summary:
+// such a scan contributes nothing (and is associated again next round)
+// rather than a cost Ceres cannot evaluate.
+void SlidingWindow::RejectOverflowingScan(Node* node) {
+  node->plane.reset();
+  node->plane_td.reset();
+  node->constraints.clear();
+  node->associated = false;
+  ++stats_.rejected_scans;
 }
 
 // Re-integrates a preintegration whose linearization biases are far from the
@@ -498,14 +502,27 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   info.SetManifold(old.pose, &pose_manifold_);
   info.SetManifold(next.pose, &pose_manifold_);
   if (estimate_extrinsics()) info.SetManifold(extrinsic_, &pose_manifold_);
-  const auto dropped = [&old](const std::vector<double*>& blocks) {
+  // lidar.time_offset_random_walk: the offset of the leaving scan and of the
+  // information before it (td_prev, dropped with the scan) is tied to the
+  // window's offset by a random walk over the interval to the next scan, so
+  // the prior carries the offset with its variance grown by q^2 dt. Without
+  // it (q = 0) one offset for the whole recording.
+  const double walk_dt_s = NsToSeconds(next.t_ns - old.t_ns);
+  const bool walk = estimate_time_offset() && options_.lidar.time_offset_random_walk > 0.0 &&
+                    walk_dt_s > 0.0;
+  double td_prev[1] = {time_offset_[0]};
+  double* const td_old = walk ? td_prev : time_offset_;
+  const auto dropped = [&old, td_prev_ptr = walk ? td_prev : nullptr](
+                           const std::vector<double*>& blocks) {
     std::vector<int> indices;
     for (size_t i = 0; i < blocks.size(); ++i)
-      if (blocks[i] == old.pose || blocks[i] == old.sb) indices.push_back(static_cast<int>(i));
+      if (blocks[i] == old.pose || blocks[i] == old.sb || blocks[i] == td_prev_ptr)
+        indices.push_back(static_cast<int>(i));
     return indices;
   };
   if (marginal_prior_) {
-    const std::vector<double*>& blocks = marginal_prior_->prior().blocks;
+    std::vector<double*> blocks = marginal_prior_->prior().blocks;
+    std::replace(blocks.begin(), blocks.end(), static_cast<double*>(time_offset_), td_old);
     info.AddResidualBlock(marginal_prior_.get(), nullptr, blocks, dropped(blocks));
   }
   if (state_prior_) info.AddResidualBlock(state_prior_.get(), nullptr, {old.pose, old.sb}, {0, 1});
@@ -514,9 +531,16 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
     info.AddResidualBlock(old.plane_ext.get(), nullptr, {old.pose, extrinsic_}, {0});
   if (extrinsic_prior_) info.AddResidualBlock(extrinsic_prior_.get(), nullptr, {extrinsic_}, {});
   if (old.plane_td)
-    info.AddResidualBlock(old.plane_td.get(), nullptr, {old.pose, old.sb, time_offset_}, {0, 1});
+    info.AddResidualBlock(old.plane_td.get(), nullptr, {old.pose, old.sb, td_old},
+                          dropped({old.pose, old.sb, td_old}));
   if (time_offset_prior_)
-    info.AddResidualBlock(time_offset_prior_.get(), nullptr, {time_offset_}, {});
+    info.AddResidualBlock(time_offset_prior_.get(), nullptr, {td_old}, dropped({td_old}));
+  std::unique_ptr<TimeOffsetRandomWalkFactor> td_walk;
+  if (walk) {
+    td_walk = std::make_unique<TimeOffsetRandomWalkFactor>(options_.lidar.time_offset_random_walk,
+                                                           walk_dt_s);
+    info.AddResidualBlock(td_walk.get(), nullptr, {td_prev, time_offset_}, {0});
+  }
   if (next.imu)
     info.AddResidualBlock(next.imu.get(), nullptr, {old.pose, old.sb, next.pose, next.sb}, {0, 1});
   else

@@ -28,8 +28,28 @@ Pose3 ScanTimePose(const FilterState& x, const ScanTimeMotion& motion, double dt
 // the offset in seconds).
 using TimeOffsetJacobian = Eigen::Matrix<double, 1, 16>;
 
-// r of Eq. (3) at ScanTimePose(x, motion, dt_s); J (optional) = dr / the
-// columns above (the pose and velocity columns perturb x at its own time).
+// What every constraint of a scan shares at one linearization point (x,
+// motion, dt): the scan-time IMU pose and the chain from the 12 columns h of
+// PointToPlaneResidualWithExtrinsics at that pose ([dtheta, dp, dphi, dt_ext]
+// at the scan's time) to TimeOffsetJacobian's 16: J = h * h_to_J. Computed
+// once per linearization point, so the per-constraint work is that of the
+// residual without the offset; a sum of h^T h over the constraints maps to
+// the 16 columns as h_to_J^T (sum h^T h) h_to_J.
+struct ScanTimeLinearization {
+  Pose3 T_world_imu;
+  Eigen::Matrix<double, 12, 16> h_to_J;
+};
+
+ScanTimeLinearization LinearizeAtScanTime(const FilterState& x, const ScanTimeMotion& motion,
+                                          double dt_s);
+
+// r of Eq. (3) at lin.T_world_imu; J (optional) = dr / the columns above
+// (the pose and velocity columns perturb x at its own time).
+double PointToPlaneResidualWithTimeOffset(const Constraint& c, const ScanTimeLinearization& lin,
+                                          const Pose3& T_imu_lidar,
+                                          TimeOffsetJacobian* J = nullptr);
+
+// The same for one constraint, linearized on the spot.
 double PointToPlaneResidualWithTimeOffset(const Constraint& c, const FilterState& x,
                                           const ScanTimeMotion& motion, double dt_s,
                                           TimeOffsetJacobian* J = nullptr);

@@ -40,8 +40,7 @@ class PlaneFactor final : public ceres::CostFunction {
   Eigen::VectorXd scale_;    // sqrt(weight) / sigma, 1/m
 };
 
-// The checks of a plane factor that keeps its constraints (the extrinsic and
-// time-offset factors): non-empty, sigma_m > 0, weights >= 0. Returns
+// The checks of the extrinsic and time-offset plane factors: non-empty, sigma_m > 0, weights >= 0. Returns
 // 1 / sigma_m.
 double CheckedPlaneInvSigma(const ConstraintList& constraints, double sigma_m);
 

@@ -47,6 +47,13 @@ Matrix13d SqrtInformation(const Matrix13d& M_lower);
 // Column k (0..2) of d vec(R Exp(d_rot)) / d d_rot at d_rot = 0: vec(R Hat(e_k)).
 Eigen::Matrix<double, 9, 1> RightRotationColumn(const Eigen::Matrix3d& R, int k);
 
+// z = [vec(R) (column-major); t - center; 1] of a world pose (R, t).
+Vector13d PoseVector(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                     const Eigen::Vector3d& center);
+
+// dz / d[d_rot, d_pos] for the perturbation (R Exp(d_rot), t + d_pos).
+Eigen::Matrix<double, 13, 6> PoseVectorJacobian(const Eigen::Matrix3d& R);
+
 }  // namespace plane_summary
 
 class PlaneSummaryFactor final : public ceres::SizedCostFunction<13, 7> {
@@ -64,6 +71,8 @@ class PlaneSummaryFactor final : public ceres::SizedCostFunction<13, 7> {
 
   int num_constraints() const { return num_constraints_; }
   const Matrix13d& information() const { return M_; }  // M above
+  const Matrix13d& sqrt_information() const { return sqrt_M_; }  // L^1/2 V^T
+  const Eigen::Vector3d& center() const { return center_; }
 
  private:
   Eigen::Vector3d center_;

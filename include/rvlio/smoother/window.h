@@ -51,8 +51,11 @@
 // td - td_lin by the motion held at the state, plane_time_offset_factor.h).
 // As with the extrinsic, its prior (lidar.time_offset, time_offset_init_std)
 // enters the first marginalization and the offset is then a kept block of the
-// marginalization prior. An estimate past lidar.time_offset_max is held at the
-// bound and reported (time_offset_at_bound()).
+// marginalization prior. At each marginalization the offset of the leaving
+// scan is tied to the window's by a random walk (lidar.time_offset_random_walk,
+// TimeOffsetRandomWalkFactor), so the prior holds it with a variance grown by
+// q^2 dt. An estimate past lidar.time_offset_max is held at the bound and
+// reported (time_offset_at_bound()).
 //
 // The window owns no map: association is a callback, so the window can be
 // driven by the odometry's voxel map or by an exact synthetic world.
@@ -232,6 +235,7 @@ class SlidingWindow {
                                         std::vector<Eigen::Vector3d> p_lidar);
   int AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
   void AssociateNode(const ScanAssociateFn& associate, Node* node);
+  void RejectOverflowingScan(Node* node);
   void RefreshImuFactors();
   bool DropNewestImuFactor();
   bool SolveRound(WindowSolveReport* report);
