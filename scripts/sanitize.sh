@@ -60,8 +60,6 @@ ex=(
   CompareTest.RefMapAddsMapColumnsInTheGroundTruthFrame
   'AblateRunTest\..*' 'PlotScriptTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   'PresetsAndBackends/TimeOffsetMatrix\..*'
-  TimeOffsetCliTest.SmootherEstimatesA30MsOffset
-  TimeOffsetCliTest.EstimateFollowsADriftingOffset
   DivergenceCli.UpsideDownLidarIsCaughtOnAShortFlight
   DivergenceCli.AccelerometerReportsGButConfigSaysMetresPerSecondSquared
   DivergenceCli.AccelerometerUnitGGivenForMetresPerSecondSquaredData
