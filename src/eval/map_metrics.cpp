@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "rvlio/common/parallel.h"
+#include "rvlio/map/voxel_order.h"
 
 namespace rvlio {
 
@@ -31,11 +32,17 @@ MapPointDistances MapToReference(const std::vector<Eigen::Vector3d>& map_points,
   SurfaceQueryOptions surface = options.surface;
   // The plane search must reach at least as far as the inlier test.
   surface.search_radius = std::max(surface.search_radius, options.max_distance);
+  // Queried voxel by voxel so that consecutive queries meet the same
+  // reference voxels in the cache; each result goes to its own index, so the
+  // numbers do not depend on the order.
+  const std::vector<uint32_t> order = VoxelOrder(map_points, options.search.voxel_size);
   const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
   ParallelFor(0, chunks, options.threads, [&](int chunk, int) {
     NeighborBuffer neighbors;
     const size_t end = std::min(n, static_cast<size_t>(chunk + 1) * kChunk);
-    for (size_t i = static_cast<size_t>(chunk) * kChunk; i < end; ++i) {
+    for (size_t j = static_cast<size_t>(chunk) * kChunk; j < end; ++j) {
+      PrefetchAhead(map_points, order, j);
+      const size_t i = order[j];
       const SurfaceDistance s = QueryReferenceSurface(ref, map_points[i], surface, &neighbors);
       d.nearest_m[i] = s.nearest_m;
       if (s.has_surface()) d.plane_m[i] = std::abs(s.signed_m);
@@ -48,14 +55,18 @@ MapPointDistances MapToReference(const std::vector<Eigen::Vector3d>& map_points,
 std::vector<double> ReferenceToMap(const std::vector<Eigen::Vector3d>& ref_points,
                                    const ReferenceMap& map, const MapEvalOptions& options) {
   const size_t n = ref_points.size();
+  const std::vector<uint32_t> order = VoxelOrder(ref_points, options.search.voxel_size);  // as above
   std::vector<double> nearest_m(n, kNaN);
   const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
   ParallelFor(0, chunks, options.threads, [&](int chunk, int) {
     NeighborBuffer neighbors;
     const size_t end = std::min(n, static_cast<size_t>(chunk + 1) * kChunk);
-    for (size_t i = static_cast<size_t>(chunk) * kChunk; i < end; ++i)
+    for (size_t j = static_cast<size_t>(chunk) * kChunk; j < end; ++j) {
+      PrefetchAhead(ref_points, order, j);
+      const size_t i = order[j];
       if (map.KNearest(ref_points[i], 1, options.max_distance, &neighbors) == 1)
         nearest_m[i] = std::sqrt(neighbors.dist2[0]);
+    }
   });
   return nearest_m;
 }

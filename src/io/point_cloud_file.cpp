@@ -467,6 +467,18 @@ Status ReadWholeFile(const std::string& path, std::string* text) {
     return Status::InvalidInput(path + ": is a directory, not a point cloud file");
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::InvalidInput(path + ": cannot open (" + std::strerror(errno) + ")");
+  // A regular file is read straight into a string of its size: a stream
+  // buffer would grow by copies and be copied once more (a 10 M point cloud
+  // is 120 MB). A pipe has no size: read through a stream buffer.
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size >= 0 && in.seekg(0, std::ios::beg)) {
+    text->resize(static_cast<size_t>(size));
+    in.read(text->data(), size);
+    if (in.gcount() != size) return Status::InvalidInput(path + ": read error");
+    return Status::Ok();
+  }
+  in.clear();
   std::ostringstream buffer;
   buffer << in.rdbuf();
   if (in.bad()) return Status::InvalidInput(path + ": read error");
