@@ -1,5 +1,8 @@
 #include "rvlio/map/reference_map.h"
 
+#include "rvlio/common/check.h"
+#include "rvlio/map/voxel_order.h"
+
 namespace rvlio {
 
 namespace {
@@ -16,8 +19,17 @@ MapOptions StaticMapOptions(const ReferenceMapOptions& options) {
 
 ReferenceMap::ReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
                            const ReferenceMapOptions& options)
+    : ReferenceMap(p_ref, VoxelOrder(p_ref, options.voxel_size), options) {}
+
+ReferenceMap::ReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
+                           const std::vector<uint32_t>& order, const ReferenceMapOptions& options)
     : map_(StaticMapOptions(options)) {
-  for (const Eigen::Vector3d& p : p_ref) {
+  RVLIO_CHECK(order.size() == p_ref.size());
+  // Filled voxel by voxel: each voxel's block is grown while it is in the
+  // cache, and neighbouring voxels' blocks lie close together in the pool.
+  for (size_t j = 0; j < order.size(); ++j) {
+    PrefetchAhead(p_ref, order, j);
+    const Eigen::Vector3d& p = p_ref[order[j]];
     if (map_.InsertPoint(p))
       bounds_.extend(p.cast<float>().cast<double>());  // the stored (float) coordinates
     else

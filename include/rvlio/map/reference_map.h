@@ -9,6 +9,7 @@
 // (constraints/neighbor_search.h); QueryReferenceSurface
 // (constraints/reference_surface.h) fits the local plane.
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -39,6 +40,11 @@ class ReferenceMap {
   // 65535 in one voxel) are counted in NumSkipped().
   explicit ReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
                         const ReferenceMapOptions& options = ReferenceMapOptions());
+  // The same, inserting the points in `order` (a permutation of p_ref's
+  // indices): VoxelOrder(p_ref, options.voxel_size), which the constructor
+  // above computes, for a caller that needs that order anyway.
+  ReferenceMap(const std::vector<Eigen::Vector3d>& p_ref, const std::vector<uint32_t>& order,
+               const ReferenceMapOptions& options);
 
   // Exact k nearest stored points of q_ref within max_dist (m), sorted by
   // distance (VoxelMap::KNearest). 1 <= k <= kMaxNeighbors. No allocation.
