@@ -45,7 +45,12 @@ ros::Time RosTime(TimeNs t_ns) {
 class RosbagSensorReader final : public SensorBagReader {
  public:
   RosbagSensorReader(std::string path, LidarOptions lidar, ImuOptions imu)
-      : path_(std::move(path)), lidar_(std::move(lidar)), imu_(std::move(imu)), gate_(imu_, lidar_, path_) {}
+      : path_(std::move(path)),
+        lidar_(std::move(lidar)),
+        imu_(std::move(imu)),
+        lidar_where_("lidar.topic '" + lidar_.topic + "' in '" + path_ + "'"),
+        imu_where_("imu.topic '" + imu_.topic + "' in '" + path_ + "'"),
+        gate_(imu_, lidar_, path_) {}
 
   Status Init(const std::optional<ReceiveTimeRange>& range) {
     if (Status s = bag_detail::OpenForRead(path_, &bag_); !s.ok()) return s;
@@ -109,11 +114,9 @@ class RosbagSensorReader final : public SensorBagReader {
   // True when *out holds a new sample; false when it was dropped.
   StatusOr<bool> ReadImu(const rosbag::MessageInstance& m, ImuSample* out) {
     if (m.getMD5Sum() != bag_detail::kImuMd5)
-      return Status::InvalidInput("imu.topic '" + imu_.topic + "' in '" + path_ +
-                                  "' does not hold sensor_msgs/Imu");
+      return Status::InvalidInput(imu_where_ + " does not hold sensor_msgs/Imu");
     const size_t size = bag_detail::ReadRawMessage(m, &bytes_);
-    StatusOr<bag_detail::Ros1Imu> msg = bag_detail::ParseRos1Imu(
-        bytes_.data(), size, "imu.topic '" + imu_.topic + "' in '" + path_ + "'");
+    StatusOr<bag_detail::Ros1Imu> msg = bag_detail::ParseRos1Imu(bytes_.data(), size, imu_where_);
     if (!msg.ok()) return msg.status();
     const auto& a = msg->linear_acceleration;
     const auto& w = msg->angular_velocity;
@@ -133,28 +136,26 @@ class RosbagSensorReader final : public SensorBagReader {
   // The cloud parsed in place from the message bytes (bytes_ is reused:
   // no allocation or zero-filled copy per message).
   StatusOr<Scan> DecodeCloud(const rosbag::MessageInstance& m, DecodeStats* decode) {
-    const std::string where = "lidar.topic '" + lidar_.topic + "' in '" + path_ + "'";
     if (m.getMD5Sum() != bag_detail::kPointCloud2Md5)
-      return Status::InvalidInput(where + " does not hold sensor_msgs/PointCloud2");
+      return Status::InvalidInput(lidar_where_ + " does not hold sensor_msgs/PointCloud2");
     const size_t size = bag_detail::ReadRawMessage(m, &bytes_);
     StatusOr<PointCloud2View> cloud =
-        bag_detail::ParseRos1PointCloud2(bytes_.data(), size, lidar_.topic, where);
+        bag_detail::ParseRos1PointCloud2(bytes_.data(), size, lidar_.topic, lidar_where_);
     if (!cloud.ok()) return cloud.status();
     return DecodePointCloud2(*cloud, lidar_, decode);
   }
 
   // Raw message bytes through the ROS-free parser (io/livox.h).
   StatusOr<Scan> DecodeLivox(const rosbag::MessageInstance& m, DecodeStats* decode) {
-    const std::string where = "lidar.topic '" + lidar_.topic + "' in '" + path_ + "'";
     if (m.getMD5Sum() != kLivoxRos1Md5)
-      return Status::InvalidInput(where + " holds " + kLivoxRos1Type + " with md5 " +
+      return Status::InvalidInput(lidar_where_ + " holds " + kLivoxRos1Type + " with md5 " +
                                   m.getMD5Sum() + ", not the driver's " + kLivoxRos1Md5 +
                                   " (a different message layout)");
     const size_t size = bag_detail::ReadRawMessage(m, &bytes_);
-    StatusOr<LivoxCustomMsg> msg = ParseLivoxRos1(bytes_.data(), size, where);
+    StatusOr<LivoxCustomMsg> msg = ParseLivoxRos1(bytes_.data(), size, lidar_where_);
     if (!msg.ok()) return msg.status();
     StatusOr<Scan> scan = DecodeLivoxCustomMsg(*msg, lidar_, decode);
-    if (!scan.ok()) return Status::InvalidInput(where + ": " + scan.status().message());
+    if (!scan.ok()) return Status::InvalidInput(lidar_where_ + ": " + scan.status().message());
     return scan;
   }
 
@@ -162,6 +163,8 @@ class RosbagSensorReader final : public SensorBagReader {
   bool livox_ = false;  // the LiDAR topic holds livox_ros_driver/CustomMsg
   LidarOptions lidar_;
   ImuOptions imu_;
+  // "lidar.topic '/x' in 'bag'": names the topic in errors (built once, not per message)
+  std::string lidar_where_, imu_where_;
   rosbag::Bag bag_;
   std::unique_ptr<rosbag::View> view_;
   rosbag::View::iterator it_;
