@@ -15,6 +15,7 @@
 #include <vector>
 #include <sstream>
 
+#include "rvlio/common/fnv1a.h"
 #include "rvlio/io/config.h"
 #include "rvlio/sim/presets.h"
 
@@ -557,16 +558,7 @@ void AddCells(const Grid& grid, const Sequence& seq, int data_index, Plan* plan)
 
 }  // namespace
 
-std::string HashHex(std::string_view bytes) {
-  uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
+std::string HashHex(std::string_view bytes) { return Fnv1aHex(bytes); }
 
 StatusOr<std::vector<std::string>> ExpandRange(const std::string& from_text,
                                                const std::string& to_text,

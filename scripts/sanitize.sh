@@ -103,6 +103,18 @@ export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_stri
 export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="halt_on_error=1:abort_on_error=1:print_stacktrace=1:suppressions=$supp/ubsan.supp"
 
+# The end-to-end fixtures' simulations (CachedSimulate, test/cli/cli_util.h)
+# come from the Release stage's tool and its cache when build/bin/rvlio
+# exists (the test command builds it first): the tool under test still runs
+# sanitized on every command; only the preparation of its input, the same
+# files either way, skips an ASan simulation per suite. The simulator runs
+# sanitized in test_sim and wherever a test calls `simulate` itself.
+# RVLIO_TEST_SIM_BIN= (empty) simulates with the sanitized tool.
+if [[ -z "${RVLIO_TEST_SIM_BIN+x}" && -x "$root/build/bin/rvlio" ]]; then
+  export RVLIO_TEST_SIM_BIN="$root/build/bin/rvlio"
+  export RVLIO_TEST_CACHE="${RVLIO_TEST_CACHE:-$root/build/test-sim-cache}"
+fi
+
 cd "$build_dir"
 args=(--output-on-failure -j "$jobs")
 [[ -n "$exclude" ]] && args+=(-E "$exclude")

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <vector>
 
+#include "rvlio/common/fnv1a.h"
 #include "rvlio/io/atomic_file.h"
 
 namespace rvlio {
@@ -16,28 +17,6 @@ namespace {
 
 using nlohmann::json;
 constexpr int kFormat = 1;
-
-// FNV-1a, 64 bit, over the values (not the padded structs) of the input.
-class Fnv1a {
- public:
-  template <class T>
-  void Add(const T& value) {
-    const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
-    for (size_t i = 0; i < sizeof(T); ++i) hash_ = (hash_ ^ bytes[i]) * 0x100000001b3ULL;
-  }
-  void AddBytes(const char* bytes, size_t n) {
-    for (size_t i = 0; i < n; ++i)
-      hash_ = (hash_ ^ static_cast<unsigned char>(bytes[i])) * 0x100000001b3ULL;
-  }
-  void AddText(const std::string& text) {
-    Add(text.size());
-    for (unsigned char c : text) hash_ = (hash_ ^ c) * 0x100000001b3ULL;
-  }
-  uint64_t value() const { return hash_; }
-
- private:
-  uint64_t hash_ = 0xcbf29ce484222325ULL;
-};
 
 std::string CheckpointPath(const std::string& dir) {
   return (std::filesystem::path(dir) / kCheckpointFile).string();

@@ -25,16 +25,11 @@ ReferenceMap::ReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
                            const std::vector<uint32_t>& order, const ReferenceMapOptions& options)
     : map_(StaticMapOptions(options)) {
   RVLIO_CHECK(order.size() == p_ref.size());
-  // Filled voxel by voxel: each voxel's block is grown while it is in the
-  // cache, and neighbouring voxels' blocks lie close together in the pool.
-  for (size_t j = 0; j < order.size(); ++j) {
-    PrefetchAhead(p_ref, order, j);
-    const Eigen::Vector3d& p = p_ref[order[j]];
-    if (map_.InsertPoint(p))
-      bounds_.extend(p.cast<float>().cast<double>());  // the stored (float) coordinates
-    else
-      ++num_skipped_;
-  }
+  // Filled voxel by voxel: each voxel's block is allocated once, at its
+  // final size, and neighbouring voxels' blocks lie close together in the pool.
+  map_.InsertInVoxelOrder(p_ref, order);
+  num_skipped_ = p_ref.size() - map_.Size();
+  map_.ForEachPoint([this](const Eigen::Vector3d& p) { bounds_.extend(p); });  // stored (float) coordinates
 }
 
 }  // namespace rvlio

@@ -10,6 +10,7 @@
 #endif
 
 #include "rvlio/common/check.h"
+#include "rvlio/map/voxel_order.h"
 
 namespace rvlio {
 
@@ -245,9 +246,15 @@ void VoxelMap::FreeBlock(int32_t offset, int capacity) {
   free_blocks_[CapacityClass(capacity)].push_back(offset);
 }
 
+int VoxelMap::BlockCapacity(int num_points) const {
+  return std::min(kFirstBlockCapacity << CapacityClass(num_points), max_points_);
+}
+
 // Moves a full voxel to a block of the next capacity class.
-void VoxelMap::GrowBlock(Slot* s) {
-  const int new_capacity = std::min(2 * s->capacity, max_points_);
+void VoxelMap::GrowBlock(Slot* s) { MoveBlock(s, std::min(2 * s->capacity, max_points_)); }
+
+// Moves a voxel's points to a block of new_capacity (a class capacity).
+void VoxelMap::MoveBlock(Slot* s, int new_capacity) {
   const int32_t new_offset = AllocateBlock(new_capacity);  // may reallocate pool_
   for (int axis = 0; axis < 3; ++axis)
     std::copy_n(pool_.begin() + s->offset + axis * s->capacity, s->count,
@@ -291,6 +298,66 @@ bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
 
 void VoxelMap::Insert(const std::vector<Eigen::Vector3d>& p_world) {
   for (const Eigen::Vector3d& p : p_world) InsertPoint(p);
+}
+
+size_t VoxelMap::InsertInVoxelOrder(const std::vector<Eigen::Vector3d>& p_world,
+                                    const std::vector<uint32_t>& order) {
+  // Pass 1: the runs of consecutive keyable points in one voxel, and the
+  // room their blocks take if their voxels are new.
+  std::vector<size_t> run_begin;
+  size_t num_floats = 0;
+  uint64_t run_key = 0;
+  auto close_run = [&](size_t end) {
+    if (run_begin.empty()) return;
+    const size_t n = std::min<size_t>(end - run_begin.back(), max_points_);
+    num_floats += 3 * static_cast<size_t>(BlockCapacity(static_cast<int>(n)));
+  };
+  for (size_t j = 0; j < order.size(); ++j) {
+    PrefetchAhead(p_world, order, j);
+    const Eigen::Vector3d& p = p_world[order[j]];
+    if (!InKeyRange(p, inv_voxel_size_)) continue;
+    const VoxelKey k = KeyOf(p, inv_voxel_size_);
+    const uint64_t key = PackKey(k.x, k.y, k.z);
+    if (run_begin.empty() || key != run_key) {
+      close_run(j);
+      run_begin.push_back(j);
+      run_key = key;
+    }
+  }
+  close_run(order.size());
+  size_t capacity = slots_.size();
+  while (2 * (num_voxels_ + run_begin.size()) > capacity) capacity *= 2;
+  if (capacity > slots_.size()) {
+    scratch_slots_.clear();
+    for (const Slot& s : slots_)
+      if (s.offset >= 0) scratch_slots_.push_back(s);
+    Rebuild(capacity, scratch_slots_);
+  }
+  pool_.reserve(pool_.size() + num_floats);
+  // Pass 2: each run's block sized once, then its points in order.
+  const size_t before = num_points_;
+  run_begin.push_back(order.size());
+  for (size_t r = 0; r + 1 < run_begin.size(); ++r) {
+    const size_t begin = run_begin[r], end = run_begin[r + 1];
+    ReserveRun(p_world[order[begin]], end - begin);
+    for (size_t j = begin; j < end; ++j) {
+      PrefetchAhead(p_world, order, j);
+      InsertPoint(p_world[order[j]]);
+    }
+  }
+  return num_points_ - before;
+}
+
+// Gives the voxel of p_world (keyable) room for num_points more points in one
+// block of its final capacity class.
+void VoxelMap::ReserveRun(const Eigen::Vector3d& p_world, size_t num_points) {
+  const VoxelKey k = KeyOf(p_world, inv_voxel_size_);
+  const uint64_t key = PackKey(k.x, k.y, k.z);
+  int slot = FindSlot(key);
+  if (slot < 0) slot = CreateSlot(key);
+  Slot& s = slots_[slot];
+  const int wanted = static_cast<int>(std::min<size_t>(s.count + num_points, max_points_));
+  if (wanted > s.capacity) MoveBlock(&s, BlockCapacity(wanted));
 }
 
 void VoxelMap::RemoveFar(const Eigen::Vector3d& center_world, double radius) {

@@ -15,6 +15,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "rvlio/common/fnv1a.h"
+
 namespace rvlio::testing_cli {
 
 struct ToolRun {
@@ -27,10 +29,12 @@ inline std::string ReadFile(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// Runs `rvlio ARGS` with stdout/stderr captured into files under `scratch`.
-inline ToolRun RunTool(const std::string& args, const std::string& scratch) {
+// Runs `BIN ARGS` (BIN: the tool under test, RVLIO_BIN, unless given) with
+// stdout/stderr captured into files under `scratch`.
+inline ToolRun RunTool(const std::string& args, const std::string& scratch,
+                       const std::string& bin = RVLIO_BIN) {
   const std::string out = scratch + "/stdout.txt", err = scratch + "/stderr.txt";
-  const std::string cmd = std::string(RVLIO_BIN) + " " + args + " >" + out + " 2>" + err;
+  const std::string cmd = bin + " " + args + " >" + out + " 2>" + err;
   const int status = std::system(cmd.c_str());
   ToolRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -85,27 +89,33 @@ inline ToolRun SimulateNoiseFreeHall(const std::string& dir) {
                  dir);
 }
 
+// The tool CachedSimulate simulates with: $RVLIO_TEST_SIM_BIN, else the tool
+// under test. The sanitize stage (scripts/sanitize.sh) points it at the
+// Release stage's tool and cache: its simulations are the Release stage's
+// (the simulator's own code runs under the sanitizers in test_sim and in the
+// tests that call `simulate` themselves), and the tool under test reads them.
+inline std::string SimulatorBin() {
+  const char* env = std::getenv("RVLIO_TEST_SIM_BIN");
+  return env != nullptr && *env != '\0' ? env : RVLIO_BIN;
+}
+
 // Where CachedSimulate keeps its simulations: $RVLIO_TEST_CACHE, else
-// test-sim-cache/ next to the build's bin/ folder.
+// test-sim-cache/ next to the simulating tool's bin/ folder.
 inline std::filesystem::path SimulationCacheDir() {
   if (const char* env = std::getenv("RVLIO_TEST_CACHE"); env != nullptr && *env != '\0') return env;
-  return std::filesystem::path(RVLIO_BIN).parent_path().parent_path() / "test-sim-cache";
+  return std::filesystem::path(SimulatorBin()).parent_path().parent_path() / "test-sim-cache";
 }
 
 // The cache key of a simulation: FNV-1a over the simulate arguments and the
-// size and modification time of the tool, so a rebuilt simulator simulates
-// again.
+// size and modification time of the simulating tool, so a rebuilt simulator
+// simulates again.
 inline std::string SimulationKey(const std::string& sim_args) {
   struct stat st {};
   const std::string text = sim_args + "|" +
-                           (::stat(RVLIO_BIN, &st) == 0
+                           (::stat(SimulatorBin().c_str(), &st) == 0
                                 ? std::to_string(st.st_size) + ":" + std::to_string(st.st_mtime)
                                 : std::string("?"));
-  uint64_t h = 1469598103934665603ull;
-  for (const unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-  char hex[17];
-  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(h));
-  return hex;
+  return Fnv1aHex(text);
 }
 
 // `rvlio simulate SIM_ARGS --out OUT`, simulated once per build and copied
@@ -123,8 +133,10 @@ inline ToolRun CachedSimulate(const std::string& sim_args, const std::string& ou
   if (!fs::exists(entry / "stdout.txt")) {
     fs::create_directories(cache, ec);
     std::string tmpl = (cache / ("tmp_XXXXXX")).string();
-    if (::mkdtemp(tmpl.data()) == nullptr) return RunTool("simulate " + sim_args + " --out " + out, scratch);
-    const ToolRun sim = RunTool("simulate " + sim_args + " --out " + tmpl + "/out", tmpl);
+    if (::mkdtemp(tmpl.data()) == nullptr)
+      return RunTool("simulate " + sim_args + " --out " + out, scratch, SimulatorBin());
+    const ToolRun sim =
+        RunTool("simulate " + sim_args + " --out " + tmpl + "/out", tmpl, SimulatorBin());
     if (sim.exit_code != 0) {
       fs::remove_all(tmpl, ec);
       return sim;

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "rvlio/map/voxel_order.h"
+
 namespace rvlio {
 namespace {
 
@@ -389,6 +391,45 @@ TEST(VoxelMap, LatticeQueriesOnVoxelFacesMatchBruteForce) {
   }
   EXPECT_GT(checked, 300);
   EXPECT_GT(deep, 20);  // neighbours beyond 1.5 m: shells 4 and deeper searched
+}
+
+
+// InsertInVoxelOrder stores what InsertPoint called in the same order stores
+// (the same points, counts and query results), whatever the order, the
+// voxel cap and the point spacing; only the voxel order is its fast path.
+TEST(VoxelMap, InsertInVoxelOrderEqualsInsertingOneByOne) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 24; ++trial) {
+    MapOptions o;
+    o.voxel_size = std::uniform_real_distribution<double>(0.2, 1.0)(rng);
+    o.max_points_per_voxel = std::uniform_int_distribution<int>(1, 40)(rng);
+    o.min_point_distance = trial % 3 == 0 ? 0.0 : 0.05;
+    std::vector<Eigen::Vector3d> pts = RandomCloud(&rng, 3000, trial % 2 == 0 ? 1.5 : 6.0);
+    pts.push_back(Eigen::Vector3d(NAN, 0.0, 0.0));  // unkeyable: skipped by both
+    pts.push_back(Eigen::Vector3d(1e12, 0.0, 0.0));
+    std::vector<uint32_t> order = VoxelOrder(pts, o.voxel_size);
+    if (trial % 4 == 3) std::shuffle(order.begin(), order.end(), rng);  // any order is correct
+    VoxelMap bulk(o), single(o);
+    if (trial % 5 == 4) {  // into a map that already holds points
+      const std::vector<Eigen::Vector3d> before = RandomCloud(&rng, 500, 2.0);
+      bulk.Insert(before);
+      single.Insert(before);
+    }
+    const size_t stored = bulk.InsertInVoxelOrder(pts, order);
+    size_t stored_single = 0;
+    for (uint32_t i : order) stored_single += single.InsertPoint(pts[i]) ? 1 : 0;
+    ASSERT_EQ(stored, stored_single) << trial;
+    ASSERT_EQ(bulk.Size(), single.Size()) << trial;
+    ASSERT_EQ(bulk.NumVoxels(), single.NumVoxels()) << trial;
+    NeighborBuffer a, b;
+    for (const Eigen::Vector3d& q : RandomCloud(&rng, 200, 3.0)) {
+      ASSERT_EQ(bulk.KNearest(q, 8, 2.0, &a), single.KNearest(q, 8, 2.0, &b)) << trial;
+      for (int k = 0; k < a.size; ++k) {
+        EXPECT_EQ(a.points[k], b.points[k]) << trial;
+        EXPECT_EQ(a.dist2[k], b.dist2[k]) << trial;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -45,6 +45,15 @@ class VoxelMap {
   // Inserts one point; true when it was stored (not skipped by the voxel's
   // capacity or by min_point_distance).
   bool InsertPoint(const Eigen::Vector3d& p_world);
+  // Inserts p_world[order[0]], p_world[order[1]], ... as InsertPoint called
+  // on each in that order would (the same points stored, the same results of
+  // every query), for a cloud listed voxel by voxel (VoxelOrder with this
+  // map's voxel size: map/voxel_order.h): the hash table and the pool grow
+  // once, and each voxel's block is allocated once at its final capacity
+  // instead of once per capacity class. Any other order is correct, only
+  // slower. Returns the number of points stored.
+  size_t InsertInVoxelOrder(const std::vector<Eigen::Vector3d>& p_world,
+                            const std::vector<uint32_t>& order);
 
   // Exact k nearest stored points of q_world among those within max_dist (m),
   // sorted by distance into *out. Returns out->size (< k when fewer points are
@@ -109,6 +118,9 @@ class VoxelMap {
   int32_t AllocateBlock(int capacity);
   void FreeBlock(int32_t offset, int capacity);
   void GrowBlock(Slot* s);
+  void MoveBlock(Slot* s, int new_capacity);
+  int BlockCapacity(int num_points) const;  // capacity of the class that holds num_points
+  void ReserveRun(const Eigen::Vector3d& p_world, size_t num_points);
 
   void ScanBlock(const Slot& s, const float q[3], Candidates* c) const;
   void VisitOffset(const VoxelKey& home, int dx, int dy, int dz, double gxy2,
