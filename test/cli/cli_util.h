@@ -77,17 +77,6 @@ inline double AteNoAlign(const std::string& gt, const std::string& est, const st
   return j.is_discarded() ? NAN : j["ape"]["rmse"].get<double>();
 }
 
-// Simulates a 10 s, 512-column hall without sensor noise, wall roughness or
-// IMU biases into `dir` (hall.bag, hall.yaml, hall_gt.tum): the oracle case.
-inline ToolRun SimulateNoiseFreeHall(const std::string& dir) {
-  return RunTool("simulate --preset hall --seed 5 --duration 10 --out " + dir +
-                     " --set lidar.columns=512 --set lidar.range_noise=0"
-                     " --set world.roughness_amplitude=0"
-                     " --set imu.gyro_noise_density=0 --set imu.accel_noise_density=0"
-                     " --set imu.gyro_bias_random_walk=0 --set imu.accel_bias_random_walk=0"
-                     " --set imu.gyro_bias=[0,0,0] --set imu.accel_bias=[0,0,0]",
-                 dir);
-}
 
 // The tool CachedSimulate simulates with: $RVLIO_TEST_SIM_BIN, else the tool
 // under test. The sanitize stage (scripts/sanitize.sh) points it at the
@@ -155,6 +144,19 @@ inline ToolRun CachedSimulate(const std::string& sim_args, const std::string& ou
   r.out = ReadFile((entry / "stdout.txt").string());
   r.err = ReadFile((entry / "stderr.txt").string());
   return r;
+}
+
+// Simulates a 10 s, 512-column hall without sensor noise, wall roughness or
+// IMU biases into `dir` (hall.bag, hall.yaml, hall_gt.tum): the oracle case.
+// Cached (CachedSimulate).
+inline ToolRun SimulateNoiseFreeHall(const std::string& dir) {
+  return CachedSimulate("--preset hall --seed 5 --duration 10"
+                        " --set lidar.columns=512 --set lidar.range_noise=0"
+                        " --set world.roughness_amplitude=0"
+                        " --set imu.gyro_noise_density=0 --set imu.accel_noise_density=0"
+                        " --set imu.gyro_bias_random_walk=0 --set imu.accel_bias_random_walk=0"
+                        " --set imu.gyro_bias=[0,0,0] --set imu.accel_bias=[0,0,0]",
+                        dir, dir);
 }
 
 // `rvlio simulate --preset tunnel` of `duration_s` seconds, 512 columns, seed
