@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <memory>
 
 #include "rvlio/common/check.h"
 #include "rvlio/map/voxel_key.h"
@@ -73,21 +74,27 @@ std::vector<uint32_t> VoxelOrder(const std::vector<Eigen::Vector3d>& points, dou
   if (std::find(keys.begin(), keys.end(), kUnkeyable) != keys.end()) bits = std::min(64, bits + 1);
   // LSD radix sort, kDigitBits per pass: each pass is stable, so points of
   // one voxel keep their index order.
-  std::vector<uint64_t> keys_tmp(n);
-  std::vector<uint32_t> order_tmp(n);
+  // The passes scatter back and forth between these and a second pair left
+  // uninitialized (every pass writes every entry; zeroing it would cost a
+  // pass over 12 bytes per point for nothing).
+  std::unique_ptr<uint64_t[]> keys_tmp(new uint64_t[n]);
+  std::unique_ptr<uint32_t[]> order_tmp(new uint32_t[n]);
+  uint64_t *keys_from = keys.data(), *keys_to = keys_tmp.get();
+  uint32_t *order_from = order.data(), *order_to = order_tmp.get();
   for (int shift = 0; shift < bits; shift += kDigitBits) {
     std::array<size_t, (size_t{1} << kDigitBits) + 1> start{};
     const auto digit = [&](uint64_t key) { return (key >> shift) & ((uint64_t{1} << kDigitBits) - 1); };
-    for (size_t i = 0; i < n; ++i) ++start[digit(keys[i]) + 1];
+    for (size_t i = 0; i < n; ++i) ++start[digit(keys_from[i]) + 1];
     for (size_t d = 1; d < start.size(); ++d) start[d] += start[d - 1];
     for (size_t i = 0; i < n; ++i) {
-      const size_t to = start[digit(keys[i])]++;
-      keys_tmp[to] = keys[i];
-      order_tmp[to] = order[i];
+      const size_t to = start[digit(keys_from[i])]++;
+      keys_to[to] = keys_from[i];
+      order_to[to] = order_from[i];
     }
-    keys.swap(keys_tmp);
-    order.swap(order_tmp);
+    std::swap(keys_from, keys_to);
+    std::swap(order_from, order_to);
   }
+  if (order_from != order.data()) std::copy_n(order_from, n, order.data());
   return order;
 }
 
