@@ -168,6 +168,7 @@ std::shared_ptr<const VoxelMap> MakeReferenceMap(const std::vector<Eigen::Vector
                                                  const LocalizationOptions& options) {
   MapOptions o;  // the working map's thinning
   o.voxel_size = options.reference_voxel_size;
+  o.neighbor_search = options.reference_neighbor_search;
   auto map = std::make_shared<VoxelMap>(o);
   map->Insert(p_ref);
   return map;

@@ -25,6 +25,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -53,6 +54,9 @@ struct LocalizationOptions {
   int search_keep = 20;             // best grid candidates aligned in full
   double search_ambiguity = 0.03;   // a distinct candidate within this overlap of the best: ambiguous
   double reference_voxel_size = 0.5;  // m, voxel edge of the reference's search structure
+  // k-NN search in the reference: exact, or the 27 voxels around the query
+  // (map.neighbor_search's choices; docs/survey.md "Per-scan cost").
+  std::string reference_neighbor_search = "exact";
   DeviationOptions deviation;       // deviation_m of map.pcd and deviation.csv
 
   template <class V>
@@ -83,6 +87,8 @@ struct LocalizationOptions {
         .Help("global search: a candidate more than 1 m or 10 deg from the best with an overlap within this of the best's makes the start ambiguous (exit 2)"));
     v.Field("reference_voxel_size", reference_voxel_size, Spec().Unit("m").Range(0.01, 20.0)
         .Help("voxel edge of the reference's search structure for association (thinned as the working map: 20 points per voxel, 0.1 m apart)"));
+    v.Field("reference_neighbor_search", reference_neighbor_search, Spec().Choices({"exact", "nearby"})
+        .Help("k-nearest search in the reference: exact, or among the 27 voxels around the query (cheaper; exact whenever the k nearest lie there, which a complete reference makes likely)"));
     v.Section("deviation", deviation);
   }
   Status Validate() {
