@@ -18,6 +18,7 @@ namespace {
 WindowOptions MakeWindowOptions(const OdometryOptions& o) {
   WindowOptions w;
   CopySections(o, &w);
+  w.rv = EffectiveRvOptions(o.rv, o.degeneracy);
   return w;
 }
 
@@ -226,6 +227,8 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuPoseHistory& his
   r->constraints = report.newest_constraints;
   r->iterations = report.iterations;
   r->rv = report.newest_rv;
+  r->degeneracy = DegeneracyReportFromRv(options_.degeneracy.method, report.newest_rv,
+                                         report.newest_position_information);
   if (options_.smoother.map_update == "newest" || !window_filled_)
     InsertIntoWorkingMap(window_->size() - 1, p_lidar_end_);
   stats_.diverged_resets += report.failures;  // each failed round was restored
