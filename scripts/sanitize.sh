@@ -87,6 +87,7 @@ ex=(
   'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
   SurveyBadInput.MissingEmptyTruncatedOrNonFiniteMap SurveyBadInput.MapInMillimetresOrFarFromTheStart
   'TimeOffsetCliTest\..*'
+  'DegeneracyCliTest\..*'
   'SurveyFlights\..*' SurveyFeatureless.StartTwentyMetresOffAlongTheAxisIsRefused
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"

@@ -109,6 +109,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
                   scan.t_end_ns, &p_lidar_end_);
   if (localizer_.enabled() && !localizer_.started() && !StartInReference()) return;
   ScanResult r;
+  r.degeneracy.method = options_.degeneracy.method;
   r.raw_points = static_cast<int>(scan.points.size());
   r.mean_acc_imu = mean_acc_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());

@@ -131,6 +131,7 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   DeskewToScanEnd(history.samples(), CurrentTImuLidar(),
                   downsampled_.points, scan.t_end_ns, &p_lidar_end_);
   ScanResult r;
+  r.degeneracy.method = options_.degeneracy.method;
   r.raw_points = static_cast<int>(scan.points.size());
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
