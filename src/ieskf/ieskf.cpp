@@ -390,6 +390,7 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
   using MatrixC = Eigen::Matrix<double, C, C>;
   using VectorC = Eigen::Matrix<double, C, 1>;
   IeskfUpdateResult result;
+  result.degeneracy.method = degeneracy_.method;  // also when no iteration runs
   if (options_.estimate_extrinsics) ReleaseExcitedAxes();
   const FilterState x0 = x_;
   MatrixN P0;

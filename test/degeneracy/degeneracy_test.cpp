@@ -233,5 +233,57 @@ TEST(Degeneracy, RemapThreshold) {
   EXPECT_FALSE(AnalyzeDegeneracy(o, H, s.constraints, Pose3(), Pose3()).report.degenerate);
 }
 
+// With coupling between the pose and the other states, the held solve is the
+// constrained minimiser: zero along the held directions, and the gradient
+// A dx + b orthogonal to every direction it may still move in.
+TEST(Degeneracy, HoldingSolveIsTheConstrainedMinimiser) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::MatrixXd M(9, 9);
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 9; ++j) M(i, j) = g(rng);
+  const Eigen::MatrixXd A = M * M.transpose() + Eigen::MatrixXd::Identity(9, 9);
+  Eigen::VectorXd b(9);
+  for (int i = 0; i < 9; ++i) b(i) = g(rng);
+  DegeneracyTreatment t;
+  PoseVector6d v1 = PoseVector6d::Zero(), v2 = PoseVector6d::Zero();
+  v1(3) = 1.0;                                      // the x translation
+  v2 << 0.0, 0.0, 0.6, 0.0, 0.8, 0.0;               // a mixed direction
+  t.held_pose.col(t.num_held++) = v1;
+  t.held_pose.col(t.num_held++) = v2;
+  const Eigen::VectorXd dx = SolveHoldingDirections(t, A, b);
+  EXPECT_NEAR(v1.dot(dx.head<6>()), 0.0, 1e-12);
+  EXPECT_NEAR(v2.dot(dx.head<6>()), 0.0, 1e-12);
+  const Eigen::VectorXd gradient = A * dx + b;
+  // Free directions: the 9-dim space orthogonal to [v1; 0] and [v2; 0].
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(9, 2);
+  C.block<6, 1>(0, 0) = v1;
+  C.block<6, 1>(0, 1) = v2;
+  const Eigen::MatrixXd P = Eigen::MatrixXd::Identity(9, 9) - C * C.transpose();
+  EXPECT_LT((P * gradient).norm(), 1e-9 * b.norm());
+  // Nothing held: the plain solve.
+  EXPECT_LT((SolveHoldingDirections(DegeneracyTreatment(), A, b) + A.ldlt().solve(b)).norm(), 1e-12);
+}
+
+TEST(Degeneracy, RvRunsOnlyAsTheSelectedMethodAndOtherBackendsRefuseTheRest) {
+  DegeneracyOptions d;
+  RvOptions rv;
+  EXPECT_TRUE(EffectiveRvOptions(rv, d).enabled);
+  rv.enabled = false;
+  EXPECT_FALSE(EffectiveRvOptions(rv, d).enabled);  // rv's own switch still works
+  rv.enabled = true;
+  for (DegeneracyMethod m : {DegeneracyMethod::kRemap, DegeneracyMethod::kLocalizability,
+                             DegeneracyMethod::kRegularized, DegeneracyMethod::kNone}) {
+    d.method = m;
+    EXPECT_FALSE(EffectiveRvOptions(rv, d).enabled) << EnumName(m);
+  }
+  EXPECT_TRUE(DegeneracyDefinedIn(DegeneracyMethod::kRv, "smoother").ok());
+  EXPECT_TRUE(DegeneracyDefinedIn(DegeneracyMethod::kNone, "refine").ok());
+  const Status s = DegeneracyDefinedIn(DegeneracyMethod::kRegularized, "refine");
+  EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
+  EXPECT_NE(s.message().find("degeneracy.method=regularized is not defined for refine"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace rvlio
