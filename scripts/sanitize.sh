@@ -92,6 +92,7 @@ ex=(
   'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
   SurveyBadInput.MissingEmptyTruncatedOrNonFiniteMap SurveyBadInput.MapInMillimetresOrFarFromTheStart
   'TimeOffsetCliTest\..*'
+  'DegeneracyCliTest\..*'
   'SurveyFlights\..*' SurveyFeatureless.StartTwentyMetresOffAlongTheAxisIsRefused
   AssociationThreadsCliTest.TwoThreadsWriteTheSameOutputsAsOne
   BatchSignalsTest.InterruptedAblationKeepsFinishedCellsAndResumes

@@ -58,6 +58,22 @@ void AddTimeOffsetColumns(const std::vector<ScanResult>& scans, Column& column) 
   });
 }
 
+// The degeneracy columns of scans.csv (weak_dir_* NaN without a weak direction).
+template <class Column>
+void AddDegeneracyColumns(const std::vector<ScanResult>& scans, py::dict& table, Column& column) {
+  py::list method;
+  for (const ScanResult& r : scans) method.append(EnumName(r.degeneracy.method));
+  table["degeneracy_method"] = py::module_::import("numpy").attr("array")(method);
+  column("degenerate", [](const ScanResult& r) { return r.degeneracy.degenerate; });
+  column("weak_dirs", [](const ScanResult& r) { return r.degeneracy.num_weak; });
+  const char* names[] = {"weak_dir_x", "weak_dir_y", "weak_dir_z"};
+  for (int k = 0; k < 3; ++k)
+    column(names[k], [k](const ScanResult& r) {
+      return r.degeneracy.num_weak > 0 ? r.degeneracy.weak_dirs_world[0](k) : std::nan("");
+    });
+  column("condition_number", [](const ScanResult& r) { return r.degeneracy.condition_number; });
+}
+
 // The per-scan table: the columns of scans.csv as numpy arrays (one row per scan).
 py::dict ScanTable(const std::vector<ScanResult>& scans) {
   const auto n = static_cast<py::ssize_t>(scans.size());
@@ -104,6 +120,7 @@ py::dict ScanTable(const std::vector<ScanResult>& scans) {
   column("residual_median_m", [](const ScanResult& r) { return r.health.residual_median_m; });
   column("residual_rms_m", [](const ScanResult& r) { return r.health.residual_rms_m; });
   column("diverged", [](const ScanResult& r) { return r.health.divergence_mask != 0; });
+  AddDegeneracyColumns(scans, table, column);
   AddExtrinsicColumns(scans, column);
   AddTimeOffsetColumns(scans, column);
   if (std::any_of(scans.begin(), scans.end(),

@@ -42,6 +42,17 @@ def test_run_result_table(py_run, cli_run):
         np.testing.assert_array_equal(table[column], csv[column])
     np.testing.assert_array_equal(table["status"], csv["status"])
     np.testing.assert_allclose(table["x"], result.trajectory[:, 1], rtol=0, atol=0)
+    # The degeneracy columns (the default method rv: its n_alpha when active).
+    np.testing.assert_array_equal(table["degeneracy_method"], csv["degeneracy_method"])
+    assert set(table["degeneracy_method"]) == {"rv"}
+    for column in ("degenerate", "weak_dirs"):
+        np.testing.assert_array_equal(table[column], csv[column])
+    for column in ("weak_dir_x", "weak_dir_y", "weak_dir_z", "condition_number"):
+        np.testing.assert_allclose(table[column], csv[column], rtol=1e-7, atol=1e-9, equal_nan=True)
+    active = table["rv_active"].astype(bool)
+    np.testing.assert_array_equal(table["degenerate"], active)
+    np.testing.assert_allclose(table["weak_dir_x"][active], table["n_alpha_x"][active], rtol=0, atol=0)
+    assert np.all(np.isnan(table["weak_dir_x"][~active]))
 
 
 def test_odometry_scan_by_scan_equals_run(tunnel, py_run):

@@ -164,6 +164,50 @@ bool TimeOffsetObservable(const Eigen::Vector3d& v_world_imu, const ScanTimeMoti
   return motion.gyro_imu.norm() >= kTimeOffsetMinRate || v_world_imu.norm() >= kTimeOffsetMinSpeed;
 }
 
+// The degeneracy stage of one iteration on the pose block of the normal
+// equations (sigma = 1 information); rv and none report from the RV pass.
+template <class MatrixC>
+DegeneracyTreatment AnalyzeScanDegeneracy(const DegeneracyOptions& options, const RvReport& rv,
+                                          const MatrixC& HtRinvH, double inv_sigma2,
+                                          const ConstraintList& constraints,
+                                          const FilterState& x_scan) {
+  const PoseMatrix6d H_pose = HtRinvH.template topLeftCorner<6, 6>() / inv_sigma2;
+  if (options.method == DegeneracyMethod::kRv || options.method == DegeneracyMethod::kNone) {
+    DegeneracyTreatment t;
+    t.report = DegeneracyReportFromRv(options.method, rv, H_pose.block<3, 3>(3, 3));
+    return t;
+  }
+  return AnalyzeDegeneracy(options, H_pose, constraints, x_scan.T_world_imu(), x_scan.T_imu_lidar());
+}
+
+// remap: the increment without its degenerate components; localizability:
+// the update solved with the held directions fixed; regularized: solved with
+// the damping added along the weak directions. The pose is dx's first six
+// entries (FilterState::kRot, kPos).
+template <class MatrixN, class VectorN>
+void TreatIncrement(DegeneracyMethod method, const DegeneracyTreatment& t, double inv_sigma2,
+                    const MatrixN& A, const VectorN& b, VectorN* dx) {
+  static_assert(FilterState::kRot == 0 && FilterState::kPos == 3, "pose block first");
+  switch (method) {
+    case DegeneracyMethod::kRemap:
+      ProjectOutHeld(t, dx->template head<6>());
+      break;
+    case DegeneracyMethod::kLocalizability:
+      if (t.num_held > 0) *dx = SolveHoldingDirections(t, A, b);
+      break;
+    case DegeneracyMethod::kRegularized:
+      if (t.report.num_damped > 0) {
+        MatrixN A_damped = A;
+        A_damped.template topLeftCorner<6, 6>() += t.damping * inv_sigma2;
+        *dx = -A_damped.ldlt().solve(b);
+      }
+      break;
+    case DegeneracyMethod::kRv:
+    case DegeneracyMethod::kNone:
+      break;
+  }
+}
+
 }  // namespace
 
 // The extrinsic block is not adjacent to the pose block in the error state
@@ -191,8 +235,14 @@ static std::array<int, 16> TimeOffsetErrorStateRows(const std::array<bool, 6>& f
 }
 
 Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
-             const ConstraintOptions& constraints, const RvOptions& rv, const LidarOptions& lidar)
-    : options_(options), imu_(imu), constraints_(constraints), rv_(rv), lidar_(lidar) {}
+             const ConstraintOptions& constraints, const RvOptions& rv, const LidarOptions& lidar,
+             const DegeneracyOptions& degeneracy)
+    : options_(options),
+      imu_(imu),
+      constraints_(constraints),
+      rv_(EffectiveRvOptions(rv, degeneracy)),
+      degeneracy_(degeneracy),
+      lidar_(lidar) {}
 
 void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu) {
   x_ = x0;
@@ -340,6 +390,7 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
   using MatrixC = Eigen::Matrix<double, C, C>;
   using VectorC = Eigen::Matrix<double, C, 1>;
   IeskfUpdateResult result;
+  result.degeneracy.method = degeneracy_.method;  // also when no iteration runs
   if (options_.estimate_extrinsics) ReleaseExcitedAxes();
   const FilterState x0 = x_;
   MatrixN P0;
@@ -406,6 +457,9 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
     } else {
       AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
     }
+    const DegeneracyTreatment degeneracy =
+        AnalyzeScanDegeneracy(degeneracy_, result.rv, HtRinvH, inv_sigma2, constraints, x_scan);
+    result.degeneracy = degeneracy.report;
 
     const Matrix24d J_inv = BoxminusJacobianInverse(x, x0);
     J = BoxminusJacobian(x, x0);
@@ -432,13 +486,16 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
       b.head(cols) += HtRinvz.head(cols);
     }
     const Eigen::LDLT<MatrixN> ldlt(A);
-    const VectorN dx = -ldlt.solve(b);
+    VectorN dx = -ldlt.solve(b);
     S = ldlt.solve(MatrixN::Identity());
     // At x = x0 (e = 0): z^T (H P0 H^T + R)^-1 z = z^T R^-1 z - b^T A^-1 b = z^T R^-1 z + b^T dx.
     if (it == 0) {
       result.nis_per_dof = (zRinvz + b.dot(dx)) / result.num_constraints;
       result.lidar_rotation_deg = LidarOnlyRotationDeg(HtRinvH, HtRinvz);
     }
+    // The degeneracy method acts on the increment; the covariance S stays
+    // the plain posterior (docs/degeneracy.md).
+    TreatIncrement(degeneracy_.method, degeneracy, inv_sigma2, A, b, &dx);
     x = Boxplus(x, dx.template head<24>());
     if constexpr (kTimeOffset) td_s += dx(kTimeOffsetIndex);
     result.iterations = it + 1;

@@ -40,7 +40,7 @@ RefineConfig ToRefineConfig(const OdometryOptions& o,
                         Eigen::Vector3d(e.translation[0], e.translation[1], e.translation[2]));
   c.map = o.map;
   c.constraints = o.constraints;
-  c.rv = o.rv;
+  c.rv = EffectiveRvOptions(o.rv, o.degeneracy);
   c.smoother = o.smoother;
   return c;
 }
@@ -308,6 +308,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   const auto t0 = Clock::now();
   RefineArgs args = in;  // an Ouster recording may supply the default extrinsic
   std::vector<std::string> notes;
+  if (Status s = DegeneracyDefinedIn(args.options.degeneracy.method, "refine"); !s.ok()) return s;
   if (Status s = ApplyRecordingExtrinsics(args.bag, args.options.lidar, &args.options.extrinsics,
                                           &notes);
       !s.ok())

@@ -54,6 +54,12 @@ int RvActiveScans(const std::vector<ScanResult>& results) {
   return n;
 }
 
+int DegenerateScans(const std::vector<ScanResult>& results) {
+  int n = 0;
+  for (const auto& r : results) n += r.degeneracy.degenerate ? 1 : 0;
+  return n;
+}
+
 // With a reference map: where the run left it (scans not localized), as
 // spans of consecutive such scans with their length along the trajectory.
 nlohmann::json LocalizationJson(const RunArgs& args, const std::vector<ScanResult>& scans) {
@@ -114,6 +120,7 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   j["real_time_factor_wall"] = data.wall_s > 0 ? duration_s / data.wall_s : 0.0;
   j["peak_memory_mb"] = PeakMemoryMb();
   j["rv_active_scans"] = RvActiveScans(result.scans);
+  j["degenerate_scans"] = DegenerateScans(result.scans);  // by degeneracy.method
   j["stats"] = StatsJson(odo.stats(), reader_stats);
   j["divergence"] = DivergenceJson(odo.divergence());
   if (odo.stats().extrinsic.enabled) j["extrinsic"] = ExtrinsicJson(odo.stats().extrinsic);

@@ -44,6 +44,20 @@ void WriteExtrinsicColumns(const std::optional<Pose3>& T_imu_lidar, std::ostream
      << T_imu_lidar->t.y() << ',' << T_imu_lidar->t.z();
 }
 
+// The degeneracy columns: method, degenerate, count of weak translation
+// directions, the weakest (world frame; empty without one), condition number.
+void WriteDegeneracyColumns(const DegeneracyReport& d, std::ostream& os) {
+  os << ',' << EnumName(d.method) << ',' << (d.degenerate ? 1 : 0) << ',' << d.num_weak;
+  if (d.num_weak > 0) {
+    const Eigen::Vector3d& w = d.weak_dirs_world[0];
+    os << ',' << w.x() << ',' << w.y() << ',' << w.z();
+  } else {
+    os << ",,,";
+  }
+  os << ',';
+  if (!std::isnan(d.condition_number)) os << d.condition_number;  // inf prints as inf
+}
+
 }  // namespace
 
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world) {
@@ -121,7 +135,8 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
   os << "t,status,raw_points,points,constraints,iterations,rv_active,n_alpha_x,n_alpha_y,"
         "n_alpha_z,scv,coplanar,repaired,K,rv_iterations,coplanar_fraction,localizability,"
         "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb,reinforced,nis,residual_median_m,"
-        "residual_rms_m,diverged";
+        "residual_rms_m,diverged,degeneracy_method,degenerate,weak_dirs,weak_dir_x,weak_dir_y,"
+        "weak_dir_z,condition_number";
   // Online extrinsic estimation: its estimate after each scan (roll/pitch/yaw
   // in degrees as in summary.json, translation in metres).
   const bool extrinsic = std::any_of(results.begin(), results.end(),
@@ -151,6 +166,7 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
        << (i < rss_mb.size() ? rss_mb[i] : std::nan("")) << ',' << v.num_reinforced << ','
        << Optional(r.health.nis_per_dof) << ',' << Optional(r.health.residual_median_m) << ','
        << Optional(r.health.residual_rms_m) << ',' << DivergenceKindNames(r.health.divergence_mask);
+    WriteDegeneracyColumns(r.degeneracy, os);
     if (extrinsic) WriteExtrinsicColumns(r.T_imu_lidar, os);
     if (time_offset) {
       if (r.time_offset_s)

@@ -28,7 +28,8 @@ DivergenceOptions MonitorOptions(const OdometryOptions& options) {
 
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization localization)
     : options_(options),
-      filter_(options.ieskf, options.imu, options.constraints, options.rv, options.lidar),
+      filter_(options.ieskf, options.imu, options.constraints, options.rv, options.lidar,
+              options.degeneracy),
       map_(options.map, options.ieskf.estimate_extrinsics),
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
@@ -108,6 +109,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
                   scan.t_end_ns, &p_lidar_end_);
   if (localizer_.enabled() && !localizer_.started() && !StartInReference()) return;
   ScanResult r;
+  r.degeneracy.method = options_.degeneracy.method;
   r.raw_points = static_cast<int>(scan.points.size());
   r.mean_acc_imu = mean_acc_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
@@ -163,6 +165,7 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   r->constraints = u.num_constraints;
   r->iterations = u.iterations;
   r->rv = u.rv;
+  r->degeneracy = u.degeneracy;
   r->health.nis_per_dof = u.nis_per_dof;
   r->health.lidar_rotation_deg = u.lidar_rotation_deg;
   if (u.ok) {

@@ -18,6 +18,7 @@ namespace {
 WindowOptions MakeWindowOptions(const OdometryOptions& o) {
   WindowOptions w;
   CopySections(o, &w);
+  w.rv = EffectiveRvOptions(o.rv, o.degeneracy);
   return w;
 }
 
@@ -130,6 +131,7 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   DeskewToScanEnd(history.samples(), CurrentTImuLidar(),
                   downsampled_.points, scan.t_end_ns, &p_lidar_end_);
   ScanResult r;
+  r.degeneracy.method = options_.degeneracy.method;
   r.raw_points = static_cast<int>(scan.points.size());
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
@@ -226,6 +228,8 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuPoseHistory& his
   r->constraints = report.newest_constraints;
   r->iterations = report.iterations;
   r->rv = report.newest_rv;
+  r->degeneracy = DegeneracyReportFromRv(options_.degeneracy.method, report.newest_rv,
+                                         report.newest_position_information);
   if (options_.smoother.map_update == "newest" || !window_filled_)
     InsertIntoWorkingMap(window_->size() - 1, p_lidar_end_);
   stats_.diverged_resets += report.failures;  // each failed round was restored

@@ -278,6 +278,7 @@ WindowSolveReport SlidingWindow::Optimize(const ScanAssociateFn& associate) {
   }
   report.newest_constraints = static_cast<int>(nodes_.back()->constraints.size());
   report.newest_rv = nodes_.back()->rv;
+  report.newest_position_information = PositionInformation(nodes_.back()->constraints);
   return report;
 }
 

@@ -13,6 +13,8 @@
 #include "rvlio/constraints/options.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/constraints/time_offset_residual.h"
+#include "rvlio/degeneracy/degeneracy.h"
+#include "rvlio/degeneracy/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/pose_history.h"
@@ -35,6 +37,7 @@ struct IeskfUpdateResult {
   int num_constraints = 0;    // of the last iteration
   double last_step_norm = 0.0;
   RvReport rv;                // of the last iteration
+  DegeneracyReport degeneracy;  // of the last iteration (degeneracy/degeneracy.h)
   // For the divergence monitor (odometry/divergence.h); no effect on the update.
   // Normalized innovation squared of the first iteration's constraints at the
   // prediction, z^T (H P H^T + R)^-1 z / n (Woodbury form); NaN if no iteration.
@@ -57,8 +60,10 @@ Eigen::Matrix<double, 24, 12> ErrorStateColumns(const std::array<bool, 6>& free_
 class Ieskf {
  public:
   // `lidar`: the time-offset keys (estimate_time_offset and its noise, bound).
+  // `degeneracy`: the treatment of weak directions; RV runs only with method rv.
   Ieskf(const IeskfOptions& options, const ImuOptions& imu, const ConstraintOptions& constraints,
-        const RvOptions& rv, const LidarOptions& lidar = LidarOptions());
+        const RvOptions& rv, const LidarOptions& lidar = LidarOptions(),
+        const DegeneracyOptions& degeneracy = DegeneracyOptions());
 
   // Starts the filter at t_ns from a static alignment; P from the init stds.
   void Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu);
@@ -119,7 +124,8 @@ class Ieskf {
   IeskfOptions options_;
   ImuOptions imu_;
   ConstraintOptions constraints_;
-  RvOptions rv_;
+  RvOptions rv_;  // EffectiveRvOptions: enabled only with degeneracy method rv
+  DegeneracyOptions degeneracy_;
   FilterState x_;
   Matrix24d P_ = Matrix24d::Identity();
   Matrix24d P_all_extrinsic_ = Matrix24d::Identity();  // as P_, every extrinsic axis estimated

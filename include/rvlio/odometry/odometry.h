@@ -18,6 +18,7 @@
 #include "rvlio/math/pose.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/options.h"
+#include "rvlio/degeneracy/degeneracy.h"
 #include "rvlio/rv/rv.h"
 
 namespace rvlio {
@@ -40,6 +41,7 @@ struct ScanResult {
   int constraints = 0;
   int iterations = 0;
   RvReport rv;
+  DegeneracyReport degeneracy;  // the same fields for every degeneracy.method
   double ms = 0.0;  // processing time of this scan: CPU time of the calling thread
   Eigen::Vector3d mean_acc_imu = Eigen::Vector3d::Zero();  // mean specific force over the scan, m/s^2
   ScanHealth health;  // what the divergence monitor read, and what it flagged

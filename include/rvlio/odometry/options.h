@@ -6,6 +6,7 @@
 
 #include "rvlio/common/options.h"
 #include "rvlio/constraints/options.h"
+#include "rvlio/degeneracy/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/io/reader_options.h"
@@ -35,6 +36,7 @@ struct OdometryOptions {
   MapOptions map;
   ConstraintOptions constraints;
   RvOptions rv;
+  DegeneracyOptions degeneracy;
   IeskfOptions ieskf;
   SmootherOptions smoother;
   DivergenceOptions divergence;
@@ -50,6 +52,7 @@ struct OdometryOptions {
     v.Section("map", map);
     v.Section("constraints", constraints);
     v.Section("rv", rv);
+    v.Section("degeneracy", degeneracy);
     v.Section("ieskf", ieskf);
     v.Section("smoother", smoother);
     v.Section("divergence", divergence);
@@ -62,13 +65,14 @@ struct OdometryOptions {
     Status s = ValidateFields(*this);
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
-                     constraints.Validate(), rv.Validate(), ieskf.Validate(), smoother.Validate(),
+                     constraints.Validate(), rv.Validate(), degeneracy.Validate(), ieskf.Validate(), smoother.Validate(),
                      divergence.Validate(), localization.Validate(), io.Validate()})
       if (!m.ok()) return m;
     if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
       return Status::InvalidInput(
           "lidar.estimate_time_offset and smoother.estimate_extrinsics: the smoother estimates "
           "one of them at a time (the IESKF both)");
+    if (backend == Backend::kSmoother) return DegeneracyDefinedIn(degeneracy.method, "smoother");
     return Status::Ok();
   }
 };

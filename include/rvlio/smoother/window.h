@@ -154,6 +154,8 @@ struct WindowSolveReport {
   int associations = 0;         // scans (re-)associated over all rounds
   int newest_constraints = 0;   // constraints of the newest state (last association)
   RvReport newest_rv;           // RV report of the newest state (last association)
+  // sum w u u^T of the newest state's constraints (sigma = 1; rv/rv.h PositionInformation).
+  Eigen::Matrix3d newest_position_information = Eigen::Matrix3d::Zero();
   double association_ms = 0.0;  // thread CPU time in association, RV and weights
   double solve_ms = 0.0;        // thread CPU time in problem building and Ceres
 };

@@ -1,0 +1,96 @@
+#pragma once
+// The degeneracy stage of one scan (one filter iteration): which pose
+// directions the scan's point-to-plane constraints leave weak, and what the
+// selected method does about it (docs/degeneracy.md).
+//
+// The pose block is the estimator's [dtheta, dp] columns: dtheta the right
+// (body-frame) rotation perturbation, dp the world-frame position, so its
+// translation directions are in the WORLD frame (the frame of RV's n_alpha).
+//
+//   remap           Zhang, Kaess, Singh (ICRA 2016): eigenvectors of the 6x6
+//                   pose information with eigenvalue < remap_min_eigenvalue are
+//                   degenerate; the increment is projected onto the others
+//                   (V_f^-1 V_u with orthonormal V_f: I - sum_weak v v^T).
+//   localizability  X-ICP (Tuna et al., T-RO 2023): per eigenvector v_k of the
+//                   translation (rotation) information block, the sum of the
+//                   constraints' contributions |n_i . v_k| (|unit(h_rot,i) . v_k|)
+//                   above the filter threshold; a direction below the
+//                   localizability threshold is held fixed: the update is
+//                   solved with the equality constraint v_k . dx = 0.
+//   regularized     DCReg-style: the rotation and translation Schur complements
+//                   of the pose information; an eigenvalue below
+//                   lambda_max / max_condition of its block is weak, and a
+//                   Tikhonov term along that eigenvector alone lifts it to
+//                   lambda_max / max_condition.
+//   rv              the RV pass (rv/rv.h) on the constraint list, as before.
+//   none            nothing.
+#include <array>
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "rvlio/constraints/constraint.h"
+#include "rvlio/degeneracy/options.h"
+#include "rvlio/math/pose.h"
+#include "rvlio/rv/rv.h"
+
+namespace rvlio {
+
+using PoseMatrix6d = Eigen::Matrix<double, 6, 6>;
+using PoseVector6d = Eigen::Matrix<double, 6, 1>;
+
+// The per-scan report, the same fields for every method.
+struct DegeneracyReport {
+  DegeneracyMethod method = DegeneracyMethod::kNone;
+  bool degenerate = false;
+  // Weak translation directions (world frame, unit), the weakest first;
+  // num_weak of them are set (0..3).
+  int num_weak = 0;
+  std::array<Eigen::Vector3d, 3> weak_dirs_world{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                                 Eigen::Vector3d::Zero()};
+  // lambda_max / lambda_min of the translation information block (sigma = 1);
+  // for regularized, of the translation Schur complement it judges. Infinite
+  // when lambda_min <= 0, NaN when there was no information.
+  double condition_number = std::numeric_limits<double>::quiet_NaN();
+  // What the method did: pose directions (of 6) held fixed (remap,
+  // localizability) or damped (regularized), and the largest damping added
+  // (sigma = 1 information). rv: the RV report says what changed.
+  int num_held = 0;
+  int num_damped = 0;
+  double max_damping = 0.0;
+};
+
+// The treatment the solve applies, with its report.
+struct DegeneracyTreatment {
+  DegeneracyReport report;
+  int num_held = 0;                                  // columns of held_pose used
+  PoseMatrix6d held_pose = PoseMatrix6d::Zero();     // orthonormal pose directions held
+  PoseMatrix6d damping = PoseMatrix6d::Zero();       // added to the pose information (sigma = 1)
+};
+
+// Analyzes one scan. pose_information: the pose block of sum_i w_i h_i^T h_i
+// (sigma = 1); constraints and the poses give the per-constraint rows for
+// localizability (other methods do not read them).
+DegeneracyTreatment AnalyzeDegeneracy(const DegeneracyOptions& options,
+                                      const PoseMatrix6d& pose_information,
+                                      const ConstraintList& constraints, const Pose3& T_world_imu,
+                                      const Pose3& T_imu_lidar);
+
+// The report of method rv (and none) from an RV report: degenerate = RV
+// active, the weak direction = n_alpha.
+DegeneracyReport DegeneracyReportFromRv(DegeneracyMethod method, const RvReport& rv,
+                                        const Eigen::Matrix3d& translation_information);
+
+// lambda_max / lambda_min of a symmetric 3x3 (see DegeneracyReport).
+double ConditionNumber(const Eigen::Matrix3d& symmetric);
+
+// remap: the pose part of an increment without its held components.
+void ProjectOutHeld(const DegeneracyTreatment& t, Eigen::Ref<PoseVector6d> dx_pose);
+
+// localizability: the minimizer of 1/2 dx^T A dx + b^T dx subject to
+// held^T dx_pose = 0 (the pose is dx's first six entries), by the null-space
+// method. Without held directions: -A^-1 b.
+Eigen::VectorXd SolveHoldingDirections(const DegeneracyTreatment& t, const Eigen::MatrixXd& A,
+                                       const Eigen::VectorXd& b);
+
+}  // namespace rvlio

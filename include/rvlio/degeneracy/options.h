@@ -1,0 +1,81 @@
+#pragma once
+// The degeneracy stage: which treatment of weak (degenerate) directions the
+// estimator applies, and each method's parameters (docs/degeneracy.md).
+#include <string>
+#include <utility>
+
+#include "rvlio/common/options.h"
+#include "rvlio/rv/options.h"
+
+namespace rvlio {
+
+enum class DegeneracyMethod { kRv, kRemap, kLocalizability, kRegularized, kNone };
+
+template <>
+struct EnumNames<DegeneracyMethod> {
+  static constexpr std::pair<DegeneracyMethod, const char*> kNames[] = {
+      {DegeneracyMethod::kRv, "rv"},
+      {DegeneracyMethod::kRemap, "remap"},
+      {DegeneracyMethod::kLocalizability, "localizability"},
+      {DegeneracyMethod::kRegularized, "regularized"},
+      {DegeneracyMethod::kNone, "none"}};
+};
+
+// Every threshold is on the information with sigma = 1 (sum of w_i h_i^T h_i
+// over the scan's point-to-plane rows: the estimator's H^T R^-1 H times
+// lidar_noise^2), so it does not move with constraints.lidar_noise.
+struct DegeneracyOptions {
+  DegeneracyMethod method = DegeneracyMethod::kRv;
+  // Solution remapping (Zhang, Kaess, Singh 2016): an eigenvalue of the 6x6
+  // pose information below this marks a degenerate direction. The paper
+  // leaves the value to experiment; 100 is the threshold of its authors'
+  // released LOAM mapping stage (also sigma-free, unit-weighted rows).
+  double remap_min_eigenvalue = 100.0;
+  // X-ICP localizability (Tuna et al. 2023): contributions |h_i . v_k| below
+  // the filter threshold are dropped; a direction whose sum of kept
+  // contributions is below the localizability threshold is held fixed.
+  double localizability_min_contribution = 0.3;
+  double localizability_translation_min = 200.0;
+  double localizability_rotation_min = 200.0;
+  // DCReg-style regularization: a Schur-complement block (rotation or
+  // translation) eigenvalue below lambda_max / max_condition is weak; the
+  // damping raises it to lambda_max / max_condition along its eigenvector.
+  double regularized_max_condition = 10.0;
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("method", method, Spec().Choices(EnumChoices<DegeneracyMethod>())
+                                  .Help("rv | remap | localizability | regularized | none"));
+    v.Field("remap_min_eigenvalue", remap_min_eigenvalue, Spec().Positive()
+        .Help("remap: pose-information eigenvalue (sigma = 1) below which a direction is degenerate"));
+    v.Field("localizability_min_contribution", localizability_min_contribution, Spec().Range(0.0, 1.0)
+        .Help("localizability: contributions |h.v| below this are filtered out"));
+    v.Field("localizability_translation_min", localizability_translation_min, Spec().Positive()
+        .Help("localizability: translation direction held when its filtered sum is below this"));
+    v.Field("localizability_rotation_min", localizability_rotation_min, Spec().Positive()
+        .Help("localizability: rotation direction held when its filtered sum is below this"));
+    v.Field("regularized_max_condition", regularized_max_condition, Spec().Range(1.0, 1e12)
+        .Help("regularized: Schur-block eigenvalues below lambda_max / this are damped up to it"));
+  }
+  Status Validate() { return ValidateFields(*this, "degeneracy"); }
+};
+
+// The sliding-window smoother and refine have no form of remap,
+// localizability or regularized yet (docs/degeneracy.md): configuring one of
+// them there is an error naming the method and the backend.
+inline Status DegeneracyDefinedIn(DegeneracyMethod method, const char* backend) {
+  if (method == DegeneracyMethod::kRv || method == DegeneracyMethod::kNone) return Status::Ok();
+  return Status::InvalidInput(std::string("degeneracy.method=") + EnumName(method) +
+                              " is not defined for " + backend +
+                              " (its solver has no increment to treat; use rv or none)");
+}
+
+// The RV switches a run uses: RV runs only when it is the selected method
+// (method none, like every other method, leaves the constraint list as
+// associated).
+inline RvOptions EffectiveRvOptions(RvOptions rv, const DegeneracyOptions& degeneracy) {
+  rv.enabled = rv.enabled && degeneracy.method == DegeneracyMethod::kRv;
+  return rv;
+}
+
+}  // namespace rvlio

@@ -1,0 +1,125 @@
+// End to end: every degeneracy.method in the IESKF on a short simulated
+// tunnel (8 s, 512 columns), the scans.csv degeneracy columns, and exit 2
+// for a method the smoother or refine does not define (docs/degeneracy.md).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli_util.h"
+
+namespace rvlio {
+namespace {
+
+using testing_cli::ReadFile;
+using testing_cli::RunTool;
+using testing_cli::ToolRun;
+
+constexpr const char* kColumns =
+    "degeneracy_method,degenerate,weak_dirs,weak_dir_x,weak_dir_y,weak_dir_z,condition_number";
+
+std::vector<std::string> Split(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream ss(line);
+  std::string f;
+  while (std::getline(ss, f, ',')) fields.push_back(f);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+class DegeneracyCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing_cli::MakeTempDir("rvlio_degeneracy_cli");
+    const ToolRun r = testing_cli::CachedSimulate(
+        "--preset tunnel --seed 1 --duration 8 --set lidar.columns=512", dir_ + "/data", dir_);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    data_ = dir_ + "/data/tunnel";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  ToolRun Run(const std::string& sets, const std::string& out) {
+    return RunTool("run --bag " + data_ + ".bag --config " + data_ + ".yaml " + sets +
+                       " --quiet --out " + out,
+                   dir_);
+  }
+  std::string dir_, data_;
+};
+
+// Per method: exit 0, the columns, the method named on every row, a unit
+// weak direction when there is one, and the share of degenerate scans.
+TEST_F(DegeneracyCliTest, EveryMethodRunsAndReportsTheDegeneracyColumns) {
+  const struct {
+    const char* method;
+    double min_degenerate, max_degenerate;  // shares of the scans
+  } cases[] = {{"none", 0.0, 0.0}, {"rv", 0.3, 1.0}, {"remap", 0.5, 1.0},
+               {"localizability", 0.8, 1.0}, {"regularized", 0.0, 1.0}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.method);
+    const std::string out = dir_ + "/" + c.method;
+    const ToolRun r = Run(std::string("--set degeneracy.method=") + c.method, out);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::istringstream csv(ReadFile(out + "/scans.csv"));
+    std::string header, line;
+    std::getline(csv, header);
+    const size_t at = header.find(kColumns);
+    ASSERT_NE(at, std::string::npos) << header;
+    const int first = static_cast<int>(std::count(header.begin(), header.begin() + at, ','));
+    int rows = 0, degenerate = 0, along_axis = 0;
+    while (std::getline(csv, line)) {
+      const std::vector<std::string> f = Split(line);
+      ASSERT_GE(static_cast<int>(f.size()), first + 7) << line;
+      EXPECT_EQ(f[first], c.method);
+      ++rows;
+      degenerate += f[first + 1] == "1" ? 1 : 0;
+      if (f[first + 2] == "0") {
+        EXPECT_TRUE(f[first + 3].empty() && f[first + 4].empty() && f[first + 5].empty());
+        continue;
+      }
+      const double x = std::stod(f[first + 3]), y = std::stod(f[first + 4]),
+                   z = std::stod(f[first + 5]);
+      EXPECT_NEAR(x * x + y * y + z * z, 1.0, 1e-5) << line;
+      along_axis += std::abs(x) > 0.9 ? 1 : 0;  // the simulated tunnel runs along world x
+    }
+    ASSERT_GT(rows, 50);
+    EXPECT_GE(degenerate, c.min_degenerate * rows);
+    EXPECT_LE(degenerate, c.max_degenerate * rows);
+    if (std::string(c.method) == "remap" || std::string(c.method) == "localizability") {
+      EXPECT_GE(along_axis, 0.5 * rows);  // the weak direction found is the tunnel's axis
+    }
+    const nlohmann::json summary =
+        nlohmann::json::parse(ReadFile(out + "/summary.json"), nullptr, false);
+    ASSERT_FALSE(summary.is_discarded());
+    EXPECT_EQ(summary["degenerate_scans"].get<int>(), degenerate);
+  }
+}
+
+TEST_F(DegeneracyCliTest, MethodsWithoutASmootherOrRefineFormExitTwo) {
+  const ToolRun bad = Run("--set degeneracy.method=bogus", dir_ + "/bogus");
+  EXPECT_EQ(bad.exit_code, 2);
+  const ToolRun smoother =
+      Run("--set backend=smoother --set degeneracy.method=remap", dir_ + "/smoother");
+  EXPECT_EQ(smoother.exit_code, 2);
+  EXPECT_NE(smoother.err.find("degeneracy.method=remap"), std::string::npos) << smoother.err;
+  EXPECT_NE(smoother.err.find("smoother"), std::string::npos) << smoother.err;
+  // refine: the check comes before any reading, so an initial trajectory of
+  // the right form is enough.
+  const ToolRun none = Run("--set degeneracy.method=none", dir_ + "/none");
+  ASSERT_EQ(none.exit_code, 0) << none.err;
+  const ToolRun refine = RunTool("refine --bag " + data_ + ".bag --config " + data_ +
+                                     ".yaml --init " + dir_ + "/none/trajectory.tum " +
+                                     "--set degeneracy.method=localizability --out " + dir_ +
+                                     "/refine",
+                                 dir_);
+  EXPECT_EQ(refine.exit_code, 2);
+  EXPECT_NE(refine.err.find("degeneracy.method=localizability is not defined for refine"),
+            std::string::npos)
+      << refine.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/refine/trajectory.tum"));
+}
+
+}  // namespace
+}  // namespace rvlio
