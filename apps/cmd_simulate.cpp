@@ -148,6 +148,10 @@ int CmdSimulate(int argc, char** argv) {
       sim.name.c_str(), static_cast<long long>(r->scans), r->rows, r->cols,
       static_cast<long long>(r->imu_samples), r->duration_s, r->bag_path.c_str(), mb, r->wall_s,
       r->cpu_s);
+  if (!r->localizability_path.empty())
+    std::printf("rvlio simulate: true localizability: %lld of %lld scans degenerate -> %s\n",
+                static_cast<long long>(r->degenerate_scans), static_cast<long long>(r->scans),
+                r->localizability_path.c_str());
   return 0;
 }
 
