@@ -46,6 +46,9 @@ CommandSpec EvalSpec() {
         false, false},
        {"truth", "SIM_DIR", "degeneracy mode: an `rvlio simulate` folder (localizability.csv, "
         "*_gt.tum; --gt FILE names the ground truth)", false, false},
+       {"truth-ratio", "R", "degeneracy mode: a true scan is degenerate when lambda_min / "
+        "lambda_max < R (default: the simulation's flags, localizability.degenerate_ratio)",
+        false, false},
        {"align", "MODE", "se3 | sim3 | origin | none (default se3)", false, false},
        {"rpe-delta", "N", "RPE step (default 1)", false, false},
        {"rpe-unit", "UNIT", "frames | meters (default frames)", false, false},
@@ -171,10 +174,15 @@ int EvalDegeneracy(const Args& args) {
   if (args.Has("map") || args.Has("ref-map") || args.Has("est"))
     return Fail(kName, "--degeneracy (degeneracy mode) cannot be combined with --map/--ref-map/--est");
   if (!args.Has("truth")) return Fail(kName, "--degeneracy RUN_DIR needs --truth SIM_DIR");
-  EvalOptions options;
-  if (std::string error = ReadOptions(args, &options); !error.empty()) return Fail(kName, error);
-  StatusOr<DegeneracyEvalResult> r = EvaluateDegeneracyFiles(
-      args.Get("degeneracy"), args.Get("truth"), args.Get("gt", ""), options);
+  DegeneracyEvalArgs d;
+  if (std::string error = ReadOptions(args, &d.eval); !error.empty()) return Fail(kName, error);
+  d.run_dir = args.Get("degeneracy");
+  d.truth_dir = args.Get("truth");
+  d.gt_path = args.Get("gt", "");
+  if (args.Has("truth-ratio") &&
+      (!ParseNumber(args.Get("truth-ratio"), &d.degenerate_ratio) || d.degenerate_ratio <= 0.0))
+    return Fail(kName, "--truth-ratio '" + args.Get("truth-ratio") + "' is not a positive number");
+  StatusOr<DegeneracyEvalResult> r = EvaluateDegeneracyFiles(d);
   if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
   for (const std::string& w : r->scores.warnings)
     std::fprintf(stderr, "rvlio %s: warning: %s\n", kName, w.c_str());

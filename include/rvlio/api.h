@@ -231,14 +231,21 @@ struct DegeneracyEvalResult {
   size_t truth_scans = 0, run_scans = 0;
   DegeneracyScores scores;
 };
+struct DegeneracyEvalArgs {
+  std::string run_dir;    // scans.csv, trajectory.tum
+  std::string truth_dir;  // localizability.csv, NAME_gt.tum (`rvlio simulate` output)
+  std::string gt_path;    // the ground truth; "" = the one *_gt.tum in truth_dir
+  // > 0: a truth scan is degenerate when its `ratio` column is below this
+  // (instead of its `degenerate` column, the simulation's
+  // localizability.degenerate_ratio).
+  double degenerate_ratio = 0.0;
+  EvalOptions eval;  // alignment and time association (max_dt)
+};
 // Reads RUN_DIR/scans.csv (columns by header name), RUN_DIR/trajectory.tum,
-// TRUTH_DIR/localizability.csv and the ground truth (gt_path, or the one
-// *_gt.tum in TRUTH_DIR when empty). InvalidInput naming the file for a
-// missing file or column, a non-finite value, or no scans matched by time.
-StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const std::string& run_dir,
-                                                       const std::string& truth_dir,
-                                                       const std::string& gt_path,
-                                                       const EvalOptions& options);
+// TRUTH_DIR/localizability.csv and the ground truth. InvalidInput naming the
+// file for a missing file or column, a non-finite value, or no scans matched
+// by time.
+StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const DegeneracyEvalArgs& args);
 // `rvlio eval --degeneracy --json`.
 nlohmann::json DegeneracyEvalJson(const DegeneracyEvalResult& result);
 

@@ -85,6 +85,22 @@ StatusOr<std::vector<DegeneracyLabel>> ReadLabels(const std::string& path,
   return labels;
 }
 
+// The truth's flags from its ratio column: degenerate when below `ratio`.
+Status Rethreshold(const std::string& path, double ratio, std::vector<DegeneracyLabel>* truth) {
+  StatusOr<ScanTable> table = ReadScanTable(path);
+  if (!table.ok()) return table.status();
+  StatusOr<const std::vector<double>*> column = Column(*table, path, "ratio");
+  if (!column.ok()) return column.status();
+  for (size_t i = 0; i < truth->size(); ++i) {
+    const double v = (**column)[i];
+    if (!std::isfinite(v))
+      return Status::InvalidInput(path + ": data row " + std::to_string(i + 1) +
+                                  ": ratio is not a finite number");
+    (*truth)[i].degenerate = v < ratio;
+  }
+  return Status::Ok();
+}
+
 // The one NAME_gt.tum of a simulation folder.
 StatusOr<std::string> FindGroundTruth(const std::string& truth_dir) {
   std::vector<std::string> found;
@@ -167,10 +183,11 @@ nlohmann::json MapEvalJson(const MapEvalResult& r) {
           {"profile", profile}};
 }
 
-StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const std::string& run_dir,
-                                                       const std::string& truth_dir,
-                                                       const std::string& gt_path,
-                                                       const EvalOptions& options) {
+StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const DegeneracyEvalArgs& args) {
+  const std::string &run_dir = args.run_dir, &truth_dir = args.truth_dir;
+  if (!(args.degenerate_ratio >= 0.0))
+    return Status::InvalidInput("degenerate ratio " + std::to_string(args.degenerate_ratio) +
+                                " is not a number >= 0");
   DegeneracyEvalResult r;
   r.scans_path = (fs::path(run_dir) / "scans.csv").string();
   r.est_path = (fs::path(run_dir) / "trajectory.tum").string();
@@ -184,7 +201,10 @@ StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const std::string& run_di
   if (!detected.ok()) return detected.status();
   StatusOr<std::vector<DegeneracyLabel>> truth = ReadLabels(r.truth_path, kDegeneracyColumns, true);
   if (!truth.ok()) return truth.status();
-  r.gt_path = gt_path;
+  if (args.degenerate_ratio > 0.0) {
+    if (Status s = Rethreshold(r.truth_path, args.degenerate_ratio, &*truth); !s.ok()) return s;
+  }
+  r.gt_path = args.gt_path;
   if (r.gt_path.empty()) {
     StatusOr<std::string> found = FindGroundTruth(truth_dir);
     if (!found.ok()) return found.status();
@@ -194,7 +214,7 @@ StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const std::string& run_di
   if (!gt.ok()) return gt.status();
   StatusOr<Trajectory> est = ReadTrajectory(r.est_path);
   if (!est.ok()) return est.status();
-  StatusOr<DegeneracyScores> scores = ScoreDegeneracy(*truth, *detected, *gt, *est, options);
+  StatusOr<DegeneracyScores> scores = ScoreDegeneracy(*truth, *detected, *gt, *est, args.eval);
   if (!scores.ok())
     return Status::InvalidInput(r.scans_path + " vs " + r.truth_path + ": " +
                                 scores.status().message());

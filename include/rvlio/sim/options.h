@@ -289,7 +289,7 @@ struct SimSurveyOptions {
 struct SimLocalizabilityOptions {
   bool enabled = true;            // write localizability.csv
   double voxel_size = 0.5;        // m, the estimator's lidar.voxel_size (its default)
-  double degenerate_ratio = 0.02; // a scan is degenerate when lambda_min / lambda_max is below
+  double degenerate_ratio = 0.1;  // a scan is degenerate when lambda_min / lambda_max is below
 
   template <class V>
   void Visit(V& v) {
