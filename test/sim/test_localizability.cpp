@@ -3,6 +3,7 @@
 // whole simulated scan of the planar tunnel (featureless preset, no
 // roughness) against an independent computation from the analytic faces.
 #include <cmath>
+#include <memory>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -57,6 +58,17 @@ TEST(SurfaceNormal, RoughFaceMatchesNumericGradient) {
   EXPECT_LT((f.Normal(p) - expected).norm(), 1e-8);
 }
 
+// A preset, shortened, and its simulator.
+std::unique_ptr<Simulator> Simulate(const char* preset, double duration_s, int columns,
+                                    double range_noise_m, SimOptions* o) {
+  *o = *PresetOptions(preset);
+  o->duration = duration_s;
+  o->lidar.columns = columns;
+  o->lidar.range_noise = range_noise_m;
+  auto sim = Simulator::Create(*o);
+  return sim.ok() ? std::move(*sim) : nullptr;
+}
+
 SurfaceHit Hit(const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
   return {p, Eigen::Vector3d::Zero(), n.normalized()};
 }
@@ -99,12 +111,10 @@ TEST(Localizability, CorridorIsDegenerateAlongItsAxisRoomIsNot) {
 // 0 (the tunnel's axis), along y and z the fractions of wall and of
 // floor/ceiling points.
 TEST(Localizability, PlanarTunnelScanMatchesAnalyticFaces) {
-  SimOptions o = *PresetOptions("featureless");
-  o.duration = 6.0;
-  o.lidar.range_noise = 0.0;
-  auto sim = Simulator::Create(o);
-  ASSERT_TRUE(sim.ok());
-  const World& world = (*sim)->world();
+  SimOptions o;
+  const auto sim = Simulate("featureless", 6.0, 1024, 0.0, &o);
+  ASSERT_TRUE(sim);
+  const World& world = sim->world();
   ASSERT_TRUE(world.boxes().empty() && world.cylinders().empty());
   LocalizabilityTruth truth(o.localizability, o.lidar);
   LidarOptions grid;
@@ -114,7 +124,7 @@ TEST(Localizability, PlanarTunnelScanMatchesAnalyticFaces) {
   ScanPreprocessor preprocessor(grid);
   for (int64_t k : {0, 45}) {
     std::vector<SurfaceHit> hits;
-    const Scan scan = (*sim)->SimulateScan(k, &hits);
+    const Scan scan = sim->SimulateScan(k, &hits);
     const ScanLocalizability l = truth.Compute(scan, hits);
     std::vector<int> kept;
     preprocessor.SelectIndices(scan, &kept);
@@ -143,15 +153,13 @@ TEST(Localizability, PlanarTunnelScanMatchesAnalyticFaces) {
 
 // A closed hall constrains every direction: no scan degenerate.
 TEST(Localizability, HallScansAreWellConstrained) {
-  SimOptions o = *PresetOptions("hall");
-  o.duration = 10.0;
-  o.lidar.columns = 512;
-  auto sim = Simulator::Create(o);
-  ASSERT_TRUE(sim.ok());
+  SimOptions o;
+  const auto sim = Simulate("hall", 10.0, 512, 0.03, &o);
+  ASSERT_TRUE(sim);
   LocalizabilityTruth truth(o.localizability, o.lidar);
   for (int64_t k : {0, 40, 90}) {
     std::vector<SurfaceHit> hits;
-    const ScanLocalizability l = truth.Compute((*sim)->SimulateScan(k, &hits), hits);
+    const ScanLocalizability l = truth.Compute(sim->SimulateScan(k, &hits), hits);
     EXPECT_GT(l.ratio, 0.2) << k;
     EXPECT_FALSE(l.degenerate) << k;
     EXPECT_NEAR(l.eigenvalues.sum(), 1.0, 1e-9);
