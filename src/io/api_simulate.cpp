@@ -329,8 +329,8 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   std::vector<sim::ScanLocalizability> localizability;
   sim::Simulator::TruthCallback on_truth;
   if (options.localizability.enabled)
-    on_truth = [&](const Scan& scan, const std::vector<sim::SurfaceHit>& hits) {
-      localizability.push_back(truth.Compute(scan, hits));
+    on_truth = [&](const Scan& scan, std::vector<sim::SurfaceHit>* hits) {
+      localizability.push_back(truth.Compute((*simulator)->world(), scan, hits));
     };
   const Status written =
       args.format == "ouster-pcap"

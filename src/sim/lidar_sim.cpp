@@ -63,7 +63,8 @@ Scan CastScan(const World& world, const FlightTrajectory& trajectory, const Lida
         SurfaceHit& h = (*truth)[static_cast<size_t>(r) * cols + c];
         h.origin_world = T_world_lidar.t;
         h.p_world = T_world_lidar.t + (T_world_lidar.R * d_lidar) * hit.range;
-        h.normal_world = world.Normal(hit, h.p_world);
+        h.surface = hit;
+        h.returned = true;
       }
     }
   }

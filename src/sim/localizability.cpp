@@ -54,10 +54,14 @@ LocalizabilityTruth::LocalizabilityTruth(const SimLocalizabilityOptions& options
                                          const SimLidarOptions& lidar)
     : degenerate_ratio_(options.degenerate_ratio), preprocessor_(GridOptions(options, lidar)) {}
 
-ScanLocalizability LocalizabilityTruth::Compute(const Scan& scan,
-                                                const std::vector<SurfaceHit>& hits) {
+ScanLocalizability LocalizabilityTruth::Compute(const World& world, const Scan& scan,
+                                                std::vector<SurfaceHit>* hits) {
   preprocessor_.SelectIndices(scan, &kept_);
-  ScanLocalizability out = LocalizabilityOf(hits, kept_, degenerate_ratio_);
+  for (int i : kept_) {
+    SurfaceHit& h = (*hits)[static_cast<size_t>(i)];
+    if (h.returned) h.normal_world = world.Normal(h.surface, h.p_world);
+  }
+  ScanLocalizability out = LocalizabilityOf(*hits, kept_, degenerate_ratio_);
   out.t_ns = scan.t_end_ns;
   return out;
 }

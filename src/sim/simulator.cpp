@@ -72,7 +72,7 @@ bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan,
   for (int64_t k = 0; k < scan_count_; ++k) {
     if (!emit_imu_until(ScanStartTime(k) + lidar_.period_ns())) return false;
     Scan scan = SimulateScan(k, on_truth ? &truth : nullptr);
-    if (on_truth) on_truth(scan, truth);
+    if (on_truth) on_truth(scan, &truth);
     ShiftScanTime(-LidarClockOffsetNs(scan.t_start_ns), &scan);
     if (!on_scan(scan, lidar_.rows(), lidar_.cols())) return false;
   }

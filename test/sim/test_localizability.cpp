@@ -70,7 +70,11 @@ std::unique_ptr<Simulator> Simulate(const char* preset, double duration_s, int c
 }
 
 SurfaceHit Hit(const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
-  return {p, Eigen::Vector3d::Zero(), n.normalized()};
+  SurfaceHit h;
+  h.p_world = p;
+  h.normal_world = n.normalized();
+  h.returned = true;
+  return h;
 }
 
 // A corridor (two walls and a floor) leaves the axis x unconstrained; a
@@ -125,7 +129,7 @@ TEST(Localizability, PlanarTunnelScanMatchesAnalyticFaces) {
   for (int64_t k : {0, 45}) {
     std::vector<SurfaceHit> hits;
     const Scan scan = sim->SimulateScan(k, &hits);
-    const ScanLocalizability l = truth.Compute(scan, hits);
+    const ScanLocalizability l = truth.Compute(world, scan, &hits);
     std::vector<int> kept;
     preprocessor.SelectIndices(scan, &kept);
     Eigen::Vector3d count = Eigen::Vector3d::Zero();
@@ -159,7 +163,8 @@ TEST(Localizability, HallScansAreWellConstrained) {
   LocalizabilityTruth truth(o.localizability, o.lidar);
   for (int64_t k : {0, 40, 90}) {
     std::vector<SurfaceHit> hits;
-    const ScanLocalizability l = truth.Compute(sim->SimulateScan(k, &hits), hits);
+    const Scan scan = sim->SimulateScan(k, &hits);
+    const ScanLocalizability l = truth.Compute(sim->world(), scan, &hits);
     EXPECT_GT(l.ratio, 0.2) << k;
     EXPECT_FALSE(l.degenerate) << k;
     EXPECT_NEAR(l.eigenvalues.sum(), 1.0, 1e-9);

@@ -37,12 +37,15 @@ class LidarModel {
 };
 
 // The noise-free truth of one return (world frame): where the ray met the
-// surface, the sensor position it left from, and the surface's unit normal
-// there. normal_world = 0 for no return.
+// surface, the sensor position it left from, and which surface it was.
+// normal_world stays zero until asked for (World::Normal; computing it for
+// every return would cost more than the few kept points need).
 struct SurfaceHit {
   Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
   Eigen::Vector3d origin_world = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();
+  RayHit surface;         // the shape hit
+  bool returned = false;  // false: no return (the other fields are unset)
 };
 
 // Casts one organized scan: rows x cols points, row-major by ring

@@ -21,6 +21,7 @@
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/sim/lidar_sim.h"
 #include "rvlio/sim/options.h"
+#include "rvlio/sim/world.h"
 
 namespace rvlio::sim {
 
@@ -43,13 +44,15 @@ struct ScanLocalizability {
 ScanLocalizability LocalizabilityOf(const std::vector<SurfaceHit>& hits,
                                     const std::vector<int>& indices, double degenerate_ratio);
 
-// Per scan: the estimator's voxel grid on the simulated scan, then
-// LocalizabilityOf the kept points' true hits. Owns the grid's workspace.
+// Per scan: the estimator's voxel grid on the simulated scan, the true
+// normals of the kept points (World::Normal), then LocalizabilityOf them.
+// Owns the grid's workspace.
 class LocalizabilityTruth {
  public:
   // `lidar`: the simulated sensor's range limits (the estimator's crop).
   LocalizabilityTruth(const SimLocalizabilityOptions& options, const SimLidarOptions& lidar);
-  ScanLocalizability Compute(const Scan& scan, const std::vector<SurfaceHit>& hits);
+  // Fills the normals of the kept hits.
+  ScanLocalizability Compute(const World& world, const Scan& scan, std::vector<SurfaceHit>* hits);
 
  private:
   double degenerate_ratio_;

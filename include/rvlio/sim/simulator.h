@@ -35,7 +35,7 @@ class Simulator {
   using ScanCallback = std::function<bool(const Scan&, int rows, int cols)>;
   // The true hits of a scan (lidar_sim.h), with the scan in true time (before
   // the LiDAR clock offset is applied), just before on_scan gets it.
-  using TruthCallback = std::function<void(const Scan&, const std::vector<SurfaceHit>&)>;
+  using TruthCallback = std::function<void(const Scan&, std::vector<SurfaceHit>*)>;
 
   // Validates the options (InvalidInput naming the key) and builds the world.
   static StatusOr<std::unique_ptr<Simulator>> Create(const SimOptions& options);
