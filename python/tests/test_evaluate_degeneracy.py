@@ -75,3 +75,14 @@ def test_bad_input(tmp_path):
     (run / "scans.csv").write_text("t,status\n1700000000.0,ok\n")
     with pytest.raises(ValueError, match="no column 'rv_active'"):
         rvlio.evaluate_degeneracy(run, truth)
+
+
+def test_simulate_returns_the_truth_file(tmp_path):
+    cheap = {"lidar.columns": 64}
+    sim = rvlio.simulate("featureless", seed=2, duration=1, out=tmp_path / "a", set=cheap)
+    assert sim["localizability"].endswith("localizability.csv")
+    assert sim["degenerate_scans"] == sim["scans"]  # planar tunnel: every scan
+    off = rvlio.simulate("featureless", seed=2, duration=1, out=tmp_path / "b",
+                         set={**cheap, "localizability.enabled": False})
+    assert off["localizability"] is None
+    assert not (tmp_path / "b" / "localizability.csv").exists()
