@@ -70,7 +70,8 @@ Status AddWeakDirectionError(const std::vector<DegeneracyLabel>& truth,
     previous = &p_gt;
   }
   s->error_scans = along.size();
-  if (along.empty()) return Status::InvalidInput("no scan has both a ground-truth and an estimated pose");
+  if (along.empty())
+    return Status::InvalidInput("no scan has both a ground-truth and an estimated pose");
   s->along_weak_rms_m = Rms(along);
   s->along_weak_rms_degenerate_m = Rms(along_degenerate);
   s->along_weak_final_m = along.back();

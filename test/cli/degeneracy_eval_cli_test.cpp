@@ -41,9 +41,8 @@ class DegeneracyEvalCli : public ::testing::Test {
     return out;
   }
   static nlohmann::json Score(const std::string& run_dir, const std::string& extra = "") {
-    const ToolRun r = RunTool("eval --degeneracy " + run_dir + " --truth " + dir_ + "/sim --json " +
-                                  extra,
-                              dir_);
+    const ToolRun r =
+        RunTool("eval --degeneracy " + run_dir + " --truth " + dir_ + "/sim --json " + extra, dir_);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return nlohmann::json::parse(r.out, nullptr, false);
   }
@@ -145,9 +144,9 @@ TEST_F(DegeneracyEvalCli, BadInputIsOneLineExit2) {
   const std::string two = dir_ + "/two_gt";
   std::filesystem::copy(dir_ + "/sim", two, std::filesystem::copy_options::recursive);
   std::filesystem::copy(two + "/featureless_gt.tum", two + "/other_gt.tum");
-  testing_cli::ExpectOneErrorLine(RunTool(base + " --truth " + two, dir_), "eval",
-                                  "ground truths");
-  EXPECT_EQ(RunTool(base + " --truth " + two + " --gt " + two + "/other_gt.tum", dir_).exit_code, 0);
+  testing_cli::ExpectOneErrorLine(RunTool(base + " --truth " + two, dir_), "eval", "ground truths");
+  EXPECT_EQ(RunTool(base + " --truth " + two + " --gt " + two + "/other_gt.tum", dir_).exit_code,
+            0);
 }
 
 }  // namespace

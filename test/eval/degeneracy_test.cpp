@@ -3,8 +3,8 @@
 // angles and error along the weak direction.
 #include <cmath>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "rvlio/eval/degeneracy.h"
 
@@ -31,10 +31,11 @@ TEST(DegeneracyScore, ConfusionCountsAnglesAndUnmatchedScans) {
   // Detection (2 ms late): flags 0-3 (TP, directions tilted by 10, 20, 30
   // degrees and a flipped sign), misses 4-5 (FN), flags 6 (FP), skips 9 (no row).
   std::vector<DegeneracyLabel> detected = {
-      Label(0, true, Tilted(10), 2'000'000), Label(1, true, Tilted(20), 2'000'000),
+      Label(0, true, Tilted(10), 2'000'000),  Label(1, true, Tilted(20), 2'000'000),
       Label(2, true, -Tilted(30), 2'000'000), Label(3, true, Eigen::Vector3d::Zero(), 2'000'000),
-      Label(4, false, y, 2'000'000), Label(5, false, y, 2'000'000),
-      Label(6, true, y, 2'000'000), Label(7, false, y, 2'000'000), Label(8, false, y, 2'000'000)};
+      Label(4, false, y, 2'000'000),          Label(5, false, y, 2'000'000),
+      Label(6, true, y, 2'000'000),           Label(7, false, y, 2'000'000),
+      Label(8, false, y, 2'000'000)};
   StatusOr<DegeneracyScores> s = ScoreDegeneracy(truth, detected, 0.01);
   ASSERT_TRUE(s.ok()) << s.status().message();
   EXPECT_EQ(s->matched, 9u);

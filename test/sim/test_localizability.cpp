@@ -5,8 +5,8 @@
 #include <cmath>
 #include <memory>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "rvlio/sim/localizability.h"
 #include "rvlio/sim/presets.h"

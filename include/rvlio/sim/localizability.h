@@ -30,12 +30,12 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 struct ScanLocalizability {
   TimeNs t_ns = 0;  // true time of the scan end (the stamp of the estimator's pose)
   int points = 0;   // kept points with a true normal
-  Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();     // of H_tt, ascending
+  Eigen::Vector3d eigenvalues = Eigen::Vector3d::Zero();      // of H_tt, ascending
   Eigen::Vector3d weak_dir_world = Eigen::Vector3d::UnitX();  // unit, of eigenvalues[0]
-  double ratio = 0.0;  // eigenvalues[0] / eigenvalues[2] (0 with no points)
-  double pose_eigenvalue_min = 0.0;               // smallest eigenvalue of H
-  Vector6d pose_weak = Vector6d::Zero();          // its unit eigenvector (rx ry rz tx ty tz)
-  bool degenerate = true;                         // ratio < degenerate_ratio (or no points)
+  double ratio = 0.0;                     // eigenvalues[0] / eigenvalues[2] (0 with no points)
+  double pose_eigenvalue_min = 0.0;       // smallest eigenvalue of H
+  Vector6d pose_weak = Vector6d::Zero();  // its unit eigenvector (rx ry rz tx ty tz)
+  bool degenerate = true;                 // ratio < degenerate_ratio (or no points)
 };
 
 // The information of a set of (point, sensor, normal) samples; hits with a
