@@ -30,7 +30,11 @@ CommandSpec EvalSpec() {
       "With --map and --ref-map instead: the map's accuracy against a reference cloud (PCD or\n"
       "PLY, same frame): point-to-plane and nearest-point distances, completeness, Chamfer\n"
       "distance, outliers and a profile along the reference's principal axis\n"
-      "(docs/map_eval.md). Exit status 2 on bad input.",
+      "(docs/map_eval.md).\n"
+      "With --degeneracy RUN_DIR --truth SIM_DIR instead: the run's per-scan degeneracy\n"
+      "detection (scans.csv) against the simulator's true localizability\n"
+      "(SIM_DIR/localizability.csv): precision, recall, weak-direction angle and the error\n"
+      "along the true weak direction (docs/degeneracy_truth.md). Exit status 2 on bad input.",
       {{"gt", "FILE", "reference trajectory (trajectory mode)", false, false},
        {"est", "FILE", "estimated trajectory (trajectory mode)", false, false},
        {"map", "FILE", "map to judge, PCD or PLY (map mode)", false, false},
@@ -38,6 +42,13 @@ CommandSpec EvalSpec() {
        {"max-distance", "M", "map mode: inlier / completeness threshold D (default 0.1)", false,
         false},
        {"profile-step", "M", "map mode: chainage bin of the profile (default 1)", false, false},
+       {"degeneracy", "RUN_DIR", "a run folder (scans.csv, trajectory.tum) to score (degeneracy mode)",
+        false, false},
+       {"truth", "SIM_DIR", "degeneracy mode: an `rvlio simulate` folder (localizability.csv, "
+        "*_gt.tum; --gt FILE names the ground truth)", false, false},
+       {"truth-ratio", "R", "degeneracy mode: a true scan is degenerate when lambda_min / "
+        "lambda_max < R (default: the simulation's flags, localizability.degenerate_ratio)",
+        false, false},
        {"align", "MODE", "se3 | sim3 | origin | none (default se3)", false, false},
        {"rpe-delta", "N", "RPE step (default 1)", false, false},
        {"rpe-unit", "UNIT", "frames | meters (default frames)", false, false},
@@ -140,6 +151,48 @@ void PrintMapTable(const MapEvalResult& r, const std::string& map_path,
                 b->map_with_plane, b->completeness);
 }
 
+void PrintDegeneracyTable(const DegeneracyEvalResult& r) {
+  const DegeneracyScores& s = r.scores;
+  std::printf("detection %s of %s vs truth %s\n", r.detection_columns.c_str(),
+              r.scans_path.c_str(), r.truth_path.c_str());
+  std::printf("matched scans  %zu of %zu (run) / %zu (truth)\n\n", s.matched, r.run_scans,
+              r.truth_scans);
+  std::printf("degenerate     true %zu   flagged %zu   both %zu\n",
+              s.true_positive + s.false_negative, s.true_positive + s.false_positive,
+              s.true_positive);
+  std::printf("precision      %.4f\nrecall         %.4f\n", s.precision, s.recall);
+  std::printf("weak-direction angle [deg]  mean %.3f   median %.3f   (%zu scans flagged by both)\n",
+              s.angle_deg.mean, s.angle_deg.median, s.angle_deg.count);
+  std::printf("error along the true weak direction [m]  rms %.4f   rms (degenerate) %.4f   "
+              "final %.4f\n",
+              s.along_weak_rms_m, s.along_weak_rms_degenerate_m, s.along_weak_final_m);
+  std::printf("growth [m per 100 m]  %.4f   (path %.1f m)\n", s.along_weak_growth_per_100m,
+              s.path_length_m);
+}
+
+int EvalDegeneracy(const Args& args) {
+  if (args.Has("map") || args.Has("ref-map") || args.Has("est"))
+    return Fail(kName, "--degeneracy (degeneracy mode) cannot be combined with --map/--ref-map/--est");
+  if (!args.Has("truth")) return Fail(kName, "--degeneracy RUN_DIR needs --truth SIM_DIR");
+  DegeneracyEvalArgs d;
+  if (std::string error = ReadOptions(args, &d.eval); !error.empty()) return Fail(kName, error);
+  d.run_dir = args.Get("degeneracy");
+  d.truth_dir = args.Get("truth");
+  d.gt_path = args.Get("gt", "");
+  if (args.Has("truth-ratio") &&
+      (!ParseNumber(args.Get("truth-ratio"), &d.degenerate_ratio) || d.degenerate_ratio <= 0.0))
+    return Fail(kName, "--truth-ratio '" + args.Get("truth-ratio") + "' is not a positive number");
+  StatusOr<DegeneracyEvalResult> r = EvaluateDegeneracyFiles(d);
+  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  for (const std::string& w : r->scores.warnings)
+    std::fprintf(stderr, "rvlio %s: warning: %s\n", kName, w.c_str());
+  if (args.Has("json"))
+    std::cout << JsonText(DegeneracyEvalJson(*r), -1) << "\n";
+  else
+    PrintDegeneracyTable(*r);
+  return 0;
+}
+
 int EvalMap(const Args& args) {
   if (args.Has("gt") || args.Has("est"))
     return Fail(kName, "--map/--ref-map (map mode) cannot be combined with --gt/--est");
@@ -162,6 +215,10 @@ int CmdEval(int argc, char** argv) {
   const CommandSpec spec = EvalSpec();
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
+  if (args.Has("degeneracy") || args.Has("truth")) {
+    if (!args.Has("degeneracy")) return Fail(kName, "--truth SIM_DIR needs --degeneracy RUN_DIR");
+    return EvalDegeneracy(args);
+  }
   if (args.Has("map") || args.Has("ref-map")) return EvalMap(args);
   for (const char* required : {"gt", "est"})  // trajectory mode
     if (!args.Has(required))

@@ -6,6 +6,8 @@
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
 //   DIR/reference_map.pcd  with --reference-map: a static laser-scanner
 //                    survey of the world (docs/simulator.md)
+//   DIR/localizability.csv  the true per-scan localizability
+//                    (docs/degeneracy_truth.md; localizability.* keys)
 // Argument parsing and the summary line only: SimulateRecording (rvlio/api.h)
 // does the work.
 #include <cerrno>
@@ -41,6 +43,9 @@ CommandSpec SimulateSpec() {
           "`rvlio run --config`). Deterministic: the same options and seed give the same files.\n"
           "--reference-map also writes DIR/reference_map.pcd, a static laser-scanner survey of\n"
           "the world in the ground truth's frame (survey.* keys; docs/simulator.md).\n"
+          "DIR/localizability.csv: the true per-scan localizability (point-to-plane information\n"
+          "of the true normals; localizability.* keys; docs/degeneracy_truth.md), scored by\n"
+          "`rvlio eval --degeneracy`.\n"
           "Presets: " +
               PresetList() + ".",
           {{"preset", "NAME", "world, sensors and flight (default tunnel)", false, false},
@@ -148,6 +153,10 @@ int CmdSimulate(int argc, char** argv) {
       sim.name.c_str(), static_cast<long long>(r->scans), r->rows, r->cols,
       static_cast<long long>(r->imu_samples), r->duration_s, r->bag_path.c_str(), mb, r->wall_s,
       r->cpu_s);
+  if (!r->localizability_path.empty())
+    std::printf("rvlio simulate: true localizability: %lld of %lld scans degenerate -> %s\n",
+                static_cast<long long>(r->degenerate_scans), static_cast<long long>(r->scans),
+                r->localizability_path.c_str());
   return 0;
 }
 

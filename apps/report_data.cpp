@@ -401,38 +401,6 @@ size_t ThinningStride(size_t points, size_t max_points) {
   return (points + max_points - 1) / max_points;
 }
 
-const std::vector<double>* ScanTable::Find(const std::string& name) const {
-  for (size_t i = 0; i < names.size(); ++i)
-    if (names[i] == name) return &columns[i];
-  return nullptr;
-}
-
-StatusOr<ScanTable> ReadScanTable(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::InvalidInput(path + ": cannot open");
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("t,", 0) != 0)
-    return Status::InvalidInput(path + ": no scans.csv header (first column t)");
-  ScanTable table;
-  std::istringstream header(line);
-  for (std::string name; std::getline(header, name, ',');) table.names.push_back(name);
-  table.columns.resize(table.names.size());
-  while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    std::istringstream fields(line);
-    std::string field;
-    for (size_t i = 0; i < table.names.size(); ++i) {
-      if (!std::getline(fields, field, ',')) field.clear();
-      char* end = nullptr;
-      double v = std::strtod(field.c_str(), &end);
-      if (field.empty() || *end != '\0') v = kNaN;
-      if (table.names[i] == "diverged") v = field.empty() ? 0.0 : 1.0;
-      table.columns[i].push_back(v);
-    }
-  }
-  return table;
-}
-
 std::vector<std::string> MetricColumns(const std::vector<json>& rows,
                                        const std::vector<std::string>& leading,
                                        const std::vector<std::string>& skip) {

@@ -37,16 +37,6 @@ std::string ReportArray(const std::vector<float>& values);
 // Every stride-th point so that at most max_points remain (stride 1 keeps all).
 size_t ThinningStride(size_t points, size_t max_points);
 
-// One column of scans.csv per name (NaN where a field is empty or not a
-// number; a non-empty `diverged` field counts 1). Header-less or unreadable
-// files are InvalidInput naming the file.
-struct ScanTable {
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> columns;
-  const std::vector<double>* Find(const std::string& name) const;
-};
-StatusOr<ScanTable> ReadScanTable(const std::string& path);
-
 // The columns of a metrics table from JSON rows: the given leading keys, then
 // every number or boolean at the top level of any row, then those of nested
 // objects one level down as "parent.key" (skipping the `skip` objects), in the

@@ -25,6 +25,7 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/eval/degeneracy.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/io/config.h"
@@ -191,6 +192,10 @@ struct SimulateResult {
   std::string reference_map_path;
   int64_t reference_map_points = 0;
   int reference_map_stations = 0;
+  // localizability.csv (the true per-scan localizability, sim/localizability.h)
+  // when localizability.enabled, else ""; its scans flagged degenerate.
+  std::string localizability_path;
+  int64_t degenerate_scans = 0;
   double reference_map_s = 0.0;  // wall time of the survey
   int64_t scans = 0, imu_samples = 0;
   int rows = 0, cols = 0;     // LiDAR rows x columns
@@ -215,6 +220,34 @@ StatusOr<EvalResult> EvaluateFiles(const std::string& gt_path, const std::string
 // `rvlio eval --json`: matched, align, scale, ape, ape_rot_deg, rpe,
 // rpe_rot_deg, end_point_error, along_axis, warnings (10 significant digits).
 nlohmann::json EvalJson(const EvalResult& result);
+
+// eval --degeneracy: a run's per-scan degeneracy detection against the
+// simulator's true localizability (eval/degeneracy.h, docs/degeneracy_truth.md).
+struct DegeneracyEvalResult {
+  // Where the detection came from: "degenerate,weak_dir" (the degeneracy
+  // columns of scans.csv) or "rv_active,n_alpha" (a run without them).
+  std::string detection_columns;
+  std::string scans_path, truth_path, gt_path, est_path;
+  size_t truth_scans = 0, run_scans = 0;
+  DegeneracyScores scores;
+};
+struct DegeneracyEvalArgs {
+  std::string run_dir;    // scans.csv, trajectory.tum
+  std::string truth_dir;  // localizability.csv, NAME_gt.tum (`rvlio simulate` output)
+  std::string gt_path;    // the ground truth; "" = the one *_gt.tum in truth_dir
+  // > 0: a truth scan is degenerate when its `ratio` column is below this
+  // (instead of its `degenerate` column, the simulation's
+  // localizability.degenerate_ratio).
+  double degenerate_ratio = 0.0;
+  EvalOptions eval;  // alignment and time association (max_dt)
+};
+// Reads RUN_DIR/scans.csv (columns by header name), RUN_DIR/trajectory.tum,
+// TRUTH_DIR/localizability.csv and the ground truth. InvalidInput naming the
+// file for a missing file or column, a non-finite value, or no scans matched
+// by time.
+StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const DegeneracyEvalArgs& args);
+// `rvlio eval --degeneracy --json`.
+nlohmann::json DegeneracyEvalJson(const DegeneracyEvalResult& result);
 
 // ---------------------------------------------------------------------------
 // eval --map: a map against a reference cloud (eval/map_metrics.h)

@@ -17,6 +17,7 @@ from ._rvlio import (  # noqa: F401
     ScanResult,
     __version__,
     evaluate,
+    evaluate_degeneracy,
     evaluate_map,
     merge,
     read_bag,

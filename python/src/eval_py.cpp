@@ -1,6 +1,7 @@
 // rvlio.evaluate: the evaluation of `rvlio eval` (eval/evaluate.h), evo's
 // definitions of APE and RPE; rvlio.evaluate_map: `rvlio eval --map`
-// (eval/map_metrics.h).
+// (eval/map_metrics.h); rvlio.evaluate_degeneracy: `rvlio eval --degeneracy`
+// (eval/degeneracy.h).
 #include "eval_py.h"
 
 #include <pybind11/eigen.h>
@@ -8,6 +9,7 @@
 
 #include <cmath>
 
+#include "rvlio/api.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/io/point_cloud_file.h"
@@ -212,6 +214,32 @@ void BindEval(py::module_& m) {
       "APE and RPE of `est` against `gt` with evo's definitions (`rvlio eval --json`, "
       "unrounded). gt/est: TUM (or KITTI) file paths or (N, 8) arrays [t_s x y z qx qy qz qw]. "
       "align: se3 | sim3 | origin | none; rpe_unit: frames | meters.");
+
+  m.def(
+      "evaluate_degeneracy",
+      [](const py::handle& run_dir, const py::handle& truth_dir, const py::object& gt,
+         double truth_ratio, const std::string& align, double max_dt) {
+        DegeneracyEvalArgs args;
+        args.run_dir = PathText(run_dir);
+        args.truth_dir = PathText(truth_dir);
+        if (!gt.is_none()) args.gt_path = PathText(gt);
+        args.degenerate_ratio = truth_ratio;
+        args.eval.align = align;
+        args.eval.max_dt = max_dt;
+        Check(args.eval.Validate());
+        StatusOr<DegeneracyEvalResult> result = Status::Internal("not evaluated");
+        {
+          py::gil_scoped_release release;
+          result = EvaluateDegeneracyFiles(args);
+        }
+        return ToPython(DegeneracyEvalJson(Take(std::move(result))));
+      },
+      py::arg("run_dir"), py::arg("truth_dir"), py::kw_only(), py::arg("gt") = py::none(),
+      py::arg("truth_ratio") = 0.0, py::arg("align") = "se3", py::arg("max_dt") = 0.01,
+      "A run's per-scan degeneracy detection (run_dir/scans.csv, trajectory.tum) against the "
+      "simulator's true localizability (truth_dir/localizability.csv and its *_gt.tum, or gt): "
+      "the dict of `rvlio eval --degeneracy --json` (docs/degeneracy_truth.md). truth_ratio > "
+      "0 re-thresholds the truth (lambda_min / lambda_max below it is degenerate).");
 }
 
 }  // namespace rvlio::python

@@ -353,6 +353,9 @@ py::dict Simulate(const std::string& preset, const py::handle& seed, const py::h
   d["duration_s"] = r.duration_s;
   d["reference_map"] = r.reference_map_path.empty() ? py::object(py::none())
                                                      : py::object(py::str(r.reference_map_path));
+  d["localizability"] = r.localizability_path.empty() ? py::object(py::none())
+                                                      : py::object(py::str(r.localizability_path));
+  d["degenerate_scans"] = r.degenerate_scans;
   return d;
 }
 
@@ -427,7 +430,9 @@ void BindRun(py::module_& m) {
         "OUT/NAME.yaml (the config for rvlio.Config.load); returns their paths and counts. "
         "flight_seed: another flight through the same world (--flight-seed); reference_map: "
         "also OUT/reference_map.pcd, a survey of the world (--reference-map). "
-        "Ctrl-C raises KeyboardInterrupt and leaves no recording.");
+        "localizability: OUT/localizability.csv, the true per-scan localizability (None with "
+        "localizability.enabled false), degenerate_scans: its degenerate scans "
+        "(docs/degeneracy_truth.md). Ctrl-C raises KeyboardInterrupt and leaves no recording.");
 }
 
 }  // namespace rvlio::python

@@ -6,6 +6,9 @@
 //                    DIR/NAME.bag with the same quantized data)
 //   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
+//   DIR/localizability.csv  with localizability.enabled (default): the true
+//                    per-scan localizability (sim/localizability.h,
+//                    docs/degeneracy_truth.md)
 //   DIR/reference_map.pcd  with survey.enabled: a static survey of the world
 //                    (binary PCD, x y z float32, the ground truth's world frame)
 // `rvlio simulate` is this call plus argument parsing, signals and its line.
@@ -23,6 +26,7 @@
 #include "rvlio/io/pcap.h"
 #include "rvlio/io/sensor_bag.h"
 #include "rvlio/io/trajectory_io.h"
+#include "rvlio/sim/localizability.h"
 #include "rvlio/sim/presets.h"
 #include "rvlio/sim/simulator.h"
 
@@ -31,6 +35,7 @@ namespace {
 
 constexpr double kGroundTruthRate = 100.0;  // Hz
 constexpr const char* kReferenceMapFile = "reference_map.pcd";
+constexpr const char* kLocalizabilityFile = "localizability.csv";
 
 // Preset, then seed / duration, then each override (applied last), then
 // validation.
@@ -140,7 +145,8 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
 // and so does `stop` (*stop_reason set). Either leaves no bag: the writer's
 // temporary file (path + ".tmp") is removed when the writer goes.
 Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
-                const BagWriterOptions& format, const StopFn& stop, std::string* stop_reason) {
+                const BagWriterOptions& format, const sim::Simulator::TruthCallback& on_truth,
+                const StopFn& stop, std::string* stop_reason) {
   StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
   if (!writer.ok()) return writer.status();
   const SimOptions& o = simulator.options();
@@ -155,7 +161,8 @@ Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool l
         error = livox ? (*writer)->WriteLivoxScan(o.lidar.topic, o.lidar.frame_id, scan)
                       : (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
         return go_on();
-      });
+      },
+      on_truth);
   if (error.ok() && stop_reason->empty()) error = (*writer)->Close();
   writer->reset();  // removes the temporary file unless Close() renamed it
   return error;
@@ -184,7 +191,8 @@ StatusOr<OusterMetadata> SimulatedMetadata(const sim::Simulator& simulator, std:
 // Imu messages (what the capture must decode to, bit for bit).
 Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pcap_path,
                           const std::string& json_path, const std::string& bag_path,
-                          const StopFn& stop, std::string* stop_reason) {
+                          const sim::Simulator::TruthCallback& on_truth, const StopFn& stop,
+                          std::string* stop_reason) {
   std::string json;
   StatusOr<OusterMetadata> meta = SimulatedMetadata(simulator, &json);
   if (!meta.ok()) return meta.status();
@@ -218,7 +226,8 @@ Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pc
         ++frame_id;
         if (error.ok()) error = (*bag)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, decoded, rows, cols);
         return go_on();
-      });
+      },
+      on_truth);
   if (!error.ok() || !stop_reason->empty()) return error;
   if (Status s = (*bag)->Close(); !s.ok()) return s;
   if (Status s = WriteFileAtomically(json_path, json); !s.ok()) return s;
@@ -229,6 +238,28 @@ std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
   return "ground truth of '" + name + "' (rvlio simulate, seed " + std::to_string(o.seed) +
          FlightSeedNote(o) +
          "): T_world_imu, world = gravity-aligned, origin and yaw of the IMU at start";
+}
+
+// localizability.csv: one row per scan (sim/localizability.h). Eigenvalues
+// of the translation information per point (sum 1), the weak direction
+// (world, unit), lambda_min / lambda_max, the pose information's smallest
+// eigenvalue and eigenvector (rotation rad first, then translation m).
+Status WriteLocalizabilityCsv(const std::string& path,
+                              const std::vector<sim::ScanLocalizability>& scans) {
+  std::ostringstream os;
+  os.precision(9);
+  os << "t,points,lambda_min,lambda_mid,lambda_max,weak_dir_x,weak_dir_y,weak_dir_z,ratio,"
+        "pose_lambda_min,pose_weak_rx,pose_weak_ry,pose_weak_rz,pose_weak_tx,pose_weak_ty,"
+        "pose_weak_tz,degenerate\n";
+  for (const sim::ScanLocalizability& l : scans) {
+    os << FormatSeconds(l.t_ns) << ',' << l.points;
+    for (int i = 0; i < 3; ++i) os << ',' << l.eigenvalues[i];
+    for (int i = 0; i < 3; ++i) os << ',' << l.weak_dir_world[i];
+    os << ',' << l.ratio << ',' << l.pose_eigenvalue_min;
+    for (int i = 0; i < 6; ++i) os << ',' << l.pose_weak[i];
+    os << ',' << (l.degenerate ? 1 : 0) << '\n';
+  }
+  return WriteFileAtomically(path, os.str());
 }
 
 // The reference map (options.survey), surveyed before anything is written
@@ -294,11 +325,19 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
     return r;
   }
   r.bag_path = (dir / (name + extension)).string();
+  sim::LocalizabilityTruth truth(options.localizability, options.lidar);
+  std::vector<sim::ScanLocalizability> localizability;
+  sim::Simulator::TruthCallback on_truth;
+  if (options.localizability.enabled)
+    on_truth = [&](const Scan& scan, std::vector<sim::SurfaceHit>* hits) {
+      localizability.push_back(truth.Compute((*simulator)->world(), scan, hits));
+    };
   const Status written =
       args.format == "ouster-pcap"
           ? WriteOusterCapture(**simulator, r.bag_path, (dir / (name + ".json")).string(),
-                               (dir / (name + ".bag")).string(), args.stop, &r.stop_reason)
-          : WriteBag(**simulator, r.bag_path, livox, format, args.stop, &r.stop_reason);
+                               (dir / (name + ".bag")).string(), on_truth, args.stop,
+                               &r.stop_reason)
+          : WriteBag(**simulator, r.bag_path, livox, format, on_truth, args.stop, &r.stop_reason);
   if (!written.ok()) return written;
   if ((r.stopped = !r.stop_reason.empty())) return r;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -309,6 +348,12 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   if (Status s = WriteTum(r.gt_path, gt, GroundTruthHeader(options, name)); !s.ok()) return s;
   r.config_path = (dir / (name + ".yaml")).string();
   if (Status s = WriteFileAtomically(r.config_path, yaml); !s.ok()) return s;
+  if (options.localizability.enabled) {
+    r.localizability_path = (dir / kLocalizabilityFile).string();
+    if (Status s = WriteLocalizabilityCsv(r.localizability_path, localizability); !s.ok()) return s;
+    r.degenerate_scans = std::count_if(localizability.begin(), localizability.end(),
+                                       [](const sim::ScanLocalizability& l) { return l.degenerate; });
+  }
   if (options.survey.enabled) {
     if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
     r.reference_map_path = map_path;

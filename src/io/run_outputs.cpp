@@ -26,12 +26,6 @@ std::string EmptyPcd() {
 
 constexpr size_t kPcdBlockPoints = 1 << 15;  // points per Append of map.pcd
 
-// Absolute stamps need all nine decimals; the stream's precision is for the rest.
-std::string FormatSeconds(TimeNs t_ns) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.9f", NsToSeconds(t_ns));
-  return buf;
-}
 
 // The six extrinsic columns of a scan (empty if the scan carries no estimate).
 void WriteExtrinsicColumns(const std::optional<Pose3>& T_imu_lidar, std::ostream& os) {
@@ -128,6 +122,12 @@ std::string Optional(double v) {
 }
 }  // namespace
 
+std::string FormatSeconds(TimeNs t_ns) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.9f", NsToSeconds(t_ns));
+  return buf;
+}
+
 Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
                      const std::vector<double>& rss_mb) {
   std::ostringstream os;
@@ -190,6 +190,38 @@ Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin
        << Optional(b.median_abs_m) << ',' << Optional(b.p95_abs_m) << ',' << Optional(b.max_abs_m)
        << '\n';
   return WriteFileAtomically(path, os.str());
+}
+
+const std::vector<double>* ScanTable::Find(const std::string& name) const {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return &columns[i];
+  return nullptr;
+}
+
+StatusOr<ScanTable> ReadScanTable(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::InvalidInput(path + ": cannot open");
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("t,", 0) != 0)
+    return Status::InvalidInput(path + ": no CSV header with first column t");
+  ScanTable table;
+  std::istringstream header(line);
+  for (std::string name; std::getline(header, name, ',');) table.names.push_back(name);
+  table.columns.resize(table.names.size());
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    std::istringstream fields(line);
+    std::string field;
+    for (size_t i = 0; i < table.names.size(); ++i) {
+      if (!std::getline(fields, field, ',')) field.clear();
+      char* end = nullptr;
+      double v = std::strtod(field.c_str(), &end);
+      if (field.empty() || *end != '\0') v = std::nan("");
+      if (table.names[i] == "diverged") v = field.empty() ? 0.0 : 1.0;
+      table.columns[i].push_back(v);
+    }
+  }
+  return table;
 }
 
 Trajectory ToTrajectory(const std::vector<ScanResult>& results) {

@@ -312,6 +312,16 @@ double Face::Distance(const Eigen::Vector3d& p) const {
   return std::abs(p[axis] - offset - relief.Height(u, v));
 }
 
+Eigen::Vector3d Face::Normal(const Eigen::Vector3d& p) const {
+  double dh_du = 0.0, dh_dv = 0.0;
+  relief.Height(p[UAxis()], p[VAxis()], &dh_du, &dh_dv);
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  n[axis] = 1.0;
+  n[UAxis()] = -dh_du;
+  n[VAxis()] = -dh_dv;
+  return n.normalized();
+}
+
 bool Box::Intersect(const Ray& ray, double t_min, double t_max, double* t) const {
   const Eigen::Vector3d o = R_world_box.transpose() * (ray.origin - center);
   const Eigen::Vector3d d = R_world_box.transpose() * ray.dir;
@@ -342,6 +352,15 @@ double Box::Distance(const Eigen::Vector3d& p) const {
 bool Box::Contains(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d q = (R_world_box.transpose() * (p - center)).cwiseAbs() - half;
   return q.maxCoeff() <= 0.0;
+}
+
+Eigen::Vector3d Box::Normal(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d local = R_world_box.transpose() * (p - center);
+  int side = 0;
+  (local.cwiseAbs() - half).maxCoeff(&side);  // the side p is on: distance ~0, the others < 0
+  Eigen::Vector3d n_box = Eigen::Vector3d::Zero();
+  n_box[side] = local[side] < 0.0 ? -1.0 : 1.0;
+  return R_world_box * n_box;
 }
 
 Eigen::AlignedBox3d Box::Bounds() const {
@@ -389,6 +408,16 @@ bool Cylinder::Contains(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d w = p - center;
   const double wa = w.dot(axis);
   return std::abs(wa) <= half_length && (w - wa * axis).squaredNorm() <= radius * radius;
+}
+
+Eigen::Vector3d Cylinder::Normal(const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d w = p - center;
+  const double wa = w.dot(axis);
+  const Eigen::Vector3d radial = w - wa * axis;
+  const double dr = radial.norm() - radius, dz = std::abs(wa) - half_length;
+  // On an end disc dz ~ 0 and dr <= 0; on the mantle dr ~ 0 and dz <= 0.
+  if (dz > dr || radial.norm() < 1e-12) return wa < 0.0 ? Eigen::Vector3d(-axis) : axis;
+  return radial / radial.norm();
 }
 
 Eigen::AlignedBox3d Cylinder::Bounds() const {

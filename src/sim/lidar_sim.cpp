@@ -35,8 +35,9 @@ LidarModel::LidarModel(const SimLidarOptions& options)
 
 Scan CastScan(const World& world, const FlightTrajectory& trajectory, const LidarModel& model,
               const SimLidarOptions& options, const Pose3& T_imu_lidar, TimeNs t_start_ns,
-              Rng& rng) {
+              Rng& rng, std::vector<SurfaceHit>* truth) {
   const int rows = model.rows(), cols = model.cols();
+  if (truth) truth->assign(static_cast<size_t>(rows) * cols, SurfaceHit());
   Scan scan;
   scan.t_start_ns = t_start_ns;
   scan.t_end_ns = t_start_ns + model.ColumnOffsetNs(cols - 1);
@@ -58,6 +59,13 @@ Scan CastScan(const World& world, const FlightTrajectory& trajectory, const Lida
           hit.range + (options.range_noise > 0.0 ? rng.Normal(options.range_noise) : 0.0);
       pt.p_lidar = (d_lidar * range).cast<float>();
       pt.intensity = Intensity(hit.reflectivity, hit.range);
+      if (truth) {
+        SurfaceHit& h = (*truth)[static_cast<size_t>(r) * cols + c];
+        h.origin_world = T_world_lidar.t;
+        h.p_world = T_world_lidar.t + (T_world_lidar.R * d_lidar) * hit.range;
+        h.surface = hit;
+        h.returned = true;
+      }
     }
   }
   return scan;

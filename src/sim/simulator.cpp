@@ -53,13 +53,15 @@ StatusOr<SurveyResult> Simulator::Survey() const {
   return SurveyWorld(world, layout_, options_.survey, seed);
 }
 
-Scan Simulator::SimulateScan(int64_t k) const {
+Scan Simulator::SimulateScan(int64_t k, std::vector<SurfaceHit>* truth) const {
   Rng rng = Rng::Stream(options_.FlightSeed(), kScanStreamBase + static_cast<uint64_t>(k));
   return CastScan(world_, *trajectory_, lidar_, options_.lidar, T_imu_lidar_, ScanStartTime(k),
-                  rng);
+                  rng, truth);
 }
 
-bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan) const {
+bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan,
+                    const TruthCallback& on_truth) const {
+  std::vector<SurfaceHit> truth;
   ImuSimulator imu(*trajectory_, options_.imu, options_.FlightSeed());
   int64_t imu_done = 0;
   auto emit_imu_until = [&](TimeNs t_ns) {
@@ -69,7 +71,8 @@ bool Simulator::Run(const ImuCallback& on_imu, const ScanCallback& on_scan) cons
   };
   for (int64_t k = 0; k < scan_count_; ++k) {
     if (!emit_imu_until(ScanStartTime(k) + lidar_.period_ns())) return false;
-    Scan scan = SimulateScan(k);
+    Scan scan = SimulateScan(k, on_truth ? &truth : nullptr);
+    if (on_truth) on_truth(scan, &truth);
     ShiftScanTime(-LidarClockOffsetNs(scan.t_start_ns), &scan);
     if (!on_scan(scan, lidar_.rows(), lidar_.cols())) return false;
   }

@@ -135,6 +135,16 @@ bool World::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, d
   return found;
 }
 
+Eigen::Vector3d World::Normal(const RayHit& hit, const Eigen::Vector3d& p) const {
+  const size_t i = static_cast<size_t>(hit.index);
+  switch (hit.kind) {
+    case ShapeKind::kFace: return faces_[i].Normal(p);
+    case ShapeKind::kBox: return boxes_[i].Normal(p);
+    case ShapeKind::kCylinder: return cylinders_[i].Normal(p);
+  }
+  return Eigen::Vector3d::Zero();
+}
+
 double World::DistanceToSurface(const Eigen::Vector3d& p) const {
   double d = kInf;
   for (const Face& f : faces_) d = std::min(d, f.Distance(p));

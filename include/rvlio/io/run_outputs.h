@@ -27,6 +27,9 @@ Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin
 // file for an unreadable, malformed, truncated or non-finite cloud.
 StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
 
+// A stamp in seconds with all nine decimals (the t column of the CSV files).
+std::string FormatSeconds(TimeNs t_ns);
+
 // One row per scan: time, status, point and constraint counts, the RV report,
 // the processing time and `rss_mb[i]`, the process's resident memory (MB) when
 // scan i was done (nan where rss_mb has no entry), and last `reinforced`, the
@@ -34,6 +37,17 @@ StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
 // rv.reinforce_max_residual leaves badly fitting ones at their plain weight).
 Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
                      const std::vector<double>& rss_mb = {});
+
+// A CSV table whose first column is t (scans.csv, localizability.csv): one
+// column per header name (NaN where a field is empty or not a number; a
+// non-empty `diverged` field counts 1). Header-less or unreadable files are
+// InvalidInput naming the file.
+struct ScanTable {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+  const std::vector<double>* Find(const std::string& name) const;
+};
+StatusOr<ScanTable> ReadScanTable(const std::string& path);
 
 // The estimated trajectory (IMU in world at each scan end).
 Trajectory ToTrajectory(const std::vector<ScanResult>& results);

@@ -99,6 +99,10 @@ struct Face {
   bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
   // |p[axis] - offset - h(p[u], p[v])| where the face covers p, else +inf.
   double Distance(const Eigen::Vector3d& p) const;
+  // Unit normal of the height field at (p[u], p[v]): the gradient of
+  // p[axis] - offset - h, i.e. e_axis - dh/du e_u - dh/dv e_v normalized
+  // (pointing to +axis; the face is two-sided).
+  Eigen::Vector3d Normal(const Eigen::Vector3d& p) const;
 };
 
 // Box with centre, orientation R_world_box and half extents (m).
@@ -112,6 +116,8 @@ struct Box {
   bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
   double Distance(const Eigen::Vector3d& p) const;  // |signed distance|
   bool Contains(const Eigen::Vector3d& p) const;    // p inside or on the box
+  // Outward unit normal of the side nearest p (p on the surface: the side it lies on).
+  Eigen::Vector3d Normal(const Eigen::Vector3d& p) const;
   Eigen::AlignedBox3d Bounds() const;
 };
 
@@ -126,6 +132,8 @@ struct Cylinder {
   bool Intersect(const Ray& ray, double t_min, double t_max, double* t) const;
   double Distance(const Eigen::Vector3d& p) const;  // |signed distance|
   bool Contains(const Eigen::Vector3d& p) const;    // p inside or on the cylinder
+  // Outward unit normal of the nearest part (mantle or end disc) for p on the surface.
+  Eigen::Vector3d Normal(const Eigen::Vector3d& p) const;
   Eigen::AlignedBox3d Bounds() const;
 };
 

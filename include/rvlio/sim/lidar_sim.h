@@ -36,11 +36,24 @@ class LidarModel {
   std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
 };
 
+// The noise-free truth of one return (world frame): where the ray met the
+// surface, the sensor position it left from, and which surface it was.
+// normal_world stays zero until asked for (World::Normal; computing it for
+// every return would cost more than the few kept points need).
+struct SurfaceHit {
+  Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
+  Eigen::Vector3d origin_world = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal_world = Eigen::Vector3d::Zero();
+  RayHit surface;         // the shape hit
+  bool returned = false;  // false: no return (the other fields are unset)
+};
+
 // Casts one organized scan: rows x cols points, row-major by ring
 // (index = row * cols + col), p_lidar = 0 for no return, every point stamped
-// with its column time (also for no return).
+// with its column time (also for no return). With `truth`, also the true hit
+// of every point (same index; resized to rows x cols).
 Scan CastScan(const World& world, const FlightTrajectory& trajectory, const LidarModel& model,
               const SimLidarOptions& options, const Pose3& T_imu_lidar, TimeNs t_start_ns,
-              Rng& rng);
+              Rng& rng, std::vector<SurfaceHit>* truth = nullptr);
 
 }  // namespace rvlio::sim

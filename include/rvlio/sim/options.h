@@ -282,6 +282,29 @@ struct SimSurveyOptions {
   }
 };
 
+// The true localizability written next to the ground truth
+// (localizability.csv, docs/degeneracy_truth.md): per scan, the point-to-plane
+// information of the true surface normals at the true hit points of the
+// points the estimator keeps (its voxel grid, lidar.voxel_size).
+struct SimLocalizabilityOptions {
+  bool enabled = true;            // write localizability.csv
+  double voxel_size = 0.5;        // m, the estimator's lidar.voxel_size (its default)
+  double degenerate_ratio = 0.1;  // a scan is degenerate when lambda_min / lambda_max is below
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("enabled", enabled, Spec().Help("write localizability.csv (the true per-scan "
+                                            "localizability) next to the ground truth"));
+    v.Field("voxel_size", voxel_size,
+            Spec().Unit("m").Range(0.0, 10.0).Help(
+                "scan voxel grid of the points that count: the estimator's lidar.voxel_size"));
+    v.Field("degenerate_ratio", degenerate_ratio,
+            Spec().Range(0.0, 1.0).Help(
+                "a scan is degenerate when the smallest over the largest eigenvalue of its "
+                "translation information sum n n^T is below this"));
+  }
+};
+
 struct SimOptions {
   int64_t seed = 1;           // world seed: every random choice of the world derives from it
   // The flight's seed (trajectory yaw/sway phases, IMU noise and bias walk,
@@ -296,6 +319,7 @@ struct SimOptions {
   SimTrajectoryOptions trajectory;
   ExtrinsicsSection extrinsics = DefaultExtrinsics();  // LiDAR pose in the IMU frame
   SimSurveyOptions survey;
+  SimLocalizabilityOptions localizability;
 
   template <class V>
   void Visit(V& v) {
@@ -312,6 +336,7 @@ struct SimOptions {
     v.Section("trajectory", trajectory);
     v.Section("extrinsics", extrinsics);
     v.Section("survey", survey);
+    v.Section("localizability", localizability);
   }
 
   // The seed of the flight: flight_seed, or seed when flight_seed is -1.

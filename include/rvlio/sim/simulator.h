@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
@@ -32,14 +33,20 @@ class Simulator {
   // Callbacks return false to stop the run early.
   using ImuCallback = std::function<bool(const ImuSample&)>;
   using ScanCallback = std::function<bool(const Scan&, int rows, int cols)>;
+  // The true hits of a scan (lidar_sim.h), with the scan in true time (before
+  // the LiDAR clock offset is applied), just before on_scan gets it.
+  using TruthCallback = std::function<void(const Scan&, std::vector<SurfaceHit>*)>;
 
   // Validates the options (InvalidInput naming the key) and builds the world.
   static StatusOr<std::unique_ptr<Simulator>> Create(const SimOptions& options);
 
   // Emits every IMU sample and scan in time order. True if it ran to the end.
-  bool Run(const ImuCallback& on_imu, const ScanCallback& on_scan) const;
-  // Scan k alone (the same as the k-th scan of Run; noise from its own stream).
-  Scan SimulateScan(int64_t k) const;
+  // With on_truth, every scan's true hits go there first.
+  bool Run(const ImuCallback& on_imu, const ScanCallback& on_scan,
+           const TruthCallback& on_truth = nullptr) const;
+  // Scan k alone (the same as the k-th scan of Run; noise from its own stream);
+  // with `truth`, its true hits too.
+  Scan SimulateScan(int64_t k, std::vector<SurfaceHit>* truth = nullptr) const;
   // The reference map (options().survey): a static survey of the world,
   // undeformed unless survey.deformed. Depends on the world seed only, not on
   // the flight seed. InvalidInput when the crop leaves nothing to survey.

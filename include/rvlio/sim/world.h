@@ -35,6 +35,9 @@ class World {
   // First surface along origin + t dir (dir unit) with 0 < t <= t_max.
   bool Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
                RayHit* hit) const;
+  // Unit normal of the surface `hit` names at the point p on it (world
+  // frame; a face's normal points to its +axis, a feature's outwards).
+  Eigen::Vector3d Normal(const RayHit& hit, const Eigen::Vector3d& p) const;
   // Distance from p to the nearest surface of any shape (m).
   double DistanceToSurface(const Eigen::Vector3d& p) const;
   // True when p lies inside a box or cylinder.
