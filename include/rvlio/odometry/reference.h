@@ -54,9 +54,12 @@ struct LocalizationOptions {
   int search_keep = 20;             // best grid candidates aligned in full
   double search_ambiguity = 0.03;   // a distinct candidate within this overlap of the best: ambiguous
   double reference_voxel_size = 0.5;  // m, voxel edge of the reference's search structure
-  // k-NN search in the reference: exact, or the 27 voxels around the query
-  // (map.neighbor_search's choices; docs/survey.md "Per-scan cost").
-  std::string reference_neighbor_search = "exact";
+  // k-NN search in the reference: the 27 voxels around the query, or exact
+  // (map.neighbor_search's choices). A reference is complete around the
+  // sensor, so the k nearest nearly always lie in those voxels (where the
+  // working map, holding only what the flight has seen, often has them
+  // farther: map.neighbor_search stays exact); measured in docs/survey.md.
+  std::string reference_neighbor_search = "nearby";
   DeviationOptions deviation;       // deviation_m of map.pcd and deviation.csv
 
   template <class V>
