@@ -277,6 +277,8 @@ TEST_F(AblatePlanTest, BadGridsStopWithExit2AndOneLineNamingFileAndKey) {
       {seq + "parameters:\n  rv.eps0: {from: 0.5, to: 0.1, step: 0.1}\n", "empty range"},
       {seq + "parameters:\n  rv.eps0: {from: 0.1, to: 0.5}\n", "parameters.rv.eps0.step"},
       {seq + "variants:\n  v: {rv.epss0: 1}\n", "rv.epss0"},
+      {seq + "variants:\n  v: {backend: smoother, degeneracy.method: remap}\n",
+       "degeneracy.method=remap is not defined for smoother"},
       {seq + "config: [nope.yaml]\n", "config: file not found"},
       {"sequences:\n  - {name: s, simulate: {preset: tunel}}\n", "sequences[0].simulate.preset"},
       {"sequences:\n  - {name: s, simulate: {preset: tunnel}, seeds: [-1]}\n", "seeds"},
