@@ -164,11 +164,43 @@ TEST_F(AblatePlanTest, ExpandsListsRangesAndTheProduct) {
 TEST_F(AblatePlanTest, ShippedGridsPlanWithTheDocumentedCellCounts) {
   const std::string grids = std::string(RVLIO_SOURCE_DIR) + "/config/grids/";
   for (const auto& [name, cells] : std::vector<std::pair<std::string, size_t>>{
-           {"rv_ablation.yaml", 36}, {"rv_defaults.yaml", 217}, {"rv_gain.yaml", 115}}) {
+           {"rv_ablation.yaml", 36},
+           {"rv_defaults.yaml", 217},
+           {"rv_gain.yaml", 115},
+           {"degeneracy.yaml", 42}}) {
     const json plan = PlanJson(grids + name);
     ASSERT_TRUE(plan.is_object()) << name;
     EXPECT_EQ(plan["cells"].size(), cells) << name;
   }
+}
+
+// The degeneracy comparison: every method on the IESKF, rv and none on the
+// smoother, each on every preset and seed, with the method and backend set.
+TEST_F(AblatePlanTest, DegeneracyGridHasEveryMethodOnEveryPresetAndSeed) {
+  const json plan = PlanJson(std::string(RVLIO_SOURCE_DIR) + "/config/grids/degeneracy.yaml");
+  ASSERT_TRUE(plan.is_object());
+  EXPECT_EQ(plan["data"].size(), 6u);  // 3 presets x 2 seeds
+  std::set<std::string> cells;
+  for (const json& c : plan["cells"]) {
+    std::string method, backend = "ieskf";
+    const std::vector<std::string> argv = c["run_argv"];
+    for (size_t i = 0; i + 1 < argv.size(); ++i) {
+      if (argv[i] != "--set") continue;
+      if (argv[i + 1].rfind("degeneracy.method=", 0) == 0) method = argv[i + 1].substr(18);
+      if (argv[i + 1].rfind("backend=", 0) == 0) backend = argv[i + 1].substr(8);
+    }
+    EXPECT_EQ(c["variant"].get<std::string>(), backend + "_" + method);
+    cells.insert(c["sequence"].get<std::string>() + "/" + backend + "_" + method + "/" +
+                 std::to_string(c["seed"].get<int>()));
+  }
+  std::set<std::string> expected;
+  for (const char* preset : {"tunnel", "corridor", "featureless"})
+    for (const char* variant : {"ieskf_none", "ieskf_rv", "ieskf_remap", "ieskf_localizability",
+                                "ieskf_regularized", "smoother_none", "smoother_rv"})
+      for (const char* seed : {"1", "2"})
+        expected.insert(std::string(preset) + "/" + variant + "/" + seed);
+  EXPECT_EQ(cells, expected);
+  EXPECT_EQ(plan["cells"].size(), expected.size());
 }
 
 TEST_F(AblatePlanTest, PlanIsStableAndTheHashFollowsTheConfiguration) {
@@ -245,6 +277,8 @@ TEST_F(AblatePlanTest, BadGridsStopWithExit2AndOneLineNamingFileAndKey) {
       {seq + "parameters:\n  rv.eps0: {from: 0.5, to: 0.1, step: 0.1}\n", "empty range"},
       {seq + "parameters:\n  rv.eps0: {from: 0.1, to: 0.5}\n", "parameters.rv.eps0.step"},
       {seq + "variants:\n  v: {rv.epss0: 1}\n", "rv.epss0"},
+      {seq + "variants:\n  v: {backend: smoother, degeneracy.method: remap}\n",
+       "degeneracy.method=remap is not defined for smoother"},
       {seq + "config: [nope.yaml]\n", "config: file not found"},
       {"sequences:\n  - {name: s, simulate: {preset: tunel}}\n", "sequences[0].simulate.preset"},
       {"sequences:\n  - {name: s, simulate: {preset: tunnel}, seeds: [-1]}\n", "seeds"},
