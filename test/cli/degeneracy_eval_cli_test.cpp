@@ -3,6 +3,7 @@
 // (docs/degeneracy_truth.md). The planar featureless tunnel is degenerate
 // along its axis on every scan; RV must find most of them and their axis.
 // Then the contract columns of scans.csv, and bad input (exit 2, one line).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -66,7 +67,7 @@ TEST_F(DegeneracyEvalCli, PlanarTunnelTruthIsDegenerateAndRvFindsItsAxis) {
 
   const nlohmann::json j = Score(dir_ + "/run");
   ASSERT_FALSE(j.is_discarded());
-  EXPECT_EQ(j["detection_columns"], "rv_active,n_alpha");
+  EXPECT_EQ(j["detection_columns"], "degenerate,weak_dir");  // the run writes them
   EXPECT_GT(j["matched"].get<int>(), 40);
   EXPECT_EQ(j["false_positive"].get<int>(), 0);
   EXPECT_GT(j["recall"].get<double>(), 0.8);
@@ -78,6 +79,37 @@ TEST_F(DegeneracyEvalCli, PlanarTunnelTruthIsDegenerateAndRvFindsItsAxis) {
   EXPECT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("recall"), std::string::npos) << text.out;
   EXPECT_EQ(Score(dir_ + "/run", "--truth-ratio 0.001")["false_negative"], j["false_negative"]);
+}
+
+// A scans.csv of an older run, without the degeneracy columns, is scored by
+// RV's own (rv_active, n_alpha_*): for the default method the same detection.
+TEST_F(DegeneracyEvalCli, OlderRunIsScoredByTheRvColumns) {
+  const std::string run = CopyRun("older");
+  std::istringstream in(ReadFile(run + "/scans.csv"));
+  const std::vector<std::string> dropped = {"degeneracy_method", "degenerate", "weak_dirs",
+                                            "weak_dir_x", "weak_dir_y", "weak_dir_z",
+                                            "condition_number"};
+  std::vector<bool> keep;
+  std::ostringstream out;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream cells(line);
+    std::string cell, row;
+    for (size_t i = 0; std::getline(cells, cell, ','); ++i) {
+      if (keep.size() <= i)
+        keep.push_back(std::find(dropped.begin(), dropped.end(), cell) == dropped.end());
+      if (keep[i]) row += (row.empty() ? "" : ",") + cell;
+    }
+    out << row << '\n';
+  }
+  ASSERT_EQ(std::count(keep.begin(), keep.end(), false), 7);
+  std::ofstream(run + "/scans.csv") << out.str();
+  const nlohmann::json older = Score(run), current = Score(dir_ + "/run");
+  ASSERT_FALSE(older.is_discarded());
+  EXPECT_EQ(older["detection_columns"], "rv_active,n_alpha");
+  EXPECT_EQ(older["true_positive"], current["true_positive"]);
+  EXPECT_EQ(older["false_positive"], current["false_positive"]);
+  EXPECT_NEAR(older["angle_deg"]["mean"].get<double>(), current["angle_deg"]["mean"].get<double>(),
+              0.5);
 }
 
 // A run with the degeneracy columns (degenerate, weak_dir_*) is read by them:
