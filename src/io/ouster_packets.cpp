@@ -271,6 +271,64 @@ ImuSample OusterImuToSample(const OusterImuPacket& p) {
   return s;
 }
 
+namespace {
+// ACCEL32_GYRO32_NMEA layout (firmware >= 3.2), byte offsets.
+constexpr int kImuHeaderBytes = 32, kImuNmeaBytes = 100, kImuBlockBytes = 36, kImuFooterBytes = 32;
+constexpr int kImuBlockAccelOffset = 12, kImuBlockGyroOffset = 24;
+}  // namespace
+
+int OusterImuPacketBytes(const OusterMetadata& meta) {
+  if (meta.imu_profile == "LEGACY") return kOusterLegacyImuPacketBytes;
+  return kImuHeaderBytes + kImuNmeaBytes + meta.imu_measurements_per_packet * kImuBlockBytes +
+         kImuFooterBytes;
+}
+
+StatusOr<std::vector<ImuSample>> DecodeOusterImuSamples(const OusterMetadata& meta,
+                                                         const uint8_t* data, size_t size,
+                                                         const std::string& where, bool* crc_ok) {
+  *crc_ok = true;
+  if (meta.imu_profile == "LEGACY") {
+    StatusOr<OusterImuPacket> legacy = DecodeOusterImuPacket(data, size, where);
+    if (!legacy.ok()) return legacy.status();
+    return std::vector<ImuSample>{OusterImuToSample(*legacy)};
+  }
+  const size_t expected = static_cast<size_t>(OusterImuPacketBytes(meta));
+  if (size != expected)
+    return Status::InvalidInput(where + ": IMU packet of " + std::to_string(size) + " bytes, not the " +
+                                std::to_string(expected) + " of the " + meta.imu_profile +
+                                " profile with " + std::to_string(meta.imu_measurements_per_packet) +
+                                " measurements per packet");
+  *crc_ok = OusterCrc64(data, size - 8) == Load<uint64_t>(data + size - 8);
+  std::vector<ImuSample> samples(static_cast<size_t>(meta.imu_measurements_per_packet));
+  const uint8_t* block = data + kImuHeaderBytes + kImuNmeaBytes;
+  for (ImuSample& s : samples) {
+    s.t_ns = static_cast<TimeNs>(Load<uint64_t>(block));
+    for (int i = 0; i < 3; ++i) {
+      s.acc_imu[i] = Load<float>(block + kImuBlockAccelOffset + 4 * i);
+      s.gyro_imu[i] = Load<float>(block + kImuBlockGyroOffset + 4 * i);
+    }
+    block += kImuBlockBytes;
+  }
+  return samples;
+}
+
+std::vector<uint8_t> EncodeOusterAccel32ImuPacket(const OusterMetadata& meta,
+                                                  const std::vector<ImuSample>& samples) {
+  RVLIO_CHECK(static_cast<int>(samples.size()) == meta.imu_measurements_per_packet);
+  std::vector<uint8_t> out(static_cast<size_t>(OusterImuPacketBytes(meta)), 0);
+  uint8_t* block = out.data() + kImuHeaderBytes + kImuNmeaBytes;
+  for (const ImuSample& s : samples) {
+    Store<uint64_t>(block, static_cast<uint64_t>(s.t_ns));
+    for (int i = 0; i < 3; ++i) {
+      Store<float>(block + kImuBlockAccelOffset + 4 * i, static_cast<float>(s.acc_imu[i]));
+      Store<float>(block + kImuBlockGyroOffset + 4 * i, static_cast<float>(s.gyro_imu[i]));
+    }
+    block += kImuBlockBytes;
+  }
+  Store<uint64_t>(out.data() + out.size() - 8, OusterCrc64(out.data(), out.size() - 8));
+  return out;
+}
+
 OusterImuPacket OusterImuPacketOf(const ImuSample& s) {
   OusterImuPacket p;
   p.sys_t_ns = p.accel_t_ns = p.gyro_t_ns = s.t_ns;

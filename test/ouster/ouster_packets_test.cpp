@@ -128,6 +128,9 @@ TEST(OusterMetadataTest, BadMetadataNamesTheProblem) {
   std::string profile = text;
   profile.replace(profile.find("RNG15_RFL8_NIR8"), 15, "RNG99_XYZ");
   fails(profile, "udp_profile_lidar");
+  std::string imu_profile = text;
+  imu_profile.replace(imu_profile.find("\"LEGACY\""), 8, "\"ACCEL99\"");
+  fails(imu_profile, "udp_profile_imu");
   std::string beams = text;
   beams.replace(beams.find("\"pixels_per_column\": 128"), 24, "\"pixels_per_column\": 64");
   fails(beams, "pixels_per_column");
@@ -198,6 +201,38 @@ TEST(OusterPacketTest, ImuPacketUnits) {
   EXPECT_DOUBLE_EQ(s.gyro_imu.x(), M_PI);
   EXPECT_DOUBLE_EQ(s.gyro_imu.z(), -M_PI / 2);
   EXPECT_FALSE(DecodeOusterImuPacket(bytes.data(), 47, "imu").ok());
+}
+
+TEST(OusterPacketTest, Accel32ImuPacketRoundTripsWithItsCrc) {
+  OusterMetadata meta;
+  meta.imu_profile = "ACCEL32_GYRO32_NMEA";
+  meta.imu_measurements_per_packet = 3;
+  ASSERT_EQ(OusterImuPacketBytes(meta), 32 + 100 + 3 * 36 + 32);
+  std::vector<ImuSample> in(3);
+  for (int i = 0; i < 3; ++i) {
+    in[i].t_ns = 1000 + 1562500 * i;
+    in[i].acc_imu = Eigen::Vector3d(0.25 * i, -0.5, 9.75);
+    in[i].gyro_imu = Eigen::Vector3d(0.125, -0.0625 * i, 0.5);
+  }
+  std::vector<uint8_t> bytes = EncodeOusterAccel32ImuPacket(meta, in);
+  bool crc_ok = false;
+  StatusOr<std::vector<ImuSample>> out = DecodeOusterImuSamples(meta, bytes.data(), bytes.size(), "imu", &crc_ok);
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  EXPECT_TRUE(crc_ok);
+  ASSERT_EQ(out->size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ((*out)[i].t_ns, in[i].t_ns);
+    EXPECT_EQ((*out)[i].acc_imu, in[i].acc_imu);  // SI in the packet: no unit conversion
+    EXPECT_EQ((*out)[i].gyro_imu, in[i].gyro_imu);
+  }
+  bytes[140] ^= 0x01;
+  ASSERT_TRUE(DecodeOusterImuSamples(meta, bytes.data(), bytes.size(), "imu", &crc_ok).ok());
+  EXPECT_FALSE(crc_ok);
+  StatusOr<std::vector<ImuSample>> short_packet =
+      DecodeOusterImuSamples(meta, bytes.data(), bytes.size() - 36, "imu.pcap", &crc_ok);
+  ASSERT_FALSE(short_packet.ok());
+  EXPECT_NE(short_packet.status().message().find("ACCEL32_GYRO32_NMEA"), std::string::npos);
+  EXPECT_NE(short_packet.status().message().find("imu.pcap"), std::string::npos);
 }
 
 TEST(OusterBeamModelTest, RangeToInvertsThePointFormula) {
