@@ -459,8 +459,25 @@ OusterScanAssembler::OusterScanAssembler(const OusterMetadata& meta, const Lidar
   columns_.resize(meta.columns_per_frame);
 }
 
-bool OusterScanAssembler::Add(const OusterLidarPacket& packet, Scan* out, DecodeStats* decode) {
+// The frame id of the window a packet belongs to. A window that wraps past
+// column 0 ([first, W-1] then [0, last]) spans two sensor frames (the frame
+// id advances at column 0): its head columns 0..last belong to the window
+// that began in the previous frame.
+uint32_t OusterScanAssembler::WindowFrameId(const OusterLidarPacket& packet) const {
+  if (meta_.column_first <= meta_.column_last) return packet.frame_id;
+  for (const OusterColumn& c : packet.columns) {
+    if (!c.valid || !meta_.InWindow(c.measurement_id)) continue;
+    if (c.measurement_id > meta_.column_last) return packet.frame_id;
+    const bool wide = meta_.header_type == "FUSA";
+    return wide ? packet.frame_id - 1u : (packet.frame_id - 1u) & 0xFFFFu;
+  }
+  return packet.frame_id;
+}
+
+bool OusterScanAssembler::Add(const OusterLidarPacket& sensor_packet, Scan* out, DecodeStats* decode) {
   ++stats_.lidar_packets;
+  OusterLidarPacket packet = sensor_packet;
+  packet.frame_id = WindowFrameId(sensor_packet);
   const bool wide = meta_.header_type == "FUSA";
   const uint32_t newest = have_frame_ ? frame_id_ : last_delivered_;
   if ((have_frame_ || have_delivered_) && packet.frame_id != newest &&
@@ -515,7 +532,10 @@ void OusterScanAssembler::Deliver(Scan* out, DecodeStats* decode) {
   out->points.clear();
   TimeNs first_column_ns = 0;
   bool any = false;
-  for (int mid = 0; mid < meta_.columns_per_frame; ++mid) {
+  // Window order: first..last, through column 0 when the window wraps.
+  const int window_columns = meta_.WindowColumns();
+  for (int k = 0; k < window_columns; ++k) {
+    const int mid = (meta_.column_first + k) % meta_.columns_per_frame;
     OusterColumn& c = columns_[mid];
     if (!c.valid) continue;
     if (!any || c.t_ns < first_column_ns) first_column_ns = c.t_ns;
@@ -536,7 +556,7 @@ void OusterScanAssembler::Deliver(Scan* out, DecodeStats* decode) {
     }
     c.valid = false;
   }
-  const int missing = meta_.WindowColumns() - columns_present_;
+  const int missing = window_columns - columns_present_;
   if (missing > 0) {
     stats_.missing_columns += missing;
     ++stats_.incomplete_frames;

@@ -91,6 +91,19 @@ TEST_F(OusterCliTest, ImuOnlyCaptureAndUndecodedLidarProfile) {
                      "lidar packets of profile RNG19_RFL8_SIG16_NIR16_ZONE16");
 }
 
+// A column window outside the mode's columns (600 of a 512-column mode).
+TEST_F(OusterCliTest, ColumnWindowOutsideTheMode) {
+  std::string json = testing_cli::ReadFile(Data("windowed_frame1_0.json"));
+  const size_t at = json.find("256", json.find("\"column_window\""));
+  ASSERT_NE(at, std::string::npos);
+  json.replace(at, 3, "600");
+  std::ofstream(dir_ + "/window.json") << json;
+  ExpectOneLineExit2(RunTool("info --bag " + Data("windowed_frame1.pcap") + " --ouster-metadata " + dir_ +
+                                 "/window.json",
+                             dir_),
+                     "column_window");
+}
+
 TEST_F(OusterCliTest, CaptureWithoutMetadata) {
   fs::copy_file(Data(kLb), dir_ + "/alone.pcap");
   ExpectOneLineExit2(RunTool("info --bag " + dir_ + "/alone.pcap", dir_), "--ouster-metadata");

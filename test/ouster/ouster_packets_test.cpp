@@ -307,6 +307,58 @@ TEST(OusterAssemblerTest, LostAndLatePackets) {
   EXPECT_FALSE(OusterFrameAfter(0, 65535, false));
 }
 
+// A column window that wraps past column 0 ([1000, 100] of 1024): the
+// sensor sends columns 1000..1023 of frame f, then 0..100 of frame f + 1;
+// one scan holds both arcs, columns 1000..1023 then 0..100, times increasing.
+TEST(OusterAssemblerTest, WindowWrappingPastColumnZero) {
+  OusterMetadata m = RealMetadata("OS-1-128_v2.3.0_1024x10.json");
+  m.column_first = 1000;
+  m.column_last = 100;
+  ASSERT_EQ(m.WindowColumns(), 24 + 101);
+  LidarOptions lidar;
+  lidar.min_range = 0.0;
+  OusterScanAssembler assembler(m, lidar);
+  Scan scan;
+  DecodeStats decode;
+  std::vector<Scan> scans;
+  // The packets a windowed sensor sends (those holding window columns), for
+  // frames 65534..65537 (16-bit frame ids wrap at 65536).
+  for (uint32_t frame = 65534; frame < 65538; ++frame) {
+    for (int k : {0, 1, 2, 3, 4, 5, 6, 62, 63}) {
+      const TimeNs t0_ns = static_cast<TimeNs>(frame) * 100000000LL;
+      if (assembler.Add(MakePacket(m, frame & 0xFFFFu, k, t0_ns), &scan, &decode)) scans.push_back(scan);
+    }
+  }
+  if (assembler.Flush(&scan, &decode)) scans.push_back(scan);
+  // Windows: (head of 65534 alone), 65534 tail + 65535 head, 65535 + 0, 0 + 1,
+  // (tail of frame 1 alone).
+  ASSERT_EQ(scans.size(), 5u);
+  EXPECT_EQ(assembler.stats().frames, 5);
+  EXPECT_EQ(assembler.stats().incomplete_frames, 2);
+  EXPECT_EQ(assembler.stats().missing_columns, 24 + 101);
+  EXPECT_EQ(assembler.stats().late_packets, 0);
+  for (size_t i = 1; i + 1 < scans.size(); ++i) {
+    const Scan& s = scans[i];
+    ASSERT_FALSE(s.points.empty());
+    const TimeNs tail_frame_ns = static_cast<TimeNs>(65533 + i) * 100000000LL;
+    std::vector<int> columns;  // in point order
+    for (size_t j = 0; j < s.points.size(); ++j) {
+      if (j > 0) {
+        ASSERT_GE(s.points[j].t_ns, s.points[j - 1].t_ns);
+      }
+      const TimeNs dt = s.points[j].t_ns - tail_frame_ns;
+      const int mid = dt >= 100000000LL ? static_cast<int>((dt - 100000000LL) / 97656) : static_cast<int>(dt / 97656);
+      if (columns.empty() || columns.back() != mid) columns.push_back(mid);
+    }
+    ASSERT_EQ(columns.size(), 125u);
+    EXPECT_EQ(columns.front(), 1000);
+    EXPECT_EQ(columns[23], 1023);
+    EXPECT_EQ(columns[24], 0);
+    EXPECT_EQ(columns.back(), 100);
+    EXPECT_EQ(s.t_start_ns, tail_frame_ns + 1000 * 97656);
+  }
+}
+
 TEST(PcapTest, FragmentedDatagramsRoundTrip) {
   const fs::path dir = fs::temp_directory_path() / ("rvlio_pcap_" + std::to_string(::getpid()));
   fs::create_directories(dir);

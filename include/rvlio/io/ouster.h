@@ -206,7 +206,10 @@ struct OusterFrameStats {
 
 // Assembles lidar packets into scans: a frame is delivered when the packet
 // holding the column window's last column arrives, or when a packet of a
-// later frame id arrives (the frame lost its end), or at Flush. Columns keep their place by
+// later frame id arrives (the frame lost its end), or at Flush. A window
+// that wraps past column 0 (column_window [first, last], first > last) is
+// one scan of columns first..W-1 of one sensor frame and 0..last of the
+// next, in that order (times increasing). Columns keep their place by
 // measurement id, so a lost packet leaves a gap (counted), never a shifted
 // frame; a packet of an older frame is dropped and counted. Points: every
 // beam with a return, range-cropped and filtered as DecodePointCloud2 does,
@@ -222,6 +225,7 @@ class OusterScanAssembler {
   OusterFrameStats& mutable_stats() { return stats_; }
 
  private:
+  uint32_t WindowFrameId(const OusterLidarPacket& packet) const;
   void Insert(const OusterLidarPacket& packet);
   void Deliver(Scan* out, DecodeStats* decode);
 
