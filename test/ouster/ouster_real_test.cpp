@@ -4,6 +4,7 @@
 // and the decoded geometry and IMU are physically plausible.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <numeric>
@@ -236,6 +237,11 @@ TEST(OusterRealTest, ImuOnlyCaptureOfFirmware32) {
       EXPECT_NEAR(s.gyro_imu[i] / gyro_step, std::round(s.gyro_imu[i] / gyro_step), 0.05);
     }
   }
+  double gyro_max_deg = 0.0;
+  for (const ImuSample& s : d.imu) gyro_max_deg = std::max(gyro_max_deg, s.gyro_imu.norm() * 180.0 / M_PI);
+  std::printf("imu_zm_no_lidar: %zu samples, mean |a| %.3f m/s^2, max |w| %.2f deg/s, %.1f Hz\n", d.imu.size(),
+              acc / d.imu.size(), gyro_max_deg,
+              (d.imu.size() - 1) / ((d.imu.back().t_ns - d.imu.front().t_ns) * 1e-9));
   EXPECT_NEAR(acc / d.imu.size(), 9.81, 0.15 * 9.81);
   for (size_t i = 1; i < d.imu.size(); ++i)
     EXPECT_NEAR((d.imu[i].t_ns - d.imu[i - 1].t_ns) * 1e-6, 1.5625, 0.05);  // 640 Hz, increasing
