@@ -53,14 +53,16 @@ void PrintOuster(const OusterRecordingInfo& o) {
             << "  sensor:   " << o.prod_line << ", firmware " << o.firmware << "\n"
             << "  mode:     " << o.lidar_mode << " (" << o.beams << " beams, " << o.window_columns
             << " of " << o.columns_per_frame << " columns sent)\n"
-            << "  profile:  " << o.lidar_profile << (o.crc ? " (CRC-64 checked)" : "") << "\n"
-            << "  lidar:    " << o.lidar_source << ", " << o.lidar_packets << " packets\n"
+            << "  profile:  " << o.lidar_profile << (o.lidar_decoded ? "" : " (not decoded)")
+            << (o.crc ? " (CRC-64 checked)" : "") << ", IMU " << o.imu_profile << "\n"
+            << "  lidar:    " << o.lidar_source << ", " << o.lidar_packets << " packets"
+            << (o.lidar_packets == 0 ? " (no lidar packets: IMU samples only)" : "") << "\n"
             << "  frames:   " << o.frames << " (" << Fixed(o.frame_rate_hz, 2) << " Hz), "
             << o.incomplete_frames << " incomplete, " << o.missing_columns << " columns missing\n"
             << "  imu:      " << o.imu_source << ", " << o.imu_packets << " packets, "
             << Fixed(o.imu_rate_hz, 1) << " Hz\n"
             << "  dropped:  " << o.late_packets << " late packets, " << o.crc_errors
-            << " CRC errors\n";
+            << " CRC errors, " << o.imu_crc_errors << " IMU CRC errors\n";
 }
 
 void Print(const BagInfo& info) {

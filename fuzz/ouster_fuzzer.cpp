@@ -96,6 +96,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (d.payload.size() != lidar_bytes) {
       auto imu = rvlio::DecodeOusterImuPacket(d.payload.data(), d.payload.size(), "imu packet");
       if (!imu.ok()) CheckError(imu.status(), "imu packet");
+      rvlio::OusterMetadata accel32;
+      accel32.imu_profile = "ACCEL32_GYRO32_NMEA";
+      accel32.imu_measurements_per_packet = 1 + static_cast<int>(d.payload.size() % 8);
+      bool crc_ok = true;
+      auto samples = rvlio::DecodeOusterImuSamples(accel32, d.payload.data(), d.payload.size(),
+                                                   "imu packet", &crc_ok);
+      if (!samples.ok()) CheckError(samples.status(), "imu packet");
     }
     auto packet = rvlio::DecodeOusterLidarPacket(meta, d.payload.data(), d.payload.size(), "lidar packet");
     if (!packet.ok()) {

@@ -44,3 +44,16 @@ def test_ros1_packet_bag():
     assert layout == "ouster_packets"
     assert sum(m.kind == "scan" for m in messages) == 1
     assert sum(m.kind == "imu" for m in messages) == 10
+
+
+def test_imu_only_capture_of_firmware_3_2():
+    # ACCEL32_GYRO32_NMEA IMU packets (8 x 8 measurements, SI units), no lidar
+    # packets: IMU samples and no scans.
+    messages, layout = kinds(os.path.join(DATA, "imu_zm_no_lidar.pcap"))
+    assert layout == "ouster_packets"
+    assert not any(m.kind == "scan" for m in messages)
+    imu = [m for m in messages if m.kind == "imu"]
+    assert len(imu) == 64
+    acc = np.mean([np.linalg.norm(s.acc) for s in imu])
+    assert abs(acc - 9.81) < 0.15 * 9.81
+    assert np.all(np.diff([s.t_ns for s in imu]) > 0)

@@ -138,6 +138,14 @@ Status ParseProfile(const Reader& r, OusterMetadata* m) {
       known = true;
     }
   }
+  // Profiles rvlio knows but does not decode: the metadata is read (IMU
+  // packets still decode) and the first lidar packet is refused.
+  for (const char* undecoded : {"RNG19_RFL8_SIG16_NIR16_ZONE16", "RNG15_RFL8_NIR8_ZONE16"}) {
+    if (m->lidar_profile_name == undecoded) {
+      known = true;
+      m->lidar_profile_decoded = false;
+    }
+  }
   if (!known)
     return r.Bad("udp_profile_lidar '" + m->lidar_profile_name + "'",
                  "is not a profile rvlio decodes (LEGACY, RNG19_RFL8_SIG16_NIR16, RNG15_RFL8_NIR8, "
@@ -145,6 +153,17 @@ Status ParseProfile(const Reader& r, OusterMetadata* m) {
   if (const json* p = r.FindAny({"lidar_data_format", "data_format", "config_params"},
                                 "udp_profile_imu"))
     m->imu_profile = r.Text(p);
+  if (m->imu_profile == "ACCEL32_GYRO32_NMEA") {
+    int64_t n = 0;
+    if (Status s = r.Int(r.FindAny({"imu_data_format", "config_params"}, "imu_measurements_per_packet"),
+                         "imu_measurements_per_packet", 1, 64, &n);
+        !s.ok())
+      return s;
+    m->imu_measurements_per_packet = static_cast<int>(n);
+  } else if (m->imu_profile != "LEGACY") {
+    return r.Bad("udp_profile_imu '" + m->imu_profile + "'",
+                 "is not an IMU profile rvlio decodes (LEGACY, ACCEL32_GYRO32_NMEA)");
+  }
   if (const json* h = r.FindAny({"lidar_data_format", "config_params"}, "header_type"))
     m->header_type = r.Text(h);
   if (m->lidar_profile == OusterLidarProfile::kFusaRng15Rfl8Nir8Dual) m->header_type = "FUSA";
@@ -290,8 +309,6 @@ StatusOr<OusterMetadata> ParseOusterMetadata(const std::string& json_text,
        {ParseMode, ParseProfile, ParseBeams, ParseDataFormat, ParseTransforms, ParseIdentity}) {
     if (Status s = step(r, &m); !s.ok()) return s;
   }
-  if (m.imu_profile != "LEGACY")
-    return r.Bad("udp_profile_imu '" + m.imu_profile + "'", "is not LEGACY, the IMU profile rvlio decodes");
   return m;
 }
 
@@ -320,6 +337,8 @@ std::string OusterMetadataJson(const OusterMetadata& m) {
                              {"lidar_origin_to_beam_origin_mm", m.lidar_origin_to_beam_origin_m * 1e3}};
   root["lidar_intrinsics"] = {{"lidar_to_sensor_transform", TransformJson(m.sensor_T_lidar)}};
   root["imu_intrinsics"] = {{"imu_to_sensor_transform", TransformJson(m.sensor_T_imu)}};
+  if (m.imu_profile != "LEGACY")
+    root["imu_data_format"] = {{"imu_measurements_per_packet", m.imu_measurements_per_packet}};
   return root.dump(2) + "\n";
 }
 

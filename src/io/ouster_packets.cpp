@@ -271,6 +271,64 @@ ImuSample OusterImuToSample(const OusterImuPacket& p) {
   return s;
 }
 
+namespace {
+// ACCEL32_GYRO32_NMEA layout (firmware >= 3.2), byte offsets.
+constexpr int kImuHeaderBytes = 32, kImuNmeaBytes = 100, kImuBlockBytes = 36, kImuFooterBytes = 32;
+constexpr int kImuBlockAccelOffset = 12, kImuBlockGyroOffset = 24;
+}  // namespace
+
+int OusterImuPacketBytes(const OusterMetadata& meta) {
+  if (meta.imu_profile == "LEGACY") return kOusterLegacyImuPacketBytes;
+  return kImuHeaderBytes + kImuNmeaBytes + meta.imu_measurements_per_packet * kImuBlockBytes +
+         kImuFooterBytes;
+}
+
+StatusOr<std::vector<ImuSample>> DecodeOusterImuSamples(const OusterMetadata& meta,
+                                                         const uint8_t* data, size_t size,
+                                                         const std::string& where, bool* crc_ok) {
+  *crc_ok = true;
+  if (meta.imu_profile == "LEGACY") {
+    StatusOr<OusterImuPacket> legacy = DecodeOusterImuPacket(data, size, where);
+    if (!legacy.ok()) return legacy.status();
+    return std::vector<ImuSample>{OusterImuToSample(*legacy)};
+  }
+  const size_t expected = static_cast<size_t>(OusterImuPacketBytes(meta));
+  if (size != expected)
+    return Status::InvalidInput(where + ": IMU packet of " + std::to_string(size) + " bytes, not the " +
+                                std::to_string(expected) + " of the " + meta.imu_profile +
+                                " profile with " + std::to_string(meta.imu_measurements_per_packet) +
+                                " measurements per packet");
+  *crc_ok = OusterCrc64(data, size - 8) == Load<uint64_t>(data + size - 8);
+  std::vector<ImuSample> samples(static_cast<size_t>(meta.imu_measurements_per_packet));
+  const uint8_t* block = data + kImuHeaderBytes + kImuNmeaBytes;
+  for (ImuSample& s : samples) {
+    s.t_ns = static_cast<TimeNs>(Load<uint64_t>(block));
+    for (int i = 0; i < 3; ++i) {
+      s.acc_imu[i] = Load<float>(block + kImuBlockAccelOffset + 4 * i);
+      s.gyro_imu[i] = Load<float>(block + kImuBlockGyroOffset + 4 * i);
+    }
+    block += kImuBlockBytes;
+  }
+  return samples;
+}
+
+std::vector<uint8_t> EncodeOusterAccel32ImuPacket(const OusterMetadata& meta,
+                                                  const std::vector<ImuSample>& samples) {
+  RVLIO_CHECK(static_cast<int>(samples.size()) == meta.imu_measurements_per_packet);
+  std::vector<uint8_t> out(static_cast<size_t>(OusterImuPacketBytes(meta)), 0);
+  uint8_t* block = out.data() + kImuHeaderBytes + kImuNmeaBytes;
+  for (const ImuSample& s : samples) {
+    Store<uint64_t>(block, static_cast<uint64_t>(s.t_ns));
+    for (int i = 0; i < 3; ++i) {
+      Store<float>(block + kImuBlockAccelOffset + 4 * i, static_cast<float>(s.acc_imu[i]));
+      Store<float>(block + kImuBlockGyroOffset + 4 * i, static_cast<float>(s.gyro_imu[i]));
+    }
+    block += kImuBlockBytes;
+  }
+  Store<uint64_t>(out.data() + out.size() - 8, OusterCrc64(out.data(), out.size() - 8));
+  return out;
+}
+
 OusterImuPacket OusterImuPacketOf(const ImuSample& s) {
   OusterImuPacket p;
   p.sys_t_ns = p.accel_t_ns = p.gyro_t_ns = s.t_ns;
@@ -401,8 +459,25 @@ OusterScanAssembler::OusterScanAssembler(const OusterMetadata& meta, const Lidar
   columns_.resize(meta.columns_per_frame);
 }
 
-bool OusterScanAssembler::Add(const OusterLidarPacket& packet, Scan* out, DecodeStats* decode) {
+// The frame id of the window a packet belongs to. A window that wraps past
+// column 0 ([first, W-1] then [0, last]) spans two sensor frames (the frame
+// id advances at column 0): its head columns 0..last belong to the window
+// that began in the previous frame.
+uint32_t OusterScanAssembler::WindowFrameId(const OusterLidarPacket& packet) const {
+  if (meta_.column_first <= meta_.column_last) return packet.frame_id;
+  for (const OusterColumn& c : packet.columns) {
+    if (!c.valid || !meta_.InWindow(c.measurement_id)) continue;
+    if (c.measurement_id > meta_.column_last) return packet.frame_id;
+    const bool wide = meta_.header_type == "FUSA";
+    return wide ? packet.frame_id - 1u : (packet.frame_id - 1u) & 0xFFFFu;
+  }
+  return packet.frame_id;
+}
+
+bool OusterScanAssembler::Add(const OusterLidarPacket& sensor_packet, Scan* out, DecodeStats* decode) {
   ++stats_.lidar_packets;
+  OusterLidarPacket packet = sensor_packet;
+  packet.frame_id = WindowFrameId(sensor_packet);
   const bool wide = meta_.header_type == "FUSA";
   const uint32_t newest = have_frame_ ? frame_id_ : last_delivered_;
   if ((have_frame_ || have_delivered_) && packet.frame_id != newest &&
@@ -457,7 +532,10 @@ void OusterScanAssembler::Deliver(Scan* out, DecodeStats* decode) {
   out->points.clear();
   TimeNs first_column_ns = 0;
   bool any = false;
-  for (int mid = 0; mid < meta_.columns_per_frame; ++mid) {
+  // Window order: first..last, through column 0 when the window wraps.
+  const int window_columns = meta_.WindowColumns();
+  for (int k = 0; k < window_columns; ++k) {
+    const int mid = (meta_.column_first + k) % meta_.columns_per_frame;
     OusterColumn& c = columns_[mid];
     if (!c.valid) continue;
     if (!any || c.t_ns < first_column_ns) first_column_ns = c.t_ns;
@@ -478,7 +556,7 @@ void OusterScanAssembler::Deliver(Scan* out, DecodeStats* decode) {
     }
     c.valid = false;
   }
-  const int missing = meta_.WindowColumns() - columns_present_;
+  const int missing = window_columns - columns_present_;
   if (missing > 0) {
     stats_.missing_columns += missing;
     ++stats_.incomplete_frames;

@@ -61,6 +61,11 @@ class OusterSensorReader final : public SensorBagReader {
     if (s.late_packets > 0)
       out.push_back("'" + source_->path() + "': " + std::to_string(s.late_packets) +
                     " lidar packets of an already completed frame dropped");
+    if (s.imu_crc_errors > 0)
+      out.push_back("'" + source_->path() + "': " + std::to_string(s.imu_crc_errors) +
+                    " IMU packets with a wrong CRC-64 dropped");
+    if (s.lidar_packets == 0)
+      out.push_back("'" + source_->path() + "': no lidar packets (IMU samples only)");
     if (s.crc_errors > 0)
       out.push_back("'" + source_->path() + "': " + std::to_string(s.crc_errors) +
                     " lidar packets with a wrong CRC-64 dropped");
@@ -70,6 +75,11 @@ class OusterSensorReader final : public SensorBagReader {
  private:
   StatusOr<SensorMessage> Step(ImuSample* imu, Scan* scan) {
     while (true) {
+      while (!pending_imu_.empty()) {
+        const ImuSample s = pending_imu_.front();
+        pending_imu_.pop_front();
+        if (gate_.AcceptImu(s.t_ns, s.acc_imu, s.gyro_imu, imu)) return SensorMessage::kImu;
+      }
       OusterRawPacket p;
       StatusOr<bool> got = NextPacket(&p);
       if (!got.ok()) return got.status();
@@ -84,12 +94,7 @@ class OusterSensorReader final : public SensorBagReader {
         return SensorMessage::kEnd;
       }
       if (p.kind == OusterPacketKind::kImu) {
-        StatusOr<OusterImuPacket> packet =
-            DecodeOusterImuPacket(p.bytes.data(), p.bytes.size(), Where(p));
-        if (!packet.ok()) return packet.status();
-        ++assembler_.mutable_stats().imu_packets;
-        const ImuSample s = OusterImuToSample(*packet);
-        if (gate_.AcceptImu(s.t_ns, s.acc_imu, s.gyro_imu, imu)) return SensorMessage::kImu;
+        if (Status s = DecodeImu(p); !s.ok()) return s;
         continue;
       }
       StatusOr<OusterLidarPacket> packet = Decode(p);
@@ -105,6 +110,23 @@ class OusterSensorReader final : public SensorBagReader {
       if (!accepted.ok()) return accepted.status();
       if (*accepted) return SensorMessage::kScan;
     }
+  }
+
+  // Queues the packet's samples (one LEGACY, several ACCEL32_GYRO32_NMEA);
+  // a packet with a wrong CRC-64 is dropped and counted.
+  Status DecodeImu(const OusterRawPacket& p) {
+    bool crc_ok = true;
+    StatusOr<std::vector<ImuSample>> samples =
+        DecodeOusterImuSamples(source_->metadata(), p.bytes.data(), p.bytes.size(), Where(p), &crc_ok);
+    if (!samples.ok()) return samples.status();
+    OusterFrameStats& stats = assembler_.mutable_stats();
+    ++stats.imu_packets;
+    if (!crc_ok) {
+      ++stats.imu_crc_errors;
+      return Status::Ok();
+    }
+    pending_imu_.insert(pending_imu_.end(), samples->begin(), samples->end());
+    return Status::Ok();
   }
 
   StatusOr<bool> NextPacket(OusterRawPacket* out) {
@@ -124,6 +146,10 @@ class OusterSensorReader final : public SensorBagReader {
   // packet showed that the firmware writes it.
   StatusOr<OusterLidarPacket> Decode(const OusterRawPacket& p) {
     const OusterMetadata& meta = source_->metadata();
+    if (!meta.lidar_profile_decoded)
+      return Status::InvalidInput(Where(p) + ": lidar packets of profile " + meta.lidar_profile_name +
+                                  " (metadata " + source_->metadata_origin() +
+                                  "), which rvlio does not decode");
     StatusOr<OusterLidarPacket> packet = DecodeOusterLidarPacket(
         meta, p.bytes.data(), p.bytes.size(), Where(p) + " (metadata " + source_->metadata_origin() + ")");
     if (!packet.ok()) return packet;
@@ -144,6 +170,7 @@ class OusterSensorReader final : public SensorBagReader {
   SensorGate gate_;
   OusterScanAssembler assembler_;
   std::deque<OusterRawPacket> peeked_;
+  std::deque<ImuSample> pending_imu_;
   bool first_decoded_ = false, crc_checked_ = false;
   Status error_;
 };
@@ -191,6 +218,8 @@ StatusOr<OusterRecordingInfo> ReadOusterRecordingInfo(const std::string& path, R
   info.firmware = meta.firmware;
   info.lidar_mode = meta.lidar_mode;
   info.lidar_profile = meta.lidar_profile_name;
+  info.imu_profile = meta.imu_profile;
+  info.lidar_decoded = meta.lidar_profile_decoded;
   info.beams = meta.pixels_per_column;
   info.columns_per_frame = meta.columns_per_frame;
   info.window_columns = meta.WindowColumns();
@@ -203,6 +232,7 @@ StatusOr<OusterRecordingInfo> ReadOusterRecordingInfo(const std::string& path, R
   info.missing_columns = f.missing_columns;
   info.late_packets = f.late_packets;
   info.crc_errors = f.crc_errors;
+  info.imu_crc_errors = f.imu_crc_errors;
   info.crc = reader.crc_checked();
   info.imu_rate_hz = Rate(imu_n, imu_first, imu_last);
   info.frame_rate_hz = Rate(scans_n, scan_first, scan_last);

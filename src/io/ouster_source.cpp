@@ -80,12 +80,12 @@ class PcapSource final : public OusterPacketSource {
   }
 
   // Lidar: the metadata's packet size, its lidar port, or any large
-  // datagram; IMU: 48 bytes or the metadata's IMU port. One sensor only.
+  // datagram; IMU: the IMU profile's packet size or the metadata's IMU port. One sensor only.
   Status Classify(const UdpDatagram& d, std::optional<OusterPacketKind>* kind) {
     const size_t n = d.payload.size();
     const bool lidar = n == lidar_bytes_ || n > kLidarLikeBytes ||
                        (meta_.udp_port_lidar != 0 && d.dst_port == meta_.udp_port_lidar);
-    const bool imu = !lidar && (n == static_cast<size_t>(kOusterLegacyImuPacketBytes) ||
+    const bool imu = !lidar && (n == static_cast<size_t>(OusterImuPacketBytes(meta_)) ||
                                 (meta_.udp_port_imu != 0 && d.dst_port == meta_.udp_port_imu));
     if (!lidar && !imu) return Status::Ok();
     Stream& s = lidar ? lidar_ : imu_;
@@ -160,7 +160,7 @@ Status LoadMetadataFile(const std::string& path, OusterMetadata* meta, std::stri
 void TrimDriverByte(const OusterMetadata& meta, OusterRawPacket* p) {
   const size_t lidar_bytes = static_cast<size_t>(OusterFormatOf(meta).PacketBytes());
   const size_t want = p->kind == OusterPacketKind::kLidar ? lidar_bytes
-                                                          : static_cast<size_t>(kOusterLegacyImuPacketBytes);
+                                                          : static_cast<size_t>(OusterImuPacketBytes(meta));
   if (p->bytes.size() == want + 1) p->bytes.pop_back();
 }
 

@@ -71,6 +71,39 @@ TEST_F(OusterCliTest, InfoReportsTheSensor) {
     EXPECT_NE(r.out.find(want), std::string::npos) << want << "\n" << r.out;
 }
 
+// Firmware 3.2 capture with IMU packets only (lidar profile
+// RNG19_RFL8_SIG16_NIR16_ZONE16, not decoded): info reports the IMU and says
+// there are no lidar packets; lidar packets under that profile are refused.
+TEST_F(OusterCliTest, ImuOnlyCaptureAndUndecodedLidarProfile) {
+  const ToolRun r = RunTool("info --bag " + Data("imu_zm_no_lidar.pcap"), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* want : {"RNG19_RFL8_SIG16_NIR16_ZONE16 (not decoded)", "IMU ACCEL32_GYRO32_NMEA",
+                           "no lidar packets: IMU samples only", "8 packets, 639.", "0 IMU CRC errors"})
+    EXPECT_NE(r.out.find(want), std::string::npos) << want << "\n" << r.out;
+  std::string json = testing_cli::ReadFile(Data("OS-2-128-U1_v2.3.0_1024x10.json"));
+  const std::string profile = "\"RNG19_RFL8_SIG16_NIR16\"";
+  for (size_t at = json.find(profile); at != std::string::npos; at = json.find(profile, at + 1))
+    json.replace(at, profile.size(), "\"RNG19_RFL8_SIG16_NIR16_ZONE16\"");
+  std::ofstream(dir_ + "/zone.json") << json;
+  ExpectOneLineExit2(RunTool("info --bag " + Data("OS-2-128-U1_v2.3.0_1024x10.pcap") + " --ouster-metadata " +
+                                 dir_ + "/zone.json",
+                             dir_),
+                     "lidar packets of profile RNG19_RFL8_SIG16_NIR16_ZONE16");
+}
+
+// A column window outside the mode's columns (600 of a 512-column mode).
+TEST_F(OusterCliTest, ColumnWindowOutsideTheMode) {
+  std::string json = testing_cli::ReadFile(Data("windowed_frame1_0.json"));
+  const size_t at = json.find("256", json.find("\"column_window\""));
+  ASSERT_NE(at, std::string::npos);
+  json.replace(at, 3, "600");
+  std::ofstream(dir_ + "/window.json") << json;
+  ExpectOneLineExit2(RunTool("info --bag " + Data("windowed_frame1.pcap") + " --ouster-metadata " + dir_ +
+                                 "/window.json",
+                             dir_),
+                     "column_window");
+}
+
 TEST_F(OusterCliTest, CaptureWithoutMetadata) {
   fs::copy_file(Data(kLb), dir_ + "/alone.pcap");
   ExpectOneLineExit2(RunTool("info --bag " + dir_ + "/alone.pcap", dir_), "--ouster-metadata");

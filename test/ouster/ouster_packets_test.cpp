@@ -128,6 +128,9 @@ TEST(OusterMetadataTest, BadMetadataNamesTheProblem) {
   std::string profile = text;
   profile.replace(profile.find("RNG15_RFL8_NIR8"), 15, "RNG99_XYZ");
   fails(profile, "udp_profile_lidar");
+  std::string imu_profile = text;
+  imu_profile.replace(imu_profile.find("\"LEGACY\""), 8, "\"ACCEL99\"");
+  fails(imu_profile, "udp_profile_imu");
   std::string beams = text;
   beams.replace(beams.find("\"pixels_per_column\": 128"), 24, "\"pixels_per_column\": 64");
   fails(beams, "pixels_per_column");
@@ -200,6 +203,38 @@ TEST(OusterPacketTest, ImuPacketUnits) {
   EXPECT_FALSE(DecodeOusterImuPacket(bytes.data(), 47, "imu").ok());
 }
 
+TEST(OusterPacketTest, Accel32ImuPacketRoundTripsWithItsCrc) {
+  OusterMetadata meta;
+  meta.imu_profile = "ACCEL32_GYRO32_NMEA";
+  meta.imu_measurements_per_packet = 3;
+  ASSERT_EQ(OusterImuPacketBytes(meta), 32 + 100 + 3 * 36 + 32);
+  std::vector<ImuSample> in(3);
+  for (int i = 0; i < 3; ++i) {
+    in[i].t_ns = 1000 + 1562500 * i;
+    in[i].acc_imu = Eigen::Vector3d(0.25 * i, -0.5, 9.75);
+    in[i].gyro_imu = Eigen::Vector3d(0.125, -0.0625 * i, 0.5);
+  }
+  std::vector<uint8_t> bytes = EncodeOusterAccel32ImuPacket(meta, in);
+  bool crc_ok = false;
+  StatusOr<std::vector<ImuSample>> out = DecodeOusterImuSamples(meta, bytes.data(), bytes.size(), "imu", &crc_ok);
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  EXPECT_TRUE(crc_ok);
+  ASSERT_EQ(out->size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ((*out)[i].t_ns, in[i].t_ns);
+    EXPECT_EQ((*out)[i].acc_imu, in[i].acc_imu);  // SI in the packet: no unit conversion
+    EXPECT_EQ((*out)[i].gyro_imu, in[i].gyro_imu);
+  }
+  bytes[140] ^= 0x01;
+  ASSERT_TRUE(DecodeOusterImuSamples(meta, bytes.data(), bytes.size(), "imu", &crc_ok).ok());
+  EXPECT_FALSE(crc_ok);
+  StatusOr<std::vector<ImuSample>> short_packet =
+      DecodeOusterImuSamples(meta, bytes.data(), bytes.size() - 36, "imu.pcap", &crc_ok);
+  ASSERT_FALSE(short_packet.ok());
+  EXPECT_NE(short_packet.status().message().find("ACCEL32_GYRO32_NMEA"), std::string::npos);
+  EXPECT_NE(short_packet.status().message().find("imu.pcap"), std::string::npos);
+}
+
 TEST(OusterBeamModelTest, RangeToInvertsThePointFormula) {
   const OusterMetadata m = RealMetadata("OS-1-128_v2.3.0_1024x10.json");
   const OusterBeamModel beams(m);
@@ -270,6 +305,58 @@ TEST(OusterAssemblerTest, LostAndLatePackets) {
   // 16-bit frame ids wrap: 65535 -> 0 is a later frame.
   EXPECT_TRUE(OusterFrameAfter(65535, 0, false));
   EXPECT_FALSE(OusterFrameAfter(0, 65535, false));
+}
+
+// A column window that wraps past column 0 ([1000, 100] of 1024): the
+// sensor sends columns 1000..1023 of frame f, then 0..100 of frame f + 1;
+// one scan holds both arcs, columns 1000..1023 then 0..100, times increasing.
+TEST(OusterAssemblerTest, WindowWrappingPastColumnZero) {
+  OusterMetadata m = RealMetadata("OS-1-128_v2.3.0_1024x10.json");
+  m.column_first = 1000;
+  m.column_last = 100;
+  ASSERT_EQ(m.WindowColumns(), 24 + 101);
+  LidarOptions lidar;
+  lidar.min_range = 0.0;
+  OusterScanAssembler assembler(m, lidar);
+  Scan scan;
+  DecodeStats decode;
+  std::vector<Scan> scans;
+  // The packets a windowed sensor sends (those holding window columns), for
+  // frames 65534..65537 (16-bit frame ids wrap at 65536).
+  for (uint32_t frame = 65534; frame < 65538; ++frame) {
+    for (int k : {0, 1, 2, 3, 4, 5, 6, 62, 63}) {
+      const TimeNs t0_ns = static_cast<TimeNs>(frame) * 100000000LL;
+      if (assembler.Add(MakePacket(m, frame & 0xFFFFu, k, t0_ns), &scan, &decode)) scans.push_back(scan);
+    }
+  }
+  if (assembler.Flush(&scan, &decode)) scans.push_back(scan);
+  // Windows: (head of 65534 alone), 65534 tail + 65535 head, 65535 + 0, 0 + 1,
+  // (tail of frame 1 alone).
+  ASSERT_EQ(scans.size(), 5u);
+  EXPECT_EQ(assembler.stats().frames, 5);
+  EXPECT_EQ(assembler.stats().incomplete_frames, 2);
+  EXPECT_EQ(assembler.stats().missing_columns, 24 + 101);
+  EXPECT_EQ(assembler.stats().late_packets, 0);
+  for (size_t i = 1; i + 1 < scans.size(); ++i) {
+    const Scan& s = scans[i];
+    ASSERT_FALSE(s.points.empty());
+    const TimeNs tail_frame_ns = static_cast<TimeNs>(65533 + i) * 100000000LL;
+    std::vector<int> columns;  // in point order
+    for (size_t j = 0; j < s.points.size(); ++j) {
+      if (j > 0) {
+        ASSERT_GE(s.points[j].t_ns, s.points[j - 1].t_ns);
+      }
+      const TimeNs dt = s.points[j].t_ns - tail_frame_ns;
+      const int mid = dt >= 100000000LL ? static_cast<int>((dt - 100000000LL) / 97656) : static_cast<int>(dt / 97656);
+      if (columns.empty() || columns.back() != mid) columns.push_back(mid);
+    }
+    ASSERT_EQ(columns.size(), 125u);
+    EXPECT_EQ(columns.front(), 1000);
+    EXPECT_EQ(columns[23], 1023);
+    EXPECT_EQ(columns[24], 0);
+    EXPECT_EQ(columns.back(), 100);
+    EXPECT_EQ(s.t_start_ns, tail_frame_ns + 1000 * 97656);
+  }
 }
 
 TEST(PcapTest, FragmentedDatagramsRoundTrip) {

@@ -4,6 +4,7 @@
 // and the decoded geometry and IMU are physically plausible.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <numeric>
@@ -210,6 +211,46 @@ TEST(OusterRealTest, ImuIsGravityAndASlowTurn) {
   EXPECT_LT(gyro_max_deg, 10.0);  // a few degrees per second (README: up to about 4.5)
   EXPECT_GT(gyro_max_deg, 0.5);   // and not all zero
   for (size_t i = 1; i < d.imu.size(); ++i) EXPECT_NEAR((d.imu[i].t_ns - d.imu[i - 1].t_ns) * 1e-6, 10.0, 1.0);
+}
+
+// Firmware 3.2, IMU profile ACCEL32_GYRO32_NMEA, no lidar packets: 8 IMU
+// packets of 8 measurements (imu_data_format) = 64 samples at 640 Hz of a
+// sensor at rest. The packet holds SI units: every accelerometer value is a
+// whole number of the +-16 g range's step (16 g / 2^15, g = 9.80665 m/s^2,
+// accel_fsr EXTENDED) and every gyroscope value a whole number of the
+// +-2000 deg/s range's step in rad/s: the units decoding assumes.
+TEST(OusterRealTest, ImuOnlyCaptureOfFirmware32) {
+  const Decoded d = ReadAll(Data("imu_zm_no_lidar.pcap"));
+  EXPECT_TRUE(d.scans.empty());
+  ASSERT_EQ(d.imu.size(), 64u);
+  EXPECT_NE(std::find_if(d.warnings.begin(), d.warnings.end(),
+                         [](const std::string& w) { return w.find("no lidar packets") != std::string::npos; }),
+            d.warnings.end());
+  const double accel_step = 16.0 / 32768.0 * 9.80665;
+  const double gyro_step = 2000.0 / 32768.0 * M_PI / 180.0;
+  double acc = 0.0;
+  for (const ImuSample& s : d.imu) {
+    acc += s.acc_imu.norm();
+    EXPECT_LT(s.gyro_imu.norm() * 180.0 / M_PI, 5.0);  // at rest
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(s.acc_imu[i] / accel_step, std::round(s.acc_imu[i] / accel_step), 0.01);
+      EXPECT_NEAR(s.gyro_imu[i] / gyro_step, std::round(s.gyro_imu[i] / gyro_step), 0.05);
+    }
+  }
+  double gyro_max_deg = 0.0;
+  for (const ImuSample& s : d.imu) gyro_max_deg = std::max(gyro_max_deg, s.gyro_imu.norm() * 180.0 / M_PI);
+  std::printf("imu_zm_no_lidar: %zu samples, mean |a| %.3f m/s^2, max |w| %.2f deg/s, %.1f Hz\n", d.imu.size(),
+              acc / d.imu.size(), gyro_max_deg,
+              (d.imu.size() - 1) / ((d.imu.back().t_ns - d.imu.front().t_ns) * 1e-9));
+  EXPECT_NEAR(acc / d.imu.size(), 9.81, 0.15 * 9.81);
+  for (size_t i = 1; i < d.imu.size(); ++i)
+    EXPECT_NEAR((d.imu[i].t_ns - d.imu[i - 1].t_ns) * 1e-6, 1.5625, 0.05);  // 640 Hz, increasing
+  StatusOr<BagInfo> info = ReadBagInfo(Data("imu_zm_no_lidar.pcap"));
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  ASSERT_TRUE(info->ouster.has_value());
+  EXPECT_EQ(info->ouster->lidar_packets, 0);
+  EXPECT_EQ(info->ouster->imu_packets, 8);
+  EXPECT_EQ(info->ouster->lidar_source, "none");
 }
 
 TEST(OusterRealTest, Ros1PacketBagDecodesToOneFrameOf512Columns) {

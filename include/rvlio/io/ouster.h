@@ -53,7 +53,11 @@ struct OusterMetadata {
   int columns_per_packet = 16;
   std::string lidar_profile_name = "LEGACY";
   OusterLidarProfile lidar_profile = OusterLidarProfile::kLegacy;
-  std::string imu_profile = "LEGACY";
+  // False for a lidar profile rvlio knows but does not decode (the _ZONE16
+  // profiles of firmware 3.2): IMU packets decode, lidar packets are refused.
+  bool lidar_profile_decoded = true;
+  std::string imu_profile = "LEGACY";  // or "ACCEL32_GYRO32_NMEA"
+  int imu_measurements_per_packet = 1;  // imu_data_format (ACCEL32_GYRO32_NMEA)
   // Packet header layout: "STANDARD" (16-bit frame id) or "FUSA" (32-bit
   // frame id): lidar_data_format.header_type, FUSA for the FUSA_ profile.
   std::string header_type = "STANDARD";
@@ -142,6 +146,27 @@ struct OusterImuPacket {
 StatusOr<OusterImuPacket> DecodeOusterImuPacket(const uint8_t* data, size_t size,
                                                 const std::string& where);
 std::vector<uint8_t> EncodeOusterImuPacket(const OusterImuPacket& packet);
+// Bytes of one IMU packet of the metadata's IMU profile: 48 for LEGACY;
+// for ACCEL32_GYRO32_NMEA the 32-byte packet header, a 100-byte NMEA block,
+// imu_measurements_per_packet blocks of 36 bytes and the 32-byte footer
+// (CRC-64 in its last 8 bytes).
+int OusterImuPacketBytes(const OusterMetadata& meta);
+// The IMU samples of one packet in SI units, oldest first: one for LEGACY
+// (OusterImuToSample), imu_measurements_per_packet for ACCEL32_GYRO32_NMEA.
+// An ACCEL32_GYRO32_NMEA measurement block: sensor time (u64 ns), a 32-bit
+// status word (not interpreted), accelerometer x y z (float32, m/s^2) and
+// gyroscope x y z (float32, rad/s) -- SI units in this profile, unlike
+// LEGACY's g and deg/s (docs/input_formats.md gives the evidence from a real
+// capture). *crc_ok is false when the footer's CRC-64 does not match
+// (ACCEL32_GYRO32_NMEA only). InvalidInput (naming `where`) for another size.
+StatusOr<std::vector<ImuSample>> DecodeOusterImuSamples(const OusterMetadata& meta,
+                                                         const uint8_t* data, size_t size,
+                                                         const std::string& where, bool* crc_ok);
+// Inverse of DecodeOusterImuSamples for ACCEL32_GYRO32_NMEA (exactly
+// imu_measurements_per_packet samples; header, NMEA block and status zero;
+// CRC-64 footer). Used by the tests.
+std::vector<uint8_t> EncodeOusterAccel32ImuPacket(const OusterMetadata& meta,
+                                                  const std::vector<ImuSample>& samples);
 // SI units (standard gravity 9.80665 m/s^2 per g), stamped at the gyroscope
 // read time (the accelerometer is read within microseconds of it).
 ImuSample OusterImuToSample(const OusterImuPacket& packet);
@@ -176,11 +201,15 @@ struct OusterFrameStats {
   int64_t incomplete_frames = 0;  // delivered frames with missing columns
   int64_t late_packets = 0;      // packets of a frame already delivered (dropped)
   int64_t crc_errors = 0;        // packets whose CRC-64 did not match (dropped)
+  int64_t imu_crc_errors = 0;    // IMU packets whose CRC-64 did not match (dropped)
 };
 
 // Assembles lidar packets into scans: a frame is delivered when the packet
 // holding the column window's last column arrives, or when a packet of a
-// later frame id arrives (the frame lost its end), or at Flush. Columns keep their place by
+// later frame id arrives (the frame lost its end), or at Flush. A window
+// that wraps past column 0 (column_window [first, last], first > last) is
+// one scan of columns first..W-1 of one sensor frame and 0..last of the
+// next, in that order (times increasing). Columns keep their place by
 // measurement id, so a lost packet leaves a gap (counted), never a shifted
 // frame; a packet of an older frame is dropped and counted. Points: every
 // beam with a return, range-cropped and filtered as DecodePointCloud2 does,
@@ -196,6 +225,7 @@ class OusterScanAssembler {
   OusterFrameStats& mutable_stats() { return stats_; }
 
  private:
+  uint32_t WindowFrameId(const OusterLidarPacket& packet) const;
   void Insert(const OusterLidarPacket& packet);
   void Deliver(Scan* out, DecodeStats* decode);
 

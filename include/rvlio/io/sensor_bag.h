@@ -131,11 +131,13 @@ struct BagTopicInfo {
 struct OusterRecordingInfo {
   std::string metadata;          // the JSON file or the bag topic it came from
   std::string prod_line, firmware, lidar_mode, lidar_profile;
+  std::string imu_profile;       // LEGACY or ACCEL32_GYRO32_NMEA
+  bool lidar_decoded = true;     // false: a lidar profile rvlio does not decode
   int beams = 0, columns_per_frame = 0, window_columns = 0;
   std::string lidar_source, imu_source;  // "udp 169.254.10.1 port 7502" or the topic
   int64_t lidar_packets = 0, imu_packets = 0;
   int64_t frames = 0, incomplete_frames = 0, missing_columns = 0;
-  int64_t late_packets = 0, crc_errors = 0;
+  int64_t late_packets = 0, crc_errors = 0, imu_crc_errors = 0;
   bool crc = false;              // the packets carry a CRC-64 (checked)
   double imu_rate_hz = 0.0;      // from the IMU packets' own times
   double frame_rate_hz = 0.0;    // from the frames' first column times
