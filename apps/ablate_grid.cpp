@@ -458,7 +458,7 @@ DataItem MakeDataItem(const Sequence& seq, int64_t seed, const std::string& out_
   if (!seq.duration.empty()) args.insert(args.end(), {"--duration", seq.duration});
   for (const auto& o : seq.sim_overrides) args.insert(args.end(), {"--set", o});
   args.insert(args.end(), {"--name", stem});
-  d.hash = HashHex(JsonText(nlohmann::json({{"format", 1}, {"simulate", args}}), -1));
+  d.hash = Fnv1aHex(JsonText(nlohmann::json({{"format", 1}, {"simulate", args}}), -1));
   d.id = stem + "_s" + std::to_string(seed) + "_" + d.hash.substr(0, 10);
   d.dir = (fs::path(out_dir) / "data" / d.id).string();
   args.insert(args.end(), {"--out", d.dir});
@@ -490,18 +490,18 @@ std::string CellHash(const Cell& c, const Plan& plan) {
   nlohmann::json files = nlohmann::json::array();
   for (const auto& f : c.config_files) {
     const bool generated = c.data_index >= 0 && f == plan.data[c.data_index].sensor_config;
-    files.push_back(generated ? std::string("<sensor config of data>") : HashHex(ReadFileText(f)));
+    files.push_back(generated ? std::string("<sensor config of data>") : Fnv1aHex(ReadFileText(f)));
   }
   const nlohmann::json identity = {
       {"format", 1},
       {"data", c.data_index >= 0 ? plan.data[c.data_index].hash : BagIdentity(c.bag)},
-      {"gt", c.gt.empty() || c.data_index >= 0 ? "" : HashHex(ReadFileText(c.gt))},
+      {"gt", c.gt.empty() || c.data_index >= 0 ? "" : Fnv1aHex(ReadFileText(c.gt))},
       {"config", files},
       {"set", c.overrides},
       {"eval", "se3,rpe1"}};
   nlohmann::json with_map = identity;
   if (!c.ref_map.empty()) with_map["ref_map"] = FileIdentity(c.ref_map);  // older hashes unchanged
-  return HashHex(JsonText(with_map, -1));
+  return Fnv1aHex(JsonText(with_map, -1));
 }
 
 // Checks the keys and values of a cell's configuration now (the sensor file
@@ -557,8 +557,6 @@ void AddCells(const Grid& grid, const Sequence& seq, int data_index, Plan* plan)
 }
 
 }  // namespace
-
-std::string HashHex(std::string_view bytes) { return Fnv1aHex(bytes); }
 
 StatusOr<std::vector<std::string>> ExpandRange(const std::string& from_text,
                                                const std::string& to_text,

@@ -97,8 +97,6 @@ StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir
 // data: [...], cells: [...]}.
 nlohmann::json PlanJson(const Plan& plan);
 
-// FNV-1a, 64 bit, as 16 lower-case hex digits.
-std::string HashHex(std::string_view bytes);
 
 // Expands a {from, to, step} range inclusively without float drift: values
 // from + i*step printed with 12 significant digits (integers when all three

@@ -204,13 +204,19 @@ void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
   for (const Slot& s : slots) InsertSlot(s);
 }
 
+// Grows the table (doubling) until it holds num_voxels at a load <= 1/2.
+void VoxelMap::ReserveSlots(size_t num_voxels) {
+  size_t capacity = slots_.size();
+  while (2 * num_voxels > capacity) capacity *= 2;
+  if (capacity == slots_.size()) return;
+  scratch_slots_.clear();
+  for (const Slot& s : slots_)
+    if (s.offset >= 0) scratch_slots_.push_back(s);
+  Rebuild(capacity, scratch_slots_);
+}
+
 int VoxelMap::CreateSlot(uint64_t key) {
-  if (2 * (num_voxels_ + 1) > slots_.size()) {  // keep the load <= 1/2
-    scratch_slots_.clear();
-    for (const Slot& s : slots_)
-      if (s.offset >= 0) scratch_slots_.push_back(s);
-    Rebuild(2 * slots_.size(), scratch_slots_);
-  }
+  ReserveSlots(num_voxels_ + 1);
   Slot s;
   s.key = key;
   s.capacity = static_cast<uint16_t>(std::min(kFirstBlockCapacity, max_points_));
@@ -325,14 +331,7 @@ size_t VoxelMap::InsertInVoxelOrder(const std::vector<Eigen::Vector3d>& p_world,
     }
   }
   close_run(order.size());
-  size_t capacity = slots_.size();
-  while (2 * (num_voxels_ + run_begin.size()) > capacity) capacity *= 2;
-  if (capacity > slots_.size()) {
-    scratch_slots_.clear();
-    for (const Slot& s : slots_)
-      if (s.offset >= 0) scratch_slots_.push_back(s);
-    Rebuild(capacity, scratch_slots_);
-  }
+  ReserveSlots(num_voxels_ + run_begin.size());
   pool_.reserve(pool_.size() + num_floats);
   // Pass 2: each run's block sized once, then its points in order.
   const size_t before = num_points_;

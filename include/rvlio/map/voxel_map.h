@@ -112,6 +112,7 @@ class VoxelMap {
 
   int FindSlot(uint64_t key) const;  // slot index, or -1
   int CreateSlot(uint64_t key);      // key must be absent; returns its slot
+  void ReserveSlots(size_t num_voxels);  // table room for num_voxels at load <= 1/2
   void InsertSlot(const Slot& s);    // key must be absent; no growth check
   void Rebuild(size_t capacity, const std::vector<Slot>& slots);
   int CapacityClass(int capacity) const;
