@@ -19,12 +19,16 @@ int CmdMerge(int argc, char** argv) {
                    "blended across them. Exit 2 naming the folder or chunk when a chunk is "
                    "missing or the chunks come from different refinements.",
                    {{"chunks", "DIR", "output folder of one chunk job", true, true},
-                    {"out", "DIR", "output folder", true}}};
+                    {"out", "DIR", "output folder", true},
+                    {"map", "REF", "the reference map the chunks were refined with "
+                                   "(refine --map): map.pcd gains deviation_m, and "
+                                   "deviation.csv is written"}}};
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   MergeArgs req;
   req.chunk_dirs = args.GetAll("chunks");
   req.out_dir = args.Get("out");
+  req.map = args.Get("map");
   StatusOr<MergeResult> result = MergeRefineChunks(req);
   if (!result.ok()) return Fail("merge", result.status().message(), result.status().exit_code());
   for (const auto& w : result->warnings) std::fprintf(stderr, "rvlio merge: warning: %s\n", w.c_str());

@@ -149,6 +149,10 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& args);
 struct MergeArgs {
   std::vector<std::string> chunk_dirs;  // the output folders of `refine --chunk K --of N`, any order
   std::string out_dir;  // empty: nothing written; else trajectory.tum, map.pcd, summary.json
+  // The reference map the chunks were refined with (`refine --map`): the
+  // merged map.pcd gains deviation_m and deviation.csv is written, as after
+  // `refine --map` (docs/survey.md). Empty: no deviation.
+  std::string map;
 };
 
 struct MergeResult {
@@ -162,7 +166,9 @@ struct MergeResult {
 // InvalidInput (one line naming the folder or the chunk) for a folder without
 // a readable chunk.json, trajectory.tum or map.pcd, chunks of different N,
 // options, initial trajectory or overlap, a chunk given twice, a missing
-// chunk K, or neighbours that share too few poses (smoother/refine_jobs.h).
+// chunk K, or neighbours that share too few poses (smoother/refine_jobs.h);
+// and for a `map` that is not the one the chunks were refined with (by
+// content) or chunks refined without one.
 StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args);
 
 // ---------------------------------------------------------------------------

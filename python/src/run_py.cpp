@@ -309,10 +309,11 @@ struct MergeOutput {
   bool written = false;
 };
 
-MergeOutput Merge(const py::iterable& chunks, const py::handle& out) {
+MergeOutput Merge(const py::iterable& chunks, const py::handle& out, const py::handle& map) {
   MergeArgs args;
   for (const py::handle& c : chunks) args.chunk_dirs.push_back(PathText(c));
   args.out_dir = OutDir(out);
+  if (!map.is_none()) args.map = PathText(map);
   StatusOr<MergeResult> result = WithoutGil([&] { return MergeRefineChunks(args); });
   MergeResult r = Take(std::move(result));
   MergeOutput o;
@@ -417,10 +418,13 @@ void BindRun(py::module_& m) {
         "map: a reference map (PCD/PLY) every scan is also held to (`refine --map`). "
         "chunk=K, of=N: the chunk job `rvlio refine --chunk K --of N` (also writes chunk.json; "
         "join the N output folders with rvlio.merge).");
-  m.def("merge", &Merge, py::arg("chunks"), py::arg("out") = py::none(),
+  m.def("merge", &Merge, py::arg("chunks"), py::arg("out") = py::none(), py::kw_only(),
+        py::arg("map") = py::none(),
         "`rvlio merge`: joins the output folders of the N chunk jobs (any order) into one "
         "trajectory and map; with `out`, writes trajectory.tum, map.pcd and summary.json there. "
-        "A missing or mismatched chunk raises ValueError naming it.");
+        "map: the reference the chunks were refined with (`merge --map`): the summary gains "
+        "localization.deviation, and with `out` map.pcd gains deviation_m and deviation.csv "
+        "is written. A missing or mismatched chunk or map raises ValueError naming it.");
   m.def("simulate", &Simulate, py::arg("preset") = "tunnel", py::kw_only(),
         py::arg("seed") = py::none(), py::arg("duration") = py::none(), py::arg("out"),
         py::arg("name") = "", py::arg("format") = "bag", py::arg("lidar_msg") = "pointcloud2",

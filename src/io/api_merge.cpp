@@ -6,12 +6,18 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <optional>
 #include <set>
 #include <utility>
 
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
+#include "rvlio/io/config.h"
+#include "rvlio/io/deviation_outputs.h"
 #include "rvlio/io/output_stage.h"
+#include "rvlio/io/reference_map.h"
+#include "rvlio/io/refine_checkpoint.h"
 #include "rvlio/io/run_outputs.h"
 #include "rvlio/io/summary_json.h"
 #include "rvlio/io/trajectory_io.h"
@@ -193,16 +199,50 @@ json Summary(const std::vector<ChunkFolder>& chunks, const RefineJobMerge& merge
   return j;
 }
 
-Status WriteOutputs(const std::string& out_dir, const MergeResult& r) {
+Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
+                    const MapDeviation* deviation) {
   OutputStage stage(out_dir);  // all outputs or none
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), r.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteMapPcd(stage.Path("map.pcd"), r.map_points); !s.ok()) return stage.Explain(s);
+  if (Status s = WriteMapOutputs(&stage, r.map_points, deviation); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
     return stage.Explain(s);
   return stage.Commit();
+}
+
+// The reference of `merge --map`, checked against the map the chunks were
+// refined with (chunk.json's map_hash: the file's content), and the chunks'
+// deviation options. Null without --map.
+struct MergeReference {
+  std::shared_ptr<const ReferenceMap> surface;
+  DeviationOptions options;
+};
+
+StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkFolder& first) {
+  MergeReference ref;
+  if (map.empty()) return ref;
+  const std::string manifest = FilePath(first.dir, "chunk.json");
+  const std::string chunk_hash = first.manifest.value("map_hash", std::string());
+  if (chunk_hash.empty())
+    return Status::InvalidInput("--map " + map + ": the chunks were refined without --map (" +
+                                manifest + ")");
+  StatusOr<uint64_t> hash = FileContentHash(map);
+  if (!hash.ok()) return Status::InvalidInput("--map " + hash.status().message());
+  if (HashText(*hash) != chunk_hash)
+    return Status::InvalidInput("--map " + map + ": not the map the chunks were refined with (" +
+                                manifest + " has map " +
+                                first.manifest.value("map", std::string()) + ", content hash " +
+                                chunk_hash + ")");
+  if (Status s = ApplyYamlText(ref.options, first.manifest.value("deviation", std::string()),
+                               manifest + " deviation");
+      !s.ok())
+    return s;
+  StatusOr<std::shared_ptr<const ReferenceMap>> surface = LoadReferenceSurface(map);
+  if (!surface.ok()) return surface.status();
+  ref.surface = std::move(*surface);
+  return ref;
 }
 
 }  // namespace
@@ -215,6 +255,8 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
     chunks.push_back(std::move(*c));
   }
   if (Status s = CheckChunks(&chunks); !s.ok()) return s;
+  StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front());
+  if (!reference.ok()) return reference.status();
   if (!args.out_dir.empty())
     if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
   std::vector<RefineJobTrajectory> jobs;
@@ -230,9 +272,21 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
     for (const std::string& w : c.warnings)
       if (std::find(r.warnings.begin(), r.warnings.end(), w) == r.warnings.end())
         r.warnings.push_back(w);
+  const std::string chunk_map = chunks.front().manifest.value("map", std::string());
+  if (args.map.empty() && !chunks.front().manifest.value("map_hash", std::string()).empty())
+    r.warnings.push_back("the chunks were refined with --map " + chunk_map +
+                         "; merge --map " + chunk_map + " writes the deviation from it");
   r.summary = Summary(chunks, *merge, r);
+  std::optional<MapDeviation> deviation;
+  if (reference->surface != nullptr) {
+    deviation = ComputeMapDeviation(r.map_points, *reference->surface, r.trajectory,
+                                    reference->options);
+    r.summary["map"] = args.map;
+    r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  }
   if (args.out_dir.empty()) return r;
-  if (Status s = WriteOutputs(args.out_dir, r); !s.ok()) return s;
+  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr); !s.ok())
+    return s;
   r.written = true;
   return r;
 }

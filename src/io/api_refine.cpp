@@ -15,6 +15,7 @@
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/output_stage.h"
+#include "rvlio/io/deviation_outputs.h"
 #include "rvlio/io/reference_map.h"
 #include "rvlio/io/refine_checkpoint.h"
 #include "rvlio/io/run_outputs.h"
@@ -152,12 +153,6 @@ nlohmann::json CoverageJson(const ScansSeen& seen, const Trajectory& init,
           {"complete", CoversRecording(seen, init, init_duration_s)}};
 }
 
-std::string HashText(uint64_t h) {
-  char buf[17];
-  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
-
 // chunk.json of a chunk job: what `rvlio merge` needs to check and merge it.
 nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const ScansSeen& seen,
                          uint64_t init_hash, uint64_t map_hash, const RefineResult& res) {
@@ -179,6 +174,7 @@ nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const
           {"init_hash", HashText(init_hash)},
           {"map_hash", args.map.empty() ? std::string() : HashText(map_hash)},
           {"map", args.map},
+          {"deviation", DumpYaml(args.options.localization.deviation)},  // for merge --map
           {"interrupted", res.stopped},
           {"bag", args.bag},
           {"init", args.init_path}};
@@ -246,7 +242,8 @@ nlohmann::json Summary(const RefineArgs& args, const RefineRunResult& r,
   return j;
 }
 
-Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r) {
+Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
+                    const MapDeviation* deviation) {
   OutputStage stage(out_dir);  // all outputs or none
   if (Status s = stage.Open(); !s.ok()) return s;
   if (!r.chunk.is_null())
@@ -254,8 +251,7 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r) {
       return stage.Explain(s);
   if (Status s = WriteTum(stage.Path("trajectory.tum"), r.refine.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteMapPcd(stage.Path("map.pcd"), r.refine.map_points); !s.ok())
-    return stage.Explain(s);
+  if (Status s = WriteMapOutputs(&stage, r.refine.map_points, deviation); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
     return stage.Explain(s);
@@ -332,9 +328,10 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   const uint64_t init_hash = job ? TrajectoryHash(input.init) : 0;
   const Trajectory init_span = {input.init.front(), input.init.back()};
   std::shared_ptr<const VoxelMap> reference;
+  std::shared_ptr<const ReferenceMap> surface;  // the full cloud, for the deviation
   if (!args.map.empty()) {  // read before anything is written
     StatusOr<std::shared_ptr<const VoxelMap>> loaded =
-        LoadReferenceMap(args.map, args.options.localization);
+        LoadReferenceMap(args.map, args.options.localization, &surface);
     if (!loaded.ok()) return loaded.status();
     reference = std::move(*loaded);
   }
@@ -391,8 +388,15 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   r.summary["truncated"] = (*reader)->truncated();
   r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
   if (job) r.summary["chunk"] = r.chunk;
+  std::optional<MapDeviation> deviation;
+  if (surface != nullptr && !r.refine.trajectory.empty()) {
+    deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
+                                    args.options.localization.deviation);
+    r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  }
   if (!write) return r;
-  if (Status s = WriteOutputs(args.out_dir, r); !s.ok()) return s;
+  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr); !s.ok())
+    return s;
   out_folder.Keep();
   r.written = true;
   return r;

@@ -12,6 +12,7 @@
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/api.h"
 #include "rvlio/io/atomic_file.h"
+#include "rvlio/io/deviation_outputs.h"
 #include "rvlio/io/extrinsic_json.h"
 #include "rvlio/io/output_stage.h"
 #include "rvlio/io/reference_map.h"
@@ -136,54 +137,13 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   return j;
 }
 
-// With a reference map: each map point's deviation from it, and per chainage bin.
-struct Deviation {
-  std::vector<Eigen::Vector3d> p_map;
-  PointDeviations points;
-  std::vector<DeviationBin> bins;
-};
-
-Deviation ComputeRunDeviation(const Odometry& odo, const ReferenceMap& reference,
-                              const Trajectory& trajectory, const DeviationOptions& options) {
-  Deviation d;
-  d.p_map = odo.MapPoints();
-  d.points = ComputeDeviations(d.p_map, reference, trajectory, options.surface);
-  d.bins = BinByChainage(d.points, options.chainage_step);
-  return d;
-}
-
-nlohmann::json DeviationJson(const Deviation& d) {
-  std::vector<double> abs_m;
-  for (double v : d.points.deviation_m)
-    if (std::isfinite(v)) abs_m.push_back(std::abs(v));
-  std::sort(abs_m.begin(), abs_m.end());
-  const auto at = [&abs_m](double q) {
-    return abs_m.empty() ? nlohmann::json(nullptr)
-                         : nlohmann::json(abs_m[std::min(abs_m.size() - 1,
-                                                         static_cast<size_t>(q * abs_m.size()))]);
-  };
-  return {{"map_points", d.p_map.size()},
-          {"with_surface", abs_m.size()},
-          {"median_abs_m", at(0.5)},
-          {"p95_abs_m", at(0.95)},
-          {"max_abs_m", abs_m.empty() ? nlohmann::json(nullptr) : nlohmann::json(abs_m.back())}};
-}
-
-Status WriteOutputs(const std::string& out_dir, const Odometry& odo, const RunResult& result,
-                    const Deviation* deviation) {
+Status WriteOutputs(const std::string& out_dir, const std::vector<Eigen::Vector3d>& p_map,
+                    const RunResult& result, const MapDeviation* deviation) {
   OutputStage stage(out_dir);
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), result.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = deviation != nullptr
-                     ? WriteMapPcd(stage.Path("map.pcd"), deviation->p_map,
-                                   &deviation->points.deviation_m)
-                     : WriteMapPcd(stage.Path("map.pcd"), odo.MapPoints());
-      !s.ok())
-    return stage.Explain(s);
-  if (deviation != nullptr)
-    if (Status s = WriteDeviationCsv(stage.Path("deviation.csv"), deviation->bins); !s.ok())
-      return stage.Explain(s);
+  if (Status s = WriteMapOutputs(&stage, p_map, deviation); !s.ok()) return s;
   if (Status s = WriteScansCsv(stage.Path("scans.csv"), result.scans, result.rss_mb); !s.ok())
     return stage.Explain(s);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(result.summary) + "\n");
@@ -384,15 +344,17 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   }
   result.trajectory = ToTrajectory(result.scans);
   result.summary = Summary(args, **odo, reader_stats, data, result);
-  std::optional<Deviation> deviation;
+  std::vector<Eigen::Vector3d> p_map;  // the output map, when written or compared
+  if (write || reference != nullptr) p_map = (*odo)->MapPoints();
+  std::optional<MapDeviation> deviation;
   if (reference != nullptr) {
-    deviation = ComputeRunDeviation(**odo, *reference, result.trajectory,
+    deviation = ComputeMapDeviation(p_map, *reference, result.trajectory,
                                     args.options.localization.deviation);
-    result.summary["localization"]["deviation"] = DeviationJson(*deviation);
+    result.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   }
   if (!write) return result;
   const Status written =
-      WriteOutputs(args.out_dir, **odo, result, deviation ? &*deviation : nullptr);
+      WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr);
   partial.Remove();  // the complete outputs (or the folder as it was) replace it
   if (!written.ok()) return written;
   result.written = true;

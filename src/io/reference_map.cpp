@@ -49,11 +49,20 @@ StatusOr<std::vector<Eigen::Vector3d>> ReadReferencePoints(const std::string& pa
 
 }  // namespace
 
-StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(const std::string& path,
-                                                               const LocalizationOptions& options) {
+StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(
+    const std::string& path, const LocalizationOptions& options,
+    std::shared_ptr<const ReferenceMap>* surface) {
   StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path);
   if (!p_ref.ok()) return p_ref.status();
-  return MakeReferenceMap(*p_ref, options);
+  std::shared_ptr<const VoxelMap> association = MakeReferenceMap(*p_ref, options);
+  if (surface != nullptr) *surface = std::make_shared<const ReferenceMap>(std::move(*p_ref));
+  return association;
+}
+
+StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(const std::string& path) {
+  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path);
+  if (!p_ref.ok()) return p_ref.status();
+  return std::make_shared<const ReferenceMap>(std::move(*p_ref));
 }
 
 StatusOr<Trajectory> ParseInitialPose(const std::string& text) {

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -128,6 +129,12 @@ uint64_t TrajectoryHash(const Trajectory& trajectory) {
       h.Add(q);
   }
   return h.value();
+}
+
+std::string HashText(uint64_t hash) {
+  char buf[17];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(hash));
+  return buf;
 }
 
 StatusOr<uint64_t> FileContentHash(const std::string& path) {

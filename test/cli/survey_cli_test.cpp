@@ -94,6 +94,14 @@ TEST_F(SurveyCli, InitialPoseFromATumFileAndRefineHeldToTheMap) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const double refine_ate = AteNoAlign(Truth(), refined + "/trajectory.tum", dir_);
   EXPECT_LT(refine_ate, 0.05);
+  // The refined map's deviation from the reference (the same flight's map).
+  const nlohmann::json dev =
+      nlohmann::json::parse(ReadFile(refined + "/summary.json"))["localization"]["deviation"];
+  EXPECT_GT(dev["with_surface"].get<double>(), 0.5 * dev["map_points"].get<double>());
+  EXPECT_LT(dev["median_abs_m"].get<double>(), 0.02);
+  EXPECT_TRUE(std::filesystem::exists(refined + "/deviation.csv"));
+  EXPECT_NE(ReadFile(refined + "/map.pcd").substr(0, 400).find("FIELDS x y z deviation_m"),
+            std::string::npos);
   std::printf("[ survey ] run --map %.4f m, refine --map %.4f m (ATE, no alignment)\n", run_ate,
               refine_ate);
 }

@@ -129,15 +129,14 @@ double ChainageAtX(const Trajectory& t, double x_m) {
   return best_chainage;
 }
 
-TEST_F(SurveyFlights, SecondFlightInTheSurveyAndTheConvergenceInDeviationCsv) {
-  const std::string run = LocalizeAndRefine(Survey(), "survey");
-  // The survey is of the undeformed world: the left wall's convergence
-  // (5 cm over 10 m around x = 20 m) shows at its chainage; the surfaces
-  // there are a mix of walls, so the bin's p95 |deviation| is the
-  // converged wall's.
-  const double c_m = ChainageAtX(Tum(run + "/trajectory.tum"), kConvergenceX);
-  const auto bins = ReadCsv(run + "/deviation.csv");
-  ASSERT_GT(bins.size(), 30u);
+// The survey is of the undeformed world: the left wall's convergence (5 cm
+// over 10 m around x = 20 m) shows in FOLDER/deviation.csv at its chainage;
+// the surfaces there are a mix of walls, so the bin's p95 |deviation| is the
+// converged wall's. map.pcd carries the per-point deviation_m.
+void ExpectConvergenceInDeviationCsv(const std::string& folder, const std::string& tag) {
+  const double c_m = ChainageAtX(Tum(folder + "/trajectory.tum"), kConvergenceX);
+  const auto bins = ReadCsv(folder + "/deviation.csv");
+  ASSERT_GT(bins.size(), 30u) << tag;
   const std::map<std::string, double>* peak = nullptr;
   double worst_median_elsewhere = 0.0;
   for (const auto& bin : bins) {
@@ -146,16 +145,24 @@ TEST_F(SurveyFlights, SecondFlightInTheSurveyAndTheConvergenceInDeviationCsv) {
     if (std::abs(bin.at("chainage_m") + 0.5 - c_m) > 0.5 * kConvergenceLengthM + 1.0)
       worst_median_elsewhere = std::max(worst_median_elsewhere, bin.at("median_abs_m"));
   }
-  ASSERT_NE(peak, nullptr);
+  ASSERT_NE(peak, nullptr) << tag;
   const auto& at_c = bins.at(static_cast<size_t>(c_m));
-  std::printf("[ survey ] convergence at chainage %.1f m: p95 |deviation| %.4f m there, peak %.4f m "
-              "at %.0f m; median |deviation| elsewhere at most %.4f m\n",
-              c_m, at_c.at("p95_abs_m"), peak->at("p95_abs_m"), peak->at("chainage_m"),
-              worst_median_elsewhere);
-  EXPECT_NEAR(at_c.at("p95_abs_m"), kConvergenceM, 0.01);
-  EXPECT_GT(at_c.at("median_m"), 0.0);  // towards the inside: positive
-  EXPECT_NEAR(peak->at("chainage_m") + 0.5, c_m, 2.0);
-  EXPECT_LT(worst_median_elsewhere, 0.01);
+  std::printf("[ survey ] %s: convergence at chainage %.1f m: p95 |deviation| %.4f m there, peak "
+              "%.4f m at %.0f m; median |deviation| elsewhere at most %.4f m\n",
+              tag.c_str(), c_m, at_c.at("p95_abs_m"), peak->at("p95_abs_m"),
+              peak->at("chainage_m"), worst_median_elsewhere);
+  EXPECT_NEAR(at_c.at("p95_abs_m"), kConvergenceM, 0.01) << tag;
+  EXPECT_GT(at_c.at("median_m"), 0.0) << tag;  // towards the inside: positive
+  EXPECT_NEAR(peak->at("chainage_m") + 0.5, c_m, 2.0) << tag;
+  EXPECT_LT(worst_median_elsewhere, 0.01) << tag;
+  const std::string pcd = testing_cli::ReadFile(folder + "/map.pcd");
+  EXPECT_NE(pcd.substr(0, 400).find("FIELDS x y z deviation_m"), std::string::npos) << tag;
+}
+
+TEST_F(SurveyFlights, SecondFlightInTheSurveyAndTheConvergenceInDeviationCsv) {
+  const std::string run = LocalizeAndRefine(Survey(), "survey");
+  ExpectConvergenceInDeviationCsv(run, "run --map");
+  ExpectConvergenceInDeviationCsv(dir_ + "/survey_refined", "refine --map");
 }
 
 TEST_F(SurveyFlights, SecondFlightInTheFirstFlightsMap) {
@@ -263,9 +270,26 @@ TEST_F(SurveyFlights, RefineMapInChunksMergesAndResumesOnlyWithItsMap) {
   }
   r = RunTool("merge --chunks " + dir_ + "/chunk2 " + dir_ + "/chunk1 --out " + dir_ + "/merged", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("merge --map " + Survey()), std::string::npos) << r.err;  // the hint
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/merged/deviation.csv"));
   const double ate = AteNoAlign(Truth(), dir_ + "/merged/trajectory.tum", dir_);
   EXPECT_LT(ate, 0.05);
   std::printf("[ survey ] refine --map in 2 chunks, merged: ATE (no alignment) %.4f m\n", ate);
+  // merge --map: the deviation of the merged map, as after refine --map.
+  r = RunTool("merge --chunks " + dir_ + "/chunk1 " + dir_ + "/chunk2 --map " + Survey() +
+                  " --out " + dir_ + "/merged_dev",
+              dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto bins = ReadCsv(dir_ + "/merged_dev/deviation.csv");
+  EXPECT_GT(bins.size(), 10u);
+  const nlohmann::json dev = nlohmann::json::parse(
+      testing_cli::ReadFile(dir_ + "/merged_dev/summary.json"))["localization"]["deviation"];
+  EXPECT_GT(dev["with_surface"].get<double>(), 0.9 * dev["map_points"].get<double>());
+  EXPECT_LT(dev["median_abs_m"].get<double>(), 0.01);
+  EXPECT_EQ(testing_cli::ReadFile(dir_ + "/merged_dev/trajectory.tum"),
+            testing_cli::ReadFile(dir_ + "/merged/trajectory.tum"));
+  std::printf("[ survey ] merge --map: median |deviation| %.4f m, p95 %.4f m\n",
+              dev["median_abs_m"].get<double>(), dev["p95_abs_m"].get<double>());
 
   r = refine(short_map, "--chunk 2 --of 2 --out " + dir_ + "/chunk2_short");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -275,6 +299,13 @@ TEST_F(SurveyFlights, RefineMapInChunksMergesAndResumesOnlyWithItsMap) {
   testing_cli::ExpectOneErrorLine(r, "merge", "map_hash");
   EXPECT_NE(r.err.find("another --map"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/merged_mixed"));
+  // merge --map with another map than the chunks': refused, nothing written.
+  r = RunTool("merge --chunks " + dir_ + "/chunk1 " + dir_ + "/chunk2 --map " + short_map +
+                  " --out " + dir_ + "/merged_other_map",
+              dir_);
+  testing_cli::ExpectOneErrorLine(r, "merge", "--map " + short_map);
+  EXPECT_NE(r.err.find("not the map the chunks were refined with"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/merged_other_map"));
 
   const std::string checkpoint = dir_ + "/checkpoint";
   r = refine(Survey(), "--checkpoint " + checkpoint + " --set smoother.refine_rounds=1 --out " +

@@ -18,8 +18,14 @@ namespace rvlio {
 // x y z in metres, validated). InvalidInput, one line starting with
 // "--map PATH", when the file is missing, unreadable, truncated, empty or
 // holds a non-finite point. The file is only read.
-StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(const std::string& path,
-                                                               const LocalizationOptions& options);
+// surface (when not null) receives the full cloud for the deviation
+// (QueryReferenceSurface), from the same read.
+StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(
+    const std::string& path, const LocalizationOptions& options,
+    std::shared_ptr<const ReferenceMap>* surface = nullptr);
+
+// The full cloud alone, for the deviation (merge --map); errors as above.
+StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(const std::string& path);
 
 // "x,y,z,roll_deg,pitch_deg,yaw_deg" (metres, degrees; R = Rz(yaw) Ry(pitch)
 // Rx(roll)) as a one-pose trajectory at t = 0. InvalidInput naming

@@ -33,6 +33,8 @@ StatusOr<uint64_t> FileContentHash(const std::string& path);
 // that `rvlio merge` only merges chunks of one refinement (refine_jobs.h).
 uint64_t RefineOptionsHash(const OdometryOptions& options);
 uint64_t TrajectoryHash(const Trajectory& trajectory);
+// A hash as chunk.json writes it: 16 lower-case hex digits.
+std::string HashText(uint64_t hash);
 
 Status WriteRefineCheckpoint(const std::string& dir, uint64_t fingerprint,
                              const RefineRoundState& state);
