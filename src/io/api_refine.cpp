@@ -35,10 +35,7 @@ RefineConfig ToRefineConfig(const OdometryOptions& o,
   RefineConfig c;
   c.reference = std::move(reference);
   c.imu = o.imu;
-  const auto& e = o.extrinsics.imu_T_lidar;
-  c.T_imu_lidar = Pose3(Eigen::Quaterniond(e.rotation_xyzw[3], e.rotation_xyzw[0],
-                                           e.rotation_xyzw[1], e.rotation_xyzw[2]),
-                        Eigen::Vector3d(e.translation[0], e.translation[1], e.translation[2]));
+  c.T_imu_lidar = ImuTLidar(o.extrinsics);
   c.map = o.map;
   c.constraints = o.constraints;
   c.rv = EffectiveRvOptions(o.rv, o.degeneracy);
