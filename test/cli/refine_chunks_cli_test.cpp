@@ -204,6 +204,11 @@ void RefineChunksCliTest::CheckBadMerges() {
   r = RunTool("merge --out " + out + " --chunks " + dir_ + "/whole", dir_);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(dir_ + "/whole/chunk.json"), std::string::npos) << r.err;
+  // --map for chunks refined without one, or a map that cannot be read.
+  const std::string map = dir_ + "/whole/map.pcd";
+  r = RunTool(MergeArgs({1, 2, 3}, out) + " --map " + map, dir_);
+  testing_cli::ExpectOneErrorLine(r, "merge", "--map " + map);
+  EXPECT_NE(r.err.find("refined without --map"), std::string::npos) << r.err;
 
   // A chunk refined with other options (one round) does not merge with the others.
   const std::string foreign = dir_ + "/foreign2";
