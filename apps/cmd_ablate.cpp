@@ -23,11 +23,11 @@
 namespace rvlio::cli {
 namespace {
 
-constexpr const char* kName = "ablate";
+constexpr const char* kAblate = "ablate";
 constexpr int kMaxJobs = 256;
 
 CommandSpec AblateSpec() {
-  return {kName,
+  return {kAblate,
           "Runs a grid of sequences x variants x parameters: each cell is one `rvlio run`\n"
           "process, evaluated against ground truth, recorded in OUT/cells/<id>/cell.json.\n"
           "Resumable: finished cells (same configuration hash) are skipped. Writes\n"
@@ -62,7 +62,7 @@ int ReadMaxCells(const Args& args, int64_t* max_cells) {
   errno = 0;
   const long long v = std::strtoll(text.c_str(), &end, 10);
   if (text.empty() || *end != '\0' || errno != 0 || v < 1)
-    return Fail(kName, "--max-cells '" + text + "' is not a positive whole number");
+    return Fail(kAblate, "--max-cells '" + text + "' is not a positive whole number");
   *max_cells = v;
   return 0;
 }
@@ -74,7 +74,7 @@ int ReadJobs(const Args& args, int* jobs) {
   const std::string text = args.Get("jobs");
   long long v = 0;
   if (!ParseWholeNumber(text, 1, kMaxJobs, &v))
-    return Fail(kName, "--jobs '" + text + "' is not a whole number in [1, " +
+    return Fail(kAblate, "--jobs '" + text + "' is not a whole number in [1, " +
                            std::to_string(kMaxJobs) + "]");
   *jobs = static_cast<int>(v);
   return 0;
@@ -82,7 +82,7 @@ int ReadJobs(const Args& args, int* jobs) {
 
 int Summarize(const ablate::Plan& plan, const Args& args) {
   StatusOr<ablate::SummaryResult> r = ablate::WriteSummary(plan, !args.Has("no-plots"));
-  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kAblate, r.status().message(), r.status().exit_code());
   std::cout << r->table_md;
   std::printf("rvlio ablate: %d cells: %d done, %d failed, %d not run -> %s/table.md\n", r->cells,
               r->done, r->failed, r->missing, plan.out_dir.c_str());
@@ -90,7 +90,7 @@ int Summarize(const ablate::Plan& plan, const Args& args) {
     std::printf("rvlio ablate: %d cells diverged (status diverged in summary.csv; left out of the "
                 "means)\n", r->diverged);
   std::printf("rvlio ablate: %s\n", r->plot_note.c_str());
-  WriteFolderReport(kName, plan.out_dir, false);
+  WriteFolderReport(kAblate, plan.out_dir, false);
   return 0;
 }
 
@@ -107,7 +107,7 @@ int ReportInterrupt(const ablate::RunCounts& c) {
 int RunSingle(const ablate::Plan& plan, const std::string& id, const ablate::RunnerOptions& o) {
   ablate::RunCounts counts;
   if (!ablate::RunOne(plan, id, o, &counts))
-    return Fail(kName,
+    return Fail(kAblate,
                 "no cell or data '" + id + "' in the plan of " + plan.grid_path + " (see --plan)");
   if (Interrupted()) return ReportInterrupt(counts);
   const char* what = counts.skipped ? "already done" : counts.failed ? "failed (recorded)" : "done";
@@ -125,19 +125,19 @@ int CmdAblate(int argc, char** argv) {
   if (int rc = ReadJobs(args, &options.jobs); rc != 0) return rc;
   int modes = 0;
   for (const char* m : {"plan", "summarize", "cell", "data"}) modes += args.Has(m) ? 1 : 0;
-  if (modes > 1) return Fail(kName, "--plan, --summarize, --cell and --data exclude each other");
+  if (modes > 1) return Fail(kAblate, "--plan, --summarize, --cell and --data exclude each other");
   options.rvlio_bin = SelfPath();
   options.progress = !args.Has("quiet");
 
   int64_t max_cells = 0;
   if (int rc = ReadMaxCells(args, &max_cells); rc != 0) return rc;
   StatusOr<ablate::Plan> plan = ablate::LoadPlan(args.Get("grid"), args.Get("out"), max_cells);
-  if (!plan.ok()) return Fail(kName, plan.status().message(), plan.status().exit_code());
+  if (!plan.ok()) return Fail(kAblate, plan.status().message(), plan.status().exit_code());
   if (args.Has("plan")) {
     std::cout << JsonText(ablate::PlanJson(*plan)) << "\n";
     return 0;
   }
-  if (!PrepareOutputDir(kName, plan->out_dir)) return 2;
+  if (!PrepareOutputDir(kAblate, plan->out_dir)) return 2;
   if (args.Has("summarize")) return Summarize(*plan, args);
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: finished cells stay, the rest run next time
   if (args.Has("cell")) return RunSingle(*plan, args.Get("cell"), options);
@@ -146,7 +146,7 @@ int CmdAblate(int argc, char** argv) {
   if (Status s =
           WriteFileAtomically(plan->out_dir + "/plan.json", JsonText(ablate::PlanJson(*plan)) + "\n");
       !s.ok())
-    return Fail(kName, s.message(), s.exit_code());
+    return Fail(kAblate, s.message(), s.exit_code());
   if (options.progress)
     std::printf("rvlio ablate: the grid has %zu cells (%zu simulated sequences) -> %s\n",
                 plan->cells.size(), plan->data.size(), plan->out_dir.c_str());

@@ -16,7 +16,7 @@
 namespace rvlio::cli {
 namespace {
 
-constexpr const char* kName = "calibrate-time";
+constexpr const char* kCalibrateTime = "calibrate-time";
 // A lag below this (and within 3 sigma of zero) counts as synchronized.
 constexpr double kSynchronizedS = 0.002;
 
@@ -93,7 +93,7 @@ void PrintOffset(const ClockCheckResult& r, const OdometryOptions& o, const Cloc
 }  // namespace
 
 int CmdCalibrateTime(int argc, char** argv) {
-  CommandSpec spec{kName,
+  CommandSpec spec{kCalibrateTime,
                    "Estimates the LiDAR-IMU clock offset of a recording offline: the rotation rate "
                    "from registering consecutive scans is correlated with the gyroscope over a "
                    "range of lags (coarse, then refined). Prints the offset to put in "
@@ -107,15 +107,15 @@ int CmdCalibrateTime(int argc, char** argv) {
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   std::vector<std::string> warnings;
   StatusOr<OdometryOptions> o = LoadConfig(args.GetAll("config"), args.GetAll("set"), &warnings);
-  if (!o.ok()) return Fail(kName, o.status().message());
-  for (const auto& w : warnings) std::fprintf(stderr, "rvlio %s: warning: %s\n", kName, w.c_str());
+  if (!o.ok()) return Fail(kCalibrateTime, o.status().message());
+  for (const auto& w : warnings) std::fprintf(stderr, "rvlio %s: warning: %s\n", kCalibrateTime, w.c_str());
   Recording rec;
   if (Status s = Read(args.Get("bag"), *o, &rec); !s.ok())
-    return Fail(kName, s.message(), s.exit_code());
+    return Fail(kCalibrateTime, s.message(), s.exit_code());
   if (rec.scan_start_ns.empty() || rec.imu.empty())
-    return Fail(kName, args.Get("bag") + ": no scans on lidar.topic '" + o->lidar.topic +
+    return Fail(kCalibrateTime, args.Get("bag") + ": no scans on lidar.topic '" + o->lidar.topic +
                            "' or no IMU samples on imu.topic '" + o->imu.topic + "'");
-  std::printf("rvlio %s: %s\n", kName, args.Get("bag").c_str());
+  std::printf("rvlio %s: %s\n", kCalibrateTime, args.Get("bag").c_str());
   PrintStamps(AnalyzeStamps(rec.scan_start_ns, rec.scan_end_ns, rec.imu_ns),
               HeaderStampLine(args.Get("bag"), o->lidar.topic));
   ClockCheckOptions c;

@@ -19,11 +19,11 @@
 namespace rvlio::cli {
 namespace {
 
-constexpr const char* kName = "eval";
+constexpr const char* kEval = "eval";
 
 CommandSpec EvalSpec() {
   return {
-      kName,
+      kEval,
       "ATE/RPE of an estimated trajectory against ground truth, with the definitions of the evo\n"
       "tool. Trajectories are TUM (t x y z qx qy qz qw) or KITTI (3x4 rows, assumed 10 Hz)\n"
       "files, detected by their column count.\n"
@@ -172,20 +172,20 @@ void PrintDegeneracyTable(const DegeneracyEvalResult& r) {
 
 int EvalDegeneracy(const Args& args) {
   if (args.Has("map") || args.Has("ref-map") || args.Has("est"))
-    return Fail(kName, "--degeneracy (degeneracy mode) cannot be combined with --map/--ref-map/--est");
-  if (!args.Has("truth")) return Fail(kName, "--degeneracy RUN_DIR needs --truth SIM_DIR");
+    return Fail(kEval, "--degeneracy (degeneracy mode) cannot be combined with --map/--ref-map/--est");
+  if (!args.Has("truth")) return Fail(kEval, "--degeneracy RUN_DIR needs --truth SIM_DIR");
   DegeneracyEvalArgs d;
-  if (std::string error = ReadOptions(args, &d.eval); !error.empty()) return Fail(kName, error);
+  if (std::string error = ReadOptions(args, &d.eval); !error.empty()) return Fail(kEval, error);
   d.run_dir = args.Get("degeneracy");
   d.truth_dir = args.Get("truth");
   d.gt_path = args.Get("gt", "");
   if (args.Has("truth-ratio") &&
       (!ParseNumber(args.Get("truth-ratio"), &d.degenerate_ratio) || d.degenerate_ratio <= 0.0))
-    return Fail(kName, "--truth-ratio '" + args.Get("truth-ratio") + "' is not a positive number");
+    return Fail(kEval, "--truth-ratio '" + args.Get("truth-ratio") + "' is not a positive number");
   StatusOr<DegeneracyEvalResult> r = EvaluateDegeneracyFiles(d);
-  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kEval, r.status().message(), r.status().exit_code());
   for (const std::string& w : r->scores.warnings)
-    std::fprintf(stderr, "rvlio %s: warning: %s\n", kName, w.c_str());
+    std::fprintf(stderr, "rvlio %s: warning: %s\n", kEval, w.c_str());
   if (args.Has("json"))
     std::cout << JsonText(DegeneracyEvalJson(*r), -1) << "\n";
   else
@@ -195,13 +195,13 @@ int EvalDegeneracy(const Args& args) {
 
 int EvalMap(const Args& args) {
   if (args.Has("gt") || args.Has("est"))
-    return Fail(kName, "--map/--ref-map (map mode) cannot be combined with --gt/--est");
+    return Fail(kEval, "--map/--ref-map (map mode) cannot be combined with --gt/--est");
   if (!args.Has("map") || !args.Has("ref-map"))
-    return Fail(kName, "map mode needs both --map FILE and --ref-map FILE");
+    return Fail(kEval, "map mode needs both --map FILE and --ref-map FILE");
   MapEvalOptions options;
-  if (std::string error = ReadMapOptions(args, &options); !error.empty()) return Fail(kName, error);
+  if (std::string error = ReadMapOptions(args, &options); !error.empty()) return Fail(kEval, error);
   StatusOr<MapEvalResult> r = EvaluateMapFiles(args.Get("map"), args.Get("ref-map"), options);
-  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kEval, r.status().message(), r.status().exit_code());
   if (args.Has("json"))
     std::cout << JsonText(MapEvalJson(*r), -1) << "\n";
   else
@@ -216,22 +216,22 @@ int CmdEval(int argc, char** argv) {
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   if (args.Has("degeneracy") || args.Has("truth")) {
-    if (!args.Has("degeneracy")) return Fail(kName, "--truth SIM_DIR needs --degeneracy RUN_DIR");
+    if (!args.Has("degeneracy")) return Fail(kEval, "--truth SIM_DIR needs --degeneracy RUN_DIR");
     return EvalDegeneracy(args);
   }
   if (args.Has("map") || args.Has("ref-map")) return EvalMap(args);
   for (const char* required : {"gt", "est"})  // trajectory mode
     if (!args.Has(required))
-      return Fail(kName, std::string("missing required option --") + required +
+      return Fail(kEval, std::string("missing required option --") + required +
                              " (or --map FILE --ref-map FILE for a map)");
   EvalOptions options;
-  if (std::string error = ReadOptions(args, &options); !error.empty()) return Fail(kName, error);
+  if (std::string error = ReadOptions(args, &options); !error.empty()) return Fail(kEval, error);
 
   StatusOr<EvalResult> result = EvaluateFiles(args.Get("gt"), args.Get("est"), options);
-  if (!result.ok()) return Fail(kName, result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail(kEval, result.status().message(), result.status().exit_code());
 
   for (const std::string& w : result->warnings)
-    std::fprintf(stderr, "rvlio %s: warning: %s\n", kName, w.c_str());
+    std::fprintf(stderr, "rvlio %s: warning: %s\n", kEval, w.c_str());
   if (args.Has("json"))
     PrintJson(*result);
   else

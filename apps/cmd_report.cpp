@@ -11,11 +11,11 @@
 namespace rvlio::cli {
 namespace {
 
-constexpr const char* kName = "report";
+constexpr const char* kReport = "report";
 constexpr long long kMaxPointsLimit = 50000000;
 
 CommandSpec ReportSpec() {
-  return {kName,
+  return {kReport,
           "The folder comes first: rvlio report DIR [options]. Writes DIR/report.html, one\n"
           "page that opens offline in a browser: the trajectories over the ground truth, the\n"
           "RV activity and health per scan, the map as a 3D point cloud and the table of\n"
@@ -30,7 +30,7 @@ int ReadMaxPoints(const Args& args, size_t* max_points) {
   const std::string text = args.Get("max-points");
   long long v = 0;
   if (!ParseWholeNumber(text, 1, kMaxPointsLimit, &v))
-    return Fail(kName, "--max-points '" + text + "' is not a whole number in [1, " +
+    return Fail(kReport, "--max-points '" + text + "' is not a whole number in [1, " +
                            std::to_string(kMaxPointsLimit) + "]");
   *max_points = static_cast<size_t>(v);
   return 0;
@@ -54,13 +54,13 @@ int CmdReport(int argc, char** argv) {
   const bool has_dir = argc > 2 && std::string(argv[2]).rfind("--", 0) != 0;
   Args args;
   if (int rc = Parse(spec, argc, argv, has_dir ? 3 : 2, &args); rc != 0) return rc < 0 ? 0 : rc;
-  if (!has_dir) return Fail(kName, "missing the folder: rvlio report DIR (see --help)");
+  if (!has_dir) return Fail(kReport, "missing the folder: rvlio report DIR (see --help)");
   const std::string dir = argv[2];
   report::ReportOptions options;
   options.gt = args.Get("gt");
   if (int rc = ReadMaxPoints(args, &options.max_points); rc != 0) return rc;
   StatusOr<report::WrittenReport> r = report::WriteReport(dir, args.Get("out"), options);
-  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kReport, r.status().message(), r.status().exit_code());
   std::printf("rvlio report: wrote %s (%.1f MB)\n", r->path.c_str(),
               static_cast<double>(r->bytes) / 1e6);
   return 0;

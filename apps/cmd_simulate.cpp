@@ -26,7 +26,7 @@
 namespace rvlio::cli {
 namespace {
 
-constexpr const char* kName = "simulate";
+constexpr const char* kSimulate = "simulate";
 
 std::string PresetList() {
   std::string list;
@@ -35,7 +35,7 @@ std::string PresetList() {
 }
 
 CommandSpec SimulateSpec() {
-  return {kName,
+  return {kSimulate,
           "Simulate a multirotor flight through a tunnel (or a hall) with a spinning LiDAR and an\n"
           "IMU. Writes DIR/NAME.bag (ROS1: Ouster PointCloud2 + sensor_msgs/Imu; or NAME.mcap /\n"
           "NAME.db3, ROS 2, with --format), DIR/NAME_gt.tum\n"
@@ -124,14 +124,14 @@ int CmdSimulate(int argc, char** argv) {
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop, leave no half bag, exit 130/143
   SimulateArgs sim;
-  if (std::string err = ReadArgs(args, &sim); !err.empty()) return Fail(kName, err);
+  if (std::string err = ReadArgs(args, &sim); !err.empty()) return Fail(kSimulate, err);
   sim.stop = [] { return InterruptSignalName(); };
   // A second signal aborts at once: the writer's temporary file goes with it.
   const std::string bag_path = SimulatedRecordingPath(sim);
   SetAbortRemovePath(bag_path + ".tmp");
   StatusOr<SimulateResult> r = SimulateRecording(sim);
   SetAbortRemovePath("");
-  if (!r.ok()) return Fail(kName, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kSimulate, r.status().message(), r.status().exit_code());
   if (r->stopped) {
     std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",
                  r->stop_reason.c_str());

@@ -39,7 +39,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-constexpr const char* kName = "compare";
+constexpr const char* kCompare = "compare";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kRefine = "refine";
 
@@ -133,7 +133,7 @@ class Steps {
   int next_, total_;
 };
 
-std::string Fixed(double v, int decimals) {
+std::string FixedOrDash(double v, int decimals) {
   if (!std::isfinite(v)) return "-";
   char buf[48];
   std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
@@ -165,30 +165,30 @@ struct Truth {
 
 int CheckInputs(const CompareRequest& req, Truth* truth) {
   StatusOr<OdometryOptions> options = LoadConfig(req.config_files, req.overrides);
-  if (!options.ok()) return Fail(kName, options.status().message());
+  if (!options.ok()) return Fail(kCompare, options.status().message());
   for (const Variant& v : StandardVariants()) {
     std::vector<std::string> sets = req.overrides;
     sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
     if (StatusOr<OdometryOptions> o = LoadConfig(req.config_files, sets); !o.ok())
-      return Fail(kName, "variant " + v.name + ": " + o.status().message());
+      return Fail(kCompare, "variant " + v.name + ": " + o.status().message());
   }
   StatusOr<Trajectory> gt = ReadTrajectory(req.gt);
-  if (!gt.ok()) return Fail(kName, "--gt: " + gt.status().message());
+  if (!gt.ok()) return Fail(kCompare, "--gt: " + gt.status().message());
   if (gt->size() < 3)
-    return Fail(kName, "--gt: " + req.gt + " has " + std::to_string(gt->size()) +
+    return Fail(kCompare, "--gt: " + req.gt + " has " + std::to_string(gt->size()) +
                            " poses; at least 3 are needed to align and evaluate");
   truth->trajectory = std::move(*gt);
   if (!req.ref_map.empty()) {
     StatusOr<PointCloudFile> ref = ReadPointCloud(req.ref_map, PointCloudReadOptions{false});
-    if (!ref.ok()) return Fail(kName, "--ref-map: " + ref.status().message());
+    if (!ref.ok()) return Fail(kCompare, "--ref-map: " + ref.status().message());
     truth->ref_map = std::move(ref->points);
   }
   ReaderOptions inline_io = options->io;
   inline_io.reader_thread = false;  // only the checks at open: read nothing ahead
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(req.bag, options->lidar, options->imu, req.window, inline_io);
-  if (!reader.ok()) return Fail(kName, reader.status().message());
-  return PrepareOutputDir(kName, req.out_dir) ? 0 : 2;
+  if (!reader.ok()) return Fail(kCompare, reader.status().message());
+  return PrepareOutputDir(kCompare, req.out_dir) ? 0 : 2;
 }
 
 // ---------------------------------------------------------------------------
@@ -210,7 +210,7 @@ void EvaluateRowMap(const Truth& truth, const std::string& dir, Row* row) {
   StatusOr<MapEvalResult> m = map.ok() ? EvaluateMap(map->points, truth.ref_map, MapEvalOptions())
                                        : StatusOr<MapEvalResult>(map.status());
   if (!m.ok()) {
-    std::fprintf(stderr, "rvlio %s: warning: %s: map evaluation: %s\n", kName, row->name.c_str(),
+    std::fprintf(stderr, "rvlio %s: warning: %s: map evaluation: %s\n", kCompare, row->name.c_str(),
                  m.status().message().c_str());
     return;
   }
@@ -224,7 +224,7 @@ void EvaluateRow(const Truth& truth, const std::string& dir, Row* row) {
   if (!e.ok()) {
     row->exit_code = e.status().exit_code();
     row->error = "evaluation: " + e.status().message();
-    std::fprintf(stderr, "rvlio %s: warning: %s: %s\n", kName, row->name.c_str(),
+    std::fprintf(stderr, "rvlio %s: warning: %s: %s\n", kCompare, row->name.c_str(),
                  row->error.c_str());
     return;
   }
@@ -395,13 +395,13 @@ std::string MarkdownText(const CompareRequest& req, const std::vector<Row>& rows
       os << "failed (exit " << r.exit_code << ") | | | | | |\n";
       continue;
     }
-    os << Fixed(r.eval->ape_m.rmse, 4) << " | " << Fixed(r.eval->rpe.trans_m.rmse, 4) << " | "
-       << Fixed(r.eval->along_axis.max_abs_m, 4) << " | " << Fixed(r.eval->end_point_error_m, 4)
-       << " | " << Fixed(r.ms_per_scan, 2) << (r.name == kRefine ? " (wall)" : "") << " | "
-       << Fixed(r.real_time_factor, 1) << "x |";
+    os << FixedOrDash(r.eval->ape_m.rmse, 4) << " | " << FixedOrDash(r.eval->rpe.trans_m.rmse, 4) << " | "
+       << FixedOrDash(r.eval->along_axis.max_abs_m, 4) << " | " << FixedOrDash(r.eval->end_point_error_m, 4)
+       << " | " << FixedOrDash(r.ms_per_scan, 2) << (r.name == kRefine ? " (wall)" : "") << " | "
+       << FixedOrDash(r.real_time_factor, 1) << "x |";
     if (with_map)
-      os << " " << (r.map_eval ? Fixed(r.map_eval->accuracy.rmse, 4) : "-") << " | "
-         << (r.map_eval ? Fixed(r.map_eval->completeness, 3) : "-") << " |";
+      os << " " << (r.map_eval ? FixedOrDash(r.map_eval->accuracy.rmse, 4) : "-") << " | "
+         << (r.map_eval ? FixedOrDash(r.map_eval->completeness, 3) : "-") << " |";
     os << "\n";
   }
   os << "\nBag `" << req.bag << "`, ground truth `" << req.gt << "`. ATE: translation RMSE after "
@@ -562,7 +562,7 @@ void PrintPlotReport(const CompareRequest& req, const PlotReport& plots) {
     return;
   }
   if (plots.status == "partial")
-    std::fprintf(stderr, "rvlio %s: warning: some plots failed: %s\n", kName,
+    std::fprintf(stderr, "rvlio %s: warning: some plots failed: %s\n", kCompare,
                  plots.message.c_str());
   if (plots.files.empty()) return;
   std::printf("  plots:  %s/plots/ (", req.out_dir.c_str());
@@ -575,7 +575,7 @@ Status WriteJson(const CompareRequest& req, const std::vector<Row>& rows,
                  const PlotReport& plots) {
   nlohmann::json j;
   j["version"] = RVLIO_VERSION;
-  j["command"] = kName;
+  j["command"] = kCompare;
   j["bag"] = req.bag;
   j["gt"] = req.gt;
   if (!req.ref_map.empty()) j["ref_map"] = req.ref_map;
@@ -609,7 +609,7 @@ int ReportInterrupt(const CompareRequest& req, const std::vector<Row>& rows) {
   PlotReport plots;
   plots.status = "skipped";
   plots.message = "interrupted";
-  if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kName, s.message(), 1);
+  if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kCompare, s.message(), 1);
   int finished = 0;
   for (const Row& r : rows) finished += r.interrupted ? 0 : 1;
   std::fprintf(stderr, "rvlio compare: interrupted by %s: %d of %zu steps finished; wrote "
@@ -644,25 +644,25 @@ int RunCompare(const CompareRequest& req) {
        {std::pair<std::string, std::string>{"compare.csv", CsvText(rows, with_map)},
         {"compare.md", MarkdownText(req, rows)}}) {
     if (Status s = WriteFileAtomically(req.out_dir + "/" + file, text); !s.ok())
-      return Fail(kName, s.message(), 1);
+      return Fail(kCompare, s.message(), 1);
   }
   PrintTable(rows, with_map);
   PlotReport plots;
   if (Interrupted()) return ReportInterrupt(req, rows);
   if (req.plots && any_ok) plots = DrawPlots(req, rows);
-  if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kName, s.message(), 1);
+  if (Status s = WriteJson(req, rows, plots); !s.ok()) return Fail(kCompare, s.message(), 1);
   std::printf("\n  tables: %s/compare.{csv,md,json}; runs: %s/<variant>/\n", req.out_dir.c_str(),
               req.out_dir.c_str());
   if (req.plots) PrintPlotReport(req, plots);
-  WriteFolderReport(kName, req.out_dir, req.quiet);
+  WriteFolderReport(kCompare, req.out_dir, req.quiet);
   int diverged = 0;
   for (const Row& r : rows) diverged += r.diverged ? 1 : 0;
   if (!any_ok && diverged > 0)
-    return Fail(kName, "every variant failed or diverged (see the table and each run's summary.json "
+    return Fail(kCompare, "every variant failed or diverged (see the table and each run's summary.json "
                 "divergence)", kExitDiverged);
-  if (!any_ok) return Fail(kName, "every variant failed (see the table)", 1);
+  if (!any_ok) return Fail(kCompare, "every variant failed (see the table)", 1);
   if (diverged > 0)
-    std::fprintf(stderr, "rvlio %s: warning: %d run(s) diverged, marked in the table\n", kName,
+    std::fprintf(stderr, "rvlio %s: warning: %d run(s) diverged, marked in the table\n", kCompare,
                  diverged);
   return 0;
 }

@@ -14,7 +14,7 @@ namespace rvlio {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 constexpr int kChunk = 4096;  // points per parallel work item (fixed: results independent of threads)
 
 // Per MAP point: nearest distance (NaN beyond the search radius) and
@@ -29,8 +29,8 @@ MapPointDistances MapToReference(const std::vector<Eigen::Vector3d>& map_points,
                                  const MapEvalOptions& options) {
   MapPointDistances d;
   const size_t n = map_points.size();
-  d.nearest_m.assign(n, kNaN);
-  d.plane_m.assign(n, kNaN);
+  d.nearest_m.assign(n, kNoValue);
+  d.plane_m.assign(n, kNoValue);
   SurfaceQueryOptions surface = options.surface;
   // The plane search must reach at least as far as the inlier test.
   surface.search_radius = std::max(surface.search_radius, options.max_distance);
@@ -59,7 +59,7 @@ std::vector<double> ReferenceToMap(const std::vector<Eigen::Vector3d>& ref_point
                                    const std::vector<uint32_t>& order, const ReferenceMap& map,
                                    const MapEvalOptions& options) {
   const size_t n = ref_points.size();
-  std::vector<double> nearest_m(n, kNaN);
+  std::vector<double> nearest_m(n, kNoValue);
   const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
   ParallelFor(0, chunks, options.threads, [&](int chunk, int) {
     NeighborBuffer neighbors;
@@ -104,10 +104,10 @@ std::vector<MapProfileBin> Profile(const std::vector<Eigen::Vector3d>& map_point
   }
   for (size_t b = 0; b < bins; ++b) {
     MapProfileBin& bin = profile[b];
-    bin.completeness = bin.ref_points == 0 ? kNaN : static_cast<double>(covered[b]) / bin.ref_points;
+    bin.completeness = bin.ref_points == 0 ? kNoValue : static_cast<double>(covered[b]) / bin.ref_points;
     bin.map_with_plane = plane[b].size();
     if (plane[b].empty()) {
-      bin.rms_m = bin.median_m = bin.p95_m = kNaN;
+      bin.rms_m = bin.median_m = bin.p95_m = kNoValue;
       continue;
     }
     const ErrorStats s = ComputeStats(std::move(plane[b]));

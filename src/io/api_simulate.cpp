@@ -96,7 +96,7 @@ std::string FlightSeedNote(const SimOptions& o) {
   return o.flight_seed >= 0 ? ", flight seed " + std::to_string(o.flight_seed) : "";
 }
 
-std::string Num(double v) {
+std::string NumberText(double v) {
   std::ostringstream os;
   os.precision(10);
   os << v;
@@ -107,7 +107,7 @@ std::string Num(double v) {
 // densities must be positive there; a noise-free simulation gets a tiny value.
 std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
                        const std::string& bag_file) {
-  auto density = [](double v) { return Num(std::max(v, 1e-9)); };
+  auto density = [](double v) { return NumberText(std::max(v, 1e-9)); };
   const auto& t = o.extrinsics.imu_T_lidar.translation;
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
   std::ostringstream y;
@@ -118,20 +118,20 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
     << "lidar:\n"
     << "  topic: " << o.lidar.topic << "\n"
     << (livox ? "  type: livox\n" : "  type: ouster\n  header_stamp: start\n")
-    << "  min_range: " << Num(o.lidar.min_range) << "\n"
-    << "  max_range: " << Num(o.lidar.max_range) << "\n"
+    << "  min_range: " << NumberText(o.lidar.min_range) << "\n"
+    << "  max_range: " << NumberText(o.lidar.max_range) << "\n"
     << "imu:\n"
     << "  topic: " << o.imu.topic << "\n"
     << "  gyro_noise_density: " << density(o.imu.gyro_noise_density) << "\n"
     << "  accel_noise_density: " << density(o.imu.accel_noise_density) << "\n"
     << "  gyro_bias_random_walk: " << density(o.imu.gyro_bias_random_walk) << "\n"
     << "  accel_bias_random_walk: " << density(o.imu.accel_bias_random_walk) << "\n"
-    << "  gravity: " << Num(o.imu.gravity) << "\n"
+    << "  gravity: " << NumberText(o.imu.gravity) << "\n"
     << "extrinsics:\n"
     << "  imu_T_lidar:\n"
-    << "    translation: [" << Num(t[0]) << ", " << Num(t[1]) << ", " << Num(t[2]) << "]\n"
-    << "    rotation_xyzw: [" << Num(q[0]) << ", " << Num(q[1]) << ", " << Num(q[2]) << ", "
-    << Num(q[3]) << "]\n";
+    << "    translation: [" << NumberText(t[0]) << ", " << NumberText(t[1]) << ", " << NumberText(t[2]) << "]\n"
+    << "    rotation_xyzw: [" << NumberText(q[0]) << ", " << NumberText(q[1]) << ", " << NumberText(q[2]) << ", "
+    << NumberText(q[3]) << "]\n";
   // The resolved simulator options, as comments, so the sequence can be
   // reproduced (rvlio simulate --set KEY=VALUE for any of them).
   y << "\n# Simulator options of this sequence:\n";

@@ -32,7 +32,7 @@ struct FieldLayout {
   size_t first_scalar = 0;  // index of its first scalar in the record (ascii)
 };
 
-struct Layout {
+struct FileLayout {
   std::vector<FieldLayout> fields;
   size_t record_bytes = 0;
   size_t record_scalars = 0;
@@ -74,7 +74,7 @@ bool ParseInt64(const std::string& s, int64_t* out) {
   return true;
 }
 
-void FinishLayout(Layout* layout) {
+void FinishLayout(FileLayout* layout) {
   size_t offset = 0, scalars = 0;
   for (FieldLayout& f : layout->fields) {
     f.offset = offset;
@@ -94,7 +94,7 @@ Status PcdError(const std::string& path, const std::string& what) {
 
 // Parses the header up to and including the DATA line; *data_kind is ascii,
 // binary or binary_compressed; *body_pos the first byte after the header.
-Status ParsePcdHeader(const std::string& path, const std::string& text, Layout* layout,
+Status ParsePcdHeader(const std::string& path, const std::string& text, FileLayout* layout,
                       std::string* data_kind, size_t* body_pos) {
   std::vector<std::string> names, sizes, types, counts;
   int64_t width = -1, height = 1, points = -1;
@@ -197,7 +197,7 @@ bool LzfDecompress(const uint8_t* in, size_t in_size, uint8_t* out, size_t out_s
 // binary_compressed: two uint32 (compressed, uncompressed size), the LZF
 // data, which decompresses to each field's values for all points in turn;
 // re-interleaved into point records.
-Status DecompressPcd(const std::string& path, const Body& body, const Layout& layout,
+Status DecompressPcd(const std::string& path, const Body& body, const FileLayout& layout,
                      std::string* records) {
   if (body.size < 8) return Status::InvalidInput(path + ": truncated (no compressed data)");
   uint32_t compressed = 0, uncompressed = 0;
@@ -260,13 +260,13 @@ bool PlyType(const std::string& t, ScalarKind* kind, int* size) {
 struct PlyElement {
   std::string name;
   int64_t count = 0;
-  Layout layout;
+  FileLayout layout;
   bool has_list = false;
 };
 
 // Parses the header; *layout is the vertex element's, *skip_records the
 // elements before it (records to skip: bytes for binary, lines for ascii).
-Status ParsePlyHeader(const std::string& path, const std::string& text, Layout* layout,
+Status ParsePlyHeader(const std::string& path, const std::string& text, FileLayout* layout,
                       std::string* format, int64_t* skip_bytes, int64_t* skip_lines,
                       size_t* body_pos) {
   size_t pos = 0;
@@ -360,7 +360,7 @@ struct FieldPlan {
   std::vector<int> kept;  // indices into layout.fields
 };
 
-Status PlanFields(const std::string& path, const Layout& layout, bool keep_fields,
+Status PlanFields(const std::string& path, const FileLayout& layout, bool keep_fields,
                   FieldPlan* plan) {
   for (size_t i = 0; i < layout.fields.size(); ++i) {
     const FieldLayout& f = layout.fields[i];
@@ -378,7 +378,7 @@ Status PlanFields(const std::string& path, const Layout& layout, bool keep_field
   return Status::Ok();
 }
 
-void PrepareCloud(const Layout& layout, const FieldPlan& plan, PointCloudFile* cloud) {
+void PrepareCloud(const FileLayout& layout, const FieldPlan& plan, PointCloudFile* cloud) {
   const size_t n = static_cast<size_t>(layout.num_points);
   cloud->points.resize(n);
   for (int f : plan.kept) {
@@ -387,7 +387,7 @@ void PrepareCloud(const Layout& layout, const FieldPlan& plan, PointCloudFile* c
   }
 }
 
-Status DecodeBinary(const std::string& path, const char* data, size_t size, const Layout& layout,
+Status DecodeBinary(const std::string& path, const char* data, size_t size, const FileLayout& layout,
                     const FieldPlan& plan, PointCloudFile* cloud) {
   const uint64_t n = static_cast<uint64_t>(layout.num_points);
   if (layout.record_bytes == 0 || size / layout.record_bytes < n)
@@ -412,7 +412,7 @@ Status DecodeBinary(const std::string& path, const char* data, size_t size, cons
 // Whitespace-separated numbers; newlines counted for messages. Skips
 // `skip_lines` lines first (PLY elements before the vertices).
 Status DecodeAscii(const std::string& path, const char* data, size_t size, int64_t skip_lines,
-                   const Layout& layout, const FieldPlan& plan, PointCloudFile* cloud) {
+                   const FileLayout& layout, const FieldPlan& plan, PointCloudFile* cloud) {
   const char* p = data;
   const char* const end = data + size;
   for (int64_t s = 0; s < skip_lines; ++s) {
@@ -502,7 +502,7 @@ Status CheckPoints(const std::string& path, const PointCloudFile& cloud, bool al
 
 StatusOr<PointCloudFile> ReadPcd(const std::string& path, const std::string& text,
                                  const PointCloudReadOptions& options) {
-  Layout layout;
+  FileLayout layout;
   std::string kind;
   size_t body_pos = 0;
   if (Status s = ParsePcdHeader(path, text, &layout, &kind, &body_pos); !s.ok()) return s;
@@ -527,7 +527,7 @@ StatusOr<PointCloudFile> ReadPcd(const std::string& path, const std::string& tex
 
 StatusOr<PointCloudFile> ReadPly(const std::string& path, const std::string& text,
                                  const PointCloudReadOptions& options) {
-  Layout layout;
+  FileLayout layout;
   std::string format;
   int64_t skip_bytes = 0, skip_lines = 0;
   size_t body_pos = 0;

@@ -7,13 +7,13 @@
 namespace rvlio {
 
 namespace {
-constexpr size_t kInitialCapacity = 1024;  // slots (power of two)
+constexpr size_t kInitialSlots = 1024;  // slots (power of two)
 }  // namespace
 
 OutputMap::OutputMap(double resolution)
     : resolution_(resolution), inv_resolution_(1.0 / resolution) {
   RVLIO_CHECK(resolution > 0.0);
-  table_.assign(kInitialCapacity, -1);
+  table_.assign(kInitialSlots, -1);
 }
 
 void OutputMap::Rehash(size_t capacity) {

@@ -87,7 +87,7 @@ LagFit FitLag(const std::vector<Interval>& intervals, const GyroIntegral& gyro, 
   return f;
 }
 
-double Median(std::vector<double> v) {
+double UpperMedian(std::vector<double> v) {
   if (v.empty()) return 0.0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
@@ -210,7 +210,7 @@ StampReport AnalyzeStamps(const std::vector<TimeNs>& scan_start_ns,
   r.scans = static_cast<int>(scan_start_ns.size());
   r.imu_samples = static_cast<int>(imu_ns.size());
   const std::vector<double> scan_p = PeriodsS(scan_start_ns);
-  r.scan_period_s = Median(scan_p);
+  r.scan_period_s = UpperMedian(scan_p);
   double sum_sq = 0.0;
   int regular = 0;
   for (double p : scan_p) {
@@ -226,9 +226,9 @@ StampReport AnalyzeStamps(const std::vector<TimeNs>& scan_start_ns,
   std::vector<double> durations;
   for (size_t i = 0; i < scan_start_ns.size() && i < scan_end_ns.size(); ++i)
     durations.push_back(NsToSeconds(scan_end_ns[i] - scan_start_ns[i]));
-  r.scan_duration_s = Median(durations);
+  r.scan_duration_s = UpperMedian(durations);
   const std::vector<double> imu_p = PeriodsS(imu_ns);
-  const double imu_period = Median(imu_p);
+  const double imu_period = UpperMedian(imu_p);
   r.imu_rate_hz = imu_period > 0.0 ? 1.0 / imu_period : 0.0;
   sum_sq = 0.0;
   for (double p : imu_p) {

@@ -11,8 +11,8 @@
 namespace rvlio::test {
 namespace {
 
-const std::string kCloudTopic = "/os_cloud_node/points";
-const std::string kImuTopic = "/imu/data";
+const std::string kWriterCloudTopic = "/os_cloud_node/points";
+const std::string kWriterImuTopic = "/imu/data";
 namespace fs = std::filesystem;
 
 class BagWriterTest : public TempDirTest {
@@ -24,14 +24,14 @@ class BagWriterTest : public TempDirTest {
     EXPECT_TRUE(writer.ok());
     for (int k = 0; k < 5; ++k) {
       scans_.push_back(SyntheticScan(kT0 + k * 100 * kMs, 8, 64, k));
-      EXPECT_TRUE((*writer)->WriteOusterScan(kCloudTopic, "os_lidar", scans_.back(), 8, 64).ok());
+      EXPECT_TRUE((*writer)->WriteOusterScan(kWriterCloudTopic, "os_lidar", scans_.back(), 8, 64).ok());
     }
     for (int i = 0; i < 100; ++i) {
       ImuSample s;
       s.t_ns = kT0 + i * 5 * kMs;
       s.acc_imu = Eigen::Vector3d(0.5, -0.25, 9.75);
       s.gyro_imu = Eigen::Vector3d(0.125, 0.0, -0.5);
-      EXPECT_TRUE((*writer)->WriteImu(kImuTopic, "imu_link", s).ok());
+      EXPECT_TRUE((*writer)->WriteImu(kWriterImuTopic, "imu_link", s).ok());
     }
     EXPECT_TRUE((*writer)->Close().ok());
     return path;
@@ -43,7 +43,7 @@ TEST_F(BagWriterTest, OusterMessageLayoutAndTimes) {
   const std::string path = WriteSample("layout.bag");
   rosbag::Bag bag;
   bag.open(path, rosbag::bagmode::Read);
-  rosbag::View clouds(bag, rosbag::TopicQuery(kCloudTopic));
+  rosbag::View clouds(bag, rosbag::TopicQuery(kWriterCloudTopic));
   ASSERT_EQ(clouds.size(), 5u);
   int k = 0;
   for (const rosbag::MessageInstance& m : clouds) {
@@ -82,7 +82,7 @@ TEST_F(BagWriterTest, OusterMessageLayoutAndTimes) {
     EXPECT_NEAR(range_mm, 1000.0 * p.p_lidar.norm(), 0.5);
     ++k;
   }
-  rosbag::View imus(bag, rosbag::TopicQuery(kImuTopic));
+  rosbag::View imus(bag, rosbag::TopicQuery(kWriterImuTopic));
   ASSERT_EQ(imus.size(), 100u);
   auto imu = imus.begin()->instantiate<sensor_msgs::Imu>();
   ASSERT_TRUE(imu);
@@ -98,7 +98,7 @@ TEST_F(BagWriterTest, UnorganizedWhenSizeDoesNotMatchRowsTimesCols) {
   auto writer = SensorBagWriter::Create(path);
   ASSERT_TRUE(writer.ok());
   Scan s = SyntheticScan(kT0, 2, 10, 0);
-  ASSERT_TRUE((*writer)->WriteOusterScan(kCloudTopic, "l", s, 3, 10).ok());
+  ASSERT_TRUE((*writer)->WriteOusterScan(kWriterCloudTopic, "l", s, 3, 10).ok());
   ASSERT_TRUE((*writer)->Close().ok());
   rosbag::Bag bag;
   bag.open(path, rosbag::bagmode::Read);
@@ -116,14 +116,14 @@ TEST_F(BagWriterTest, WritesToTempAndRenamesOnClose) {
     ASSERT_TRUE(writer.ok());
     ImuSample s;
     s.t_ns = kT0;
-    ASSERT_TRUE((*writer)->WriteImu(kImuTopic, "imu", s).ok());
+    ASSERT_TRUE((*writer)->WriteImu(kWriterImuTopic, "imu", s).ok());
     EXPECT_FALSE(fs::exists(path));
     EXPECT_TRUE(fs::exists(path + ".tmp"));
     ASSERT_TRUE((*writer)->Close().ok());
     EXPECT_TRUE(fs::exists(path));
     EXPECT_FALSE(fs::exists(path + ".tmp"));
     EXPECT_FALSE((*writer)->Close().ok());  // twice is a programmer's slip, not a crash
-    EXPECT_FALSE((*writer)->WriteImu(kImuTopic, "imu", s).ok());
+    EXPECT_FALSE((*writer)->WriteImu(kWriterImuTopic, "imu", s).ok());
   }
   const std::string abandoned = Path("abandoned.bag");
   {
@@ -131,7 +131,7 @@ TEST_F(BagWriterTest, WritesToTempAndRenamesOnClose) {
     ASSERT_TRUE(writer.ok());
     ImuSample s;
     s.t_ns = kT0;
-    ASSERT_TRUE((*writer)->WriteImu(kImuTopic, "imu", s).ok());
+    ASSERT_TRUE((*writer)->WriteImu(kWriterImuTopic, "imu", s).ok());
   }  // destroyed without Close: no half bag left
   EXPECT_FALSE(fs::exists(abandoned));
   EXPECT_FALSE(fs::exists(abandoned + ".tmp"));
@@ -146,20 +146,20 @@ TEST_F(BagWriterTest, RejectsTimesRosCannotHold) {
   ASSERT_TRUE(writer.ok());
   ImuSample s;
   s.t_ns = -1;
-  Status st = (*writer)->WriteImu(kImuTopic, "imu", s);
+  Status st = (*writer)->WriteImu(kWriterImuTopic, "imu", s);
   EXPECT_EQ(st.code(), StatusCode::kInvalidInput);
   EXPECT_NE(st.message().find("IMU stamp -1 ns"), std::string::npos) << st.message();
   s.t_ns = 0;  // allowed: recorded at the smallest bag time
-  EXPECT_TRUE((*writer)->WriteImu(kImuTopic, "imu", s).ok());
+  EXPECT_TRUE((*writer)->WriteImu(kWriterImuTopic, "imu", s).ok());
 
   Scan scan = SyntheticScan(kT0, 2, 8, 0);
   scan.points[1].t_ns = kT0 - 1;  // before the sweep start
-  st = (*writer)->WriteOusterScan(kCloudTopic, "l", scan, 2, 8);
+  st = (*writer)->WriteOusterScan(kWriterCloudTopic, "l", scan, 2, 8);
   EXPECT_EQ(st.code(), StatusCode::kInvalidInput);
   EXPECT_NE(st.message().find("point 1"), std::string::npos) << st.message();
   scan = SyntheticScan(kT0, 2, 8, 0);
   scan.t_end_ns = kT0 - 1;
-  EXPECT_FALSE((*writer)->WriteOusterScan(kCloudTopic, "l", scan, 2, 8).ok());
+  EXPECT_FALSE((*writer)->WriteOusterScan(kWriterCloudTopic, "l", scan, 2, 8).ok());
   EXPECT_TRUE((*writer)->Close().ok());
 }
 
@@ -214,7 +214,7 @@ TEST_F(BagWriterTest, BagInfoListsTopicsRatesAndLayout) {
   ASSERT_EQ(info->topics.size(), 2u);
   const BagTopicInfo& imu = info->topics[0];  // sorted by name
   const BagTopicInfo& cloud = info->topics[1];
-  EXPECT_EQ(imu.topic, kImuTopic);
+  EXPECT_EQ(imu.topic, kWriterImuTopic);
   EXPECT_EQ(imu.type, "sensor_msgs/Imu");
   EXPECT_EQ(imu.count, 100);
   EXPECT_NEAR(imu.rate_hz, 200.0, 1e-6);
@@ -233,13 +233,13 @@ TEST_F(BagWriterTest, BagInfoListsTopicsRatesAndLayout) {
   EXPECT_EQ(cloud.scans_sampled, 5);
   EXPECT_DOUBLE_EQ(cloud.points_per_scan, valid / 5.0);
 
-  StatusOr<BagInfo> wrong = ReadBagInfo(path, kImuTopic);
+  StatusOr<BagInfo> wrong = ReadBagInfo(path, kWriterImuTopic);
   ASSERT_FALSE(wrong.ok());
   EXPECT_NE(wrong.status().message().find("expected sensor_msgs/PointCloud2"), std::string::npos);
   StatusOr<BagInfo> missing = ReadBagInfo(path, "/points");
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.status().message().find("/imu/data (sensor_msgs/Imu)"), std::string::npos);
-  StatusOr<BagInfo> only = ReadBagInfo(path, kCloudTopic);
+  StatusOr<BagInfo> only = ReadBagInfo(path, kWriterCloudTopic);
   ASSERT_TRUE(only.ok());
   EXPECT_EQ(only->topics[1].lidar_layout, "ouster");
 

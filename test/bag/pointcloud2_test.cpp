@@ -13,7 +13,7 @@ namespace {
 
 using test::RawCloud;
 
-constexpr TimeNs kStamp = 1700000000123456789LL;
+constexpr TimeNs kCloudStamp = 1700000000123456789LL;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Expected {
@@ -63,7 +63,7 @@ void ExpectPattern(const Scan& scan, uint32_t n, bool check_ring = true) {
 
 TEST(PointCloud2Decode, OusterRelativeNsFromStartStamp) {
   RawCloud c = test::OusterCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   const uint32_t n = 200;
   FillPattern(&c, n, [](uint32_t i) { return 500.0 * i + 7; });
   DecodeStats stats;
@@ -71,11 +71,11 @@ TEST(PointCloud2Decode, OusterRelativeNsFromStartStamp) {
   ASSERT_TRUE(scan.ok()) << scan.status().message();
   ExpectPattern(*scan, n);
   for (uint32_t i = 0; i < n; ++i) {
-    EXPECT_EQ(scan->points[i].t_ns, kStamp + 500 * i + 7);
+    EXPECT_EQ(scan->points[i].t_ns, kCloudStamp + 500 * i + 7);
     EXPECT_FLOAT_EQ(scan->points[i].intensity, 10.0f + i);
   }
-  EXPECT_EQ(scan->t_start_ns, kStamp + 7);
-  EXPECT_EQ(scan->t_end_ns, kStamp + 500 * (n - 1) + 7);
+  EXPECT_EQ(scan->t_start_ns, kCloudStamp + 7);
+  EXPECT_EQ(scan->t_end_ns, kCloudStamp + 500 * (n - 1) + 7);
   EXPECT_EQ(stats.layout, "ouster");
   EXPECT_FALSE(stats.stamp_is_end);
   EXPECT_EQ(stats.raw_points, n);
@@ -84,24 +84,24 @@ TEST(PointCloud2Decode, OusterRelativeNsFromStartStamp) {
 
 TEST(PointCloud2Decode, OusterForcedEndStampPutsLastPointAtStamp) {
   RawCloud c = test::OusterCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   const uint32_t n = 64;
   FillPattern(&c, n, [](uint32_t i) { return 1000.0 * i; });
   DecodeStats stats;
   StatusOr<Scan> scan = DecodePointCloud2(c.View(), Lidar("ouster", "end"), &stats);
   ASSERT_TRUE(scan.ok()) << scan.status().message();
   EXPECT_TRUE(stats.stamp_is_end);
-  EXPECT_EQ(scan->t_end_ns, kStamp);
-  EXPECT_EQ(scan->t_start_ns, kStamp - 1000 * (n - 1));
+  EXPECT_EQ(scan->t_end_ns, kCloudStamp);
+  EXPECT_EQ(scan->t_start_ns, kCloudStamp - 1000 * (n - 1));
   for (uint32_t i = 0; i < n; ++i)
-    EXPECT_EQ(scan->points[i].t_ns, kStamp - 1000 * TimeNs(n - 1) + 1000 * TimeNs(i));
+    EXPECT_EQ(scan->points[i].t_ns, kCloudStamp - 1000 * TimeNs(n - 1) + 1000 * TimeNs(i));
 }
 
 TimeNs RelSecondsToNs(double s) { return std::llround(double(float(s)) * 1e9); }
 
 TEST(PointCloud2Decode, VelodyneNegativeTimesMeanEndStamp) {
   RawCloud c = test::VelodyneCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   const uint32_t n = 100;
   auto rel = [](uint32_t i) { return -0.099 + 0.001 * i; };  // -0.099 .. 0
   FillPattern(&c, n, rel);
@@ -113,14 +113,14 @@ TEST(PointCloud2Decode, VelodyneNegativeTimesMeanEndStamp) {
     EXPECT_TRUE(stats.stamp_is_end) << stamp;
     ExpectPattern(*scan, n);
     for (uint32_t i = 0; i < n; ++i)
-      EXPECT_EQ(scan->points[i].t_ns, kStamp + RelSecondsToNs(rel(i))) << stamp << " " << i;
-    EXPECT_LE(std::llabs(scan->t_end_ns - kStamp), 1);
+      EXPECT_EQ(scan->points[i].t_ns, kCloudStamp + RelSecondsToNs(rel(i))) << stamp << " " << i;
+    EXPECT_LE(std::llabs(scan->t_end_ns - kCloudStamp), 1);
   }
 }
 
 TEST(PointCloud2Decode, VelodynePositiveTimesMeanStartStamp) {
   RawCloud c = test::VelodyneCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   const uint32_t n = 100;
   auto rel = [](uint32_t i) { return 0.001 * i; };
   FillPattern(&c, n, rel);
@@ -128,13 +128,13 @@ TEST(PointCloud2Decode, VelodynePositiveTimesMeanStartStamp) {
   StatusOr<Scan> scan = DecodePointCloud2(c.View(), Lidar(), &stats);
   ASSERT_TRUE(scan.ok()) << scan.status().message();
   EXPECT_FALSE(stats.stamp_is_end);
-  EXPECT_EQ(scan->t_start_ns, kStamp);
-  for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(scan->points[i].t_ns, kStamp + RelSecondsToNs(rel(i)));
+  EXPECT_EQ(scan->t_start_ns, kCloudStamp);
+  for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(scan->points[i].t_ns, kCloudStamp + RelSecondsToNs(rel(i)));
 }
 
 TEST(PointCloud2Decode, VelodyneForcedStartWithNegativeTimesPutsFirstPointAtStamp) {
   RawCloud c = test::VelodyneCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   const uint32_t n = 50;
   auto rel = [](uint32_t i) { return -0.05 + 0.001 * i; };
   FillPattern(&c, n, rel);
@@ -142,10 +142,10 @@ TEST(PointCloud2Decode, VelodyneForcedStartWithNegativeTimesPutsFirstPointAtStam
   StatusOr<Scan> scan = DecodePointCloud2(c.View(), Lidar("velodyne", "start"), &stats);
   ASSERT_TRUE(scan.ok()) << scan.status().message();
   EXPECT_FALSE(stats.stamp_is_end);
-  EXPECT_EQ(scan->t_start_ns, kStamp);
+  EXPECT_EQ(scan->t_start_ns, kCloudStamp);
   for (uint32_t i = 0; i < n; ++i) {
     const double shifted = double(float(rel(i))) * 1e9 - double(float(rel(0))) * 1e9;
-    EXPECT_EQ(scan->points[i].t_ns, kStamp + std::llround(shifted));
+    EXPECT_EQ(scan->points[i].t_ns, kCloudStamp + std::llround(shifted));
   }
 }
 
@@ -193,7 +193,7 @@ TEST(PointCloud2Decode, LivoxAbsoluteTimestampInNanosecondsOrSeconds) {
 
 TEST(PointCloud2Decode, LivoxOffsetTimeIsRelativeNs) {
   RawCloud c = test::LivoxOffsetCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   const uint32_t n = 30;
   FillPattern(&c, n, [](uint32_t i) { return 3333.0 * i; });
   DecodeStats stats;
@@ -201,12 +201,12 @@ TEST(PointCloud2Decode, LivoxOffsetTimeIsRelativeNs) {
   ASSERT_TRUE(scan.ok()) << scan.status().message();
   EXPECT_EQ(stats.layout, "livox");
   ExpectPattern(*scan, n);
-  for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(scan->points[i].t_ns, kStamp + 3333 * i);
+  for (uint32_t i = 0; i < n; ++i) EXPECT_EQ(scan->points[i].t_ns, kCloudStamp + 3333 * i);
 }
 
 TEST(PointCloud2Decode, ForcedTypeOverridesDetectionAndNeedsItsField) {
   RawCloud c = test::HesaiCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   FillPattern(&c, 10, [](uint32_t i) { return 1700000000.0 + 0.01 * i; });
   // hesai fields read as livox: still absolute seconds (nearest the stamp).
   DecodeStats stats;
@@ -243,7 +243,7 @@ TEST(PointCloud2Decode, NoTimeFieldSaysWhatToDo) {
 
 TEST(PointCloud2Decode, OrganizedCloudDropsNoReturnNanInfAndOutOfRange) {
   RawCloud c = test::OusterCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   const uint32_t rows = 4, cols = 8;
   c.Resize(cols, rows, /*pad=*/12);
   int expect_invalid = 0, expect_range = 0, expect_kept = 0;
@@ -269,17 +269,17 @@ TEST(PointCloud2Decode, OrganizedCloudDropsNoReturnNanInfAndOutOfRange) {
   for (const LidarPoint& p : scan->points) {
     const uint32_t i = uint32_t(std::lround(p.p_lidar.x() - 3.0));
     EXPECT_EQ(p.ring, i / cols);
-    EXPECT_EQ(p.t_ns, kStamp + 1000 * TimeNs(i % cols));
+    EXPECT_EQ(p.t_ns, kCloudStamp + 1000 * TimeNs(i % cols));
     EXPECT_FLOAT_EQ(p.p_lidar.y(), -1.0f);
   }
   // A cloud with only dropped points decodes to an empty scan at the stamp.
   RawCloud empty = test::OusterCloud();
-  empty.stamp_ns = kStamp;
+  empty.stamp_ns = kCloudStamp;
   empty.Resize(5, 2);
   StatusOr<Scan> none = DecodePointCloud2(empty.View(), Lidar(), &stats);
   ASSERT_TRUE(none.ok());
   EXPECT_TRUE(none->points.empty());
-  EXPECT_EQ(none->t_start_ns, kStamp);
+  EXPECT_EQ(none->t_start_ns, kCloudStamp);
   EXPECT_EQ(stats.invalid_points, 10);
 }
 
@@ -291,7 +291,7 @@ TEST(PointCloud2Decode, BigEndianCloudDecodesLikeLittleEndian) {
     auto time_of = [&](uint32_t i) {
       return field == "timestamp" ? 1700000000.0 + 1e-3 * i : field == "time" ? 1e-3 * i : 100.0 * i;
     };
-    base.stamp_ns = big.stamp_ns = kStamp;
+    base.stamp_ns = big.stamp_ns = kCloudStamp;
     FillPattern(&base, 40, time_of);
     FillPattern(&big, 40, time_of);
     ASSERT_NE(base.data, big.data);
@@ -319,7 +319,7 @@ void ExpectRejected(const RawCloud& c, const std::string& needle) {
 
 RawCloud SmallOuster() {
   RawCloud c = test::OusterCloud();
-  c.stamp_ns = kStamp;
+  c.stamp_ns = kCloudStamp;
   FillPattern(&c, 10, [](uint32_t i) { return 10.0 * i; });
   return c;
 }
@@ -385,7 +385,7 @@ TEST(PointCloud2Fuzz, RandomCorruptionsAreRejectedOrDecodedConsistently) {
   int accepted = 0, rejected = 0;
   for (int trial = 0; trial < 4000; ++trial) {
     RawCloud c = bases[trial % bases.size()];
-    c.stamp_ns = kStamp;
+    c.stamp_ns = kCloudStamp;
     const bool abs = c.time_field == "timestamp";
     FillPattern(&c, uni(0, 40), [&](uint32_t i) { return abs ? 1.7e9 + 1e-3 * i : 1e3 * i; });
     const int mutations = int(uni(0, 3));

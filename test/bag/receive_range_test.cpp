@@ -16,8 +16,8 @@
 namespace rvlio::test {
 namespace {
 
-const std::string kCloudTopic = "/os_cloud_node/points";
-const std::string kImuTopic = "/imu/data";
+const std::string kRangeCloudTopic = "/os_cloud_node/points";
+const std::string kRangeImuTopic = "/imu/data";
 constexpr int kScans = 30;
 constexpr TimeNs kScanEndNs = 99 * kMs;  // SyntheticScan: receive time = start + 99 ms
 
@@ -65,9 +65,9 @@ class ReceiveRangeTest : public TempDirTest, public ::testing::WithParamInterfac
         s.t_ns = kT0 + imu_index * 5 * kMs;
         s.acc_imu = Eigen::Vector3d(0.5, -0.25, 9.75);
         s.gyro_imu = Eigen::Vector3d(0.125, 0.0, -0.5 + 0.001 * imu_index);
-        EXPECT_TRUE((*writer)->WriteImu(kImuTopic, "imu_link", s).ok());
+        EXPECT_TRUE((*writer)->WriteImu(kRangeImuTopic, "imu_link", s).ok());
       }
-      EXPECT_TRUE((*writer)->WriteOusterScan(kCloudTopic, "os_lidar", scan, 16, 128).ok());
+      EXPECT_TRUE((*writer)->WriteOusterScan(kRangeCloudTopic, "os_lidar", scan, 16, 128).ok());
     }
     EXPECT_TRUE((*writer)->Close().ok());
   }
@@ -86,7 +86,7 @@ struct Delivered {
 std::vector<Delivered> ReadDelivered(const std::string& path,
                                      const std::optional<ReceiveTimeRange>& range) {
   std::vector<Delivered> out;
-  auto reader = SensorBagReader::Open(path, LidarOn(kCloudTopic), ImuOn(kImuTopic), range);
+  auto reader = SensorBagReader::Open(path, LidarOn(kRangeCloudTopic), ImuOn(kRangeImuTopic), range);
   EXPECT_TRUE(reader.ok()) << reader.status().message();
   if (!reader.ok()) return out;
   ImuSample imu;

@@ -13,7 +13,7 @@ namespace {
 
 using Eigen::Vector3d;
 
-const Vector3d kGravity(0.0, 0.0, -9.81);
+const Vector3d kGravityHistory(0.0, 0.0, -9.81);
 
 // A turning, accelerating signal sampled every 5 ms (biases included).
 std::vector<ImuSample> Signal(TimeNs t0_ns, TimeNs t1_ns) {
@@ -48,9 +48,9 @@ const Vector3d kBg(0.01, -0.02, 0.005), kBa(0.05, -0.03, 0.02);
 TEST(ImuPoseHistory, ForwardIntegrationReproducesEveryKnotAndPredictsTheEnd) {
   const std::vector<ImuSample> imu = Signal(0, 200000000);
   const TimeNs t0 = 12000000, t1 = 113000000;  // off the sample grid
-  const ImuPoseHistory h = ImuPoseHistory::Integrate(Start(t0), imu, t1, kBg, kBa, kGravity);
+  const ImuPoseHistory h = ImuPoseHistory::Integrate(Start(t0), imu, t1, kBg, kBa, kGravityHistory);
   const std::vector<ImuKinematics> knots =
-      IntegrateTrajectory(Start(t0), imu, t1, kBg, kBa, kGravity);
+      IntegrateTrajectory(Start(t0), imu, t1, kBg, kBa, kGravityHistory);
   ASSERT_EQ(h.samples().size(), knots.size());
   for (size_t i = 0; i < knots.size(); ++i) {
     EXPECT_EQ(h.samples()[i].t_ns, knots[i].t_ns);
@@ -65,8 +65,8 @@ TEST(ImuPoseHistory, ForwardIntegrationReproducesEveryKnotAndPredictsTheEnd) {
 TEST(ImuPoseHistory, BackwardIntegrationIsSortedAndAgreesWithForward) {
   const std::vector<ImuSample> imu = Signal(0, 200000000);
   const TimeNs t0 = 12000000, t1 = 113000000;
-  const ImuPoseHistory fwd = ImuPoseHistory::Integrate(Start(t0), imu, t1, kBg, kBa, kGravity);
-  const ImuPoseHistory bwd = ImuPoseHistory::Integrate(fwd.Newest(), imu, t0, kBg, kBa, kGravity);
+  const ImuPoseHistory fwd = ImuPoseHistory::Integrate(Start(t0), imu, t1, kBg, kBa, kGravityHistory);
+  const ImuPoseHistory bwd = ImuPoseHistory::Integrate(fwd.Newest(), imu, t0, kBg, kBa, kGravityHistory);
   ASSERT_EQ(bwd.samples().size(), fwd.samples().size());
   EXPECT_EQ(bwd.samples().front().t_ns, t0);
   EXPECT_EQ(bwd.samples().back().t_ns, t1);

@@ -34,7 +34,7 @@ struct Read {
 
 // Everything `reader` delivers; with `until_ns`, stops after the last message
 // not later than it (a full read's view of a window's end).
-Read ReadAll(SensorBagReader* reader, TimeNs until_ns = -1) {
+Read ReadEverything(SensorBagReader* reader, TimeNs until_ns = -1) {
   Read r;
   ImuSample imu;
   Scan scan;
@@ -92,7 +92,7 @@ TEST_P(WindowSkipTest, DeliversWhatAFullReadGivesTheWindow) {
       auto windowed = OpenSensorStream(path, lidar, imu, window, io);
       ASSERT_TRUE(full.ok()) << full.status().message();
       ASSERT_TRUE(windowed.ok()) << windowed.status().message();
-      const Read all = ReadAll(full->get());
+      const Read all = ReadEverything(full->get());
       ASSERT_FALSE(all.messages.empty());
       // The window rules of sensor_stream.h on the full read.
       const TimeNs start_ns = all.messages.front().t_ns + SecondsToNs(window.start_s);
@@ -105,14 +105,14 @@ TEST_P(WindowSkipTest, DeliversWhatAFullReadGivesTheWindow) {
           want.push_back(m);
       }
       ASSERT_FALSE(want.empty());
-      const Read got = ReadAll(windowed->get());
+      const Read got = ReadEverything(windowed->get());
       EXPECT_EQ(got.messages, want);
       // Without the time offset the scans before the window were not decoded:
       // fewer dropped points counted than a full read up to the window's end;
       // with +4 s the recording was read from its start: at least as many.
       auto until_end = OpenSensorStream(path, lidar, imu, ReadWindow(), io);
       ASSERT_TRUE(until_end.ok());
-      const int64_t full_invalid = ReadAll(until_end->get(), want.back().t_ns).invalid_points;
+      const int64_t full_invalid = ReadEverything(until_end->get(), want.back().t_ns).invalid_points;
       if (time_offset_s == 0.0) {
         EXPECT_LT(got.invalid_points, full_invalid);
       }

@@ -16,7 +16,7 @@ using Eigen::Vector3d;
 using so3::Exp;
 using so3::Log;
 
-constexpr int kTrials = 1000;
+constexpr int kSo3Trials = 1000;
 
 Vector3d RandomUnit(std::mt19937& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
@@ -25,7 +25,7 @@ Vector3d RandomUnit(std::mt19937& rng) {
 }
 
 // A rotation vector with angle uniform in [0, max_angle).
-Vector3d RandomRotationVector(std::mt19937& rng, double max_angle) {
+Vector3d RandomSo3Vector(std::mt19937& rng, double max_angle) {
   std::uniform_real_distribution<double> u(0.0, max_angle);
   return u(rng) * RandomUnit(rng);
 }
@@ -45,7 +45,7 @@ double RotationDistance(const Matrix3d& A, const Matrix3d& B) { return (A - B).n
 TEST(So3, HatIsCrossProductAndVeeInvertsIt) {
   std::mt19937 rng(1);
   std::normal_distribution<double> n(0.0, 3.0);
-  for (int i = 0; i < kTrials; ++i) {
+  for (int i = 0; i < kSo3Trials; ++i) {
     const Vector3d w(n(rng), n(rng), n(rng)), v(n(rng), n(rng), n(rng));
     EXPECT_LT((so3::Hat(w) * v - w.cross(v)).norm(), 1e-12);
     EXPECT_LT((so3::Vee(so3::Hat(w)) - w).norm(), 1e-15);
@@ -55,8 +55,8 @@ TEST(So3, HatIsCrossProductAndVeeInvertsIt) {
 
 TEST(So3, ExpIsRotationAndMatchesEigenAngleAxis) {
   std::mt19937 rng(2);
-  for (int i = 0; i < kTrials; ++i) {
-    const Vector3d w = RandomRotationVector(rng, 3.0 * M_PI);
+  for (int i = 0; i < kSo3Trials; ++i) {
+    const Vector3d w = RandomSo3Vector(rng, 3.0 * M_PI);
     const Matrix3d R = Exp(w);
     EXPECT_LT((R.transpose() * R - Matrix3d::Identity()).norm(), 1e-14);
     EXPECT_NEAR(R.determinant(), 1.0, 1e-14);
@@ -78,15 +78,15 @@ TEST(So3, ExpSmallAnglesAgreeWithSeries) {
 
 TEST(So3, LogInvertsExpBelowPi) {
   std::mt19937 rng(4);
-  for (int i = 0; i < kTrials; ++i) {
-    const Vector3d w = RandomRotationVector(rng, M_PI - 1e-6);
+  for (int i = 0; i < kSo3Trials; ++i) {
+    const Vector3d w = RandomSo3Vector(rng, M_PI - 1e-6);
     EXPECT_LT((Log(Exp(w)) - w).norm(), 1e-12) << w.transpose();
   }
 }
 
 TEST(So3, ExpInvertsLogForRandomRotations) {
   std::mt19937 rng(5);
-  for (int i = 0; i < kTrials; ++i) {
+  for (int i = 0; i < kSo3Trials; ++i) {
     const Matrix3d R = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
     const Vector3d w = Log(R);
     EXPECT_LE(w.norm(), M_PI + 1e-12);
@@ -149,8 +149,8 @@ TEST(So3, LogExactlyPiAboutSeveralAxes) {
 
 TEST(So3, QuaternionExpLogAgreeWithMatrixForms) {
   std::mt19937 rng(9);
-  for (int i = 0; i < kTrials; ++i) {
-    const Vector3d w = RandomRotationVector(rng, M_PI - 1e-6);
+  for (int i = 0; i < kSo3Trials; ++i) {
+    const Vector3d w = RandomSo3Vector(rng, M_PI - 1e-6);
     const Eigen::Quaterniond q = so3::ExpQuat(w);
     EXPECT_NEAR(q.norm(), 1.0, 1e-15);
     EXPECT_LT(RotationDistance(q.toRotationMatrix(), Exp(w)), 1e-14);
@@ -168,8 +168,8 @@ TEST(So3, QuaternionExpLogAgreeWithMatrixForms) {
 TEST(So3, RightJacobianMatchesNumeric) {
   // Exp(w + d) = Exp(w) Exp(Jr(w) d)  =>  Jr = d Log(Exp(w)^T Exp(w + d)) / d d.
   std::mt19937 rng(10);
-  for (int i = 0; i < kTrials; ++i) {
-    const Vector3d w = RandomRotationVector(rng, M_PI - 0.1);
+  for (int i = 0; i < kSo3Trials; ++i) {
+    const Vector3d w = RandomSo3Vector(rng, M_PI - 0.1);
     const Matrix3d Rt = Exp(w).transpose();
     const Matrix3d J = NumericJacobian([&](const Vector3d& d) { return Log(Rt * Exp(w + d)); });
     EXPECT_LT((so3::Jr(w) - J).norm(), 1e-8) << w.transpose();
@@ -179,8 +179,8 @@ TEST(So3, RightJacobianMatchesNumeric) {
 TEST(So3, LeftJacobianMatchesNumeric) {
   // Exp(w + d) = Exp(Jl(w) d) Exp(w).
   std::mt19937 rng(11);
-  for (int i = 0; i < kTrials; ++i) {
-    const Vector3d w = RandomRotationVector(rng, M_PI - 0.1);
+  for (int i = 0; i < kSo3Trials; ++i) {
+    const Vector3d w = RandomSo3Vector(rng, M_PI - 0.1);
     const Matrix3d Rt = Exp(w).transpose();
     const Matrix3d J = NumericJacobian([&](const Vector3d& d) { return Log(Exp(w + d) * Rt); });
     EXPECT_LT((so3::Jl(w) - J).norm(), 1e-8) << w.transpose();
@@ -191,8 +191,8 @@ TEST(So3, LeftJacobianMatchesNumeric) {
 TEST(So3, InverseJacobiansMatchNumericAndInvert) {
   // Log(Exp(w) Exp(d)) = w + JrInv(w) d ;  Log(Exp(d) Exp(w)) = w + JlInv(w) d.
   std::mt19937 rng(12);
-  for (int i = 0; i < kTrials; ++i) {
-    const Vector3d w = RandomRotationVector(rng, M_PI - 0.1);
+  for (int i = 0; i < kSo3Trials; ++i) {
+    const Vector3d w = RandomSo3Vector(rng, M_PI - 0.1);
     const Matrix3d R = Exp(w);
     const Matrix3d Jri = NumericJacobian([&](const Vector3d& d) { return Log(R * Exp(d)); });
     const Matrix3d Jli = NumericJacobian([&](const Vector3d& d) { return Log(Exp(d) * R); });
@@ -227,8 +227,8 @@ TEST(So3, InverseRightJacobianIsFiniteAtPi) {
 TEST(So3, ExpTimesVectorJacobianMatchesNumeric) {
   std::mt19937 rng(14);
   std::normal_distribution<double> n(0.0, 2.0);
-  for (int i = 0; i < kTrials; ++i) {
-    const Vector3d w = RandomRotationVector(rng, 2.0 * M_PI);
+  for (int i = 0; i < kSo3Trials; ++i) {
+    const Vector3d w = RandomSo3Vector(rng, 2.0 * M_PI);
     const Vector3d v(n(rng), n(rng), n(rng));
     const Matrix3d J = NumericJacobian([&](const Vector3d& d) { return Vector3d(Exp(w + d) * v); });
     EXPECT_LT((so3::ExpTimesVectorJacobian(w, v) - J).norm(), 1e-7 * (1.0 + v.norm()));

@@ -14,37 +14,37 @@ using Eigen::Matrix3d;
 using Eigen::Vector3d;
 using S = FilterState;
 
-constexpr int kTrials = 1000;
+constexpr int kStateTrials = 1000;
 
-Vector3d RandomVector(std::mt19937& rng, double sigma) {
+Vector3d RandomStateVector(std::mt19937& rng, double sigma) {
   std::normal_distribution<double> n(0.0, sigma);
   return Vector3d(n(rng), n(rng), n(rng));
 }
 
-Vector3d RandomRotationVector(std::mt19937& rng, double max_angle) {
+Vector3d RandomStateRotation(std::mt19937& rng, double max_angle) {
   std::uniform_real_distribution<double> u(0.0, max_angle);
-  return u(rng) * RandomVector(rng, 1.0).normalized();
+  return u(rng) * RandomStateVector(rng, 1.0).normalized();
 }
 
 FilterState RandomState(std::mt19937& rng) {
   FilterState x;
-  x.R_world_imu = so3::Exp(RandomRotationVector(rng, M_PI));
-  x.p_world_imu = RandomVector(rng, 50.0);
-  x.v_world_imu = RandomVector(rng, 5.0);
-  x.bg = RandomVector(rng, 0.01);
-  x.ba = RandomVector(rng, 0.1);
-  x.R_imu_lidar = so3::Exp(RandomRotationVector(rng, M_PI));
-  x.t_imu_lidar = RandomVector(rng, 0.3);
-  x.g_world = Vector3d(0, 0, -9.81) + RandomVector(rng, 0.1);
+  x.R_world_imu = so3::Exp(RandomStateRotation(rng, M_PI));
+  x.p_world_imu = RandomStateVector(rng, 50.0);
+  x.v_world_imu = RandomStateVector(rng, 5.0);
+  x.bg = RandomStateVector(rng, 0.01);
+  x.ba = RandomStateVector(rng, 0.1);
+  x.R_imu_lidar = so3::Exp(RandomStateRotation(rng, M_PI));
+  x.t_imu_lidar = RandomStateVector(rng, 0.3);
+  x.g_world = Vector3d(0, 0, -9.81) + RandomStateVector(rng, 0.1);
   return x;
 }
 
 // A tangent vector whose two rotation parts are shorter than max_angle.
 Vector24d RandomDelta(std::mt19937& rng, double max_angle) {
   Vector24d d;
-  for (int i = 0; i < S::kDim; i += 3) d.segment<3>(i) = RandomVector(rng, 2.0);
-  d.segment<3>(S::kRot) = RandomRotationVector(rng, max_angle);
-  d.segment<3>(S::kExtRot) = RandomRotationVector(rng, max_angle);
+  for (int i = 0; i < S::kDim; i += 3) d.segment<3>(i) = RandomStateVector(rng, 2.0);
+  d.segment<3>(S::kRot) = RandomStateRotation(rng, max_angle);
+  d.segment<3>(S::kExtRot) = RandomStateRotation(rng, max_angle);
   return d;
 }
 
@@ -68,7 +68,7 @@ TEST(FilterState, OffsetsTileTheTangentSpace) {
 
 TEST(FilterState, BoxminusOfBoxplusReturnsDelta) {
   std::mt19937 rng(21);
-  for (int i = 0; i < kTrials; ++i) {
+  for (int i = 0; i < kStateTrials; ++i) {
     const FilterState x = RandomState(rng);
     const Vector24d d = RandomDelta(rng, M_PI - 1e-6);
     EXPECT_LT((Boxminus(Boxplus(x, d), x) - d).cwiseAbs().maxCoeff(), 1e-9);
@@ -77,7 +77,7 @@ TEST(FilterState, BoxminusOfBoxplusReturnsDelta) {
 
 TEST(FilterState, BoxplusOfBoxminusReturnsTarget) {
   std::mt19937 rng(22);
-  for (int i = 0; i < kTrials; ++i) {
+  for (int i = 0; i < kStateTrials; ++i) {
     const FilterState x = RandomState(rng);
     const FilterState y = RandomState(rng);
     EXPECT_LT(StateDistance(Boxplus(x, Boxminus(y, x)), y), 1e-12);

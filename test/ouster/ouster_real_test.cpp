@@ -22,7 +22,7 @@
 namespace rvlio {
 namespace {
 
-std::string Data(const std::string& name) { return std::string(RVLIO_TEST_DATA) + "/ouster/" + name; }
+std::string RealCapture(const std::string& name) { return std::string(RVLIO_TEST_DATA) + "/ouster/" + name; }
 
 using testing_ouster::Decoded;
 
@@ -74,7 +74,7 @@ const Expected kCaptures[] = {
 TEST(OusterRealTest, EveryCaptureDecodesWithItsMetadata) {
   for (const Expected& e : kCaptures) {
     SCOPED_TRACE(e.pcap);
-    StatusOr<BagInfo> info = ReadBagInfo(Data(e.pcap), "", Data(e.json));
+    StatusOr<BagInfo> info = ReadBagInfo(RealCapture(e.pcap), "", RealCapture(e.json));
     ASSERT_TRUE(info.ok()) << info.status().message();
     ASSERT_TRUE(info->ouster.has_value());
     EXPECT_EQ(info->ouster->lidar_profile, e.profile);
@@ -90,9 +90,9 @@ TEST(OusterRealTest, EveryCaptureDecodesWithItsMetadata) {
     const int64_t placed = info->ouster->frames * info->ouster->window_columns - info->ouster->missing_columns;
     EXPECT_LE(placed, sent);
     EXPECT_GE(placed, sent - 16 * 2);  // a windowed capture sends its edge packets' outside columns
-    const Decoded d = ReadAll(Data(e.pcap), [&] {
+    const Decoded d = ReadAll(RealCapture(e.pcap), [&] {
       LidarOptions l = AllReturns();
-      l.ouster_metadata = Data(e.json);
+      l.ouster_metadata = RealCapture(e.json);
       return l;
     }());
     EXPECT_EQ(static_cast<int>(d.imu.size()), e.imu);
@@ -103,17 +103,17 @@ TEST(OusterRealTest, EveryCaptureDecodesWithItsMetadata) {
 TEST(OusterRealTest, MetadataIsFoundNextToTheCapture) {
   // STEM.json, STEM_0.json, and the longest NAME.json with STEM = NAME_...
   for (const char* pcap : {"crc_test.pcap", "windowed_frame1.pcap", "OS-1-128_v2.3.0_1024x10_lb_n3.pcap"}) {
-    StatusOr<BagInfo> info = ReadBagInfo(Data(pcap));
+    StatusOr<BagInfo> info = ReadBagInfo(RealCapture(pcap));
     ASSERT_TRUE(info.ok()) << pcap << ": " << info.status().message();
     ASSERT_TRUE(info->ouster.has_value());
   }
-  StatusOr<BagInfo> lb = ReadBagInfo(Data("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
+  StatusOr<BagInfo> lb = ReadBagInfo(RealCapture("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
   ASSERT_TRUE(lb.ok());
-  EXPECT_EQ(lb->ouster->metadata, Data("OS-1-128_v2.3.0_1024x10.json"));
+  EXPECT_EQ(lb->ouster->metadata, RealCapture("OS-1-128_v2.3.0_1024x10.json"));
 }
 
 TEST(OusterRealTest, LowBandwidthCaptureHasThreeCompleteFrames) {
-  StatusOr<BagInfo> info = ReadBagInfo(Data("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
+  StatusOr<BagInfo> info = ReadBagInfo(RealCapture("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
   ASSERT_TRUE(info.ok()) << info.status().message();
   const OusterRecordingInfo& o = *info->ouster;
   EXPECT_EQ(o.prod_line, "OS-1-128");
@@ -128,7 +128,7 @@ TEST(OusterRealTest, LowBandwidthCaptureHasThreeCompleteFrames) {
 }
 
 TEST(OusterRealTest, ColumnTimesIncreaseAtTheModeRate) {
-  const Decoded d = ReadAll(Data("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
+  const Decoded d = ReadAll(RealCapture("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
   ASSERT_EQ(d.scans.size(), 3u);
   for (const Scan& scan : d.scans) {
     const std::vector<TimeNs> t = ColumnTimes(scan);
@@ -151,7 +151,7 @@ TEST(OusterRealTest, ColumnTimesIncreaseAtTheModeRate) {
 // capture it is about 23 deg from the ground normal (the rig stands on a
 // slope or accelerates), so the ground cannot check the IMU axes here.
 TEST(OusterRealTest, GroundPlaneBelowTheSensor) {
-  const Decoded d = ReadAll(Data("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
+  const Decoded d = ReadAll(RealCapture("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
   ASSERT_EQ(d.scans.size(), 3u);
   std::vector<Eigen::Vector3d> ground;
   for (const LidarPoint& p : d.scans[0].points) {
@@ -184,7 +184,7 @@ TEST(OusterRealTest, GroundPlaneBelowTheSensor) {
 }
 
 TEST(OusterRealTest, RangesWithinTheSensorsLimits) {
-  const Decoded d = ReadAll(Data("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
+  const Decoded d = ReadAll(RealCapture("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
   ASSERT_EQ(d.scans.size(), 3u);
   for (const Scan& scan : d.scans) {
     ASSERT_GT(scan.points.size(), 50000u);
@@ -199,7 +199,7 @@ TEST(OusterRealTest, RangesWithinTheSensorsLimits) {
 }
 
 TEST(OusterRealTest, ImuIsGravityAndASlowTurn) {
-  const Decoded d = ReadAll(Data("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
+  const Decoded d = ReadAll(RealCapture("OS-1-128_v2.3.0_1024x10_lb_n3.pcap"));
   ASSERT_EQ(d.imu.size(), 30u);
   double acc = 0.0, gyro_max_deg = 0.0;
   for (const ImuSample& s : d.imu) {
@@ -220,7 +220,7 @@ TEST(OusterRealTest, ImuIsGravityAndASlowTurn) {
 // accel_fsr EXTENDED) and every gyroscope value a whole number of the
 // +-2000 deg/s range's step in rad/s: the units decoding assumes.
 TEST(OusterRealTest, ImuOnlyCaptureOfFirmware32) {
-  const Decoded d = ReadAll(Data("imu_zm_no_lidar.pcap"));
+  const Decoded d = ReadAll(RealCapture("imu_zm_no_lidar.pcap"));
   EXPECT_TRUE(d.scans.empty());
   ASSERT_EQ(d.imu.size(), 64u);
   EXPECT_NE(std::find_if(d.warnings.begin(), d.warnings.end(),
@@ -245,7 +245,7 @@ TEST(OusterRealTest, ImuOnlyCaptureOfFirmware32) {
   EXPECT_NEAR(acc / d.imu.size(), 9.81, 0.15 * 9.81);
   for (size_t i = 1; i < d.imu.size(); ++i)
     EXPECT_NEAR((d.imu[i].t_ns - d.imu[i - 1].t_ns) * 1e-6, 1.5625, 0.05);  // 640 Hz, increasing
-  StatusOr<BagInfo> info = ReadBagInfo(Data("imu_zm_no_lidar.pcap"));
+  StatusOr<BagInfo> info = ReadBagInfo(RealCapture("imu_zm_no_lidar.pcap"));
   ASSERT_TRUE(info.ok()) << info.status().message();
   ASSERT_TRUE(info->ouster.has_value());
   EXPECT_EQ(info->ouster->lidar_packets, 0);
@@ -254,7 +254,7 @@ TEST(OusterRealTest, ImuOnlyCaptureOfFirmware32) {
 }
 
 TEST(OusterRealTest, Ros1PacketBagDecodesToOneFrameOf512Columns) {
-  StatusOr<BagInfo> info = ReadBagInfo(Data("512x10_raw.bag"));
+  StatusOr<BagInfo> info = ReadBagInfo(RealCapture("512x10_raw.bag"));
   ASSERT_TRUE(info.ok()) << info.status().message();
   ASSERT_TRUE(info->ouster.has_value());
   EXPECT_EQ(info->ouster->metadata, "topic /os_node0/metadata");
@@ -263,7 +263,7 @@ TEST(OusterRealTest, Ros1PacketBagDecodesToOneFrameOf512Columns) {
   EXPECT_EQ(info->ouster->imu_packets, 10);
   EXPECT_EQ(info->ouster->frames, 1);
   EXPECT_EQ(info->ouster->missing_columns, 0);
-  const Decoded d = ReadAll(Data("512x10_raw.bag"));
+  const Decoded d = ReadAll(RealCapture("512x10_raw.bag"));
   ASSERT_EQ(d.scans.size(), 1u);
   EXPECT_EQ(ColumnTimes(d.scans[0]).size() <= 512u, true);
   EXPECT_GT(ColumnTimes(d.scans[0]).size(), 450u);

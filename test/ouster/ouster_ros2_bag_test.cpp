@@ -25,9 +25,9 @@
 namespace rvlio {
 namespace {
 
-std::string Data(const std::string& name) { return std::string(RVLIO_TEST_DATA) + "/ouster/" + name; }
+std::string BagCapture(const std::string& name) { return std::string(RVLIO_TEST_DATA) + "/ouster/" + name; }
 
-std::string ReadText(const std::string& path) {
+std::string ReadWholeText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
@@ -63,7 +63,7 @@ int WritePacketBag(const std::string& pcap_path, const std::string& json_path,
     m.log_time_ns = m.publish_time_ns = static_cast<uint64_t>(d.t_ns);
     if (sequence == 0) {  // the driver latches the metadata before the packets
       cdr::Writer text;
-      text.String(ReadText(json_path));
+      text.String(ReadWholeText(json_path));
       m.channel_id = meta;
       m.sequence = sequence++;
       m.data = text.Take();
@@ -80,7 +80,7 @@ int WritePacketBag(const std::string& pcap_path, const std::string& json_path,
   return packets;
 }
 
-LidarOptions AllReturns(const std::string& metadata = "") {
+LidarOptions AllBagReturns(const std::string& metadata = "") {
   LidarOptions lidar;
   lidar.min_range = 0.0;
   lidar.max_range = 1e6;
@@ -91,13 +91,13 @@ LidarOptions AllReturns(const std::string& metadata = "") {
 TEST(OusterRos2Bag, ReadsAsTheCaptureItWasMadeFrom) {
   const std::string dir = testing_cli::MakeTempDir("rvlio_ouster_ros2");
   ASSERT_FALSE(dir.empty());
-  const std::string pcap = Data("OS-1-128_v2.3.0_1024x10_lb_n3.pcap");
-  const std::string json = Data("OS-1-128_v2.3.0_1024x10.json");
+  const std::string pcap = BagCapture("OS-1-128_v2.3.0_1024x10_lb_n3.pcap");
+  const std::string json = BagCapture("OS-1-128_v2.3.0_1024x10.json");
   const std::string bag = dir + "/packets.mcap";
   EXPECT_EQ(WritePacketBag(pcap, json, bag), 192 + 30);  // 3 frames x 64 lidar packets, 30 IMU
 
-  const testing_ouster::Decoded from_pcap = testing_ouster::ReadAll(pcap, AllReturns(json), ImuOptions());
-  const testing_ouster::Decoded from_bag = testing_ouster::ReadAll(bag, AllReturns(), ImuOptions());
+  const testing_ouster::Decoded from_pcap = testing_ouster::ReadAll(pcap, AllBagReturns(json), ImuOptions());
+  const testing_ouster::Decoded from_bag = testing_ouster::ReadAll(bag, AllBagReturns(), ImuOptions());
   ASSERT_EQ(from_bag.scans.size(), from_pcap.scans.size());
   ASSERT_EQ(from_pcap.scans.size(), 3u);
   for (size_t i = 0; i < from_pcap.scans.size(); ++i) {

@@ -24,7 +24,7 @@
 namespace rvlio {
 namespace {
 
-std::string Data(const std::string& name) {
+std::string PairCapture(const std::string& name) {
   return std::string(RVLIO_TEST_DATA) + "/small_gicp_pair/" + name;
 }
 
@@ -121,11 +121,11 @@ Alignment Align(const std::vector<Eigen::Vector3d>& source, const VoxelMap& targ
 class RealScanPairTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    source_ = new std::vector<Eigen::Vector3d>(Downsampled(ReadPly(Data("source.ply"))));
+    source_ = new std::vector<Eigen::Vector3d>(Downsampled(ReadPly(PairCapture("source.ply"))));
     MapOptions map_options;
     map_options.voxel_size = 0.5;
     target_ = new VoxelMap(map_options);
-    target_->Insert(ReadPly(Data("target.ply")));
+    target_->Insert(ReadPly(PairCapture("target.ply")));
   }
   static void TearDownTestSuite() {
     delete source_;
@@ -139,7 +139,7 @@ VoxelMap* RealScanPairTest::target_ = nullptr;
 
 TEST_F(RealScanPairTest, PointToPlaneAgreesWithSmallGicp) {
   ASSERT_GT(source_->size(), 5000u);
-  const Pose3 peer = ReadTransform(Data("T_target_source.txt"));
+  const Pose3 peer = ReadTransform(PairCapture("T_target_source.txt"));
   const Alignment a = Align(*source_, *target_, 0.0);
   EXPECT_GT(a.constraints, 3000);
   const double dt_m = (a.T_target_source.t - peer.t).norm();
@@ -151,7 +151,7 @@ TEST_F(RealScanPairTest, PointToPlaneAgreesWithSmallGicp) {
 }
 
 TEST_F(RealScanPairTest, AWrongPlaneModelFails) {
-  const Pose3 peer = ReadTransform(Data("T_target_source.txt"));
+  const Pose3 peer = ReadTransform(PairCapture("T_target_source.txt"));
   const Alignment a = Align(*source_, *target_, 0.10);
   const double dt_m = (a.T_target_source.t - peer.t).norm();
   const double dr_deg = so3::Log(peer.R.transpose() * a.T_target_source.R).norm() * 180.0 / M_PI;

@@ -16,7 +16,7 @@ namespace {
 
 constexpr TimeNs kT0 = 1700000000LL * kNsPerSecond;
 
-FlightTrajectory Make(const SimOptions& o, uint64_t seed = 1) {
+FlightTrajectory MakeFlight(const SimOptions& o, uint64_t seed = 1) {
   return FlightTrajectory(*ParseWaypoints(o.trajectory.waypoints), o.trajectory, o.imu.gravity, kT0,
                           seed);
 }
@@ -45,7 +45,7 @@ TEST(Waypoints, ParseAcceptsSpacesAndRejectsBadItems) {
 // The paper's waypoints: reached in order, at rest, with level attitude.
 TEST(Trajectory, TunnelFlightPassesThroughThePaperWaypoints) {
   const SimOptions o = *PresetOptions("tunnel");
-  const FlightTrajectory traj = Make(o);
+  const FlightTrajectory traj = MakeFlight(o);
   const std::vector<Eigen::Vector3d> paper = {
       {0, 0, 0}, {0, 0, 2.5}, {30, 0, 2.5}, {30, 0, 4.5}, {50, 0, 4.5}};
   ASSERT_EQ(traj.waypoints().size(), paper.size());
@@ -68,7 +68,7 @@ TEST(Trajectory, TunnelFlightPassesThroughThePaperWaypoints) {
 
 TEST(Trajectory, StartsAtTheOriginAtRestForTheStaticPhase) {
   const SimOptions o = *PresetOptions("tunnel");
-  const FlightTrajectory traj = Make(o);
+  const FlightTrajectory traj = MakeFlight(o);
   for (double tau = 0.0; tau <= o.trajectory.static_duration; tau += 0.05) {
     const TruthState s = traj.At(At(tau));
     EXPECT_LT(s.T_world_imu.t.norm(), 1e-12);
@@ -85,7 +85,7 @@ TEST(Trajectory, AnalyticDerivativesMatchFiniteDifferences) {
   for (const char* preset : {"tunnel", "hall", "loopback"}) {
     SimOptions o = *PresetOptions(preset);
     o.trajectory.yaw_amplitude = 0.3;
-    const FlightTrajectory traj = Make(o);
+    const FlightTrajectory traj = MakeFlight(o);
     Rng rng(9);
     for (int i = 0; i < 300; ++i) {
       const double tau = rng.Uniform(0.0, traj.MotionEnd() + 1.0);
@@ -115,10 +115,10 @@ TEST(Trajectory, AnalyticDerivativesMatchFiniteDifferences) {
 // about each body axis, and 0 leaves the attitude exactly as without it.
 TEST(Trajectory, SwayRotatesAboutAllAxesWithConsistentAngularRate) {
   SimOptions o = *PresetOptions("tunnel");
-  const FlightTrajectory plain = Make(o);
+  const FlightTrajectory plain = MakeFlight(o);
   o.trajectory.sway_amplitude = 0.05;
   o.trajectory.sway_frequency = 0.8;
-  const FlightTrajectory traj = Make(o);
+  const FlightTrajectory traj = MakeFlight(o);
   Rng rng(4);
   Eigen::Vector3d max_sway = Eigen::Vector3d::Zero();
   for (int i = 0; i < 300; ++i) {
@@ -143,7 +143,7 @@ TEST(Trajectory, SwayRotatesAboutAllAxesWithConsistentAngularRate) {
 // shocks reach a few m/s^2 and tilt the vehicle.
 TEST(Trajectory, AccelerationIsContinuousAndShocksAreAFewMetresPerSecondSquared) {
   const SimOptions o = *PresetOptions("tunnel");
-  const FlightTrajectory traj = Make(o);
+  const FlightTrajectory traj = MakeFlight(o);
   double max_acc = 0.0, max_step = 0.0, max_tilt = 0.0, max_rate = 0.0;
   TruthState prev = traj.At(At(0.0));
   const double dt = 0.001;
@@ -167,7 +167,7 @@ TEST(Trajectory, AccelerationIsContinuousAndShocksAreAFewMetresPerSecondSquared)
 
 TEST(Trajectory, YawMotionIsSmallAndSeeded) {
   const SimOptions o = *PresetOptions("tunnel");
-  const FlightTrajectory a = Make(o, 1), b = Make(o, 1), c = Make(o, 2);
+  const FlightTrajectory a = MakeFlight(o, 1), b = MakeFlight(o, 1), c = MakeFlight(o, 2);
   double max_yaw = 0.0, diff = 0.0;
   for (double tau = 0.0; tau < 50.0; tau += 0.1) {
     double ya, ra, yb, rb, yc, rc;
@@ -185,7 +185,7 @@ TEST(Trajectory, YawMotionIsSmallAndSeeded) {
 
 TEST(Trajectory, LoopbackReturnsToTheStartPose) {
   const SimOptions o = *PresetOptions("loopback");
-  const FlightTrajectory traj = Make(o);
+  const FlightTrajectory traj = MakeFlight(o);
   const TruthState end = traj.At(At(o.duration));
   EXPECT_LT(end.T_world_imu.t.norm(), 1e-9);
   double farthest = 0.0;
@@ -198,7 +198,7 @@ TEST(Trajectory, LoopbackReturnsToTheStartPose) {
 TEST(Trajectory, ShortSegmentsStayBetweenTheirWaypoints) {
   SimOptions o = *PresetOptions("tunnel");
   o.trajectory.waypoints = "0,0,0; 0,0,0.2; 0.3,0,0.2";
-  const FlightTrajectory traj = Make(o);
+  const FlightTrajectory traj = MakeFlight(o);
   for (double tau = 0; tau < traj.MotionEnd() + 1; tau += 0.01) {
     const Eigen::Vector3d p = traj.At(At(tau)).T_world_imu.t;
     EXPECT_GE(p.z(), -1e-12);
