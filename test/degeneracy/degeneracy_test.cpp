@@ -265,7 +265,7 @@ TEST(Degeneracy, HoldingSolveIsTheConstrainedMinimiser) {
   EXPECT_LT((SolveHoldingDirections(DegeneracyTreatment(), A, b) + A.ldlt().solve(b)).norm(), 1e-12);
 }
 
-TEST(Degeneracy, RvRunsOnlyAsTheSelectedMethodAndOtherBackendsRefuseTheRest) {
+TEST(Degeneracy, RvRunsOnlyAsTheSelectedMethod) {
   DegeneracyOptions d;
   RvOptions rv;
   EXPECT_TRUE(EffectiveRvOptions(rv, d).enabled);
@@ -277,12 +277,43 @@ TEST(Degeneracy, RvRunsOnlyAsTheSelectedMethodAndOtherBackendsRefuseTheRest) {
     d.method = m;
     EXPECT_FALSE(EffectiveRvOptions(rv, d).enabled) << EnumName(m);
   }
-  EXPECT_TRUE(DegeneracyDefinedIn(DegeneracyMethod::kRv, "smoother").ok());
-  EXPECT_TRUE(DegeneracyDefinedIn(DegeneracyMethod::kNone, "refine").ok());
-  const Status s = DegeneracyDefinedIn(DegeneracyMethod::kRegularized, "refine");
-  EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
-  EXPECT_NE(s.message().find("degeneracy.method=regularized is not defined for refine"),
-            std::string::npos);
+}
+
+// The smoother's and refine's form (a prior at an anchor): S^T S is the
+// hold information along the held directions (remap, localizability), the
+// IESKF's damping (regularized), nothing for rv and none; and the scan's
+// pose information is the sum the IESKF builds.
+TEST(Degeneracy, PriorOfTheLeastSquaresBackendsActsAlongTheTreatedDirectionsOnly) {
+  const Scene s = Corridor();
+  EXPECT_LT((ScanPoseInformation(s.constraints, Pose3(), Pose3()) - PoseInformation(s.constraints))
+                .norm(),
+            1e-9 * PoseInformation(s.constraints).norm());
+  for (DegeneracyMethod m : {DegeneracyMethod::kRv, DegeneracyMethod::kNone, DegeneracyMethod::kRemap,
+                             DegeneracyMethod::kLocalizability, DegeneracyMethod::kRegularized}) {
+    SCOPED_TRACE(EnumName(m));
+    DegeneracyOptions o;
+    o.method = m;
+    const DegeneracyTreatment t = Analyze(m, s);
+    bool has_prior = true;
+    const PoseMatrix6d S = DegeneracyPriorSqrtInformation(o, t, &has_prior);
+    const PoseMatrix6d W = S.transpose() * S;
+    if (m == DegeneracyMethod::kRv || m == DegeneracyMethod::kNone) {
+      EXPECT_FALSE(has_prior);
+      EXPECT_TRUE(W.isZero());
+      continue;
+    }
+    ASSERT_TRUE(has_prior);
+    if (m == DegeneracyMethod::kRegularized) {
+      EXPECT_LT((W - t.damping).norm(), 1e-9 * t.damping.norm());
+    } else {
+      const Eigen::MatrixXd V = t.held_pose.leftCols(t.num_held);
+      EXPECT_LT((W - o.hold_information * V * V.transpose()).norm(), 1e-6 * o.hold_information);
+    }
+    // Along the corridor's axis (pose index 3) and nowhere in the
+    // well-constrained translations.
+    EXPECT_GT(W(3, 3), 0.0);
+    EXPECT_LT(std::abs(W(4, 4)) + std::abs(W(5, 5)), 1e-9 * W(3, 3));
+  }
 }
 
 }  // namespace
