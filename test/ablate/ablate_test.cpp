@@ -167,15 +167,15 @@ TEST_F(AblatePlanTest, ShippedGridsPlanWithTheDocumentedCellCounts) {
            {"rv_ablation.yaml", 36},
            {"rv_defaults.yaml", 217},
            {"rv_gain.yaml", 115},
-           {"degeneracy.yaml", 42}}) {
+           {"degeneracy.yaml", 60}}) {
     const json plan = PlanJson(grids + name);
     ASSERT_TRUE(plan.is_object()) << name;
     EXPECT_EQ(plan["cells"].size(), cells) << name;
   }
 }
 
-// The degeneracy comparison: every method on the IESKF, rv and none on the
-// smoother, each on every preset and seed, with the method and backend set.
+// The degeneracy comparison: every method on the IESKF and on the smoother,
+// each on every preset and seed, with the method and backend set.
 TEST_F(AblatePlanTest, DegeneracyGridHasEveryMethodOnEveryPresetAndSeed) {
   const json plan = PlanJson(std::string(RVLIO_SOURCE_DIR) + "/config/grids/degeneracy.yaml");
   ASSERT_TRUE(plan.is_object());
@@ -196,7 +196,9 @@ TEST_F(AblatePlanTest, DegeneracyGridHasEveryMethodOnEveryPresetAndSeed) {
   std::set<std::string> expected;
   for (const char* preset : {"tunnel", "corridor", "featureless"})
     for (const char* variant : {"ieskf_none", "ieskf_rv", "ieskf_remap", "ieskf_localizability",
-                                "ieskf_regularized", "smoother_none", "smoother_rv"})
+                                "ieskf_regularized", "smoother_none", "smoother_rv",
+                                "smoother_remap", "smoother_localizability",
+                                "smoother_regularized"})
       for (const char* seed : {"1", "2"})
         expected.insert(std::string(preset) + "/" + variant + "/" + seed);
   EXPECT_EQ(cells, expected);
