@@ -12,12 +12,12 @@
 //   Room: a closed box. No method finds a weak direction: the result equals
 //   the untreated one.
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "rvlio/smoother/window.h"
+#include "../degeneracy/degeneracy_scenes.h"
 #include "smoother_test_util.h"
 
 namespace rvlio {
@@ -25,43 +25,31 @@ namespace {
 
 using Eigen::Vector3d;
 
+// The planes' points and normals of a constructed scene
+// (test/degeneracy/degeneracy_scenes.h).
 struct World {
-  std::vector<Vector3d> q_world, n_world;  // points on the planes, unit normals
-  void Add(const Vector3d& q, const Vector3d& n) {
-    q_world.push_back(q);
-    n_world.push_back(n.normalized());
-  }
+  std::vector<Vector3d> q_world, n_world;
 };
 
-World Corridor() {
+World FromScene(const test::Scene& scene) {
   World w;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> x(-6, 6), yz(-3, 3);
-  for (int i = 0; i < 200; ++i) {
-    w.Add({x(rng), 3.0, yz(rng)}, {0, -1, 0});
-    w.Add({x(rng), -3.0, yz(rng)}, {0, 1, 0});
-    w.Add({x(rng), yz(rng), 3.0}, {0, 0, -1});
-    w.Add({x(rng), yz(rng), -3.0}, {0, 0, 1});
+  for (const Constraint& c : scene.constraints) {
+    w.q_world.push_back(c.q_world);
+    w.n_world.push_back(c.normal_world);
   }
-  // A symmetric grid: no coupling of the x translation with the rotations.
-  for (double y : {-2.0, -1.0, 0.0, 1.0, 2.0})
-    for (double z : {-1.5, -0.5, 0.5, 1.5}) w.Add({8.0, y, z}, {-1, 0, 0});
   return w;
 }
 
-World Room() {
-  World w;
-  std::mt19937 rng(8);
-  std::uniform_real_distribution<double> x(-5, 5), y(-4, 4), z(-3, 3);
-  for (int i = 0; i < 150; ++i) {
-    for (double s : {-1.0, 1.0}) {
-      w.Add({s * 5.0, y(rng), z(rng)}, {-s, 0, 0});
-      w.Add({x(rng), s * 4.0, z(rng)}, {0, -s, 0});
-      w.Add({x(rng), y(rng), s * 3.0}, {0, 0, -s});
-    }
-  }
-  return w;
+// The corridor and a small end wall x = 8 on a symmetric grid: weak but not
+// null along x, and no coupling of x with the rotations.
+World Corridor() {
+  test::Scene scene = test::Corridor();
+  for (double y : {-2.0, -1.0, 0.0, 1.0, 2.0})
+    for (double z : {-1.5, -0.5, 0.5, 1.5}) test::AddPoint({8.0, y, z}, {-1, 0, 0}, &scene.constraints);
+  return FromScene(scene);
 }
+
+World Room() { return FromScene(test::Room()); }
 
 // The world's points in the LiDAR (= IMU) frame of a pose.
 std::vector<Vector3d> Observe(const World& w, const Pose3& T_world_imu) {
