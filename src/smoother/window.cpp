@@ -348,8 +348,8 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
 }
 
 // remap, localizability, regularized: the scan's pose information at the
-// pose of this association (after RV and the Huber weights, the weights the
-// plane factor uses) -> the method's weak directions (AnalyzeDegeneracy, as
+// pose of this association (with the Huber weights the plane factor uses;
+// RV is off for these methods) -> the method's weak directions (AnalyzeDegeneracy, as
 // in the IESKF) -> a prior at the node's anchor along them (sigma: the
 // plane factor's lidar_noise, so the prior is in the scan's units).
 void SlidingWindow::TreatDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar,
