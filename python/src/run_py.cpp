@@ -142,6 +142,7 @@ py::dict RoundDict(const RefineRound& r) {
   d["max_rotation_change_deg"] = r.max_rotation_change_deg;
   d["constraints"] = r.constraints;
   d["rv_active_scans"] = r.rv_active_scans;
+  d["degenerate_scans"] = r.degenerate_scans;  // by degeneracy.method (rv: RV active)
   d["total_s"] = r.total_s;
   return d;
 }

@@ -78,6 +78,9 @@ def test_refine_gives_the_cli_trajectory(rvlio_bin, tunnel, cli_run, py_run, tmp
     refined = rvlio.refine(tunnel["bag"], cli_run / "trajectory.tum", config, out=out)
     assert refined.written and len(refined.rounds) >= 1
     assert filecmp.cmp(out / "trajectory.tum", cli_out / "trajectory.tum", shallow=False)
+    cli_rounds = json.loads((cli_out / "summary.json").read_text())["rounds"]
+    assert [r["degenerate_scans"] for r in refined.rounds] == \
+        [r["degenerate_scans"] for r in cli_rounds]
     from_run = rvlio.refine(tunnel["bag"], run_result, config)
     assert not from_run.written
     # From the exact run trajectory, not its 9-decimal file: the same to well below a micrometre.

@@ -141,6 +141,8 @@ void AnalyzeRegularized(const DegeneracyOptions& o, const PoseMatrix6d& H, Degen
       if (!(lambda < floor)) continue;
       const Eigen::Vector3d v = eig.eigenvectors().col(k);
       t->damping.block<3, 3>(offset, offset) += (floor - lambda) * v * v.transpose();
+      t->damped_pose.block<3, 1>(offset, r.num_damped) = v;
+      t->damped_amount(r.num_damped) = floor - lambda;
       r.max_damping = std::max(r.max_damping, floor - lambda);
       ++r.num_damped;
       if (offset == kTrans) r.weak_dirs_world[r.num_weak++] = v;
@@ -196,6 +198,39 @@ DegeneracyReport DegeneracyReportFromRv(DegeneracyMethod method, const RvReport&
   r.num_weak = 1;
   r.weak_dirs_world[0] = rv.n_alpha;
   return r;
+}
+
+PoseMatrix6d ScanPoseInformation(const ConstraintList& constraints, const Pose3& T_world_imu,
+                                 const Pose3& T_imu_lidar) {
+  PoseMatrix6d H = PoseMatrix6d::Zero();
+  Eigen::Matrix<double, 1, 6> h;
+  for (const Constraint& c : constraints) {
+    PointToPlaneResidual(c, T_world_imu, T_imu_lidar, &h);
+    H.noalias() += c.weight * h.transpose() * h;
+  }
+  return H;
+}
+
+PoseMatrix6d DegeneracyPriorSqrtInformation(const DegeneracyOptions& options,
+                                            const DegeneracyTreatment& t, bool* has_prior) {
+  PoseMatrix6d S = PoseMatrix6d::Zero();
+  int rows = 0;
+  switch (options.method) {
+    case DegeneracyMethod::kRemap:
+    case DegeneracyMethod::kLocalizability:
+      for (; rows < t.num_held; ++rows)
+        S.row(rows) = std::sqrt(options.hold_information) * t.held_pose.col(rows).transpose();
+      break;
+    case DegeneracyMethod::kRegularized:
+      for (; rows < t.report.num_damped; ++rows)
+        S.row(rows) = std::sqrt(t.damped_amount(rows)) * t.damped_pose.col(rows).transpose();
+      break;
+    case DegeneracyMethod::kRv:
+    case DegeneracyMethod::kNone:
+      break;
+  }
+  if (has_prior != nullptr) *has_prior = rows > 0;
+  return S;
 }
 
 void ProjectOutHeld(const DegeneracyTreatment& t, Eigen::Ref<PoseVector6d> dx_pose) {

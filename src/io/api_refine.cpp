@@ -39,6 +39,7 @@ RefineConfig ToRefineConfig(const OdometryOptions& o,
   c.map = o.map;
   c.constraints = o.constraints;
   c.rv = EffectiveRvOptions(o.rv, o.degeneracy);
+  c.degeneracy = o.degeneracy;
   c.smoother = o.smoother;
   return c;
 }
@@ -223,6 +224,8 @@ nlohmann::json Summary(const RefineArgs& args, const RefineRunResult& r,
   j["g_world"] = {res.g_world.x(), res.g_world.y(), res.g_world.z()};
   j["rounds"] = nlohmann::json::array();
   for (const RefineRound& round : res.rounds) j["rounds"].push_back(RoundJson(round));
+  // The last round's count, by degeneracy.method (the run's summary has the same key).
+  j["degenerate_scans"] = res.rounds.empty() ? 0 : res.rounds.back().degenerate_scans;
   j["converged"] = res.converged;
   j["interrupted"] = res.stopped;
   if (res.stopped) j["signal"] = r.stop_reason;
@@ -301,7 +304,6 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   const auto t0 = Clock::now();
   RefineArgs args = in;  // an Ouster recording may supply the default extrinsic
   std::vector<std::string> notes;
-  if (Status s = DegeneracyDefinedIn(args.options.degeneracy.method, "refine"); !s.ok()) return s;
   if (Status s = ApplyRecordingExtrinsics(args.bag, args.options.lidar, &args.options.extrinsics,
                                           &notes);
       !s.ok())

@@ -41,6 +41,7 @@ RefineRound RoundFrom(const json& j) {
   r.points = j.at("points").get<int64_t>();
   r.constraints = j.at("constraints").get<int64_t>();
   r.rv_active_scans = j.at("rv_active_scans").get<int>();
+  r.degenerate_scans = j.value("degenerate_scans", 0);  // absent in older checkpoints
   r.solve_failures = j.at("solve_failures").get<int>();
   const json& t = j.at("time_s");
   r.deskew_s = t.at("deskew").get<double>();
@@ -103,6 +104,7 @@ json RoundJson(const RefineRound& r) {
           {"points", r.points},
           {"constraints", r.constraints},
           {"rv_active_scans", r.rv_active_scans},
+          {"degenerate_scans", r.degenerate_scans},
           {"solve_failures", r.solve_failures},
           {"time_s",
            {{"deskew", r.deskew_s},

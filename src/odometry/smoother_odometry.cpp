@@ -228,8 +228,11 @@ ScanStatus SmootherOdometry::UpdateWindow(TimeNs t_ns, const ImuPoseHistory& his
   r->constraints = report.newest_constraints;
   r->iterations = report.iterations;
   r->rv = report.newest_rv;
-  r->degeneracy = DegeneracyReportFromRv(options_.degeneracy.method, report.newest_rv,
-                                         report.newest_position_information);
+  const DegeneracyMethod method = options_.degeneracy.method;
+  r->degeneracy = method == DegeneracyMethod::kRv || method == DegeneracyMethod::kNone
+                      ? DegeneracyReportFromRv(method, report.newest_rv,
+                                               report.newest_position_information)
+                      : report.newest_degeneracy;
   if (options_.smoother.map_update == "newest" || !window_filled_)
     InsertIntoWorkingMap(window_->size() - 1, p_lidar_end_);
   stats_.diverged_resets += report.failures;  // each failed round was restored

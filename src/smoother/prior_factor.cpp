@@ -43,7 +43,14 @@ bool StatePriorFactor::Evaluate(double const* const* parameters, double* residua
 PosePriorFactor::PosePriorFactor(const PoseBlock& pose0, double sigma_rot, double sigma_pos)
     : pose0_(pose0) {
   RVLIO_CHECK(sigma_rot > 0.0 && sigma_pos > 0.0);
-  inv_sigma_ << Eigen::Vector3d::Constant(1.0 / sigma_rot), Eigen::Vector3d::Constant(1.0 / sigma_pos);
+  Eigen::Matrix<double, 6, 1> inv_sigma;
+  inv_sigma << Eigen::Vector3d::Constant(1.0 / sigma_rot), Eigen::Vector3d::Constant(1.0 / sigma_pos);
+  sqrt_information_ = inv_sigma.asDiagonal();
+}
+
+PosePriorFactor::PosePriorFactor(const PoseBlock& pose0, const Matrix6d& sqrt_information)
+    : pose0_(pose0), sqrt_information_(sqrt_information) {
+  RVLIO_CHECK(sqrt_information.allFinite());
 }
 
 bool PosePriorFactor::Evaluate(double const* const* parameters, double* residuals,
@@ -51,12 +58,12 @@ bool PosePriorFactor::Evaluate(double const* const* parameters, double* residual
   const PoseBlock pose = PoseBlock::FromArray(parameters[0]);
   const PoseBlock::Tangent d_pose = Minus(pose, pose0_);
   Eigen::Map<Eigen::Matrix<double, 6, 1>> r(residuals);
-  r = inv_sigma_.cwiseProduct(d_pose);
+  r = sqrt_information_ * d_pose;
   if (jacobians == nullptr || jacobians[0] == nullptr) return true;
   Eigen::Matrix<double, 6, 6, Eigen::RowMajor> J_t = Eigen::Matrix<double, 6, 6>::Zero();
   J_t.block<3, 3>(0, PoseBlock::kRot) = so3::JrInv(d_pose.head<3>());
   J_t.block<3, 3>(3, PoseBlock::kTrans).setIdentity();
-  J_t = inv_sigma_.asDiagonal() * J_t;
+  J_t = sqrt_information_ * J_t;
   PoseTangentToAmbientJacobian(parameters[0], J_t, jacobians[0]);
   return true;
 }

@@ -60,6 +60,7 @@ class BatchRefiner {
   PoseManifold pose_manifold_;
   RefineSequence sequence_;
   std::vector<RefineState> states_;  // per refined scan
+  std::vector<PoseBlock> anchors_;   // per refined scan: its initial pose (degeneracy priors)
   RefineRoundMap round_map_;
   std::function<bool()> stop_;  // RefineHooks::stop
   RefineResult result_;
@@ -79,6 +80,8 @@ Status BatchRefiner::Initialize() {
   result_.stats.gravity_from_static = g.from_static;
   if (!g.warning.empty()) result_.warnings.push_back(g.warning);
   states_ = InitialRefineStates(sequence_, input_.init, g.bg);
+  anchors_.reserve(states_.size());
+  for (const RefineState& s : states_) anchors_.push_back(PoseBlock::FromArray(s.pose.data()));
   return Status::Ok();
 }
 
@@ -90,6 +93,7 @@ void BatchRefiner::SolveChunk(const ScanRange& chunk, int next_begin, RefineRoun
   report->points += a.points;
   report->constraints += a.constraints;
   report->rv_active_scans += a.rv_active_scans;
+  report->degenerate_scans += a.degenerate_scans;
   report->associate_s += SecondsSince(t0);
   if (StopRequested()) return;
   ReleaseAssociatedScans(chunk, next_begin, &round_map_);
@@ -99,6 +103,7 @@ void BatchRefiner::SolveChunk(const ScanRange& chunk, int next_begin, RefineRoun
   const bool hold_first_pose = chunk.begin > 0 || config_.reference == nullptr;
   BuildRefineChunkProblem(sequence_, noise_, result_.g_world, chunk, hold_first_pose, &a.factors,
                           &pose_manifold_, &states_, &problem);
+  AddRefineDegeneracyPriors(chunk, a.factors, anchors_, &states_, &problem);
   const RefineSolveReport r = SolveRefineProblem(
       &problem, solver_.Options(config_.smoother.refine_solver_iterations), chunk, stop_, &states_);
   if (!r.accepted) {
@@ -261,7 +266,7 @@ StatusOr<RefineResult> Refine(const RefineConfig& config, RefineInput input,
                               const RefineHooks& hooks) {
   RefineConfig checked = config;
   for (Status s : {checked.imu.Validate(), checked.map.Validate(), checked.constraints.Validate(),
-                   checked.rv.Validate(), checked.smoother.Validate()})
+                   checked.rv.Validate(), checked.degeneracy.Validate(), checked.smoother.Validate()})
     if (!s.ok()) return s;
   BatchRefiner refiner(config, std::move(input));
   return refiner.Run(hooks);

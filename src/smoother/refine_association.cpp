@@ -136,6 +136,31 @@ void AddReferencePlanes(const RefineConfig& config, const std::vector<Eigen::Vec
   w->fixed.insert(w->fixed.end(), w->reference.begin(), w->reference.end());
 }
 
+// remap, localizability, regularized: the scan's weak directions at its
+// current estimate (the weights of its plane factors) and the prior along
+// them (degeneracy/degeneracy.h).
+void TreatRefineDegeneracy(const RefineConfig& config, const Pose3& T_world_imu,
+                           RefineAssociationWorkspace* w, ScanFactors* f) {
+  f->degeneracy.method = config.degeneracy.method;
+  if (config.degeneracy.method == DegeneracyMethod::kRv ||
+      config.degeneracy.method == DegeneracyMethod::kNone)
+    return;
+  const ConstraintList* all = &w->list;
+  if (config.reference != nullptr) {
+    w->all = w->list;
+    w->all.insert(w->all.end(), w->reference.begin(), w->reference.end());
+    all = &w->all;
+  }
+  if (static_cast<int>(all->size()) < kMinPoseConstraints) return;
+  const DegeneracyTreatment t = AnalyzeDegeneracy(
+      config.degeneracy, ScanPoseInformation(*all, T_world_imu, config.T_imu_lidar), *all,
+      T_world_imu, config.T_imu_lidar);
+  f->degeneracy = t.report;
+  f->degeneracy_sqrt_information =
+      DegeneracyPriorSqrtInformation(config.degeneracy, t, &f->has_degeneracy_prior) /
+      config.constraints.lidar_noise;
+}
+
 }  // namespace
 
 ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap& round,
@@ -156,9 +181,12 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
                          states, round.map_poses, &w->fixed, &w->attached);
   }
   AddReferencePlanes(config, round.p_lidar_end[k], T_world_lidar, w);
-  if (w->fixed.empty() && w->attached.empty()) return ScanFactors();
-  return MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise,
-                         config.smoother.refine_summarize_pairs, states[k].T_world_imu().t);
+  ScanFactors f;
+  if (!w->fixed.empty() || !w->attached.empty())
+    f = MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise,
+                        config.smoother.refine_summarize_pairs, states[k].T_world_imu().t);
+  TreatRefineDegeneracy(config, states[k].T_world_imu(), w, &f);
+  return f;
 }
 
 ChunkAssociation AssociateRefineChunk(const RefineConfig& config, const RefineRoundMap& round,
@@ -182,6 +210,9 @@ ChunkAssociation AssociateRefineChunk(const RefineConfig& config, const RefineRo
     out.points += stats[i].num_points;
     out.constraints += stats[i].num_accepted;
     out.rv_active_scans += active[i];
+    out.degenerate_scans += config.degeneracy.method == DegeneracyMethod::kRv
+                                ? active[i]
+                                : (out.factors[i].degeneracy.degenerate ? 1 : 0);
   }
   return out;
 }

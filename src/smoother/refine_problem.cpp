@@ -8,6 +8,7 @@
 
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/smoother/imu_factor.h"
+#include "rvlio/smoother/prior_factor.h"
 
 namespace rvlio {
 namespace {
@@ -76,6 +77,17 @@ void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noi
   AddRefineImuFactors(sequence, noise, g_world, chunk, states, problem);
   if (hold_first_pose)  // gauge / previous chunk
     problem->SetParameterBlockConstant((*states)[chunk.begin].pose.data());
+}
+
+void AddRefineDegeneracyPriors(const ScanRange& chunk, const std::vector<ScanFactors>& factors,
+                               const std::vector<PoseBlock>& anchors,
+                               std::vector<RefineState>* states, ceres::Problem* problem) {
+  for (int k = chunk.begin; k < chunk.end; ++k) {
+    const ScanFactors& f = factors[k - chunk.begin];
+    if (!f.has_degeneracy_prior) continue;
+    problem->AddResidualBlock(new PosePriorFactor(anchors[k], f.degeneracy_sqrt_information),
+                              nullptr, (*states)[k].pose.data());
+  }
 }
 
 RefineSolver RefineSolver::Make(int threads) {

@@ -38,6 +38,9 @@ struct SlidingWindow::Node {
   double td_lin_s = 0.0;   // the time offset the scan was deskewed with
   std::unique_ptr<ImuFactor> imu;                    // from the previous node, or null
   std::unique_ptr<SpeedBiasContinuityFactor> gap;    // from the previous node when imu is null
+  PoseBlock anchor;  // the initial value (IMU prediction): where a degeneracy prior holds the pose
+  DegeneracyReport degeneracy;                          // of the last association
+  std::unique_ptr<PosePriorFactor> degeneracy_prior;   // null: no weak direction treated
 
   Pose3 T_world_imu() const { return PoseBlock::FromArray(pose).ToPose3(); }
 };
@@ -185,6 +188,7 @@ std::unique_ptr<SlidingWindow::Node> SlidingWindow::MakeNode(
   auto node = std::make_unique<Node>();
   node->t_ns = t_ns;
   pose.ToArray(node->pose);
+  node->anchor = pose;
   speed_bias.ToArray(node->sb);
   node->p_lidar = std::move(p_lidar);
   return node;
@@ -278,6 +282,7 @@ WindowSolveReport SlidingWindow::Optimize(const ScanAssociateFn& associate) {
   }
   report.newest_constraints = static_cast<int>(nodes_.back()->constraints.size());
   report.newest_rv = nodes_.back()->rv;
+  report.newest_degeneracy = nodes_.back()->degeneracy;
   report.newest_position_information = PositionInformation(nodes_.back()->constraints);
   return report;
 }
@@ -321,7 +326,11 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   node->plane.reset();
   node->plane_ext.reset();
   node->plane_td.reset();
+  node->degeneracy_prior.reset();
+  node->degeneracy = DegeneracyReport();
+  node->degeneracy.method = options_.degeneracy.method;
   if (static_cast<int>(node->constraints.size()) < kMinPoseConstraints) return;
+  TreatDegeneracy(T_world_imu, T_imu_lidar, node);
   if (estimate_time_offset()) {
     node->plane_td = std::make_unique<PlaneTimeOffsetFactor>(
         node->constraints, options_.constraints.lidar_noise, T_imu_lidar_config_, node->motion,
@@ -338,11 +347,34 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   if (!node->plane->information().allFinite()) RejectOverflowingScan(node);
 }
 
+// remap, localizability, regularized: the scan's pose information at the
+// pose of this association (with the Huber weights the plane factor uses;
+// RV is off for these methods) -> the method's weak directions (AnalyzeDegeneracy, as
+// in the IESKF) -> a prior at the node's anchor along them (sigma: the
+// plane factor's lidar_noise, so the prior is in the scan's units).
+void SlidingWindow::TreatDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar,
+                                    Node* node) const {
+  const DegeneracyMethod method = options_.degeneracy.method;
+  if (method == DegeneracyMethod::kRv || method == DegeneracyMethod::kNone) return;
+  const DegeneracyTreatment t = AnalyzeDegeneracy(
+      options_.degeneracy, ScanPoseInformation(node->constraints, T_world_imu, T_imu_lidar),
+      node->constraints, T_world_imu, T_imu_lidar);
+  node->degeneracy = t.report;
+  bool has_prior = false;
+  const PoseMatrix6d S = DegeneracyPriorSqrtInformation(options_.degeneracy, t, &has_prior);
+  if (has_prior)
+    node->degeneracy_prior = std::make_unique<PosePriorFactor>(
+        node->anchor, S / options_.constraints.lidar_noise);
+}
+
 // Finite but absurd records (a plane 1e300 m away) overflow the summary:
 // such a scan contributes nothing (and is associated again next round)
 // rather than a cost Ceres cannot evaluate.
 void SlidingWindow::RejectOverflowingScan(Node* node) {
   node->plane.reset();
+  node->degeneracy_prior.reset();
+  node->degeneracy = DegeneracyReport();
+  node->degeneracy.method = options_.degeneracy.method;
   node->plane_td.reset();
   node->constraints.clear();
   node->associated = false;
@@ -389,6 +421,7 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
       problem.AddResidualBlock(n.plane_td.get(), nullptr, n.pose, n.sb, time_offset_);
       pose_used[k] = true;
     }
+    if (n.degeneracy_prior) problem.AddResidualBlock(n.degeneracy_prior.get(), nullptr, n.pose);
     if (k == 0) continue;
     Node& p = *nodes_[k - 1];
     if (n.imu) {

@@ -13,83 +13,17 @@
 
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/degeneracy/degeneracy.h"
+#include "degeneracy_scenes.h"
 
 namespace rvlio {
 namespace {
 
-struct Scene {
-  ConstraintList constraints;
-  std::vector<int> weak_pose_indices;  // [dtheta 0-2, dp 3-5] with no information
-  std::vector<Eigen::Vector3d> weak_translations;  // spanning the weak translation subspace
-};
-
-void AddPoint(const Eigen::Vector3d& p, const Eigen::Vector3d& n, ConstraintList* list) {
-  Constraint c;
-  c.p_lidar = p;
-  c.normal_world = n.normalized();
-  c.q_world = p;
-  c.residual = 0.0;
-  list->push_back(c);
-}
-
-// Walls y = +-3 and floor/ceiling z = +-3 along x in [-6, 6] (a section
-// short enough that the roll is well constrained: a long thin one leaves
-// the roll weak too, which X-ICP and the Schur test rightly report).
-Scene Corridor() {
-  Scene s;
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<double> x(-6, 6), yz(-3, 3);
-  for (int i = 0; i < 200; ++i) {
-    AddPoint({x(rng), 3.0, yz(rng)}, {0, -1, 0}, &s.constraints);
-    AddPoint({x(rng), -3.0, yz(rng)}, {0, 1, 0}, &s.constraints);
-    AddPoint({x(rng), yz(rng), 3.0}, {0, 0, -1}, &s.constraints);
-    AddPoint({x(rng), yz(rng), -3.0}, {0, 0, 1}, &s.constraints);
-  }
-  s.weak_pose_indices = {3};
-  s.weak_translations = {Eigen::Vector3d::UnitX()};
-  return s;
-}
-
-// A cylinder of radius 2 about the x axis.
-Scene Pipe() {
-  Scene s;
-  std::mt19937 rng(2);
-  std::uniform_real_distribution<double> x(-10, 10), angle(-M_PI, M_PI);
-  for (int i = 0; i < 800; ++i) {
-    const double a = angle(rng);
-    const Eigen::Vector3d n(0.0, std::cos(a), std::sin(a));
-    AddPoint(Eigen::Vector3d(x(rng), 0, 0) + 2.0 * n, -n, &s.constraints);
-  }
-  s.weak_pose_indices = {0, 3};  // rotation about and translation along the axis
-  s.weak_translations = {Eigen::Vector3d::UnitX()};
-  return s;
-}
-
-// The ground z = -1.5.
-Scene Plane() {
-  Scene s;
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> xy(-10, 10);
-  for (int i = 0; i < 800; ++i) AddPoint({xy(rng), xy(rng), -1.5}, {0, 0, 1}, &s.constraints);
-  s.weak_pose_indices = {2, 3, 4};  // yaw, x, y
-  s.weak_translations = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()};
-  return s;
-}
-
-// A closed box x = +-5, y = +-4, z = +-3.
-Scene Room() {
-  Scene s;
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> x(-5, 5), y(-4, 4), z(-3, 3);
-  for (int i = 0; i < 150; ++i) {
-    for (double sign : {-1.0, 1.0}) {
-      AddPoint({sign * 5.0, y(rng), z(rng)}, {-sign, 0, 0}, &s.constraints);
-      AddPoint({x(rng), sign * 4.0, z(rng)}, {0, -sign, 0}, &s.constraints);
-      AddPoint({x(rng), y(rng), sign * 3.0}, {0, 0, -sign}, &s.constraints);
-    }
-  }
-  return s;
-}
+using test::AddPoint;
+using test::Corridor;
+using test::Pipe;
+using test::Plane;
+using test::Room;
+using test::Scene;
 
 // sum_i h_i^T h_i of the pose columns (sigma = 1, unit weights).
 PoseMatrix6d PoseInformation(const ConstraintList& constraints) {
@@ -265,7 +199,7 @@ TEST(Degeneracy, HoldingSolveIsTheConstrainedMinimiser) {
   EXPECT_LT((SolveHoldingDirections(DegeneracyTreatment(), A, b) + A.ldlt().solve(b)).norm(), 1e-12);
 }
 
-TEST(Degeneracy, RvRunsOnlyAsTheSelectedMethodAndOtherBackendsRefuseTheRest) {
+TEST(Degeneracy, RvRunsOnlyAsTheSelectedMethod) {
   DegeneracyOptions d;
   RvOptions rv;
   EXPECT_TRUE(EffectiveRvOptions(rv, d).enabled);
@@ -277,12 +211,43 @@ TEST(Degeneracy, RvRunsOnlyAsTheSelectedMethodAndOtherBackendsRefuseTheRest) {
     d.method = m;
     EXPECT_FALSE(EffectiveRvOptions(rv, d).enabled) << EnumName(m);
   }
-  EXPECT_TRUE(DegeneracyDefinedIn(DegeneracyMethod::kRv, "smoother").ok());
-  EXPECT_TRUE(DegeneracyDefinedIn(DegeneracyMethod::kNone, "refine").ok());
-  const Status s = DegeneracyDefinedIn(DegeneracyMethod::kRegularized, "refine");
-  EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
-  EXPECT_NE(s.message().find("degeneracy.method=regularized is not defined for refine"),
-            std::string::npos);
+}
+
+// The smoother's and refine's form (a prior at an anchor): S^T S is the
+// hold information along the held directions (remap, localizability), the
+// IESKF's damping (regularized), nothing for rv and none; and the scan's
+// pose information is the sum the IESKF builds.
+TEST(Degeneracy, PriorOfTheLeastSquaresBackendsActsAlongTheTreatedDirectionsOnly) {
+  const Scene s = Corridor();
+  EXPECT_LT((ScanPoseInformation(s.constraints, Pose3(), Pose3()) - PoseInformation(s.constraints))
+                .norm(),
+            1e-9 * PoseInformation(s.constraints).norm());
+  for (DegeneracyMethod m : {DegeneracyMethod::kRv, DegeneracyMethod::kNone, DegeneracyMethod::kRemap,
+                             DegeneracyMethod::kLocalizability, DegeneracyMethod::kRegularized}) {
+    SCOPED_TRACE(EnumName(m));
+    DegeneracyOptions o;
+    o.method = m;
+    const DegeneracyTreatment t = Analyze(m, s);
+    bool has_prior = true;
+    const PoseMatrix6d S = DegeneracyPriorSqrtInformation(o, t, &has_prior);
+    const PoseMatrix6d W = S.transpose() * S;
+    if (m == DegeneracyMethod::kRv || m == DegeneracyMethod::kNone) {
+      EXPECT_FALSE(has_prior);
+      EXPECT_TRUE(W.isZero());
+      continue;
+    }
+    ASSERT_TRUE(has_prior);
+    if (m == DegeneracyMethod::kRegularized) {
+      EXPECT_LT((W - t.damping).norm(), 1e-9 * t.damping.norm());
+    } else {
+      const Eigen::MatrixXd V = t.held_pose.leftCols(t.num_held);
+      EXPECT_LT((W - o.hold_information * V * V.transpose()).norm(), 1e-6 * o.hold_information);
+    }
+    // Along the corridor's axis (pose index 3) and nowhere in the
+    // well-constrained translations.
+    EXPECT_GT(W(3, 3), 0.0);
+    EXPECT_LT(std::abs(W(4, 4)) + std::abs(W(5, 5)), 1e-9 * W(3, 3));
+  }
 }
 
 }  // namespace

@@ -275,13 +275,18 @@ TEST(RefineAssociation, ReleaseFreesTheAssociatedScansThenTheMap) {
 
 // ---- problem build and solve ----
 
+// The round's deskewed scans and map at the round's states.
+void PrepareRound(const Round& r, const RefineConfig& config, int threads, RefineRoundMap* round) {
+  DeskewRefineScans(r.sequence, r.states, test::Gravity(), config.T_imu_lidar, threads,
+                    &round->p_lidar_end);
+  BuildRefineMap(r.states, config.T_imu_lidar, round);
+}
+
 TEST(RefineProblem, ChunkProblemHoldsItsFirstPoseAndLinksEveryScan) {
   Round r = MakeRound(8);
   const RefineConfig config = Config();
   RefineRoundMap round(config.map);
-  DeskewRefineScans(r.sequence, r.states, test::Gravity(), config.T_imu_lidar, 2,
-                    &round.p_lidar_end);
-  BuildRefineMap(r.states, config.T_imu_lidar, &round);
+  PrepareRound(r, config, 2, &round);
   const ScanRange chunk{3, 8};
   ChunkAssociation a = AssociateRefineChunk(config, round, r.states, chunk, 2, nullptr);
   int plane_blocks = 0;
@@ -307,6 +312,62 @@ TEST(RefineProblem, ChunkProblemHoldsItsFirstPoseAndLinksEveryScan) {
   EXPECT_EQ(r.states[3].pose, before[3].pose);              // held
   EXPECT_EQ(r.states[2].speed_bias, before[2].speed_bias);  // outside the chunk
   EXPECT_NE(r.states[5].pose, before[5].pose);
+}
+
+// The degeneracy stage of refine: none adds no prior and calls no scan
+// degenerate; remap with its threshold above every eigenvalue holds all six
+// directions of every scan, one prior per scan, and the poses then stay at
+// their initial (anchor) values: they move by less than 5 % of what the
+// same solve without the priors moves them.
+TEST(RefineProblem, DegeneracyPriorsHoldThePosesAtTheirInitialValues) {
+  {
+    Round r = MakeRound(6);
+    RefineConfig config = Config();
+    config.degeneracy.method = DegeneracyMethod::kNone;
+    RefineRoundMap round(config.map);
+    PrepareRound(r, config, 1, &round);
+    const ChunkAssociation a = AssociateRefineChunk(config, round, r.states, {0, 6}, 1, nullptr);
+    EXPECT_EQ(a.degenerate_scans, 0);
+    for (const ScanFactors& f : a.factors) {
+      EXPECT_FALSE(f.has_degeneracy_prior);
+      EXPECT_EQ(f.degeneracy.method, DegeneracyMethod::kNone);
+    }
+  }
+  // Every direction held, and the same chunk without the priors.
+  RefineConfig config = Config();
+  config.degeneracy.method = DegeneracyMethod::kRemap;
+  config.degeneracy.remap_min_eigenvalue = 1e15;  // every direction degenerate
+  double moved[2] = {0.0, 0.0};                    // largest motion from the anchors, m
+  for (bool with_priors : {false, true}) {
+    Round r = MakeRound(6);
+    RefineRoundMap round(config.map);
+    PrepareRound(r, config, 1, &round);
+    const ScanRange chunk{0, 6};
+    ChunkAssociation a = AssociateRefineChunk(config, round, r.states, chunk, 1, nullptr);
+    EXPECT_EQ(a.degenerate_scans, 6);
+    std::vector<PoseBlock> anchors;
+    for (const RefineState& s : r.states) anchors.push_back(PoseBlock::FromArray(s.pose.data()));
+    PoseManifold manifold;
+    ceres::Problem problem(RefineProblemOptions());
+    BuildRefineChunkProblem(r.sequence, ImuNoise::FromOptions(config.imu), test::Gravity(), chunk,
+                            /*hold_first_pose=*/true, &a.factors, &manifold, &r.states, &problem);
+    const int blocks = problem.NumResidualBlocks();
+    if (with_priors) {
+      AddRefineDegeneracyPriors(chunk, a.factors, anchors, &r.states, &problem);
+      EXPECT_EQ(problem.NumResidualBlocks(), blocks + 6);
+    }
+    const RefineSolveReport rep =
+        SolveRefineProblem(&problem, RefineSolver::Make(1).Options(10), chunk, nullptr, &r.states);
+    ASSERT_TRUE(rep.accepted) << rep.message;
+    for (int k = 1; k < 6; ++k) {
+      const PoseBlock::Tangent d = Minus(PoseBlock::FromArray(r.states[k].pose.data()), anchors[k]);
+      moved[with_priors] = std::max(moved[with_priors], d.tail<3>().norm());
+    }
+  }
+  // The priors (lidar_noise / 1000) hold against the scans; what is left is
+  // the pull of the IMU factors, stiffer here than the scans.
+  EXPECT_GT(moved[0], 0.05);
+  EXPECT_LT(moved[1], 0.05 * moved[0]);
 }
 
 // A residual whose evaluation fails: Ceres gives no usable solution.

@@ -66,7 +66,36 @@ struct DegeneracyTreatment {
   int num_held = 0;                                  // columns of held_pose used
   PoseMatrix6d held_pose = PoseMatrix6d::Zero();     // orthonormal pose directions held
   PoseMatrix6d damping = PoseMatrix6d::Zero();       // added to the pose information (sigma = 1)
+  // regularized: the damping as report.num_damped (direction, amount) pairs,
+  // damping = sum_k damped_amount(k) damped_pose.col(k) damped_pose.col(k)^T
+  // (the directions orthonormal).
+  PoseMatrix6d damped_pose = PoseMatrix6d::Zero();
+  PoseVector6d damped_amount = PoseVector6d::Zero();
 };
+
+// The pose block of sum_i w_i h_i^T h_i (sigma = 1) of a scan's constraints
+// at the given poses: the rows of the IESKF's normal equations
+// (PointToPlaneResidual), for the backends that build no normal equations of
+// their own (the smoother, refine).
+PoseMatrix6d ScanPoseInformation(const ConstraintList& constraints, const Pose3& T_world_imu,
+                                 const Pose3& T_imu_lidar);
+
+// A method's form in a nonlinear least-squares solve without an explicit
+// increment (the smoother, refine; docs/degeneracy.md "Backends"): a prior
+// on the scan's pose at an anchor (its predicted or initial value), whose
+// residual is S (pose [-] anchor) with S the returned square-root
+// information (sigma = 1, pose tangent [dtheta, dp]; rows sqrt(c_k) v_k^T,
+// the unused rows zero):
+//   remap, localizability  c_k = options.hold_information along every held
+//                          direction v_k (a stiff prior: the pose stays at
+//                          its anchor along them);
+//   regularized            c_k = the Tikhonov damping along each damped
+//                          eigenvector (the same term as in the IESKF);
+//   rv, none               zero (no prior).
+// has_prior (optional): whether any row is non-zero.
+PoseMatrix6d DegeneracyPriorSqrtInformation(const DegeneracyOptions& options,
+                                            const DegeneracyTreatment& t,
+                                            bool* has_prior = nullptr);
 
 // Analyzes one scan. pose_information: the pose block of sum_i w_i h_i^T h_i
 // (sigma = 1); constraints and the poses give the per-constraint rows for

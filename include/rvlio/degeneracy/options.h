@@ -41,6 +41,15 @@ struct DegeneracyOptions {
   // translation) eigenvalue below lambda_max / max_condition is weak; the
   // damping raises it to lambda_max / max_condition along its eigenvector.
   double regularized_max_condition = 10.0;
+  // The smoother and refine (no explicit increment): remap and
+  // localizability hold the scan's pose at its anchor (the IMU prediction in
+  // the smoother, the --init pose in refine) along the held directions by a
+  // prior of this information (sigma = 1, like the thresholds): the pose's
+  // standard deviation along a held direction is constraints.lidar_noise /
+  // sqrt(hold_information), 1/1000 of the noise with the default. Stiff
+  // against a scan's own information (sums of 1e3-1e5), not so stiff that
+  // the solver's normal equations lose precision.
+  double hold_information = 1e6;
 
   template <class V>
   void Visit(V& v) {
@@ -56,19 +65,11 @@ struct DegeneracyOptions {
         .Help("localizability: rotation direction held when its filtered sum is below this"));
     v.Field("regularized_max_condition", regularized_max_condition, Spec().Range(1.0, 1e12)
         .Help("regularized: Schur-block eigenvalues below lambda_max / this are damped up to it"));
+    v.Field("hold_information", hold_information, Spec().Range(1.0, 1e12)
+        .Help("smoother/refine, remap and localizability: information (sigma = 1) of the prior holding a weak direction"));
   }
   Status Validate() { return ValidateFields(*this, "degeneracy"); }
 };
-
-// The sliding-window smoother and refine have no form of remap,
-// localizability or regularized yet (docs/degeneracy.md): configuring one of
-// them there is an error naming the method and the backend.
-inline Status DegeneracyDefinedIn(DegeneracyMethod method, const char* backend) {
-  if (method == DegeneracyMethod::kRv || method == DegeneracyMethod::kNone) return Status::Ok();
-  return Status::InvalidInput(std::string("degeneracy.method=") + EnumName(method) +
-                              " is not defined for " + backend +
-                              " (its solver has no increment to treat; use rv or none)");
-}
 
 // The RV switches a run uses: RV runs only when it is the selected method
 // (method none, like every other method, leaves the constraint list as

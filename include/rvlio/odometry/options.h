@@ -72,7 +72,6 @@ struct OdometryOptions {
       return Status::InvalidInput(
           "lidar.estimate_time_offset and smoother.estimate_extrinsics: the smoother estimates "
           "one of them at a time (the IESKF both)");
-    if (backend == Backend::kSmoother) return DegeneracyDefinedIn(degeneracy.method, "smoother");
     return Status::Ok();
   }
 };

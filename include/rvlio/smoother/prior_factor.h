@@ -48,20 +48,25 @@ class StatePriorFactor final : public ceres::SizedCostFunction<15, 7, 9> {
   Eigen::Matrix<double, 15, 1> inv_sigma_;
 };
 
-// PosePriorFactor: a Gaussian prior on one pose block alone (the LiDAR-IMU
-// extrinsic when smoother.estimate_extrinsics is on):
-//   r = diag(1/sigma_rot x3, 1/sigma_pos x3) (pose [-] pose0),
-// tangent Jacobian W blockdiag(JrInv(Log(R0^T R)), I3).
+// PosePriorFactor: a Gaussian prior on one pose block alone:
+//   r = W (pose [-] pose0),
+// tangent Jacobian W blockdiag(JrInv(Log(R0^T R)), I3). W = diag(1/sigma_rot
+// x3, 1/sigma_pos x3) for the LiDAR-IMU extrinsic (smoother.estimate_extrinsics);
+// a general square-root information W (rank-deficient allowed) for the
+// degeneracy priors of the smoother and refine (degeneracy/degeneracy.h).
 class PosePriorFactor final : public ceres::SizedCostFunction<6, 7> {
  public:
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
   PosePriorFactor(const PoseBlock& pose0, double sigma_rot, double sigma_pos);
+  PosePriorFactor(const PoseBlock& pose0, const Matrix6d& sqrt_information);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
   PoseBlock pose0_;
-  Eigen::Matrix<double, 6, 1> inv_sigma_;
+  Matrix6d sqrt_information_;
 };
 
 class SpeedBiasContinuityFactor final : public ceres::SizedCostFunction<9, 9, 9> {

@@ -30,6 +30,11 @@
 //   RV       per scan when rv.enabled (rv/rv.h: 1/K on SCVs, normal repair),
 //            then Huber IRLS weights (smoother.refine_huber_delta) folded into the
 //            constraint weights;
+//   Degeneracy per scan with degeneracy.method remap, localizability or
+//            regularized: the weak directions of its constraints at the
+//            round's estimate (degeneracy/degeneracy.h) and a prior along
+//            them at the scan's initial pose (from --init), added to the
+//            chunk's problem;
 //   Solve    one Ceres problem per chunk: PoseBlock + SpeedBiasBlock per
 //            scan, ImuFactor between consecutive scans (preintegrated at the
 //            current biases), and the scan's point-to-plane constraints: a
@@ -72,6 +77,7 @@
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
 #include "rvlio/constraints/options.h"
+#include "rvlio/degeneracy/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/map/options.h"
@@ -89,6 +95,10 @@ struct RefineConfig {
   MapOptions map;
   ConstraintOptions constraints;
   RvOptions rv;
+  // degeneracy.method remap, localizability, regularized: per scan and
+  // round, a prior at the scan's initial (--init) pose along the weak
+  // directions of its constraints (docs/degeneracy.md "Backends").
+  DegeneracyOptions degeneracy;
   SmootherOptions smoother;
   // A fixed reference map (`refine --map`, docs/survey.md), or null. Each
   // scan is then also associated with it every round (the same association
@@ -116,6 +126,7 @@ struct RefineRound {
   int64_t points = 0;       // deskewed scan points associated
   int64_t constraints = 0;  // accepted point-to-plane constraints
   int rv_active_scans = 0;
+  int degenerate_scans = 0;  // scans degeneracy.method called degenerate (rv: RV active)
   int solve_failures = 0;   // chunks whose solve was rejected (states restored)
   double deskew_s = 0.0, map_s = 0.0, associate_s = 0.0, solve_s = 0.0, total_s = 0.0;  // wall
 };

@@ -18,6 +18,7 @@
 #include <ceres/cost_function.h>
 
 #include "rvlio/constraints/constraint.h"
+#include "rvlio/degeneracy/degeneracy.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/rv.h"
 #include "rvlio/smoother/plane_factor.h"
@@ -73,6 +74,12 @@ constexpr int kRefineSummaryMinConstraints = 16;
 struct ScanFactors {
   std::unique_ptr<ceres::CostFunction> fixed;                                // pose_k
   std::vector<std::pair<int, std::unique_ptr<ceres::CostFunction>>> pairs;  // source j; pose_k, pose_j
+  // The degeneracy stage (remap, localizability, regularized): its report,
+  // and the square-root information of the prior on pose_k at its initial
+  // pose, already divided by constraints.lidar_noise (has_degeneracy_prior).
+  DegeneracyReport degeneracy;
+  bool has_degeneracy_prior = false;
+  PoseMatrix6d degeneracy_sqrt_information = PoseMatrix6d::Zero();
 };
 
 // Where the planes of scan k's constraints live. A plane whose source scan j
@@ -90,12 +97,14 @@ void SplitScanConstraints(int k, const ScanRange& chunk, int plane_window,
 // Per-slot scratch of the association.
 struct RefineAssociationWorkspace {
   ConstraintList list, fixed, reference;
+  ConstraintList all;  // list and reference, for the degeneracy stage with a reference map
   std::vector<int32_t> sources;
   std::vector<std::pair<int32_t, int>> attached;  // source scan, constraint index
   RvWorkspace rv;
 };
 
-// Scan k of `chunk`: associate -> RV -> Huber weights -> its plane factors.
+// Scan k of `chunk`: associate -> RV -> Huber weights -> its plane factors
+// -> the degeneracy stage on all its constraints (own and reference planes).
 // *rv_active: the RV pass edited the scan's constraints.
 ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap& round,
                                 const std::vector<RefineState>& states, int k,
@@ -108,6 +117,7 @@ struct ChunkAssociation {
   int64_t points = 0;                // deskewed points tried
   int64_t constraints = 0;           // accepted
   int rv_active_scans = 0;
+  int degenerate_scans = 0;  // degeneracy.method's call (rv: RV active)
 };
 
 // Every scan of the chunk, on `threads`. stop (may be empty) is polled before

@@ -50,6 +50,13 @@ void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noi
                              PoseManifold* pose_manifold, std::vector<RefineState>* states,
                              ceres::Problem* problem);
 
+// The degeneracy priors of the chunk's scans (ScanFactors::has_degeneracy_prior):
+// a PosePriorFactor on pose k at anchors[k] (the scan's initial pose) with
+// the scan's square-root information. Call after BuildRefineChunkProblem.
+void AddRefineDegeneracyPriors(const ScanRange& chunk, const std::vector<ScanFactors>& factors,
+                               const std::vector<PoseBlock>& anchors,
+                               std::vector<RefineState>* states, ceres::Problem* problem);
+
 // The linear solver the refine problems use, and the Ceres threads.
 struct RefineSolver {
   ceres::SparseLinearAlgebraLibraryType sparse_library = ceres::EIGEN_SPARSE;

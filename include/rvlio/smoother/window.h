@@ -13,6 +13,13 @@
 //     plane_summary_factor.h). Per-point information = Constraint::weight / sigma^2
 //     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
 //     min(1, sliding_window_huber_delta / |r|) at the pose of association);
+//   - with degeneracy.method remap, localizability or regularized, a
+//     PosePriorFactor per state along the weak directions its scan's
+//     constraints leave (degeneracy/degeneracy.h
+//     DegeneracyPriorSqrtInformation), anchored at the state's initial value
+//     (the IMU prediction); analyzed at each association, at the scan's pose
+//     of that association; not marginalized (a statement about the solve,
+//     not information: docs/degeneracy.md);
 //   - the prior on the oldest state: a StatePriorFactor on the first state of
 //     the run, then the marginalization prior (marginalization.h), whose
 //     Jacobian stays at its linearization point (first-estimate Jacobians).
@@ -73,6 +80,8 @@
 #include "rvlio/common/time.h"
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/constraints/options.h"
+#include "rvlio/degeneracy/degeneracy.h"
+#include "rvlio/degeneracy/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/noise.h"
@@ -108,6 +117,7 @@ class PlaneTimeOffsetFactor;
 struct WindowOptions {
   SmootherOptions smoother;       // window_size, rounds, iterations, sliding_window_huber_delta, ...
   RvOptions rv;                   // the same switches and parameters as the filter
+  DegeneracyOptions degeneracy;   // method and parameters (the per-scan degeneracy prior)
   ImuOptions imu;                 // noise densities of the preintegration (re-integration)
   ConstraintOptions constraints;  // lidar_noise: sigma of one point-to-plane residual
   IeskfOptions ieskf;             // init_*_std: prior of the run's first state (the same static
@@ -120,6 +130,7 @@ struct WindowOptions {
   void Visit(V& v) {
     v.Section("smoother", smoother);
     v.Section("rv", rv);
+    v.Section("degeneracy", degeneracy);
     v.Section("imu", imu);
     v.Section("constraints", constraints);
     v.Section("ieskf", ieskf);
@@ -154,6 +165,9 @@ struct WindowSolveReport {
   int associations = 0;         // scans (re-)associated over all rounds
   int newest_constraints = 0;   // constraints of the newest state (last association)
   RvReport newest_rv;           // RV report of the newest state (last association)
+  // The degeneracy report of the newest state (last association) for
+  // remap, localizability and regularized; rv and none report from newest_rv.
+  DegeneracyReport newest_degeneracy;
   // sum w u u^T of the newest state's constraints (sigma = 1; rv/rv.h PositionInformation).
   Eigen::Matrix3d newest_position_information = Eigen::Matrix3d::Zero();
   double association_ms = 0.0;  // thread CPU time in association, RV and weights
@@ -238,6 +252,7 @@ class SlidingWindow {
   int AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
   void AssociateNode(const ScanAssociateFn& associate, Node* node);
   void RejectOverflowingScan(Node* node);
+  void TreatDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar, Node* node) const;
   void RefreshImuFactors();
   bool DropNewestImuFactor();
   bool SolveRound(WindowSolveReport* report);
