@@ -779,8 +779,16 @@ def CmdDeviation(args):
   if not rows:
     raise PlotError("%s: no rows" % path)
   col = {c: np.array([ToFloat(r.get(c)) for r in rows]) for c in needed}
+  # Per surface (left, right, floor, ceiling): a second panel with each
+  # surface's signed median, when the file has those columns.
+  sides = [s for s in ("left", "right", "floor", "ceiling") if s + "_median_m" in header]
+  for side in sides:
+    col[side] = np.array([ToFloat(r.get(side + "_median_m")) for r in rows])
   plt = Pyplot()
-  fig, ax = plt.subplots(figsize=(8, 3.5))
+  if sides:
+    fig, (ax, ax_sides) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+  else:
+    fig, ax = plt.subplots(figsize=(8, 3.5))
   cm = 100.0
   ax.plot(col["chainage_m"], cm * col["p95_abs_m"], label="p95 |deviation|", color="tab:red")
   ax.plot(col["chainage_m"], cm * col["median_abs_m"], label="median |deviation|",
@@ -794,10 +802,27 @@ def CmdDeviation(args):
                os.path.basename(os.path.normpath(args.run)))
   ax.grid(True, alpha=0.3)
   ax.legend(loc="upper right", fontsize=8)
+  if sides:
+    ax.set_xlabel("")
+    for side in sides:
+      ax_sides.plot(col["chainage_m"], cm * col[side], label=side)
+    ax_sides.axhline(0.0, color="0.6", linewidth=0.8)
+    ax_sides.set_xlabel("chainage [m]")
+    ax_sides.set_ylabel("signed median per surface [cm]")
+    ax_sides.grid(True, alpha=0.3)
+    ax_sides.legend(loc="upper right", fontsize=8, ncol=len(sides))
   fig.tight_layout()
   peak = int(np.nanargmax(col["p95_abs_m"]))
   print("peak p95 |deviation| %.4f m at chainage %.1f m; median |deviation| median %.4f m" %
         (col["p95_abs_m"][peak], col["chainage_m"][peak], float(np.nanmedian(col["median_abs_m"]))))
+  largest = []
+  for side in sides:
+    if np.all(np.isnan(col[side])):
+      continue
+    k = int(np.nanargmax(np.abs(col[side])))
+    largest.append("%s %.4f m at %.1f m" % (side, col[side][k], col["chainage_m"][k]))
+  if largest:
+    print("largest signed median per surface: " + ", ".join(largest))
   SaveFigure(fig, args.out, "deviation")
 
 

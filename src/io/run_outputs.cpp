@@ -184,11 +184,19 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
 Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin>& bins) {
   std::ostringstream os;
   os.precision(6);
-  os << "chainage_m,count,median_m,median_abs_m,p95_abs_m,max_abs_m\n";
-  for (const DeviationBin& b : bins)
+  os << "chainage_m,count,median_m,median_abs_m,p95_abs_m,max_abs_m";
+  for (int k = 0; k < kTunnelSides; ++k) {  // per surface: left, right, floor, ceiling
+    const std::string side = TunnelSideName(static_cast<TunnelSide>(k));
+    os << ',' << side << "_count," << side << "_median_m," << side << "_p95_abs_m";
+  }
+  os << '\n';
+  for (const DeviationBin& b : bins) {
     os << b.chainage_m << ',' << b.count << ',' << Optional(b.median_m) << ','
-       << Optional(b.median_abs_m) << ',' << Optional(b.p95_abs_m) << ',' << Optional(b.max_abs_m)
-       << '\n';
+       << Optional(b.median_abs_m) << ',' << Optional(b.p95_abs_m) << ',' << Optional(b.max_abs_m);
+    for (const DeviationBin::Side& s : b.sides)
+      os << ',' << s.count << ',' << Optional(s.median_m) << ',' << Optional(s.p95_abs_m);
+    os << '\n';
+  }
   return WriteFileAtomically(path, os.str());
 }
 

@@ -2,6 +2,7 @@
 #include "rvlio/odometry/deviation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -14,21 +15,40 @@ constexpr double kMaxSampleDistanceM = 50.0;  // a point farther from the trajec
 struct Sample {
   Eigen::Vector3d p;
   double chainage_m;
+  Eigen::Vector3d forward;  // unit direction of travel there (zero while not moving)
 };
 
-// Positions every kSampleStepM along the trajectory with their chainage.
+// Positions every kSampleStepM along the trajectory with their chainage and
+// direction of travel (the first sample takes the first segment's).
 std::vector<Sample> Resample(const Trajectory& t) {
-  std::vector<Sample> s{{t.front().p_world_imu, 0.0}};
+  std::vector<Sample> s{{t.front().p_world_imu, 0.0, Eigen::Vector3d::Zero()}};
   double chainage = 0.0;
   for (size_t i = 1; i < t.size(); ++i) {
     const Eigen::Vector3d a = t[i - 1].p_world_imu, b = t[i].p_world_imu;
     const double len = (b - a).norm();
+    const Eigen::Vector3d forward = len > 0.0 ? Eigen::Vector3d((b - a) / len) : Eigen::Vector3d::Zero();
+    if (s.size() == 1 && len > 0.0) s.front().forward = forward;
     const int n = std::max(1, static_cast<int>(std::ceil(len / kSampleStepM)));
     for (int k = 1; k <= n; ++k)
-      s.push_back({a + (b - a) * (static_cast<double>(k) / n), chainage + len * k / n});
+      s.push_back({a + (b - a) * (static_cast<double>(k) / n), chainage + len * k / n, forward});
     chainage += len;
   }
   return s;
+}
+
+// TunnelSide (deviation.h) of p_world on a reference plane of unit normal
+// `normal`, seen from `view`.
+TunnelSide SideOf(const Eigen::Vector3d& p_world, const Eigen::Vector3d& normal,
+                  const Sample& view) {
+  const Eigen::Vector3d& forward = view.forward;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ() - forward.z() * forward;
+  if (forward.isZero() || up.norm() < 0.1) return TunnelSide::kNone;  // within ~6 deg of vertical
+  const Eigen::Vector3d up_across = up.normalized();
+  const Eigen::Vector3d left = up_across.cross(forward);
+  const Eigen::Vector3d d = p_world - view.p;
+  if (std::abs(normal.dot(up_across)) >= std::abs(normal.dot(left)))
+    return d.dot(up_across) > 0.0 ? TunnelSide::kCeiling : TunnelSide::kFloor;
+  return d.dot(left) > 0.0 ? TunnelSide::kLeft : TunnelSide::kRight;
 }
 
 // The samples in an implicit k-d tree (the median of each range splits it
@@ -93,7 +113,33 @@ double Median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// Count, signed median and p95 |deviation| of the values.
+DeviationBin::Side SideStats(const std::vector<double>& v) {
+  DeviationBin::Side o;
+  o.count = static_cast<int>(v.size());
+  if (v.empty()) {
+    o.median_m = o.p95_abs_m = std::numeric_limits<double>::quiet_NaN();
+    return o;
+  }
+  o.median_m = Median(v);
+  std::vector<double> a(v.size());
+  std::transform(v.begin(), v.end(), a.begin(), [](double x) { return std::abs(x); });
+  o.p95_abs_m = Quantile(&a, 0.95);
+  return o;
+}
+
 }  // namespace
+
+const char* TunnelSideName(TunnelSide side) {
+  switch (side) {
+    case TunnelSide::kLeft: return "left";
+    case TunnelSide::kRight: return "right";
+    case TunnelSide::kFloor: return "floor";
+    case TunnelSide::kCeiling: return "ceiling";
+    case TunnelSide::kNone: break;
+  }
+  return "none";
+}
 
 PointDeviations ComputeDeviations(const std::vector<Eigen::Vector3d>& p_map,
                                   const ReferenceMap& reference, const Trajectory& trajectory,
@@ -102,6 +148,7 @@ PointDeviations ComputeDeviations(const std::vector<Eigen::Vector3d>& p_map,
   PointDeviations d;
   d.deviation_m.resize(p_map.size(), std::numeric_limits<double>::quiet_NaN());
   d.chainage_m.resize(p_map.size(), std::numeric_limits<double>::quiet_NaN());
+  d.side.resize(p_map.size(), TunnelSide::kNone);
   NeighborBuffer neighbors;
   for (size_t i = 0; i < p_map.size(); ++i) {
     const Sample* view = samples.Nearest(p_map[i]);
@@ -109,18 +156,23 @@ PointDeviations ComputeDeviations(const std::vector<Eigen::Vector3d>& p_map,
     d.chainage_m[i] = view->chainage_m;
     const SurfaceDistance s =
         QueryReferenceSurface(reference, p_map[i], options, &neighbors, &view->p);
-    if (s.has_surface()) d.deviation_m[i] = s.signed_m;
+    if (!s.has_surface()) continue;
+    d.deviation_m[i] = s.signed_m;
+    d.side[i] = SideOf(p_map[i], s.normal, *view);
   }
   return d;
 }
 
 std::vector<DeviationBin> BinByChainage(const PointDeviations& d, double step_m) {
   std::vector<std::vector<double>> bins;
+  std::vector<std::array<std::vector<double>, kTunnelSides>> side_bins;
   for (size_t i = 0; i < d.deviation_m.size(); ++i) {
     if (!std::isfinite(d.deviation_m[i]) || !std::isfinite(d.chainage_m[i])) continue;
     const size_t b = static_cast<size_t>(std::max(0.0, d.chainage_m[i]) / step_m);
-    if (b >= bins.size()) bins.resize(b + 1);
+    if (b >= bins.size()) bins.resize(b + 1), side_bins.resize(b + 1);
     bins[b].push_back(d.deviation_m[i]);
+    const TunnelSide side = i < d.side.size() ? d.side[i] : TunnelSide::kNone;
+    if (side != TunnelSide::kNone) side_bins[b][static_cast<int>(side)].push_back(d.deviation_m[i]);
   }
   std::vector<DeviationBin> out(bins.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -128,6 +180,7 @@ std::vector<DeviationBin> BinByChainage(const PointDeviations& d, double step_m)
     DeviationBin& o = out[b];
     o.chainage_m = static_cast<double>(b) * step_m;
     o.count = static_cast<int>(bins[b].size());
+    for (int k = 0; k < kTunnelSides; ++k) o.sides[k] = SideStats(side_bins[b][k]);
     if (bins[b].empty()) {
       o.median_m = o.median_abs_m = o.p95_abs_m = o.max_abs_m = nan;
       continue;

@@ -155,6 +155,15 @@ void ExpectConvergenceInDeviationCsv(const std::string& folder, const std::strin
   EXPECT_GT(at_c.at("median_m"), 0.0) << tag;  // towards the inside: positive
   EXPECT_NEAR(peak->at("chainage_m") + 0.5, c_m, 2.0) << tag;
   EXPECT_LT(worst_median_elsewhere, 0.01) << tag;
+  // Per surface: the left wall (+y, the flight goes along +x) shows the
+  // convergence in its own median, the other three do not move.
+  std::printf("[ survey ] %s: at the convergence, median deviation left %.4f right %.4f floor "
+              "%.4f ceiling %.4f m\n",
+              tag.c_str(), at_c.at("left_median_m"), at_c.at("right_median_m"),
+              at_c.at("floor_median_m"), at_c.at("ceiling_median_m"));
+  EXPECT_NEAR(at_c.at("left_median_m"), kConvergenceM, 0.01) << tag;
+  for (const char* side : {"right", "floor", "ceiling"})
+    EXPECT_LT(std::abs(at_c.at(std::string(side) + "_median_m")), 0.01) << tag << " " << side;
   const std::string pcd = testing_cli::ReadFile(folder + "/map.pcd");
   EXPECT_NE(pcd.substr(0, 400).find("FIELDS x y z deviation_m"), std::string::npos) << tag;
 }

@@ -66,5 +66,78 @@ TEST(Deviation, NoReferenceSurfaceGivesNaN) {
   EXPECT_TRUE(std::isnan(bins[0].median_m));
 }
 
+// A box tunnel around the flight along x (walls at y = +-3 m, floor z = 0,
+// ceiling z = 4 m, x 0..20 m), every step_m; with `bulge_m` the left wall
+// (y = +3) moves that far inwards for 8 <= x < 12 (a convergence).
+std::vector<Eigen::Vector3d> Box(double step_m, double bulge_m) {
+  std::vector<Eigen::Vector3d> p;
+  for (double x = 0.0; x < 20.0; x += step_m) {
+    const double left_y = 3.0 - (x >= 8.0 && x < 12.0 ? bulge_m : 0.0);
+    for (double z = 0.2; z <= 3.8; z += step_m) {
+      p.emplace_back(x, left_y, z);
+      p.emplace_back(x, -3.0, z);
+    }
+    for (double y = -2.8; y <= 2.8; y += step_m) {
+      p.emplace_back(x, y, 0.0);
+      p.emplace_back(x, y, 4.0);
+    }
+  }
+  return p;
+}
+
+TEST(Deviation, EachSurfaceOfTheTunnelHasItsOwnStatistics) {
+  const ReferenceMap reference(Box(0.05, 0.0));
+  const std::vector<Eigen::Vector3d> p_map = Box(0.2, 0.05);
+  const PointDeviations d = ComputeDeviations(p_map, reference, AlongX(), SurfaceQueryOptions());
+  ASSERT_EQ(d.side.size(), p_map.size());
+  // The flight goes along +x with +z up: +y is on its left.
+  for (size_t i = 0; i < p_map.size(); ++i) {
+    const Eigen::Vector3d& p = p_map[i];
+    const TunnelSide want = p.z() == 0.0   ? TunnelSide::kFloor
+                            : p.z() == 4.0 ? TunnelSide::kCeiling
+                            : p.y() > 0.0  ? TunnelSide::kLeft
+                                           : TunnelSide::kRight;
+    ASSERT_EQ(d.side[i], want) << p.transpose();
+  }
+  const std::vector<DeviationBin> bins = BinByChainage(d, 1.0);
+  ASSERT_GE(bins.size(), 19u);
+  const auto side = [](const DeviationBin& b, TunnelSide s) { return b.sides[static_cast<int>(s)]; };
+  const DeviationBin& in = bins[9];  // wholly inside the convergence
+  EXPECT_NEAR(side(in, TunnelSide::kLeft).median_m, 0.05, 0.002);
+  EXPECT_NEAR(side(in, TunnelSide::kLeft).p95_abs_m, 0.05, 0.002);
+  for (TunnelSide s : {TunnelSide::kRight, TunnelSide::kFloor, TunnelSide::kCeiling}) {
+    EXPECT_LT(std::abs(side(in, s).median_m), 0.002) << TunnelSideName(s);
+    EXPECT_GT(side(in, s).count, 0) << TunnelSideName(s);
+  }
+  // The four surfaces' counts make up the bin's (every point has a side here).
+  int sum = 0;
+  for (const DeviationBin::Side& s : in.sides) sum += s.count;
+  EXPECT_EQ(sum, in.count);
+  // The bin's median of all four surfaces hides the one wall that moved.
+  EXPECT_LT(std::abs(in.median_m), 0.01);
+  EXPECT_NEAR(side(bins[3], TunnelSide::kLeft).median_m, 0.0, 0.002);
+}
+
+TEST(Deviation, AVerticalTrajectoryHasNoSides) {
+  Trajectory up;
+  for (int i = 0; i <= 10; ++i) {
+    StampedPose s;
+    s.t_ns = i * 100000000LL;
+    s.p_world_imu = Eigen::Vector3d(5.0, 0.0, 0.5 * i);
+    up.push_back(s);
+  }
+  const ReferenceMap reference(Wall(0.05, 0.0));
+  const PointDeviations d =
+      ComputeDeviations({Eigen::Vector3d(5.0, 3.0, 2.0)}, reference, up, SurfaceQueryOptions());
+  EXPECT_EQ(d.side[0], TunnelSide::kNone);
+  const std::vector<DeviationBin> bins = BinByChainage(d, 1.0);
+  ASSERT_FALSE(bins.empty());
+  EXPECT_EQ(bins.back().count, 1);
+  for (const DeviationBin::Side& s : bins.back().sides) {
+    EXPECT_EQ(s.count, 0);
+    EXPECT_TRUE(std::isnan(s.median_m));
+  }
+}
+
 }  // namespace
 }  // namespace rvlio

@@ -438,6 +438,22 @@ TEST_F(PlotScriptTest, DeviationAlongTheChainage) {
       << r.out;
   ExpectFigures("deviation");
   for (const auto& entry : fs::directory_iterator(dir_ + "/out")) fs::remove(entry.path());
+  // With the per-surface columns: a second panel, and each surface's
+  // largest signed median (the left wall's convergence at 1 m).
+  std::string sides = "chainage_m,count,median_m,median_abs_m,p95_abs_m,max_abs_m";
+  for (const char* side : {"left", "right", "floor", "ceiling"})
+    sides += std::string(",") + side + "_count," + side + "_median_m," + side + "_p95_abs_m";
+  WriteText(run + "/deviation.csv",
+            sides + "\n0,100,0.001,0.002,0.01,0.02,25,0.002,0.01,25,0.001,0.01,25,0,0.01,25,-0.001,0.01\n"
+                    "1,120,0.02,0.021,0.048,0.06,30,0.045,0.05,30,0.002,0.01,30,0.001,0.01,30,0,0.01\n"
+                    "2,0,,,,,0,,,0,,,0,,,0,,\n");
+  const Result with_sides = Plot("deviation --run " + run + " " + Out());
+  ASSERT_EQ(with_sides.exit_code, 0) << with_sides.err;
+  EXPECT_NE(with_sides.out.find("left 0.0450 m at 1.0 m, right 0.0020 m at 1.0 m"),
+            std::string::npos)
+      << with_sides.out;
+  ExpectFigures("deviation");
+  for (const auto& entry : fs::directory_iterator(dir_ + "/out")) fs::remove(entry.path());
   WriteText(run + "/deviation.csv", "chainage_m,count\n0,1\n");
   ExpectBadInput("deviation --run " + run + " " + Out(), "missing column(s) median_m");
 }

@@ -8,6 +8,7 @@
 // the reference has no surface within the query radius. Then, along the
 // trajectory, statistics per chainage bin (the along-track distance of the
 // nearest trajectory position).
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -31,9 +32,22 @@ struct DeviationOptions {
   }
 };
 
+// Which surface of a tunnel a map point lies on, seen from its nearest
+// trajectory position: the reference plane's normal at the point faces
+// mostly "up" across the track (the frame's +z with its along-track part
+// removed: a floor or a ceiling, told apart by whether the point lies below
+// or above the trajectory) or mostly "left" (up x forward: a wall, left or
+// right by the side of the track it lies on). kNone: no reference surface,
+// no trajectory position near, or a vertical stretch of trajectory (no
+// across-track up).
+enum class TunnelSide : uint8_t { kLeft = 0, kRight = 1, kFloor = 2, kCeiling = 3, kNone = 4 };
+constexpr int kTunnelSides = 4;
+const char* TunnelSideName(TunnelSide side);  // "left", "right", "floor", "ceiling", "none"
+
 struct PointDeviations {
   std::vector<double> deviation_m;  // per map point, NaN without a reference surface
   std::vector<double> chainage_m;   // per map point, of its nearest trajectory position
+  std::vector<TunnelSide> side;     // per map point
 };
 
 // Every map point against the reference; `trajectory` (sorted by time,
@@ -49,6 +63,15 @@ struct DeviationBin {
   double median_abs_m = 0.0;
   double p95_abs_m = 0.0;
   double max_abs_m = 0.0;
+  // The same per surface (index: TunnelSide), so that one wall's movement is
+  // not diluted by the other three: count, signed median, p95 |deviation|
+  // (NaN without points).
+  struct Side {
+    int count = 0;
+    double median_m = 0.0;
+    double p95_abs_m = 0.0;
+  };
+  Side sides[kTunnelSides];
 };
 
 // Bins of step_m from chainage 0 to the last point's; empty bins have count 0
