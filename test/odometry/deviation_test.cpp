@@ -19,16 +19,19 @@ std::vector<Eigen::Vector3d> Wall(double step_m, double bulge_m) {
   return p;
 }
 
-Trajectory AlongX() {
+// `count` poses 0.1 s apart from `start` in steps of `step` (m).
+Trajectory Line(const Eigen::Vector3d& start, const Eigen::Vector3d& step, int count) {
   Trajectory t;
-  for (int i = 0; i <= 20; ++i) {
+  for (int i = 0; i < count; ++i) {
     StampedPose s;
     s.t_ns = i * 100000000LL;
-    s.p_world_imu = Eigen::Vector3d(i, 0.0, 1.5);
+    s.p_world_imu = start + i * step;
     t.push_back(s);
   }
   return t;
 }
+
+Trajectory AlongX() { return Line(Eigen::Vector3d(0.0, 0.0, 1.5), Eigen::Vector3d::UnitX(), 21); }
 
 TEST(Deviation, AConvergenceShowsAtItsChainageWithItsSign) {
   const ReferenceMap reference(Wall(0.05, 0.0));
@@ -119,13 +122,7 @@ TEST(Deviation, EachSurfaceOfTheTunnelHasItsOwnStatistics) {
 }
 
 TEST(Deviation, AVerticalTrajectoryHasNoSides) {
-  Trajectory up;
-  for (int i = 0; i <= 10; ++i) {
-    StampedPose s;
-    s.t_ns = i * 100000000LL;
-    s.p_world_imu = Eigen::Vector3d(5.0, 0.0, 0.5 * i);
-    up.push_back(s);
-  }
+  const Trajectory up = Line(Eigen::Vector3d(5.0, 0.0, 0.0), 0.5 * Eigen::Vector3d::UnitZ(), 11);
   const ReferenceMap reference(Wall(0.05, 0.0));
   const PointDeviations d =
       ComputeDeviations({Eigen::Vector3d(5.0, 3.0, 2.0)}, reference, up, SurfaceQueryOptions());
