@@ -121,9 +121,9 @@ TEST_F(TimeOffsetCliTest, EstimationWithSynchronizedClocksKeepsTheAccuracy) {
   ASSERT_EQ(Run("sync", off, "--set backend=ieskf").exit_code, 0);
   ASSERT_EQ(Run("sync", on, "--set backend=ieskf --set lidar.estimate_time_offset=true").exit_code,
             0);
-  // The target is 5 %; over tunnel seeds 3, 5, 7 and the hall the measured
-  // ratio is 0.97 to 1.10, this seed's 1.10 (docs/time_offset.md): the bound
-  // guards against regressions without claiming the target.
+  // The target is 5 %; over seeds 3 to 13 of the tunnel and the hall the
+  // measured ratio is 0.97 to 1.15, this seed's 1.10 (docs/time_offset.md):
+  // the bound guards against regressions without claiming the target.
   EXPECT_LT(Ate("sync", on), 1.15 * Ate("sync", off));
   EXPECT_NEAR(TimeOffset(on)["estimate_s"].get<double>(), 0.0, 0.002);
 }
