@@ -258,6 +258,7 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
   P_td_td_ = lidar_.estimate_time_offset ? lidar_.time_offset_init_std * lidar_.time_offset_init_std
                                          : 0.0;
   td_at_bound_ = false;
+  td_observed_ = false;
   ClearPoseHistory();
 }
 
@@ -416,7 +417,8 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
     // At rest the offset's column (w, v) is IMU noise alone: no update of
     // the offset (it would fit the noise and leave a confident wrong value
     // for the motion to undo).
-    if (!TimeOffsetObservable(x0.v_world_imu, scan_motion_)) td_rows[15] = -1;
+    td_observed_ = TimeOffsetObservable(x0.v_world_imu, scan_motion_);
+    if (!td_observed_) td_rows[15] = -1;
   } else {
     E = ErrorStateColumns(free);
   }

@@ -114,7 +114,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.mean_acc_imu = mean_acc_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.status = map_.Empty() && !localizer_.enabled() ? ScanStatus::kMapInit : Correct(&r);
-  InsertIntoMap(scan.t_end_ns);
+  InsertIntoMap(scan.t_end_ns, ProvisionalInMap(scan.t_end_ns));
   ReportExtrinsic(&r);
   ReportTimeOffset(&r);
   filter_.ClearPoseHistory();
@@ -229,17 +229,53 @@ void IeskfOdometry::ReportTimeOffset(ScanResult* r) {
   stats_.time_offset =
       MakeTimeOffsetReport(time_offset_excitation_, options_.lidar, filter_.time_offset_s(),
                            filter_.time_offset_std_s(), filter_.time_offset_at_bound());
+  stats_.time_offset.map_hold_scans = map_hold_scans_;
   if (stats_.time_offset.at_bound && !was_at_bound)
     warnings_.push_back(TimeOffsetAtBoundWarning(options_.lidar, filter_.time_ns()));
 }
 
+// The map hold (lidar.time_offset_map_hold, docs/time_offset.md "Map hold"):
+// the offset is not observed at rest, so the first moving scans are predicted,
+// deskewed and placed with the prior offset, and the filter cannot revisit the
+// map it builds from them. At the first moving scan the working map is copied
+// (the scans at rest, which the offset does not affect); the moving scans are
+// then inserted provisionally (registration keeps a fresh map) and kept out of
+// the output map. When the offset's 1-sigma falls below
+// lidar.time_offset_map_std, the working map returns to the copy, so the
+// provisional scans, deskewed and placed with the unconverged offset, leave
+// it, and the scans from then on rebuild it. If the offset does not converge
+// within time_offset_map_hold seconds of motion, the provisional scans stay.
+// Memory: one copy of the working map, once per run.
+bool IeskfOdometry::ProvisionalInMap(TimeNs t_ns) {
+  if (map_hold_over_ || !options_.lidar.estimate_time_offset ||
+      options_.lidar.time_offset_map_hold <= 0.0 || map_.Empty())
+    return false;
+  if (map_hold_start_ns_ < 0) {
+    if (!filter_.time_offset_observed()) return false;  // at rest: the offset does not matter
+    map_hold_start_ns_ = t_ns;
+    map_before_motion_ = map_;
+  }
+  const bool converged = filter_.time_offset_std_s() < options_.lidar.time_offset_map_std;
+  if (converged) map_ = std::move(*map_before_motion_);
+  map_hold_over_ =
+      converged || NsToSeconds(t_ns - map_hold_start_ns_) >= options_.lidar.time_offset_map_hold;
+  if (map_hold_over_) {
+    map_before_motion_.reset();
+    return false;
+  }
+  ++map_hold_scans_;
+  return true;
+}
+
 // The scan's points were deskewed to its end on the LiDAR clock, which the
 // estimated offset puts at the filter's ScanTimeImuPose().
-void IeskfOdometry::InsertIntoMap(TimeNs t_ns) {
+void IeskfOdometry::InsertIntoMap(TimeNs t_ns, bool provisional) {
   const FilterState& x = filter_.state();
   const Pose3 T_world_imu =
       options_.lidar.estimate_time_offset ? filter_.ScanTimeImuPose() : x.T_world_imu();
-  output_map_.Insert(map_.InsertScan(t_ns, T_world_imu, x.T_imu_lidar(), p_lidar_end_));
+  const std::vector<Eigen::Vector3d>& p_world =
+      map_.InsertScan(t_ns, T_world_imu, x.T_imu_lidar(), p_lidar_end_);
+  if (!provisional) output_map_.Insert(p_world);
 }
 
 }  // namespace rvlio

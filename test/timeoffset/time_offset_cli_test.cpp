@@ -121,11 +121,31 @@ TEST_F(TimeOffsetCliTest, EstimationWithSynchronizedClocksKeepsTheAccuracy) {
   ASSERT_EQ(Run("sync", off, "--set backend=ieskf").exit_code, 0);
   ASSERT_EQ(Run("sync", on, "--set backend=ieskf --set lidar.estimate_time_offset=true").exit_code,
             0);
-  // The target is 5 %; over tunnel seeds 3, 5, 7 and the hall the measured
-  // ratio is 0.97 to 1.10, this seed's 1.10 (docs/time_offset.md): the bound
-  // guards against regressions without claiming the target.
+  // The target is 5 %; over seeds 3 to 13 of the tunnel and the hall the
+  // measured ratio is 0.97 to 1.15, this seed's 1.10 (docs/time_offset.md):
+  // the bound guards against regressions without claiming the target.
   EXPECT_LT(Ate("sync", on), 1.15 * Ate("sync", off));
   EXPECT_NEAR(TimeOffset(on)["estimate_s"].get<double>(), 0.0, 0.002);
+}
+
+// The IESKF map hold (lidar.time_offset_map_hold): on the +30 ms bag the
+// first moving scans are provisional until the offset converges (about 0.5 s
+// of motion at 10 Hz: between 1 and 10 scans), the estimate is as accurate
+// and the ATE within 20 % of the synchronized run (measured 1.02,
+// docs/time_offset.md "Map hold"). Off by default: no provisional scans.
+TEST_F(TimeOffsetCliTest, IeskfMapHoldKeepsTheAccuracy) {
+  const std::string sync = dir_ + "/hold_sync", off = dir_ + "/hold_off", on = dir_ + "/hold_on";
+  ASSERT_EQ(Run("sync", sync, "--set backend=ieskf").exit_code, 0);
+  const std::string est = "--set backend=ieskf --set lidar.estimate_time_offset=true";
+  ASSERT_EQ(Run("off30", off, est).exit_code, 0);
+  const ToolRun r = Run("off30", on, est + " --set lidar.time_offset_map_hold=1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(TimeOffset(off)["map_hold_scans"].get<int>(), 0);
+  const nlohmann::json t = TimeOffset(on);
+  EXPECT_GE(t["map_hold_scans"].get<int>(), 1) << t.dump();
+  EXPECT_LE(t["map_hold_scans"].get<int>(), 10) << t.dump();
+  EXPECT_NEAR(t["estimate_s"].get<double>(), kOffsetS, 0.002) << t.dump();
+  EXPECT_LT(Ate("off30", on), 1.2 * Ate("sync", sync));
 }
 
 // A drifting LiDAR clock (simulator lidar.time_offset_drift, 200 ppm: the

@@ -106,6 +106,9 @@ class Ieskf {
   double time_offset_std_s() const;
   // True once an update pushed the estimate to +-lidar.time_offset_max (held there).
   bool time_offset_at_bound() const { return td_at_bound_; }
+  // True when the last update estimated the offset: the motion showed it
+  // (not at rest; estimate_time_offset only).
+  bool time_offset_observed() const { return td_observed_; }
   // The IMU pose at the time of the last updated scan (the state's pose when
   // the offset is not estimated; see ScanTimeMotion).
   Pose3 ScanTimeImuPose() const { return ScanTimePose(x_, scan_motion_, td_s_ - td_lin_s_); }
@@ -144,6 +147,7 @@ class Ieskf {
   Vector24d P_x_td_ = Vector24d::Zero();
   double P_td_td_ = 0.0;
   bool td_at_bound_ = false;
+  bool td_observed_ = false;  // the last update estimated the offset (not at rest)
 };
 
 }  // namespace rvlio

@@ -28,6 +28,12 @@ struct LidarOptions {
   double time_offset_init_std = 0.05;      // s, prior std around time_offset
   double time_offset_random_walk = 1e-4;   // s/sqrt(s), process noise of the estimate
   double time_offset_excited_std = 0.002;  // s, 1-sigma under which an excited estimate is trusted
+  // IESKF map hold (docs/time_offset.md "Map hold"): the first moving scans
+  // are provisional in the working map until the estimate's 1-sigma falls
+  // below time_offset_map_std (then the map returns to its state before the
+  // motion), for at most time_offset_map_hold seconds of motion (0: off).
+  double time_offset_map_hold = 0.0;    // s (0: off)
+  double time_offset_map_std = 0.001;   // s
 
   template <class V>
   void Visit(V& v) {
@@ -72,6 +78,14 @@ struct LidarOptions {
     v.Field("time_offset_excited_std", time_offset_excited_std,
             Spec().Unit("s").Range(1e-6, 1.0).Help(
                 "the estimate counts as trustworthy once excited and its 1-sigma is below this"));
+    v.Field("time_offset_map_hold", time_offset_map_hold,
+            Spec().Unit("s").Range(0.0, 60.0).Help(
+                "IESKF with estimate_time_offset: the first moving scans are provisional in the "
+                "map, which returns to its state before the motion once the estimate converges "
+                "(time_offset_map_std), for at most this long; 0: off"));
+    v.Field("time_offset_map_std", time_offset_map_std,
+            Spec().Unit("s").Range(1e-6, 1.0).Help(
+                "IESKF map hold: the estimate counts as converged once its 1-sigma is below this"));
   }
   Status Validate() {
     Status s = ValidateFields(*this, "lidar");

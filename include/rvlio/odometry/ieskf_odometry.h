@@ -1,6 +1,7 @@
 #pragma once
 // The IESKF backend of the odometry pipeline (see odometry.h).
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,15 @@ class IeskfOdometry : public Odometry {
   bool StartInReference();
   // Reference map: the map this scan is matched with, at the prediction.
   const VoxelMap& ChooseMap(AssociationCache* cache, ScanResult* r);
-  void InsertIntoMap(TimeNs t_ns);
+  // provisional: in the working map only (ProvisionalInMap), not in the output map.
+  void InsertIntoMap(TimeNs t_ns, bool provisional = false);
+  // lidar.estimate_time_offset: true while the first moving scans are
+  // provisional in the map, until the offset converges (lidar.time_offset_map_hold).
+  bool ProvisionalInMap(TimeNs t_ns);
+  TimeNs map_hold_start_ns_ = -1;  // the first moving scan's time (-1: none yet)
+  bool map_hold_over_ = false;
+  std::optional<WorkingMap> map_before_motion_;  // the map at the first moving scan
+  int64_t map_hold_scans_ = 0;
   void ReportExtrinsic(ScanResult* r);  // ieskf.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
   // lidar.estimate_time_offset: how far the scans are moved beyond
   // lidar.time_offset (the reader's shift) onto the IMU clock (0 when off).
