@@ -209,11 +209,13 @@ check "Slurm's table equals rvlio ablate's (scripts/ablate_compare.py)" \
 
 # 4. A bad cell, and a retried job.
 cat >"$work/bad.yaml" <<EOF
-# tiny.yaml's tunnel with one seed; the variant "bad" reads a topic the bag
-# does not have, so its \`rvlio run\` fails.
+# tiny.yaml's tunnel with one seed, 12 s long: its one good cell is the only
+# one to cancel while it runs, and at 6 s it ran for well under a second,
+# too short a window to catch it running every time. The variant "bad"
+# reads a topic the bag does not have, so its \`rvlio run\` fails.
 sequences:
   - name: tunnel
-    simulate: {preset: tunnel, duration: 6, set: {lidar.columns: 512}}
+    simulate: {preset: tunnel, duration: 12, set: {lidar.columns: 512}}
     seeds: [3]
 variants:
   good: {}
