@@ -233,6 +233,22 @@ PoseMatrix6d DegeneracyPriorSqrtInformation(const DegeneracyOptions& options,
   return S;
 }
 
+LeastSquaresDegeneracy TreatLeastSquaresDegeneracy(const DegeneracyOptions& options,
+                                                   const ConstraintList& constraints,
+                                                   const Pose3& T_world_imu,
+                                                   const Pose3& T_imu_lidar, double lidar_noise) {
+  LeastSquaresDegeneracy out;
+  out.report.method = options.method;
+  if (options.method == DegeneracyMethod::kRv || options.method == DegeneracyMethod::kNone)
+    return out;
+  const DegeneracyTreatment t =
+      AnalyzeDegeneracy(options, ScanPoseInformation(constraints, T_world_imu, T_imu_lidar),
+                        constraints, T_world_imu, T_imu_lidar);
+  out.report = t.report;
+  out.sqrt_information = DegeneracyPriorSqrtInformation(options, t, &out.has_prior) / lidar_noise;
+  return out;
+}
+
 void ProjectOutHeld(const DegeneracyTreatment& t, Eigen::Ref<PoseVector6d> dx_pose) {
   for (int i = 0; i < t.num_held; ++i) {
     const PoseVector6d v = t.held_pose.col(i);

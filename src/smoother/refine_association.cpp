@@ -152,13 +152,11 @@ void TreatRefineDegeneracy(const RefineConfig& config, const Pose3& T_world_imu,
     all = &w->all;
   }
   if (static_cast<int>(all->size()) < kMinPoseConstraints) return;
-  const DegeneracyTreatment t = AnalyzeDegeneracy(
-      config.degeneracy, ScanPoseInformation(*all, T_world_imu, config.T_imu_lidar), *all,
-      T_world_imu, config.T_imu_lidar);
-  f->degeneracy = t.report;
-  f->degeneracy_sqrt_information =
-      DegeneracyPriorSqrtInformation(config.degeneracy, t, &f->has_degeneracy_prior) /
-      config.constraints.lidar_noise;
+  const LeastSquaresDegeneracy d = TreatLeastSquaresDegeneracy(
+      config.degeneracy, *all, T_world_imu, config.T_imu_lidar, config.constraints.lidar_noise);
+  f->degeneracy = d.report;
+  f->has_degeneracy_prior = d.has_prior;
+  f->degeneracy_sqrt_information = d.sqrt_information;
 }
 
 }  // namespace

@@ -349,22 +349,17 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
 
 // remap, localizability, regularized: the scan's pose information at the
 // pose of this association (with the Huber weights the plane factor uses;
-// RV is off for these methods) -> the method's weak directions (AnalyzeDegeneracy, as
-// in the IESKF) -> a prior at the node's anchor along them (sigma: the
+// RV is off for these methods) -> the method's weak directions and prior (TreatLeastSquaresDegeneracy,
+// shared with refine) -> a prior at the node's anchor along them (sigma: the
 // plane factor's lidar_noise, so the prior is in the scan's units).
 void SlidingWindow::TreatDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar,
                                     Node* node) const {
-  const DegeneracyMethod method = options_.degeneracy.method;
-  if (method == DegeneracyMethod::kRv || method == DegeneracyMethod::kNone) return;
-  const DegeneracyTreatment t = AnalyzeDegeneracy(
-      options_.degeneracy, ScanPoseInformation(node->constraints, T_world_imu, T_imu_lidar),
-      node->constraints, T_world_imu, T_imu_lidar);
-  node->degeneracy = t.report;
-  bool has_prior = false;
-  const PoseMatrix6d S = DegeneracyPriorSqrtInformation(options_.degeneracy, t, &has_prior);
-  if (has_prior)
-    node->degeneracy_prior = std::make_unique<PosePriorFactor>(
-        node->anchor, S / options_.constraints.lidar_noise);
+  const LeastSquaresDegeneracy d =
+      TreatLeastSquaresDegeneracy(options_.degeneracy, node->constraints, T_world_imu,
+                                  T_imu_lidar, options_.constraints.lidar_noise);
+  node->degeneracy = d.report;
+  if (d.has_prior)
+    node->degeneracy_prior = std::make_unique<PosePriorFactor>(node->anchor, d.sqrt_information);
 }
 
 // Finite but absurd records (a plane 1e300 m away) overflow the summary:

@@ -97,6 +97,22 @@ PoseMatrix6d DegeneracyPriorSqrtInformation(const DegeneracyOptions& options,
                                             const DegeneracyTreatment& t,
                                             bool* has_prior = nullptr);
 
+// The degeneracy stage of the least-squares backends (the smoother, refine)
+// for one scan: its constraints' pose information at T_world_imu
+// (ScanPoseInformation) -> AnalyzeDegeneracy -> the prior
+// (DegeneracyPriorSqrtInformation) in the scan's units, i.e. divided by
+// lidar_noise (m). rv and none: no analysis, no prior; the report names the
+// method.
+struct LeastSquaresDegeneracy {
+  DegeneracyReport report;
+  bool has_prior = false;
+  PoseMatrix6d sqrt_information = PoseMatrix6d::Zero();
+};
+LeastSquaresDegeneracy TreatLeastSquaresDegeneracy(const DegeneracyOptions& options,
+                                                   const ConstraintList& constraints,
+                                                   const Pose3& T_world_imu,
+                                                   const Pose3& T_imu_lidar, double lidar_noise);
+
 // Analyzes one scan. pose_information: the pose block of sum_i w_i h_i^T h_i
 // (sigma = 1); constraints and the poses give the per-constraint rows for
 // localizability (other methods do not read them).
