@@ -12,6 +12,7 @@
 #include "ouster_source.h"
 #include "ros1_messages.h"
 #include "rosbag_common.h"
+#include "sensor_reader_common.h"
 #include "rvlio/io/recording.h"
 #include "rvlio/io/sensor_bag.h"
 
@@ -176,23 +177,9 @@ class RosbagSensorReader final : public SensorBagReader {
 
 }  // namespace
 
-StatusOr<std::unique_ptr<SensorBagReader>> SensorBagReader::Open(
+StatusOr<std::unique_ptr<SensorBagReader>> bag_detail::OpenRos1SensorReader(
     const std::string& path, const LidarOptions& lidar, const ImuOptions& imu,
     const std::optional<ReceiveTimeRange>& range) {
-  StatusOr<RecordingKind> kind = DetectRecording(path);
-  if (!kind.ok()) return kind.status();
-  StatusOr<bool> packets = bag_detail::HoldsOusterPackets(path, *kind, lidar.topic);
-  if (!packets.ok()) return packets.status();
-  if (*packets) {
-    StatusOr<std::unique_ptr<bag_detail::OusterPacketSource>> source =
-        *kind == RecordingKind::kPcap
-            ? bag_detail::OpenOusterPcapSource(path, lidar.ouster_metadata, range)
-            : bag_detail::OpenOusterBagSource(path, *kind, lidar.ouster_metadata, range);
-    if (!source.ok()) return source.status();
-    return bag_detail::OpenOusterReader(std::move(source).value(), lidar, imu);
-  }
-  if (*kind != RecordingKind::kRos1Bag)
-    return bag_detail::OpenRos2SensorReader(path, lidar, imu, range);
   auto reader = std::make_unique<RosbagSensorReader>(path, lidar, imu);
   if (Status s = reader->Init(range); !s.ok()) return s;
   return std::unique_ptr<SensorBagReader>(std::move(reader));

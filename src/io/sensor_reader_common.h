@@ -66,4 +66,9 @@ StatusOr<std::unique_ptr<SensorBagReader>> OpenRos2SensorReader(
     const std::string& path, const LidarOptions& lidar, const ImuOptions& imu,
     const std::optional<ReceiveTimeRange>& range);
 
+// The SensorBagReader of a ROS1 bag; src/io/sensor_bag_reader.cpp.
+StatusOr<std::unique_ptr<SensorBagReader>> OpenRos1SensorReader(
+    const std::string& path, const LidarOptions& lidar, const ImuOptions& imu,
+    const std::optional<ReceiveTimeRange>& range);
+
 }  // namespace rvlio::bag_detail
