@@ -11,6 +11,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
+# Ninja when installed (scripts/install_deps.sh installs it): it compiles a
+# target's sources while the libraries it links are still being built, where
+# Makefiles wait for each library, so no core idles between them. A build
+# folder keeps the generator it was first configured with.
+command -v ninja >/dev/null && export CMAKE_GENERATOR=${CMAKE_GENERATOR:-Ninja}
 targets=()
 configure_args=()
 while [[ $# -gt 0 ]]; do
