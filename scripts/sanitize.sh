@@ -102,7 +102,7 @@ ex=(
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}
 
-cmake -S . -B "$build_dir" -DRVLIO_SANITIZE=ON -DRVLIO_BUILD_BENCH=OFF -DRVLIO_WERROR=ON \
+cmake -S . -B "$build_dir" -DRVLIO_SANITIZE=ON -DRVLIO_BUILD_BENCH=OFF -DRVLIO_WERROR=ON -DRVLIO_UNITY_BUILD=all \
   -DCMAKE_C_COMPILER=gcc -DCMAKE_CXX_COMPILER=g++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1" >/dev/null
