@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config git ccache
+  build-essential cmake ninja-build pkg-config git ccache
   libeigen3-dev libceres-dev libsuitesparse-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
   libpcl-dev libzstd-dev liblz4-dev libdeflate-dev zlib1g-dev
@@ -22,10 +22,11 @@ packages=(
 # Slurm controller, node daemon, client and munge for scripts/slurm_local.sh;
 # GNU time for the peak memory of scripts/refine_scaling.sh; scipy for the
 # independent check of the map metrics in python/tests/test_evaluate_map.py;
-# chromium for the headless browser test of report.html).
+# chromium for the headless browser test of report.html; lld, the faster
+# linker the build uses when it is installed).
 if [[ "${1:-}" == "--with-test-tools" ]]; then
   packages+=(python3-pytest python3-scipy snakemake clang-14 libclang-rt-14-dev llvm-14 munge slurmctld slurmd slurm-client)
-  packages+=(time chromium)
+  packages+=(time chromium lld)
 fi
 
 missing=()

@@ -50,6 +50,8 @@ count_tests() {
 
 bash scripts/install_deps.sh --with-test-tools
 finish_stage deps
+# Every stage's new build folder is configured for Ninja (scripts/build.sh).
+command -v ninja >/dev/null && export CMAKE_GENERATOR=${CMAKE_GENERATOR:-Ninja}
 
 # run_stage NAME COMMAND...: one stage whose output names its count of tests.
 run_stage() {

@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "rvlio/common/memory.h"
+
 namespace rvlio {
 
 const PointCloudField* PointCloudFile::Field(const std::string& name) const {
@@ -380,9 +382,11 @@ Status PlanFields(const std::string& path, const FileLayout& layout, bool keep_f
 
 void PrepareCloud(const FileLayout& layout, const FieldPlan& plan, PointCloudFile* cloud) {
   const size_t n = static_cast<size_t>(layout.num_points);
+  ReserveWithHugePages(&cloud->points, n);
   cloud->points.resize(n);
   for (int f : plan.kept) {
     cloud->fields.push_back(PointCloudField{layout.fields[f].name, {}});
+    ReserveWithHugePages(&cloud->fields.back().values, n);
     cloud->fields.back().values.resize(n);
   }
 }
@@ -474,6 +478,7 @@ Status ReadWholeFile(const std::string& path, std::string* text) {
   const std::streamoff size = in.tellg();
   in.seekg(0, std::ios::beg);
   if (size >= 0 && in) {
+    ReserveWithHugePages(text, static_cast<size_t>(size));
     text->resize(static_cast<size_t>(size));
     in.read(text->data(), size);
     if (in.gcount() != size) return Status::InvalidInput(path + ": read error (changed while read?)");

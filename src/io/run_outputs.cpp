@@ -6,10 +6,6 @@
 #include <fstream>
 #include <sstream>
 
-#include <pcl/io/pcd_io.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/extrinsic_json.h"
 #include "rvlio/io/point_cloud_file.h"
@@ -17,15 +13,21 @@
 namespace rvlio {
 namespace {
 
-// A valid PCD with no points (PCL refuses to write an empty cloud).
-std::string EmptyPcd() {
-  return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
-         "TYPE F F F\nCOUNT 1 1 1\nWIDTH 0\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\n"
-         "DATA binary\n";
+// The header of a binary PCD (v0.7) of n unorganized float32 points with the
+// fields x y z, plus `extra_field` when it is not empty: byte for byte the
+// header PCL's PCDWriter::writeBinary writes for such a cloud (test
+// MapPcdIsWhatPclWritesAndReads), also for n = 0, which PCL refuses to write.
+std::string PcdBinaryHeader(size_t n, const std::string& extra_field) {
+  const bool extra = !extra_field.empty();
+  const std::string count = std::to_string(n);
+  return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z" +
+         (extra ? " " + extra_field : std::string()) + "\nSIZE 4 4 4" + (extra ? " 4" : "") +
+         "\nTYPE F F F" + (extra ? " F" : "") + "\nCOUNT 1 1 1" + (extra ? " 1" : "") +
+         "\nWIDTH " + count + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + count +
+         "\nDATA binary\n";
 }
 
 constexpr size_t kPcdBlockPoints = 1 << 15;  // points per Append of map.pcd
-
 
 // The six extrinsic columns of a scan (empty if the scan carries no estimate).
 void WriteExtrinsicColumns(const std::optional<Pose3>& T_imu_lidar, std::ostream& os) {
@@ -58,31 +60,14 @@ Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& 
   return WriteMapPcd(path, p_world, nullptr);
 }
 
-namespace {
-
-// The header of a binary PCD of n points with fields x y z and `field` (float32).
-std::string PcdHeaderWithField(size_t n, const std::string& field) {
-  const std::string count = std::to_string(n);
-  return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z " + field +
-         "\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " + count +
-         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + count + "\nDATA binary\n";
-}
-
-}  // namespace
-
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world,
                    const std::vector<double>* deviation_m) {
-  // PCL's own writer maps the file into memory after fallocate and throws on
-  // failure; a full disk must instead be a clean error that leaves no half
-  // file. So PCL only makes the header and the points go through the atomic
-  // writer, byte for byte what PCDWriter::writeBinary produces.
-  const pcl::PointCloud<pcl::PointXYZ> no_points;  // the header needs only the fields
+  // Not PCL's writer: it maps the file into memory after fallocate and throws
+  // on failure, where a full disk must be a clean error that leaves no half
+  // file. The points go through the atomic writer, byte for byte what
+  // PCDWriter::writeBinary produces.
   const std::string header =
-      deviation_m != nullptr ? PcdHeaderWithField(p_world.size(), "deviation_m")
-      : p_world.empty()
-          ? EmptyPcd()
-          : pcl::PCDWriter::generateHeader(no_points, static_cast<int>(p_world.size())) +
-                "DATA binary\n";
+      PcdBinaryHeader(p_world.size(), deviation_m != nullptr ? "deviation_m" : "");
   const size_t fields = deviation_m != nullptr ? 4 : 3;
   AtomicFileWriter writer;
   if (Status s = writer.Open(path); !s.ok()) return s;

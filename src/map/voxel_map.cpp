@@ -10,6 +10,7 @@
 #endif
 
 #include "rvlio/common/check.h"
+#include "rvlio/common/memory.h"
 #include "rvlio/map/voxel_order.h"
 
 namespace rvlio {
@@ -198,6 +199,10 @@ void VoxelMap::InsertSlot(const Slot& s) {
 }
 
 void VoxelMap::Rebuild(size_t capacity, const std::vector<Slot>& slots) {
+  if (slots_.capacity() < capacity) {
+    std::vector<Slot>().swap(slots_);
+    ReserveWithHugePages(&slots_, capacity);
+  }
   slots_.assign(capacity, Slot());
   mask_ = capacity - 1;
   num_voxels_ = slots.size();
@@ -244,6 +249,8 @@ int32_t VoxelMap::AllocateBlock(int capacity) {
   }
   const size_t offset = pool_.size();
   RVLIO_CHECK(offset + 3 * capacity < static_cast<size_t>(std::numeric_limits<int32_t>::max()));
+  if (offset + 3 * capacity > pool_.capacity())  // grown geometrically, as resize would
+    ReserveWithHugePages(&pool_, std::max(2 * pool_.capacity(), offset + 3 * capacity));
   pool_.resize(offset + 3 * capacity);
   return static_cast<int32_t>(offset);
 }
@@ -332,7 +339,7 @@ size_t VoxelMap::InsertInVoxelOrder(const std::vector<Eigen::Vector3d>& p_world,
   }
   close_run(order.size());
   ReserveSlots(num_voxels_ + run_begin.size());
-  pool_.reserve(pool_.size() + num_floats);
+  ReserveWithHugePages(&pool_, pool_.size() + num_floats);
   // Pass 2: each run's block sized once, then its points in order.
   const size_t before = num_points_;
   run_begin.push_back(order.size());

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "rvlio/common/check.h"
+#include "rvlio/common/memory.h"
 #include "rvlio/map/voxel_key.h"
 
 namespace rvlio {
@@ -48,7 +49,9 @@ std::vector<uint64_t> PackedKeys(const std::vector<Eigen::Vector3d>& points, dou
   // merge along z; the order stays spatially coherent).
   const int drop_z = std::max(0, bx + by + bz - 63);
   *bits = bx + by + bz - drop_z;
-  std::vector<uint64_t> packed(points.size(), kUnkeyable);
+  std::vector<uint64_t> packed;
+  ReserveWithHugePages(&packed, points.size());
+  packed.assign(points.size(), kUnkeyable);
   for (size_t i = 0; i < points.size(); ++i) {
     if (!keyable(points[i])) continue;
     const VoxelKey k = KeyOf(points[i], inv_voxel_size);
@@ -67,7 +70,9 @@ std::vector<uint32_t> VoxelOrder(const std::vector<Eigen::Vector3d>& points, dou
   const size_t n = points.size();
   int bits = 0;
   std::vector<uint64_t> keys = PackedKeys(points, 1.0 / voxel_size_m, &bits);
-  std::vector<uint32_t> order(n);
+  std::vector<uint32_t> order;
+  ReserveWithHugePages(&order, n);
+  order.resize(n);
   for (size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
   // Unkeyable points carry all ones: they sort after every key of `bits`
   // bits once one more bit is looked at.
@@ -79,6 +84,8 @@ std::vector<uint32_t> VoxelOrder(const std::vector<Eigen::Vector3d>& points, dou
   // pass over 12 bytes per point for nothing).
   std::unique_ptr<uint64_t[]> keys_tmp(new uint64_t[n]);
   std::unique_ptr<uint32_t[]> order_tmp(new uint32_t[n]);
+  AdviseHugePages(keys_tmp.get(), n * sizeof(uint64_t));
+  AdviseHugePages(order_tmp.get(), n * sizeof(uint32_t));
   uint64_t *keys_from = keys.data(), *keys_to = keys_tmp.get();
   uint32_t *order_from = order.data(), *order_to = order_tmp.get();
   for (int shift = 0; shift < bits; shift += kDigitBits) {

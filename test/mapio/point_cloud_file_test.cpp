@@ -15,8 +15,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -106,6 +108,47 @@ TEST_F(PointCloudFileTest, MapWithADeviationFieldReadsAsPointsAndField) {
   EXPECT_FLOAT_EQ(field->values[0], 0.012f);
   EXPECT_TRUE(std::isnan(field->values[1]));
   EXPECT_FLOAT_EQ(field->values[2], -0.03f);
+}
+
+// rvlio writes map.pcd itself (atomically, without PCL): the file must be
+// byte for byte what PCL's binary writer makes of the same cloud, and PCL's
+// reader must take the map with its deviation_m field (what CloudCompare and
+// the PCL viewers show as a scalar field).
+TEST_F(PointCloudFileTest, MapPcdIsWhatPclWritesAndReads) {
+  const std::vector<Eigen::Vector3d> points = {{1, 2, 3}, {-4.5, 0.25, 7}, {0, 0, -1}};
+  ASSERT_TRUE(WriteMapPcd(Path("ours.pcd"), points).ok());
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (const Eigen::Vector3d& p : points)
+    cloud.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                  static_cast<float>(p.z())));
+  ASSERT_EQ(pcl::PCDWriter().writeBinary(Path("pcl.pcd"), cloud), 0);
+  auto bytes = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  EXPECT_EQ(bytes(Path("ours.pcd")), bytes(Path("pcl.pcd")));
+
+  const std::vector<double> deviation_m = {0.012, std::numeric_limits<double>::quiet_NaN(), -0.03};
+  ASSERT_TRUE(WriteMapPcd(Path("deviation.pcd"), points, &deviation_m).ok());
+  pcl::PCLPointCloud2 blob;
+  ASSERT_EQ(pcl::io::loadPCDFile(Path("deviation.pcd"), blob), 0);
+  ASSERT_EQ(blob.width * blob.height, points.size());
+  int field = -1;
+  for (size_t i = 0; i < blob.fields.size(); ++i)
+    if (blob.fields[i].name == "deviation_m") field = static_cast<int>(i);
+  ASSERT_GE(field, 0);
+  ASSERT_EQ(blob.fields[field].datatype, pcl::PCLPointField::FLOAT32);
+  std::vector<float> read(points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+    std::memcpy(&read[i], &blob.data[i * blob.point_step + blob.fields[field].offset],
+                sizeof(float));
+  EXPECT_FLOAT_EQ(read[0], 0.012f);
+  EXPECT_TRUE(std::isnan(read[1]));
+  EXPECT_FLOAT_EQ(read[2], -0.03f);
+  pcl::PointCloud<pcl::PointXYZ> xyz;
+  ASSERT_EQ(pcl::io::loadPCDFile(Path("deviation.pcd"), xyz), 0);
+  ASSERT_EQ(xyz.size(), points.size());
+  EXPECT_FLOAT_EQ(xyz[1].x, -4.5f);
 }
 
 TEST_F(PointCloudFileTest, ReadsPclPlyAsciiAndBinary) {
