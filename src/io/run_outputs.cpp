@@ -10,6 +10,8 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include "rvlio/common/median.h"
+#include "rvlio/common/text.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/point_cloud_file.h"
 #include "rvlio/odometry/scan_columns.h"
@@ -85,17 +87,6 @@ StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path) {
   return std::move(cloud->points);
 }
 
-namespace {
-// A statistic that may be unknown (NaN): an empty field.
-std::string Optional(double v) {
-  if (!std::isfinite(v)) return "";
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-}  // namespace
-
 std::string FormatSeconds(TimeNs t_ns) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.9f", NsToSeconds(t_ns));
@@ -106,7 +97,8 @@ Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& res
                      const std::vector<double>& rss_mb) {
   const std::vector<const ScanColumn*> columns = ScanColumnsOf(results);
   std::string csv;
-  for (const ScanColumn* c : columns) csv += (c == columns.front() ? "" : ",") + std::string(c->name);
+  for (const ScanColumn* c : columns)
+    csv += (c == columns.front() ? "" : ",") + std::string(c->name);
   csv += '\n';
   for (size_t i = 0; i < results.size(); ++i) {
     const ScanRecord record{results[i], i < rss_mb.size() ? rss_mb[i] : std::nan("")};
@@ -127,10 +119,12 @@ Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin
   }
   os << '\n';
   for (const DeviationBin& b : bins) {
-    os << b.chainage_m << ',' << b.count << ',' << Optional(b.median_m) << ','
-       << Optional(b.median_abs_m) << ',' << Optional(b.p95_abs_m) << ',' << Optional(b.max_abs_m);
+    os << b.chainage_m << ',' << b.count << ',' << FormatFinite(b.median_m, 6) << ','
+       << FormatFinite(b.median_abs_m, 6) << ',' << FormatFinite(b.p95_abs_m, 6) << ','
+       << FormatFinite(b.max_abs_m, 6);
     for (const DeviationBin::Side& s : b.sides)
-      os << ',' << s.count << ',' << Optional(s.median_m) << ',' << Optional(s.p95_abs_m);
+      os << ',' << s.count << ',' << FormatFinite(s.median_m, 6) << ','
+         << FormatFinite(s.p95_abs_m, 6);
     os << '\n';
   }
   return WriteFileAtomically(path, os.str());
@@ -192,7 +186,7 @@ TimingStats ComputeTimingStats(const std::vector<ScanResult>& results) {
   }
   std::sort(ms.begin(), ms.end());
   const size_t n = ms.size();
-  s.median_ms = n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+  s.median_ms = Median(ms);
   s.p95_ms = ms[std::min(n - 1, static_cast<size_t>(0.95 * static_cast<double>(n)))];
   s.max_ms = ms.back();
   return s;

@@ -137,10 +137,14 @@ const std::vector<ScanColumn> kColumns = {
 
 bool Carries(const ScanResult& r, ScanColumnGroup group) {
   switch (group) {
-    case G::kAlways: return true;
-    case G::kExtrinsic: return r.T_imu_lidar.has_value();
-    case G::kTimeOffset: return r.time_offset_s.has_value();
-    case G::kReference: return r.map_overlap.has_value();
+    case G::kAlways:
+      return true;
+    case G::kExtrinsic:
+      return r.T_imu_lidar.has_value();
+    case G::kTimeOffset:
+      return r.time_offset_s.has_value();
+    case G::kReference:
+      return r.map_overlap.has_value();
   }
   return false;
 }

@@ -32,13 +32,46 @@ std::string Cell(const std::string& name, const ScanResult& scan, double rss_mb 
 TEST(ScanColumnsTest, ColumnsEveryRunHasKeepTheirCsvOrderWithTheVelocityAfterThem) {
   // The order readers of scans.csv by position rely on; vx vy vz come after
   // the columns scans.csv always had.
-  const std::vector<std::string> expected = {
-      "t", "status", "raw_points", "points", "constraints", "iterations", "rv_active",
-      "n_alpha_x", "n_alpha_y", "n_alpha_z", "scv", "coplanar", "repaired", "K", "rv_iterations",
-      "coplanar_fraction", "localizability", "ms", "x", "y", "z", "acc_x", "acc_y", "acc_z",
-      "rss_mb", "reinforced", "nis", "residual_median_m", "residual_rms_m", "diverged",
-      "degeneracy_method", "degenerate", "weak_dirs", "weak_dir_x", "weak_dir_y", "weak_dir_z",
-      "condition_number", "vx", "vy", "vz"};
+  const std::vector<std::string> expected = {"t",
+                                             "status",
+                                             "raw_points",
+                                             "points",
+                                             "constraints",
+                                             "iterations",
+                                             "rv_active",
+                                             "n_alpha_x",
+                                             "n_alpha_y",
+                                             "n_alpha_z",
+                                             "scv",
+                                             "coplanar",
+                                             "repaired",
+                                             "K",
+                                             "rv_iterations",
+                                             "coplanar_fraction",
+                                             "localizability",
+                                             "ms",
+                                             "x",
+                                             "y",
+                                             "z",
+                                             "acc_x",
+                                             "acc_y",
+                                             "acc_z",
+                                             "rss_mb",
+                                             "reinforced",
+                                             "nis",
+                                             "residual_median_m",
+                                             "residual_rms_m",
+                                             "diverged",
+                                             "degeneracy_method",
+                                             "degenerate",
+                                             "weak_dirs",
+                                             "weak_dir_x",
+                                             "weak_dir_y",
+                                             "weak_dir_z",
+                                             "condition_number",
+                                             "vx",
+                                             "vy",
+                                             "vz"};
   EXPECT_EQ(Names(ScanColumnsOf({})), expected);
   EXPECT_EQ(Names(ScanColumnsOf({ScanResult()})), expected);
 }
@@ -100,7 +133,7 @@ TEST(ScanColumnsTest, CellsAreWrittenInTheirColumnsFormat) {
   EXPECT_EQ(Cell("rss_mb", r, std::nan("")), "nan");  // not measured
   EXPECT_EQ(Cell("diverged", r), DivergenceKindNames(r.health.divergence_mask));
   EXPECT_EQ(Column("diverged").value(ScanRecord{r, 0.0}), 1.0);  // numeric readers: a flag
-  EXPECT_EQ(Cell("weak_dir_x", r), "");  // no weak direction
+  EXPECT_EQ(Cell("weak_dir_x", r), "");                          // no weak direction
   EXPECT_EQ(Cell("condition_number", r), "inf");
 }
 

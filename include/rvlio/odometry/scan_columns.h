@@ -43,7 +43,7 @@ struct ScanColumn {
   ScanValueType type;
   ScanCsvFormat format;
   ScanColumnGroup group;
-  double (*value)(const ScanRecord&);       // numeric value (flags 0/1); null for text only
+  double (*value)(const ScanRecord&);      // numeric value (flags 0/1); null for text only
   std::string (*text)(const ScanRecord&);  // text form written to the CSV; null: the value
 };
 
