@@ -1,5 +1,5 @@
 #pragma once
-// The files `rvlio run` writes (docs/design.md section 7), each atomically.
+// The files `rvlio run` writes (docs/design.md "The command-line contract"), each atomically.
 #include <string>
 #include <utility>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 // The sliding-window smoother backend of the odometry pipeline (see
-// odometry.h; docs/design.md section 6; the window itself: smoother/window.h).
+// odometry.h; docs/design.md "The backends"; the window itself: smoother/window.h).
 //
 // Per scan: Predict (IMU integration from the newest window state) ->
 // Downsample -> Deskew (with the predicted motion) -> add the state with the
