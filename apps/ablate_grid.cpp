@@ -1,4 +1,5 @@
 #include "ablate_grid.h"
+#include "rvlio/common/text.h"
 #include "rvlio/io/summary_json.h"
 
 #include <sys/stat.h>
@@ -50,12 +51,6 @@ const Node* Find(const Node& map, const std::string& key) {
   for (size_t i = 0; i < map.keys.size(); ++i)
     if (map.keys[i] == key) return &map.items[i];
   return nullptr;
-}
-
-std::string Join(const std::vector<std::string>& items, const std::string& sep) {
-  std::string s;
-  for (const auto& i : items) s += (s.empty() ? "" : sep) + i;
-  return s;
 }
 
 // Every key of `map` must be one of `known`.

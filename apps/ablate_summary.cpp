@@ -8,6 +8,7 @@
 
 #include "ablate_runner.h"
 #include "plot_runner.h"
+#include "rvlio/common/text.h"
 #include "rvlio/io/atomic_file.h"
 
 namespace rvlio::cli::ablate {
@@ -41,13 +42,6 @@ std::string Csv(const std::string& s) {
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
-}
-
-std::string Num(double v) {
-  if (!std::isfinite(v)) return "";
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.12g", v);
-  return buf;
 }
 
 // Mean and sample standard deviation (n-1) of the finite values.
@@ -101,8 +95,8 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
       << (r.is_object() && r["exit_code"].is_number() ? std::to_string(r["exit_code"].get<int>())
                                                       : "");
     for (const auto& m : MetricNames(plan.HasRefMap()))
-      o << "," << Num(r.is_object() ? MetricOf(r, m) : NAN);
-    o << "," << Num(r.is_object() ? r.value("wall_s", NAN) : NAN) << ","
+      o << "," << FormatFinite(r.is_object() ? MetricOf(r, m) : NAN, 12);
+    o << "," << FormatFinite(r.is_object() ? r.value("wall_s", NAN) : NAN, 12) << ","
       << Csv(r.is_object() && r["error"].is_string() ? r["error"].get<std::string>() : "") << "\n";
   }
   return o.str();
@@ -149,7 +143,7 @@ std::string TableCsv(const Plan& plan, const std::vector<Group>& groups) {
     o << "," << g.cells << "," << g.done << "," << g.failed << "," << g.diverged;
     for (const auto& [m, header] : TableMetrics(with_map)) {
       const Stats s = Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>());
-      o << "," << Num(s.mean) << "," << Num(s.std);
+      o << "," << FormatFinite(s.mean, 12) << "," << FormatFinite(s.std, 12);
     }
     o << "\n";
   }

@@ -1,5 +1,5 @@
 // rvlio eval: ATE/RPE of an estimated trajectory against ground truth with the
-// definitions of evo (docs/design.md section 8), or with --map a map against
+// definitions of evo (docs/design.md "Evaluation"), or with --map a map against
 // a reference cloud (docs/map_eval.md). Argument parsing and output only;
 // EvaluateFiles / EvaluateMapFiles and EvalJson / MapEvalJson (rvlio/api.h)
 // do the work.

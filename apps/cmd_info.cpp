@@ -6,22 +6,11 @@
 
 #include "commands.h"
 #include "common_options.h"
+#include "rvlio/common/text.h"
 #include "rvlio/io/sensor_bag.h"
 
 namespace rvlio::cli {
 namespace {
-
-std::string Fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
-  return buf;
-}
-
-std::string Join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ",") + s;
-  return out;
-}
 
 void PrintCloud(const BagTopicInfo& t) {
   if (t.lidar_layout.empty()) return;
@@ -31,9 +20,9 @@ void PrintCloud(const BagTopicInfo& t) {
     std::cout << "    layout: " << t.lidar_layout << " (header stamp marks the scan "
               << t.header_stamp << ")\n";
   }
-  std::cout << "    fields: " << Join(t.fields) << "\n";
+  std::cout << "    fields: " << Join(t.fields, ",") << "\n";
   if (t.decode_error.empty()) {
-    std::cout << "    points per scan: " << Fixed(t.points_per_scan, 1) << " (mean of first "
+    std::cout << "    points per scan: " << FormatFixed(t.points_per_scan, 1) << " (mean of first "
               << t.scans_sampled << ")\n";
   }
 }
@@ -57,10 +46,10 @@ void PrintOuster(const OusterRecordingInfo& o) {
             << (o.crc ? " (CRC-64 checked)" : "") << ", IMU " << o.imu_profile << "\n"
             << "  lidar:    " << o.lidar_source << ", " << o.lidar_packets << " packets"
             << (o.lidar_packets == 0 ? " (no lidar packets: IMU samples only)" : "") << "\n"
-            << "  frames:   " << o.frames << " (" << Fixed(o.frame_rate_hz, 2) << " Hz), "
+            << "  frames:   " << o.frames << " (" << FormatFixed(o.frame_rate_hz, 2) << " Hz), "
             << o.incomplete_frames << " incomplete, " << o.missing_columns << " columns missing\n"
             << "  imu:      " << o.imu_source << ", " << o.imu_packets << " packets, "
-            << Fixed(o.imu_rate_hz, 1) << " Hz\n"
+            << FormatFixed(o.imu_rate_hz, 1) << " Hz\n"
             << "  dropped:  " << o.late_packets << " late packets, " << o.crc_errors
             << " CRC errors, " << o.imu_crc_errors << " IMU CRC errors\n";
 }
@@ -69,15 +58,15 @@ void Print(const BagInfo& info) {
   std::cout << "bag:      " << info.path << "\n"
             << "storage:  " << info.storage << "\n";
   if (!info.compressions.empty())
-    std::cout << "compression: " << Join(info.compressions) << "\n";
-  std::cout << "duration: " << Fixed(NsToSeconds(info.end_ns - info.start_ns), 3) << " s\n"
+    std::cout << "compression: " << Join(info.compressions, ",") << "\n";
+  std::cout << "duration: " << FormatFixed(NsToSeconds(info.end_ns - info.start_ns), 3) << " s\n"
             << "start:    " << Stamp(info.start_ns) << " s\n"
             << "end:      " << Stamp(info.end_ns) << " s\n"
             << "messages: " << info.messages << "\n"
             << "topics:\n";
   for (const auto& t : info.topics) {
     std::cout << "  " << t.topic << "  " << t.type << "  " << t.count << " msgs  "
-              << Fixed(t.rate_hz, 2) << " Hz\n";
+              << FormatFixed(t.rate_hz, 2) << " Hz\n";
     PrintCloud(t);
   }
   if (info.ouster) PrintOuster(*info.ouster);

@@ -1,5 +1,5 @@
 #pragma once
-// The subcommands of docs/design.md section 7. Each returns the process exit
+// The subcommands of docs/design.md "The command-line contract". Each returns the process exit
 // status: 0 success, 2 bad input or configuration, 1 internal failure.
 #include <string>
 

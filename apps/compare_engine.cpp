@@ -24,6 +24,7 @@
 #include "window_options.h"
 #include "rvlio/api.h"
 #include "rvlio/common/cpu_time.h"
+#include "rvlio/common/text.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/io/atomic_file.h"
@@ -140,17 +141,9 @@ std::string FixedOrDash(double v, int decimals) {
   return buf;
 }
 
-// Enough digits for the CSV to reproduce `rvlio eval --json` (10 significant).
-std::string Exact(double v) {
-  if (!std::isfinite(v)) return "";
-  char buf[48];
-  std::snprintf(buf, sizeof(buf), "%.10g", v);
-  return buf;
-}
-
 nlohmann::json Num(double v) {
   if (!std::isfinite(v)) return nullptr;
-  return std::strtod(Exact(v).c_str(), nullptr);
+  return std::strtod(FormatFinite(v, 10).c_str(), nullptr);
 }
 
 // What every row is evaluated against.
@@ -348,7 +341,8 @@ std::string CsvField(const std::string& text) {
 // The map columns (with --ref-map): accuracy RMS and completeness, or empty.
 std::string MapCsvFields(const Row& r) {
   if (!r.map_eval) return ",,";
-  return "," + Exact(r.map_eval->accuracy.rmse) + "," + Exact(r.map_eval->completeness);
+  return "," + FormatFinite(r.map_eval->accuracy.rmse, 10) + "," +
+         FormatFinite(r.map_eval->completeness, 10);
 }
 
 std::string CsvText(const std::vector<Row>& rows, bool with_map) {
@@ -360,9 +354,11 @@ std::string CsvText(const std::vector<Row>& rows, bool with_map) {
     os << r.name << "," << CsvField(r.label) << "," << r.StatusName() << ","
        << r.exit_code << "," << r.init << "," << r.scans;
     if (r.measured()) {
-      os << "," << Exact(r.eval->ape_m.rmse) << "," << Exact(r.eval->rpe.trans_m.rmse) << ","
-         << Exact(r.eval->along_axis.max_abs_m) << "," << Exact(r.eval->end_point_error_m) << ","
-         << Exact(r.ms_per_scan) << "," << Exact(r.real_time_factor);
+      os << "," << FormatFinite(r.eval->ape_m.rmse, 10) << ","
+         << FormatFinite(r.eval->rpe.trans_m.rmse, 10) << ","
+         << FormatFinite(r.eval->along_axis.max_abs_m, 10) << ","
+         << FormatFinite(r.eval->end_point_error_m, 10) << "," << FormatFinite(r.ms_per_scan, 10)
+         << "," << FormatFinite(r.real_time_factor, 10);
     } else {
       os << ",,,,,,";
     }

@@ -34,7 +34,7 @@ struct RunOutcome {
 };
 
 // Reads the bag, runs the odometry and writes the outputs of docs/design.md
-// section 7. Returns the exit status; errors are printed as one line.
+// "The command-line contract". Returns the exit status; errors are printed as one line.
 // While it runs, trajectory.partial.tum in the output folder receives each
 // pose as it is estimated (removed at an orderly end). Under an InterruptScope
 // (interrupt.h) a signal stops the reading: the outputs of the scans done so

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "rvlio/common/text.h"
+
 namespace rvlio::cli {
 namespace {
 
@@ -11,12 +13,6 @@ bool ParseSeconds(const std::string& text, double* value) {
   char* end = nullptr;
   *value = std::strtod(text.c_str(), &end);
   return !text.empty() && *end == '\0' && std::isfinite(*value);
-}
-
-std::string Text(double v) {
-  char text[40];
-  std::snprintf(text, sizeof(text), "%.17g", v);
-  return text;
 }
 
 }  // namespace
@@ -41,8 +37,9 @@ std::string ParseWindow(const Args& args, ReadWindow* window) {
 
 std::vector<std::string> WindowArgs(const ReadWindow& window) {
   std::vector<std::string> args;
-  if (window.start_s > 0.0) args.insert(args.end(), {"--start", Text(window.start_s)});
-  if (window.duration_s > 0.0) args.insert(args.end(), {"--duration", Text(window.duration_s)});
+  if (window.start_s > 0.0) args.insert(args.end(), {"--start", FormatG(window.start_s, 17)});
+  if (window.duration_s > 0.0)
+    args.insert(args.end(), {"--duration", FormatG(window.duration_s, 17)});
   return args;
 }
 

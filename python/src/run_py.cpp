@@ -13,7 +13,7 @@
 #include "config_py.h"
 #include "odometry_py.h"
 #include "rvlio/api.h"
-#include "rvlio/io/extrinsic_json.h"
+#include "rvlio/odometry/scan_columns.h"
 
 namespace rvlio::python {
 namespace {
@@ -23,111 +23,35 @@ constexpr const char* kStopReason = "KeyboardInterrupt";
 // while reading without new results at most this often.
 constexpr std::chrono::milliseconds kProgressPeriod{200};
 
-// The six extrinsic columns of scans.csv (NaN for a scan without an
-// estimate), only when some scan carries one.
-template <typename Column>
-void AddExtrinsicColumns(const std::vector<ScanResult>& scans, Column& column) {
-  if (std::none_of(scans.begin(), scans.end(),
-                   [](const ScanResult& r) { return r.T_imu_lidar.has_value(); }))
-    return;
-  const auto rpy_deg = [](const ScanResult& r, int i) {
-    return r.T_imu_lidar ? RpyDeg(r.T_imu_lidar->R)(i) : std::nan("");
-  };
-  const auto t_m = [](const ScanResult& r, int i) {
-    return r.T_imu_lidar ? r.T_imu_lidar->t(i) : std::nan("");
-  };
-  column("ext_roll_deg", [&](const ScanResult& r) { return rpy_deg(r, 0); });
-  column("ext_pitch_deg", [&](const ScanResult& r) { return rpy_deg(r, 1); });
-  column("ext_yaw_deg", [&](const ScanResult& r) { return rpy_deg(r, 2); });
-  column("ext_x_m", [&](const ScanResult& r) { return t_m(r, 0); });
-  column("ext_y_m", [&](const ScanResult& r) { return t_m(r, 1); });
-  column("ext_z_m", [&](const ScanResult& r) { return t_m(r, 2); });
-}
-
-// The time-offset columns of scans.csv (NaN for a scan without an
-// estimate), only when some scan carries one.
-template <typename Column>
-void AddTimeOffsetColumns(const std::vector<ScanResult>& scans, Column& column) {
-  if (std::none_of(scans.begin(), scans.end(),
-                   [](const ScanResult& r) { return r.time_offset_s.has_value(); }))
-    return;
-  column("time_offset_s",
-         [](const ScanResult& r) { return r.time_offset_s ? *r.time_offset_s : std::nan(""); });
-  column("time_offset_std_s", [](const ScanResult& r) {
-    return r.time_offset_s ? r.time_offset_std_s : std::nan("");
-  });
-}
-
-// The degeneracy columns of scans.csv (weak_dir_* NaN without a weak direction).
-template <class Column>
-void AddDegeneracyColumns(const std::vector<ScanResult>& scans, py::dict& table, Column& column) {
-  py::list method;
-  for (const ScanResult& r : scans) method.append(EnumName(r.degeneracy.method));
-  table["degeneracy_method"] = py::module_::import("numpy").attr("array")(method);
-  column("degenerate", [](const ScanResult& r) { return r.degeneracy.degenerate; });
-  column("weak_dirs", [](const ScanResult& r) { return r.degeneracy.num_weak; });
-  const char* names[] = {"weak_dir_x", "weak_dir_y", "weak_dir_z"};
-  for (int k = 0; k < 3; ++k)
-    column(names[k], [k](const ScanResult& r) {
-      return r.degeneracy.num_weak > 0 ? r.degeneracy.weak_dirs_world[0](k) : std::nan("");
-    });
-  column("condition_number", [](const ScanResult& r) { return r.degeneracy.condition_number; });
-}
-
-// The per-scan table: the columns of scans.csv as numpy arrays (one row per scan).
-py::dict ScanTable(const std::vector<ScanResult>& scans) {
-  const auto n = static_cast<py::ssize_t>(scans.size());
+// The per-scan table: the columns of scans.csv (odometry/scan_columns.h) as
+// numpy arrays, one row per scan: text columns as strings, flags as bool,
+// counts as int, the rest float (NaN: none).
+py::dict ScanTable(const std::vector<ScanResult>& scans, const std::vector<double>& rss_mb) {
   py::dict table;
-  auto column = [&](const char* name, auto value_of) {
-    using T = decltype(value_of(scans.front()));
-    py::array_t<T> a(n);
-    auto w = a.template mutable_unchecked<1>();
-    for (py::ssize_t i = 0; i < n; ++i) w(i) = value_of(scans[static_cast<size_t>(i)]);
-    table[name] = a;
-  };
   if (scans.empty()) return table;
-  column("t", [](const ScanResult& r) { return NsToSeconds(r.t_ns); });
-  py::list status;
-  for (const ScanResult& r : scans) status.append(ScanStatusName(r.status));
-  table["status"] = py::module_::import("numpy").attr("array")(status);
-  column("raw_points", [](const ScanResult& r) { return r.raw_points; });
-  column("points", [](const ScanResult& r) { return r.downsampled_points; });
-  column("constraints", [](const ScanResult& r) { return r.constraints; });
-  column("iterations", [](const ScanResult& r) { return r.iterations; });
-  column("rv_active", [](const ScanResult& r) { return r.rv.active; });
-  column("n_alpha_x", [](const ScanResult& r) { return r.rv.n_alpha.x(); });
-  column("n_alpha_y", [](const ScanResult& r) { return r.rv.n_alpha.y(); });
-  column("n_alpha_z", [](const ScanResult& r) { return r.rv.n_alpha.z(); });
-  column("scv", [](const ScanResult& r) { return r.rv.num_scv; });
-  column("coplanar", [](const ScanResult& r) { return r.rv.num_coplanar; });
-  column("repaired", [](const ScanResult& r) { return r.rv.num_repaired; });
-  column("K", [](const ScanResult& r) { return r.rv.K; });
-  column("rv_iterations", [](const ScanResult& r) { return r.rv.iterations; });
-  column("coplanar_fraction", [](const ScanResult& r) { return r.rv.coplanar_fraction; });
-  column("localizability", [](const ScanResult& r) { return r.rv.localizability; });
-  column("ms", [](const ScanResult& r) { return r.ms; });
-  column("x", [](const ScanResult& r) { return r.T_world_imu.t.x(); });
-  column("y", [](const ScanResult& r) { return r.T_world_imu.t.y(); });
-  column("z", [](const ScanResult& r) { return r.T_world_imu.t.z(); });
-  column("vx", [](const ScanResult& r) { return r.v_world_imu.x(); });
-  column("vy", [](const ScanResult& r) { return r.v_world_imu.y(); });
-  column("vz", [](const ScanResult& r) { return r.v_world_imu.z(); });
-  column("acc_x", [](const ScanResult& r) { return r.mean_acc_imu.x(); });
-  column("acc_y", [](const ScanResult& r) { return r.mean_acc_imu.y(); });
-  column("acc_z", [](const ScanResult& r) { return r.mean_acc_imu.z(); });
-  column("reinforced", [](const ScanResult& r) { return r.rv.num_reinforced; });
-  column("nis", [](const ScanResult& r) { return r.health.nis_per_dof; });
-  column("residual_median_m", [](const ScanResult& r) { return r.health.residual_median_m; });
-  column("residual_rms_m", [](const ScanResult& r) { return r.health.residual_rms_m; });
-  column("diverged", [](const ScanResult& r) { return r.health.divergence_mask != 0; });
-  AddDegeneracyColumns(scans, table, column);
-  AddExtrinsicColumns(scans, column);
-  AddTimeOffsetColumns(scans, column);
-  if (std::any_of(scans.begin(), scans.end(),
-                  [](const ScanResult& r) { return r.map_overlap.has_value(); })) {
-    column("map_overlap",
-           [](const ScanResult& r) { return r.map_overlap ? *r.map_overlap : std::nan(""); });
-    column("localized", [](const ScanResult& r) { return r.localized; });
+  const auto n = static_cast<py::ssize_t>(scans.size());
+  const auto record = [&](py::ssize_t i) {
+    const auto k = static_cast<size_t>(i);
+    return ScanRecord{scans[k], k < rss_mb.size() ? rss_mb[k] : std::nan("")};
+  };
+  const auto fill = [&](auto array, const ScanColumn& c) {
+    auto w = array.template mutable_unchecked<1>();
+    using T = typename decltype(array)::value_type;
+    for (py::ssize_t i = 0; i < n; ++i) w(i) = static_cast<T>(c.value(record(i)));
+    return array;
+  };
+  for (const ScanColumn* c : ScanColumnsOf(scans)) {
+    if (c->type == ScanValueType::kText) {
+      py::list text;
+      for (py::ssize_t i = 0; i < n; ++i) text.append(c->text(record(i)));
+      table[c->name] = py::module_::import("numpy").attr("array")(text);
+    } else if (c->type == ScanValueType::kFlag) {
+      table[c->name] = fill(py::array_t<bool>(n), *c);
+    } else if (c->type == ScanValueType::kInteger) {
+      table[c->name] = fill(py::array_t<int>(n), *c);
+    } else {
+      table[c->name] = fill(py::array_t<double>(n), *c);
+    }
   }
   return table;
 }
@@ -234,7 +158,7 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
   if (!r.read_error.ok()) Raise(r.read_error);
   RunOutput o;
   o.trajectory = TrajectoryArray(r.trajectory);
-  o.scans = ScanTable(r.scans);
+  o.scans = ScanTable(r.scans, r.rss_mb);
   o.summary = ToPython(r.summary);
   o.results = std::move(r.scans);
   o.poses = std::move(r.trajectory);

@@ -55,6 +55,19 @@ def test_run_result_table(py_run, cli_run):
     assert np.all(np.isnan(table["weak_dir_x"][~active]))
 
 
+def test_run_table_has_the_columns_of_scans_csv_in_its_order(py_run, cli_run):
+    # Both come from one table (odometry/scan_columns.h): same names, same order.
+    out, result = py_run
+    for folder in (cli_run, out):
+        header = (folder / "scans.csv").read_text().splitlines()[0].split(",")
+        assert list(result.scans) == header, folder
+    csv = np.genfromtxt(cli_run / "scans.csv", delimiter=",", names=True, dtype=None,
+                        encoding="utf-8")
+    for column in ("vx", "vy", "vz"):  # the velocity, in the CSV too
+        np.testing.assert_allclose(result.scans[column], csv[column], rtol=1e-8, atol=1e-12)
+    assert np.all(result.scans["rss_mb"] > 0)  # the memory, in the table too
+
+
 def test_odometry_scan_by_scan_equals_run(tunnel, py_run):
     _, result = py_run
     _, results = feed(tunnel["bag"], rvlio.Config.load(tunnel["config"]))

@@ -7,6 +7,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
+#include "rvlio/common/text.h"
+
 namespace rvlio {
 namespace {
 
@@ -20,13 +22,6 @@ Eigen::Matrix3Xd Positions(const Trajectory& trajectory) {
   return p;
 }
 
-std::string FormatRatio(double x) {
-  std::ostringstream os;
-  os.precision(3);
-  os << x;
-  return os.str();
-}
-
 // Why Umeyama should not be trusted for these matched poses; empty if fine.
 std::string UmeyamaConcern(const Trajectory& ref, const AlignOptions& options) {
   if (ref.size() < options.min_poses)
@@ -34,8 +29,8 @@ std::string UmeyamaConcern(const Trajectory& ref, const AlignOptions& options) {
            std::to_string(options.min_poses) + ")";
   const double ratio = LateralRatio(ref);
   if (!(ratio >= options.min_lateral_ratio))
-    return "reference positions are nearly collinear (lateral/axial spread " + FormatRatio(ratio) +
-           " < " + FormatRatio(options.min_lateral_ratio) +
+    return "reference positions are nearly collinear (lateral/axial spread " + FormatG(ratio, 3) +
+           " < " + FormatG(options.min_lateral_ratio, 3) +
            "): the rotation about the line is unobservable";
   return "";
 }

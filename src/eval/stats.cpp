@@ -3,18 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rvlio/common/median.h"
+
 namespace rvlio {
 namespace {
-
-// numpy.median: the middle value, or the mean of the two middle values.
-double Median(std::vector<double> v) {
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  const double upper = v[mid];
-  if (v.size() % 2 == 1) return upper;
-  const double lower = *std::max_element(v.begin(), v.begin() + mid);
-  return 0.5 * (lower + upper);
-}
 
 // numpy.percentile(v, 100 q) with linear interpolation between the two
 // order statistics around q (n - 1).

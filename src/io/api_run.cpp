@@ -1,5 +1,5 @@
 // RunRecording (rvlio/api.h): the odometry over a recording, with the outputs
-// of docs/design.md section 7 when an output folder is given. `rvlio run` is this
+// of docs/design.md "The command-line contract" when an output folder is given. `rvlio run` is this
 // call plus argument parsing, signals and the terminal lines.
 #include <algorithm>
 #include <cmath>

@@ -20,6 +20,8 @@
 #include <sstream>
 
 #include "rvlio/api.h"
+#include "rvlio/common/cpu_time.h"
+#include "rvlio/common/text.h"
 #include "rvlio/io/atomic_file.h"
 #include "rvlio/io/run_outputs.h"
 #include "rvlio/io/ouster.h"
@@ -96,42 +98,35 @@ std::string FlightSeedNote(const SimOptions& o) {
   return o.flight_seed >= 0 ? ", flight seed " + std::to_string(o.flight_seed) : "";
 }
 
-std::string NumberText(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
 // The estimator's sensor keys (odometry/options.h) as simulated. The noise
 // densities must be positive there; a noise-free simulation gets a tiny value.
 std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
                        const std::string& bag_file) {
-  auto density = [](double v) { return NumberText(std::max(v, 1e-9)); };
+  auto density = [](double v) { return FormatG(std::max(v, 1e-9), 10); };
   const auto& t = o.extrinsics.imu_T_lidar.translation;
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
   std::ostringstream y;
   y << "# Sensor configuration of the simulated sequence '" << name << "' (rvlio simulate, seed "
     << o.seed << FlightSeedNote(o) << ").\n# Use: rvlio run --bag " << bag_file << " --config "
-    << name
-    << ".yaml --out DIR\n"
+    << name << ".yaml --out DIR\n"
     << "lidar:\n"
     << "  topic: " << o.lidar.topic << "\n"
     << (livox ? "  type: livox\n" : "  type: ouster\n  header_stamp: start\n")
-    << "  min_range: " << NumberText(o.lidar.min_range) << "\n"
-    << "  max_range: " << NumberText(o.lidar.max_range) << "\n"
+    << "  min_range: " << FormatG(o.lidar.min_range, 10) << "\n"
+    << "  max_range: " << FormatG(o.lidar.max_range, 10) << "\n"
     << "imu:\n"
     << "  topic: " << o.imu.topic << "\n"
     << "  gyro_noise_density: " << density(o.imu.gyro_noise_density) << "\n"
     << "  accel_noise_density: " << density(o.imu.accel_noise_density) << "\n"
     << "  gyro_bias_random_walk: " << density(o.imu.gyro_bias_random_walk) << "\n"
     << "  accel_bias_random_walk: " << density(o.imu.accel_bias_random_walk) << "\n"
-    << "  gravity: " << NumberText(o.imu.gravity) << "\n"
+    << "  gravity: " << FormatG(o.imu.gravity, 10) << "\n"
     << "extrinsics:\n"
     << "  imu_T_lidar:\n"
-    << "    translation: [" << NumberText(t[0]) << ", " << NumberText(t[1]) << ", " << NumberText(t[2]) << "]\n"
-    << "    rotation_xyzw: [" << NumberText(q[0]) << ", " << NumberText(q[1]) << ", " << NumberText(q[2]) << ", "
-    << NumberText(q[3]) << "]\n";
+    << "    translation: [" << FormatG(t[0], 10) << ", " << FormatG(t[1], 10) << ", "
+    << FormatG(t[2], 10) << "]\n"
+    << "    rotation_xyzw: [" << FormatG(q[0], 10) << ", " << FormatG(q[1], 10) << ", "
+    << FormatG(q[2], 10) << ", " << FormatG(q[3], 10) << "]\n";
   // The resolved simulator options, as comments, so the sequence can be
   // reproduced (rvlio simulate --set KEY=VALUE for any of them).
   y << "\n# Simulator options of this sequence:\n";
@@ -271,8 +266,7 @@ Status RunSurvey(const sim::Simulator& simulator, SimulateResult* r,
   if (!survey.ok()) return survey.status();
   r->reference_map_points = static_cast<int64_t>(survey->p_world.size());
   r->reference_map_stations = static_cast<int>(survey->stations.size());
-  r->reference_map_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  r->reference_map_s = SecondsSince(wall0);
   *p_world = std::move(survey->p_world);
   return Status::Ok();
 }
@@ -320,7 +314,7 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   if (args.reference_map_only) {
     if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
     r.reference_map_path = map_path;
-    r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    r.wall_s = SecondsSince(wall0);
     r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
     return r;
   }
@@ -340,7 +334,7 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
           : WriteBag(**simulator, r.bag_path, livox, format, on_truth, args.stop, &r.stop_reason);
   if (!written.ok()) return written;
   if ((r.stopped = !r.stop_reason.empty())) return r;
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  r.wall_s = SecondsSince(wall0);
   r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
 
   r.gt_path = (dir / (name + "_gt.tum")).string();

@@ -18,13 +18,6 @@ nlohmann::json PoseJson(const Pose3& T) {
 
 }  // namespace
 
-Eigen::Vector3d RpyDeg(const Eigen::Matrix3d& R) {
-  const double pitch = std::asin(std::max(-1.0, std::min(1.0, -R(2, 0))));
-  const double roll = std::atan2(R(2, 1), R(2, 2));
-  const double yaw = std::atan2(R(1, 0), R(0, 0));
-  return Eigen::Vector3d(roll, pitch, yaw) * kRadToDeg;
-}
-
 nlohmann::json ExtrinsicJson(const ExtrinsicReport& r) {
   static const char* kAxes[6] = {"rot_x", "rot_y", "rot_z", "pos_x", "pos_y", "pos_z"};
   nlohmann::json excited = nlohmann::json::object(), ratio = nlohmann::json::object();

@@ -6,9 +6,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "rvlio/common/median.h"
+#include "rvlio/common/text.h"
 #include "rvlio/io/atomic_file.h"
-#include "rvlio/io/extrinsic_json.h"
 #include "rvlio/io/point_cloud_file.h"
+#include "rvlio/odometry/scan_columns.h"
 
 namespace rvlio {
 namespace {
@@ -28,31 +30,6 @@ std::string PcdBinaryHeader(size_t n, const std::string& extra_field) {
 }
 
 constexpr size_t kPcdBlockPoints = 1 << 15;  // points per Append of map.pcd
-
-// The six extrinsic columns of a scan (empty if the scan carries no estimate).
-void WriteExtrinsicColumns(const std::optional<Pose3>& T_imu_lidar, std::ostream& os) {
-  if (!T_imu_lidar) {
-    os << ",,,,,,";
-    return;
-  }
-  const Eigen::Vector3d rpy = RpyDeg(T_imu_lidar->R);
-  os << ',' << rpy.x() << ',' << rpy.y() << ',' << rpy.z() << ',' << T_imu_lidar->t.x() << ','
-     << T_imu_lidar->t.y() << ',' << T_imu_lidar->t.z();
-}
-
-// The degeneracy columns: method, degenerate, count of weak translation
-// directions, the weakest (world frame; empty without one), condition number.
-void WriteDegeneracyColumns(const DegeneracyReport& d, std::ostream& os) {
-  os << ',' << EnumName(d.method) << ',' << (d.degenerate ? 1 : 0) << ',' << d.num_weak;
-  if (d.num_weak > 0) {
-    const Eigen::Vector3d& w = d.weak_dirs_world[0];
-    os << ',' << w.x() << ',' << w.y() << ',' << w.z();
-  } else {
-    os << ",,,";
-  }
-  os << ',';
-  if (!std::isnan(d.condition_number)) os << d.condition_number;  // inf prints as inf
-}
 
 }  // namespace
 
@@ -96,17 +73,6 @@ StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path) {
   return std::move(cloud->points);
 }
 
-namespace {
-// A statistic that may be unknown (NaN): an empty field.
-std::string Optional(double v) {
-  if (!std::isfinite(v)) return "";
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
-}  // namespace
-
 std::string FormatSeconds(TimeNs t_ns) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.9f", NsToSeconds(t_ns));
@@ -115,55 +81,18 @@ std::string FormatSeconds(TimeNs t_ns) {
 
 Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
                      const std::vector<double>& rss_mb) {
-  std::ostringstream os;
-  os.precision(9);
-  os << "t,status,raw_points,points,constraints,iterations,rv_active,n_alpha_x,n_alpha_y,"
-        "n_alpha_z,scv,coplanar,repaired,K,rv_iterations,coplanar_fraction,localizability,"
-        "ms,x,y,z,acc_x,acc_y,acc_z,rss_mb,reinforced,nis,residual_median_m,"
-        "residual_rms_m,diverged,degeneracy_method,degenerate,weak_dirs,weak_dir_x,weak_dir_y,"
-        "weak_dir_z,condition_number";
-  // Online extrinsic estimation: its estimate after each scan (roll/pitch/yaw
-  // in degrees as in summary.json, translation in metres).
-  const bool extrinsic = std::any_of(results.begin(), results.end(),
-                                     [](const ScanResult& r) { return r.T_imu_lidar.has_value(); });
-  if (extrinsic) os << ",ext_roll_deg,ext_pitch_deg,ext_yaw_deg,ext_x_m,ext_y_m,ext_z_m";
-  // Online time-offset estimation: its estimate and 1-sigma after each scan (s).
-  const bool time_offset = std::any_of(results.begin(), results.end(), [](const ScanResult& r) {
-    return r.time_offset_s.has_value();
-  });
-  if (time_offset) os << ",time_offset_s,time_offset_std_s";
-  // Localization in a reference map (run --map).
-  const bool reference = std::any_of(results.begin(), results.end(),
-                                     [](const ScanResult& r) { return r.map_overlap.has_value(); });
-  if (reference) os << ",map_overlap,localized";
-  os << '\n';
+  const std::vector<const ScanColumn*> columns = ScanColumnsOf(results);
+  std::string csv;
+  for (const ScanColumn* c : columns)
+    csv += (c == columns.front() ? "" : ",") + std::string(c->name);
+  csv += '\n';
   for (size_t i = 0; i < results.size(); ++i) {
-    const ScanResult& r = results[i];
-    const RvReport& v = r.rv;
-    os << FormatSeconds(r.t_ns) << ',' << ScanStatusName(r.status) << ',' << r.raw_points << ','
-       << r.downsampled_points << ',' << r.constraints << ',' << r.iterations << ','
-       << (v.active ? 1 : 0) << ',' << v.n_alpha.x() << ',' << v.n_alpha.y() << ','
-       << v.n_alpha.z() << ',' << v.num_scv << ',' << v.num_coplanar << ',' << v.num_repaired
-       << ',' << v.K << ',' << v.iterations << ',' << v.coplanar_fraction << ','
-       << v.localizability << ',' << r.ms << ',' << r.T_world_imu.t.x() << ','
-       << r.T_world_imu.t.y() << ',' << r.T_world_imu.t.z() << ',' << r.mean_acc_imu.x() << ','
-       << r.mean_acc_imu.y() << ',' << r.mean_acc_imu.z() << ','
-       << (i < rss_mb.size() ? rss_mb[i] : std::nan("")) << ',' << v.num_reinforced << ','
-       << Optional(r.health.nis_per_dof) << ',' << Optional(r.health.residual_median_m) << ','
-       << Optional(r.health.residual_rms_m) << ',' << DivergenceKindNames(r.health.divergence_mask);
-    WriteDegeneracyColumns(r.degeneracy, os);
-    if (extrinsic) WriteExtrinsicColumns(r.T_imu_lidar, os);
-    if (time_offset) {
-      if (r.time_offset_s)
-        os << ',' << *r.time_offset_s << ',' << r.time_offset_std_s;
-      else
-        os << ",,";
-    }
-    if (reference)
-      os << ',' << (r.map_overlap ? Optional(*r.map_overlap) : "") << ',' << (r.localized ? 1 : 0);
-    os << '\n';
+    const ScanRecord record{results[i], i < rss_mb.size() ? rss_mb[i] : std::nan("")};
+    for (const ScanColumn* c : columns)
+      csv += (c == columns.front() ? "" : ",") + FormatScanCell(*c, record);
+    csv += '\n';
   }
-  return WriteFileAtomically(path, os.str());
+  return WriteFileAtomically(path, csv);
 }
 
 Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin>& bins) {
@@ -176,10 +105,12 @@ Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin
   }
   os << '\n';
   for (const DeviationBin& b : bins) {
-    os << b.chainage_m << ',' << b.count << ',' << Optional(b.median_m) << ','
-       << Optional(b.median_abs_m) << ',' << Optional(b.p95_abs_m) << ',' << Optional(b.max_abs_m);
+    os << b.chainage_m << ',' << b.count << ',' << FormatFinite(b.median_m, 6) << ','
+       << FormatFinite(b.median_abs_m, 6) << ',' << FormatFinite(b.p95_abs_m, 6) << ','
+       << FormatFinite(b.max_abs_m, 6);
     for (const DeviationBin::Side& s : b.sides)
-      os << ',' << s.count << ',' << Optional(s.median_m) << ',' << Optional(s.p95_abs_m);
+      os << ',' << s.count << ',' << FormatFinite(s.median_m, 6) << ','
+         << FormatFinite(s.p95_abs_m, 6);
     os << '\n';
   }
   return WriteFileAtomically(path, os.str());
@@ -241,7 +172,7 @@ TimingStats ComputeTimingStats(const std::vector<ScanResult>& results) {
   }
   std::sort(ms.begin(), ms.end());
   const size_t n = ms.size();
-  s.median_ms = n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+  s.median_ms = Median(ms);
   s.p95_ms = ms[std::min(n - 1, static_cast<size_t>(0.95 * static_cast<double>(n)))];
   s.max_ms = ms.back();
   return s;

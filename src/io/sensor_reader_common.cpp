@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "rvlio/common/median.h"
+
 namespace rvlio::bag_detail {
 
 constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
@@ -51,12 +53,6 @@ namespace {
 
 constexpr size_t kPointTimeCheckScans = 5;  // scans whose point-time spans are judged
 
-template <typename T>
-T Median(std::vector<T> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 // The per-point times of a sweeping LiDAR span about one scan period. Times
@@ -75,8 +71,8 @@ Status SensorGate::CheckPointTimes(const Scan& scan) {
     if (first_starts_ns_[k] > first_starts_ns_[k - 1])
       periods_ns.push_back(first_starts_ns_[k] - first_starts_ns_[k - 1]);
   if (periods_ns.empty()) return Status::Ok();  // stamps do not advance: judged elsewhere
-  const double period_s = NsToSeconds(Median(periods_ns));
-  const double span_s = NsToSeconds(Median(first_spans_ns_));
+  const double period_s = NsToSeconds(UpperMedian(periods_ns));
+  const double span_s = NsToSeconds(UpperMedian(first_spans_ns_));
   stats_.point_time_span_ratio = span_s / period_s;
   if (stats_.point_time_span_ratio >= lidar_.point_time_span_stop) return Status::Ok();
   char text[400];

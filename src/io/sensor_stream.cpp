@@ -12,6 +12,8 @@
 #include <thread>
 #include <utility>
 
+#include "rvlio/common/text.h"
+
 namespace rvlio {
 namespace {
 
@@ -294,27 +296,22 @@ class ThreadedReader final : public SensorBagReader {
   bool ended_ = false;
 };
 
-std::string Seconds(double s) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.3f", s);
-  return text;
-}
-
 // InvalidInput when the window starts at or after the recording's end.
 // *first_receive_ns: the recording's first receive time (start > 0 only).
 Status CheckWindow(const std::string& path, const ReadWindow& window, TimeNs* first_receive_ns) {
   if (!(window.start_s >= 0.0) || !std::isfinite(window.start_s))
-    return Status::InvalidInput("--start " + Seconds(window.start_s) + " must be >= 0 s");
+    return Status::InvalidInput("--start " + FormatFixed(window.start_s, 3) + " must be >= 0 s");
   if (!(window.duration_s >= 0.0) || !std::isfinite(window.duration_s))
-    return Status::InvalidInput("--duration " + Seconds(window.duration_s) + " must be > 0 s");
+    return Status::InvalidInput("--duration " + FormatFixed(window.duration_s, 3) +
+                                " must be > 0 s");
   if (window.start_s == 0.0) return Status::Ok();
   StatusOr<BagInfo> info = ReadBagSpan(path);
   if (!info.ok()) return info.status();
   *first_receive_ns = info->start_ns;
   const double length_s = NsToSeconds(info->end_ns - info->start_ns);
   if (window.start_s >= length_s)
-    return Status::InvalidInput("recording '" + path + "' is " + Seconds(length_s) +
-                                " s long; --start " + Seconds(window.start_s) +
+    return Status::InvalidInput("recording '" + path + "' is " + FormatFixed(length_s, 3) +
+                                " s long; --start " + FormatFixed(window.start_s, 3) +
                                 " s is at or past its end");
   return Status::Ok();
 }

@@ -5,15 +5,10 @@
 
 #include <cstdio>
 
+#include "rvlio/common/text.h"
+
 namespace rvlio {
 namespace {
-
-// A number in its shortest form ("0.1", "2e-05").
-std::string Short(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 }  // namespace
 
@@ -51,7 +46,7 @@ std::vector<std::string> ReaderWarnings(const SensorReaderStats& r, const LidarO
     char text[160];
     std::snprintf(text, sizeof(text), " (longest %.3f s) were bridged by the estimator",
                   r.imu_max_gap_s);
-    w.push_back("IMU gaps longer than imu.max_gap " + Short(imu.max_gap) + " s" + imu_on + ": " +
+    w.push_back("IMU gaps longer than imu.max_gap " + FormatG(imu.max_gap) + " s" + imu_on + ": " +
                 std::to_string(r.imu_gaps) + text);
   }
   if (r.point_time_span_ratio >= 0.0 && r.point_time_span_ratio < lidar.point_time_span_warn) {

@@ -17,6 +17,7 @@
 
 #include <Eigen/SVD>
 
+#include "rvlio/common/text.h"
 #include "rvlio/io/atomic_file.h"
 
 namespace rvlio {
@@ -35,12 +36,6 @@ struct DataLine {
   int number = 0;  // 1-based line number in the file
   std::vector<std::string> tokens;
 };
-
-std::string FormatG(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", x);
-  return buf;
-}
 
 Status LineError(const std::string& path, int line, const std::string& message) {
   return Status::InvalidInput(path + ", line " + std::to_string(line) + ": " + message);

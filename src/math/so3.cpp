@@ -1,5 +1,6 @@
 #include "rvlio/math/so3.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rvlio/common/check.h"
@@ -102,4 +103,12 @@ Eigen::Matrix3d ExpTimesVectorJacobian(const Eigen::Vector3d& w, const Eigen::Ve
 }
 
 }  // namespace so3
+
+Eigen::Vector3d RpyDeg(const Eigen::Matrix3d& R) {
+  const double pitch = std::asin(std::max(-1.0, std::min(1.0, -R(2, 0))));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  return Eigen::Vector3d(roll, pitch, yaw) * (180.0 / M_PI);
+}
+
 }  // namespace rvlio

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "rvlio/common/median.h"
 #include "rvlio/constraints/associate.h"
 #include "rvlio/math/so3.h"
 
@@ -85,13 +86,6 @@ LagFit FitLag(const std::vector<Interval>& intervals, const GyroIntegral& gyro, 
   f.bias /= static_cast<double>(intervals.size());
   for (const Eigen::Vector3d& dk : d) f.cost += (dk - f.bias).squaredNorm();
   return f;
-}
-
-double UpperMedian(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
 }
 
 std::vector<double> PeriodsS(const std::vector<TimeNs>& t_ns) {

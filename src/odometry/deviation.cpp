@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rvlio/common/median.h"
+
 namespace rvlio {
 namespace {
 
@@ -105,12 +107,6 @@ double Quantile(std::vector<double>* v, double q) {
   const size_t k = std::min(v->size() - 1, static_cast<size_t>(q * static_cast<double>(v->size())));
   std::nth_element(v->begin(), v->begin() + k, v->end());
   return (*v)[k];
-}
-
-double Median(std::vector<double> v) {
-  const size_t n = v.size();
-  std::sort(v.begin(), v.end());
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // Count, signed median and p95 |deviation| of the values.

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "rvlio/common/median.h"
 #include "rvlio/smoother/refine.h"
 
 namespace rvlio {
@@ -82,11 +83,7 @@ double DivergenceMonitor::Window::Mean() const {
 }
 
 double DivergenceMonitor::Window::Median() const {
-  std::vector<double> v(values.begin(), values.end());
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
+  return UpperMedian(std::vector<double>(values.begin(), values.end()));
 }
 
 DivergenceMonitor::DivergenceMonitor(const DivergenceOptions& options, double lidar_noise_m,

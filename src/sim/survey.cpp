@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "rvlio/common/parallel.h"
+#include "rvlio/common/text.h"
 #include "rvlio/common/types.h"
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/sim/random.h"
@@ -17,12 +18,6 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kRaiseStep = 0.5;            // m, a station in a feature is raised by this
 constexpr uint64_t kStationStreamBase = 5000;  // station k draws from stream base + k
 constexpr int kStationsPerBatch = 4;           // per thread and batch (bounds the memory)
-
-std::string Fmt(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 // The voxel grid of the map: ScanPreprocessor's (nearest to the voxel centre
 // wins, ties keep the earlier point), on world coordinates, without a range
@@ -87,9 +82,9 @@ StatusOr<SurveyResult> SurveyWorld(const World& world, const WorldLayout& layout
                                    const SimSurveyOptions& o, uint64_t seed) {
   const double lo = std::max(o.x_min, layout.x_entrance), hi = std::min(o.x_max, layout.x_end);
   if (!(lo <= hi))
-    return Status::InvalidInput("survey.x_min/survey.x_max: [" + Fmt(o.x_min) + ", " +
-                                Fmt(o.x_max) + "] m does not overlap the world's x extent [" +
-                                Fmt(layout.x_entrance) + ", " + Fmt(layout.x_end) + "] m");
+    return Status::InvalidInput("survey.x_min/survey.x_max: [" + FormatG(o.x_min) + ", " +
+                                FormatG(o.x_max) + "] m does not overlap the world's x extent [" +
+                                FormatG(layout.x_entrance) + ", " + FormatG(layout.x_end) + "] m");
   SurveyResult r;
   const int count = std::max(1, static_cast<int>(std::ceil((hi - lo) / o.station_spacing)));
   for (int k = 0; k < count; ++k) {

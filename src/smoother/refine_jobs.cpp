@@ -5,14 +5,10 @@
 #include <cstdio>
 #include <map>
 
+#include "rvlio/common/text.h"
+
 namespace rvlio {
 namespace {
-
-std::string Seconds(double s) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.3f", s);
-  return buf;
-}
 
 Pose3 ToPose(const StampedPose& p) { return Pose3(p.q_world_imu, p.p_world_imu); }
 
@@ -111,11 +107,13 @@ StatusOr<RefineJobSpan> MakeRefineJobSpan(TimeNs t0_ns, TimeNs t1_ns, int chunk,
   const double length_s = NsToSeconds(t1_ns - t0_ns);
   const double core_s = length_s / count;
   if (count > 1 && core_s < overlap_s)
-    return Status::InvalidInput(
-        "--of " + std::to_string(count) + ": chunks of " + Seconds(core_s) + " s (" +
-        Seconds(length_s) + " s of initial trajectory) are shorter than their overlap "
-        "smoother.refine_job_overlap_s = " + Seconds(overlap_s) + " s; use fewer chunks or a "
-        "shorter overlap");
+    return Status::InvalidInput("--of " + std::to_string(count) + ": chunks of " +
+                                FormatFixed(core_s, 3) + " s (" + FormatFixed(length_s, 3) +
+                                " s of initial trajectory) are shorter than their overlap "
+                                "smoother.refine_job_overlap_s = " +
+                                FormatFixed(overlap_s, 3) +
+                                " s; use fewer chunks or a "
+                                "shorter overlap");
   RefineJobSpan s;
   s.chunk = chunk;
   s.count = count;

@@ -5,12 +5,15 @@
 // by scripts/install_test.sh against the installed tool.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "../cli/cli_util.h"
 #include "rvlio/api.h"
+#include "rvlio/io/run_outputs.h"
 #include "rvlio/io/trajectory_io.h"
+#include "rvlio/odometry/scan_columns.h"
 
 namespace rvlio {
 namespace {
@@ -104,6 +107,17 @@ TEST_F(ApiTest, RunWithAndWithoutOutputFolderGivesTheSameTrajectory) {
   EXPECT_FALSE(summary["interrupted"].get<bool>());
   for (const char* f : {"map.pcd", "scans.csv"})
     EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << f;
+  // scans.csv has the columns of the table (odometry/scan_columns.h), in its order.
+  StatusOr<ScanTable> csv = ReadScanTable(out + "/scans.csv");
+  ASSERT_TRUE(csv.ok()) << csv.status().message();
+  std::vector<std::string> table_names;
+  for (const ScanColumn* c : ScanColumnsOf(written->scans)) table_names.push_back(c->name);
+  EXPECT_EQ(csv->names, table_names);
+  ASSERT_EQ(csv->columns[0].size(), written->scans.size());
+  for (size_t i = 0; i < written->scans.size(); ++i) {
+    EXPECT_NEAR((*csv->Find("vx"))[i], written->scans[i].v_world_imu.x(), 1e-6) << i;
+    EXPECT_NEAR((*csv->Find("rss_mb"))[i], written->rss_mb[i], 1e-6 * written->rss_mb[i]) << i;
+  }
   EXPECT_FALSE(std::filesystem::exists(out + "/trajectory.partial.tum"));
 
   // Evaluation of the written file equals that of the in-memory trajectory.

@@ -1,5 +1,5 @@
 #pragma once
-// Error values for bad data (docs/design.md section 2): library code never exits or
+// Error values for bad data (docs/design.md "Conventions"): library code never exits or
 // prints; it returns a Status whose message names the file, topic or key.
 #include <optional>
 #include <string>

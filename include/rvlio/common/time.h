@@ -1,6 +1,6 @@
 #pragma once
 // Time at every interface is int64 nanoseconds; double seconds only inside a
-// computation (docs/design.md section 2).
+// computation (docs/design.md "Conventions").
 #include <cstdint>
 
 namespace rvlio {

@@ -1,8 +1,8 @@
 #pragma once
-// Point-to-plane association of one scan against a map (docs/design.md section 4):
-// for each point, transform it to the world with the current estimate, take
-// its k nearest map points, fit and validate a local plane (plane_fit.h) and
-// keep the constraint when |r| <= max_residual.
+// Point-to-plane association of one scan against a map (docs/design.md "The shared measurement
+// model"): for each point, transform it to the world with the current estimate, take its k nearest
+// map points, fit and validate a local plane (plane_fit.h) and keep the constraint when |r| <=
+// max_residual.
 //
 // One routine serves every map: AssociateWith<Search> below, where Search is
 // any type with a NeighborSearchTraits specialization (neighbor_search.h):

@@ -1,6 +1,7 @@
 #pragma once
 // The constraint record both estimators consume and the RV module edits
-// (docs/design.md section 4): one point-to-plane correspondence of one scan point.
+// (docs/design.md "The shared measurement model"): one point-to-plane correspondence of one scan
+// point.
 #include <cstdint>
 #include <vector>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Point-to-plane association (docs/design.md section 4).
+// Point-to-plane association (docs/design.md "The shared measurement model").
 #include "rvlio/common/options.h"
 
 namespace rvlio {

@@ -1,6 +1,6 @@
 #pragma once
 // Local plane fit of a scan point's map neighbours, with the validity test of
-// docs/design.md section 4.
+// docs/design.md "The shared measurement model".
 //
 // The plane is the total-least-squares fit: centroid c of the n points and the
 // eigen-decomposition of their covariance C = 1/n sum (p_i - c)(p_i - c)^T with

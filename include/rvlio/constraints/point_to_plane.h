@@ -1,6 +1,6 @@
 #pragma once
 // The point-to-plane residual shared by both estimators (paper Eq. 3,
-// docs/design.md section 4):
+// docs/design.md "The shared measurement model"):
 //
 //   p_imu   = R_imu_lidar p_lidar + t_imu_lidar
 //   p_world = R_world_imu p_imu + t_world_imu

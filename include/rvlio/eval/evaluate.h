@@ -1,6 +1,6 @@
 #pragma once
 // The whole evaluation of `rvlio eval`: associate, align, APE, RPE, end-point
-// and along-axis error (docs/design.md section 8).
+// and along-axis error (docs/design.md "Evaluation").
 #include <cstddef>
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// Options of the trajectory evaluation (docs/design.md section 8; definitions of
+// Options of the trajectory evaluation (docs/design.md "Evaluation"; definitions of
 // evo, see evo_reference/README.md).
 #include <cmath>
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
 // On-manifold IMU preintegration between two times (Forster et al., "On-
 // Manifold Preintegration for Real-Time Visual-Inertial Odometry", T-RO 2017),
-// for the smoother's IMU factor (docs/design.md section 6).
+// for the smoother's IMU factor (docs/design.md "The backends").
 //
 // Deltas (IMU frame at t_i, independent of the state at t_i and of gravity):
 //   dR = R_i^T R_j,  dv = R_i^T (v_j - v_i - g dt),  dp = R_i^T (p_j - p_i - v_i dt - g dt^2 / 2)

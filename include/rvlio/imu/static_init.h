@@ -1,6 +1,6 @@
 #pragma once
 // Static alignment from the first IMU samples: gravity direction and
-// magnitude, gyroscope bias, and the world frame of docs/design.md section 2
+// magnitude, gyroscope bias, and the world frame of docs/design.md "Conventions"
 // (z up, origin and yaw of the IMU at start).
 #include <vector>
 

@@ -1,6 +1,6 @@
 #pragma once
-// Atomic file output (docs/design.md section 7: "outputs are written atomically").
-// Content goes to `<path>.tmp.<pid>`, is fsync'ed and then renamed over
+// Atomic file output (docs/design.md "The command-line contract": "outputs are written
+// atomically"). Content goes to `<path>.tmp.<pid>`, is fsync'ed and then renamed over
 // `<path>`, so a reader sees either the old file or the complete new one, never
 // a half-written file. On any failure the temporary file is removed and an
 // InvalidInput status names the path and the system error text.

@@ -1,5 +1,5 @@
 #pragma once
-// Configuration loading (docs/design.md section 7): built-in defaults, then each
+// Configuration loading (docs/design.md "The command-line contract"): built-in defaults, then each
 // `--config` YAML file in order (later files win), then each
 // `--set a.b=value` override, then validation. Works on any Options struct
 // with a `template <class V> void Visit(V&)` member (common/options.h), so new

@@ -1,5 +1,5 @@
 #pragma once
-// The files `rvlio run` writes (docs/design.md section 7), each atomically.
+// The files `rvlio run` writes (docs/design.md "The command-line contract"), each atomically.
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,11 +30,9 @@ StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
 // A stamp in seconds with all nine decimals (the t column of the CSV files).
 std::string FormatSeconds(TimeNs t_ns);
 
-// One row per scan: time, status, point and constraint counts, the RV report,
-// the processing time and `rss_mb[i]`, the process's resident memory (MB) when
-// scan i was done (nan where rss_mb has no entry), and last `reinforced`, the
-// SCVs whose weight the reinforcement scaled (fewer than `scv` when
-// rv.reinforce_max_residual leaves badly fitting ones at their plain weight).
+// scans.csv: one row per scan, the columns of odometry/scan_columns.h
+// (ScanColumnsOf(results)); `rss_mb[i]` is the process's resident memory (MB)
+// when scan i was done (nan where rss_mb has no entry).
 Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,
                      const std::vector<double>& rss_mb = {});
 

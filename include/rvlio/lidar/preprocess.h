@@ -1,5 +1,5 @@
 #pragma once
-// Scan preprocessing before association (docs/design.md section 1, lidar/):
+// Scan preprocessing before association (docs/design.md "Modules and their dependencies", lidar/):
 // every point_stride-th raw point, range crop to [min_range, max_range]
 // (non-finite points dropped), then a voxel grid of edge voxel_size in the
 // LiDAR frame keeping one point per voxel: the one nearest the voxel centre

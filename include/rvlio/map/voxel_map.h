@@ -1,5 +1,5 @@
 #pragma once
-// The working map of the odometry (docs/design.md section 1, map/): an
+// The working map of the odometry (docs/design.md "Modules and their dependencies", map/): an
 // incremental voxel-hash map with exact k-nearest-neighbour search.
 //
 // Points (world frame, m) live in cubic voxels of edge MapOptions::voxel_size

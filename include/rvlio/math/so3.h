@@ -64,4 +64,8 @@ Eigen::Matrix3d LogRightJacobian(const Eigen::Matrix3d& R);
 Eigen::Matrix3d ExpTimesVectorJacobian(const Eigen::Vector3d& w, const Eigen::Vector3d& v);
 
 }  // namespace so3
+
+// Roll, pitch, yaw (deg) of R = Rz(yaw) Ry(pitch) Rx(roll).
+Eigen::Vector3d RpyDeg(const Eigen::Matrix3d& R);
+
 }  // namespace rvlio

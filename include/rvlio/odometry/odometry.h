@@ -1,6 +1,6 @@
 #pragma once
 // The odometry pipeline: AddImu / AddScan in, one ScanResult per scan out.
-// Per scan it reads like the recipe of docs/design.md section 9:
+// Per scan it reads like the recipe of docs/design.md "Data flow: from a recording to the outputs":
 //   Predict -> Downsample -> Deskew -> Associate -> RV -> Update -> Insert.
 // It owns one estimator and the map; no I/O.
 #include <array>

@@ -1,6 +1,6 @@
 #pragma once
 // The sliding-window smoother backend of the odometry pipeline (see
-// odometry.h; docs/design.md section 6; the window itself: smoother/window.h).
+// odometry.h; docs/design.md "The backends"; the window itself: smoother/window.h).
 //
 // Per scan: Predict (IMU integration from the newest window state) ->
 // Downsample -> Deskew (with the predicted motion) -> add the state with the
@@ -23,30 +23,8 @@
 //   newest: every scan enters right after its first solve (as the IESKF
 //     inserts it); window scans then also match their own points.
 //
-// Defaults, measured on simulated OS1-32 (32 x 1024, 10 Hz) tunnel, corridor
-// and hall sequences, 30 s, seeds 1-3, mean ATE over the 9 runs:
-//   map_update marginalized 1.04 cm vs newest 1.31 cm (Huber 0.1 m; self-matching);
-//   sliding_window_huber_delta 0.02 / 0.03 / 0.04 / 0.05 / 0.1 / 0.3 m:
-//     0.83 / 0.82 / 0.84 / 0.88 / 1.04 / 1.62 cm;
-//   window_size 5 / 8 / 10 / 12 / 15 / 20 (Huber 0.03 m):
-//     0.89 / 0.84 / 0.82 / 0.81 / 0.84 / 0.86 cm, median CPU per scan
-//     8.1 / 9.4 / 10.5 / 11.1 / 11.2 / 13.5 ms: 10 is kept;
-//   association_rounds 1 vs 2 and reassociate_min_motion 0.005-0.05 m: equal
-//     within 0.1 mm (0 m, Huber 0.1 m: 1.28 cm vs 1.04 cm and 9x slower);
-//   linear_solver (solve CPU per scan): dense_schur 1.3-1.6 ms,
-//     sparse_normal_cholesky 1.2-1.4 ms, dense_normal_cholesky 3.8-4.5 ms,
-//     dense_qr 11.5-12.2 ms.
-// Re-measured (docs/speed.md, "Where the smoother's time goes"; 20 s bags of
-// every preset, seeds 1-3, 15 runs; solve CPU summed over the runs):
-//   solve_unchanged_rounds false (a later round that re-associates no scan
-//     is not solved) vs true (the earlier behaviour): ATE within 1e-9 m
-//     on every run, solve CPU -13.5 %;
-//   function_tolerance 1e-6 (Ceres' default, kept) vs 1e-5 / 1e-4 / 1e-3:
-//     solve CPU -23 / -32 / -48 %, ATE worst change outside featureless
-//     +2.4 / +12.5 / +69 % (featureless, degenerate: -60..+17 % already
-//     at 1e-5);
-//   sparse_normal_cholesky vs dense_schur: ATE within 1e-9 m, solve CPU
-//     -8 % (kept dense_schur: see docs/speed.md).
+// The defaults and the measurements behind them: docs/speed.md, "The smoother's
+// defaults" and "Where the smoother's time goes".
 #include <deque>
 #include <memory>
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 // Vector-distribution criterion (paper Section 3.1 and 3.3, Alg. 1;
-// docs/design.md section 5).
+// docs/design.md "The RV pass").
 //
 // The constraint vectors u_i are the unit plane normals of one scan's
 // point-to-plane constraints. Only their directions matter, so they share the
@@ -78,7 +78,7 @@ struct CriterionResult {
 
 // Alg. 1 on the normals of `constraints`. Fills ws (unit normals, d_i, and the
 // class kScv for d_i > eps0). Activation (our reading of "most vectors" in
-// Proposition 1, docs/design.md section 5): num_usable >= min_constraints and the
+// Proposition 1, docs/design.md "The RV pass"): num_usable >= min_constraints and the
 // fraction of usable vectors with d_i <= eps0 is >= activation_ratio.
 CriterionResult EvaluateCriterion(const RvOptions& options, const ConstraintList& constraints,
                                   RvWorkspace* ws);

@@ -1,5 +1,5 @@
 #pragma once
-// RV modules (paper Section 3, Alg. 1-3; docs/design.md section 5).
+// RV modules (paper Section 3, Alg. 1-3; docs/design.md "The RV pass").
 #include "rvlio/common/options.h"
 
 namespace rvlio {

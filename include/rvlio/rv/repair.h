@@ -5,7 +5,7 @@
 // ALONG n_alpha (out of plane alpha); it contradicts the text ("pull the
 // deviated vector back toward the correct direction": wall normals are
 // coplanar). We implement the in-plane projection instead (docs/design.md
-// section 5):  u' = normalize(u - (u . n_alpha) n_alpha).
+// "The RV pass"):  u' = normalize(u - (u . n_alpha) n_alpha).
 #include <Eigen/Core>
 
 #include "rvlio/constraints/constraint.h"

@@ -4,7 +4,7 @@
 // it through the same Visit() list as every other options struct.
 //
 // Frames: world = gravity-aligned (z up), origin and yaw of the IMU at the
-// start pose (docs/design.md section 2). The tunnel axis is world x; the world
+// start pose (docs/design.md "Conventions"). The tunnel axis is world x; the world
 // geometry is placed relative to the start pose by world.start_*.
 #include <array>
 #include <cstdint>

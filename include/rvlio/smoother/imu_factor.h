@@ -1,6 +1,6 @@
 #pragma once
 // IMU preintegration factor between two consecutive scan states (Forster et
-// al. 2017, Eq. 45 and Appendix; docs/design.md section 6).
+// al. 2017, Eq. 45 and Appendix; docs/design.md "The backends").
 //
 // Parameter blocks: pose_i (7), speed_bias_i (9), pose_j (7), speed_bias_j (9)
 // (math/smoother_blocks.h). With the deltas of `preintegration` corrected to

@@ -1,6 +1,6 @@
 #pragma once
 // Marginalization prior (Schur complement), as in VINS-Mono / OKVIS
-// (docs/design.md section 6).
+// (docs/design.md "The backends").
 //
 // Given the residual blocks f_k connected to the parameter blocks to drop,
 // linearized once at the current estimate x0 (tangent-space Jacobians J_k,

@@ -1,5 +1,5 @@
 #pragma once
-// Sliding-window smoother and batch refinement (docs/design.md section 6).
+// Sliding-window smoother and batch refinement (docs/design.md "The backends").
 #include <string>
 
 #include "rvlio/common/options.h"

@@ -1,5 +1,5 @@
 #pragma once
-// Offline batch refinement of a whole sequence (docs/design.md section 6,
+// Offline batch refinement of a whole sequence (docs/design.md "The backends",
 // "refine"; `rvlio refine`). No I/O: the caller reads the bag and writes the
 // outputs.
 //
@@ -18,7 +18,7 @@
 // vector is the static alignment's (measured magnitude) rotated into that
 // world frame by the initial trajectory's attitude at the static interval, so
 // any world frame works; with a moving start (no alignment possible) the world
-// frame must be gravity-aligned, z up (docs/design.md section 2, which is what
+// frame must be gravity-aligned, z up (docs/design.md "Conventions", which is what
 // `rvlio run` writes), and g_world = (0, 0, -imu.gravity).
 //
 // Each outer round (smoother.refine_rounds):

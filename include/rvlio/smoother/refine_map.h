@@ -1,5 +1,5 @@
 #pragma once
-// The leave-one-out map of batch refinement (docs/design.md section 6, "refine":
+// The leave-one-out map of batch refinement (docs/design.md "The backends", "refine":
 // a scan never matches its own points).
 //
 // It holds every scan's points in the world frame, each tagged with its scan

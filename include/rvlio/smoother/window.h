@@ -1,5 +1,5 @@
 #pragma once
-// The sliding window of the smoother backend (docs/design.md section 6).
+// The sliding window of the smoother backend (docs/design.md "The backends").
 //
 // One state per scan, at the scan's end time: a PoseBlock (7, PoseManifold)
 // and a SpeedBiasBlock (9) (math/smoother_blocks.h). The cost of a solve:
