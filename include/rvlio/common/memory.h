@@ -3,7 +3,7 @@
 // hundreds of megabytes (a 10 M point reference map: its file, its points,
 // its voxel storage) faults in one 4 KiB page at a time, and on a virtual
 // machine each fault is expensive: with 2 MiB pages the loading of such a map
-// took less than half the CPU time (docs/survey.md). A hint only: where the
+// took about half the CPU time (docs/survey.md). A hint only: where the
 // kernel gives no huge pages (transparent_hugepage "never", other systems)
 // nothing changes.
 #include <cstddef>
