@@ -1,6 +1,6 @@
 #include "ablate_grid.h"
 #include "rvlio/common/text.h"
-#include "rvlio/io/summary_json.h"
+#include "rvlio/outputs/summary_json.h"
 
 #include <sys/stat.h>
 
@@ -17,7 +17,7 @@
 #include <sstream>
 
 #include "rvlio/common/fnv1a.h"
-#include "rvlio/io/config.h"
+#include "rvlio/config/config.h"
 #include "rvlio/sim/presets.h"
 
 namespace rvlio::cli::ablate {

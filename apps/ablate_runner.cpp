@@ -1,6 +1,6 @@
 #include "ablate_runner.h"
 #include "divergence_cli.h"
-#include "rvlio/io/summary_json.h"
+#include "rvlio/outputs/summary_json.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -22,9 +22,9 @@
 #include "interrupt.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
-#include "rvlio/io/point_cloud_file.h"
-#include "rvlio/io/atomic_file.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/formats/atomic_file.h"
+#include "rvlio/formats/trajectory_io.h"
 
 extern char** environ;
 

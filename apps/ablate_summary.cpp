@@ -9,7 +9,7 @@
 #include "ablate_runner.h"
 #include "plot_runner.h"
 #include "rvlio/common/text.h"
-#include "rvlio/io/atomic_file.h"
+#include "rvlio/formats/atomic_file.h"
 
 namespace rvlio::cli::ablate {
 namespace {

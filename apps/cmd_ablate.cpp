@@ -11,14 +11,14 @@
 #include <iostream>
 
 #include "ablate_grid.h"
-#include "rvlio/io/summary_json.h"
+#include "rvlio/outputs/summary_json.h"
 #include "ablate_runner.h"
 #include "ablate_summary.h"
 #include "commands.h"
 #include "common_options.h"
 #include "interrupt.h"
 #include "run_pipeline.h"
-#include "rvlio/io/atomic_file.h"
+#include "rvlio/formats/atomic_file.h"
 
 namespace rvlio::cli {
 namespace {

@@ -8,9 +8,9 @@
 
 #include "commands.h"
 #include "common_options.h"
-#include "rvlio/io/config.h"
-#include "rvlio/io/sensor_bag.h"
-#include "rvlio/io/sensor_stream.h"
+#include "rvlio/config/config.h"
+#include "rvlio/formats/sensor_bag.h"
+#include "rvlio/formats/sensor_stream.h"
 #include "rvlio/odometry/clock_check.h"
 
 namespace rvlio::cli {

@@ -3,7 +3,7 @@
 #include "commands.h"
 #include "common_options.h"
 #include "compare_engine.h"
-#include "window_options.h"
+#include "time_range_options.h"
 
 namespace rvlio::cli {
 

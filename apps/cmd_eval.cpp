@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "commands.h"
-#include "rvlio/io/summary_json.h"
+#include "rvlio/outputs/summary_json.h"
 #include "common_options.h"
 #include "rvlio/api.h"
 

@@ -7,7 +7,7 @@
 #include "commands.h"
 #include "common_options.h"
 #include "rvlio/common/text.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio::cli {
 namespace {

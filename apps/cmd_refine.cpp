@@ -2,7 +2,7 @@
 // signals and lines: reads the whole bag into memory (downsampled scans and
 // all IMU samples; with --chunk K --of N only chunk K's scans and the IMU
 // samples around them), batch-refines the initial trajectory
-// (smoother/refine.h) and writes trajectory.tum, map.pcd and summary.json
+// (refine/refine.h) and writes trajectory.tum, map.pcd and summary.json
 // (and chunk.json) atomically.
 #include <cerrno>
 #include <chrono>
@@ -17,11 +17,11 @@
 #include "divergence_cli.h"
 #include "interrupt.h"
 #include "run_pipeline.h"
-#include "window_options.h"
+#include "time_range_options.h"
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/api.h"
-#include "rvlio/io/refine_checkpoint.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/api/refine_checkpoint.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio::cli {
 namespace {

@@ -4,7 +4,7 @@
 #include "common_options.h"
 #include "interrupt.h"
 #include "run_pipeline.h"
-#include "window_options.h"
+#include "time_range_options.h"
 
 namespace rvlio::cli {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "rvlio/io/sensor_stream.h"
+#include "rvlio/formats/sensor_stream.h"
 
 namespace rvlio::cli {
 

@@ -2,12 +2,12 @@
 // How the commands report the divergence monitor (odometry/divergence.h):
 // one warning line per episode while running, a `divergence` object in
 // summary.json, and exit status kExitDiverged unless --allow-divergence
-// (common_options.h). DivergenceJson is in rvlio/io/summary_json.h.
+// (common_options.h). DivergenceJson is in rvlio/outputs/summary_json.h.
 #include <cstddef>
 #include <string>
 
 #include "cli.h"
-#include "rvlio/io/summary_json.h"
+#include "rvlio/outputs/summary_json.h"
 #include "rvlio/odometry/divergence.h"
 
 namespace rvlio::cli {

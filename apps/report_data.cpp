@@ -10,11 +10,11 @@
 #include <optional>
 #include <sstream>
 
-#include "rvlio/eval/associate.h"
+#include "rvlio/eval/time_matching.h"
 #include "rvlio/eval/evaluate.h"
-#include "rvlio/io/point_cloud_file.h"
-#include "rvlio/io/run_outputs.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/trajectory_io.h"
 #include "rvlio/version.h"
 
 namespace rvlio::cli::report {

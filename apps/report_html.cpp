@@ -5,7 +5,7 @@
 
 #include "report_assets.h"
 #include "rvlio/common/check.h"
-#include "rvlio/io/atomic_file.h"
+#include "rvlio/formats/atomic_file.h"
 #include "rvlio/version.h"
 
 namespace rvlio::cli::report {

@@ -9,7 +9,7 @@
 #include "divergence_cli.h"
 #include "interrupt.h"
 #include "rvlio/api.h"
-#include "rvlio/io/run_outputs.h"
+#include "rvlio/outputs/run_outputs.h"
 
 namespace rvlio::cli {
 namespace {

@@ -6,10 +6,10 @@
 #include <utility>
 #include <vector>
 
-#include "rvlio/io/output_stage.h"
-#include "rvlio/io/sensor_bag.h"
-#include "rvlio/io/sensor_stream.h"
-#include "rvlio/io/summary_json.h"
+#include "rvlio/outputs/output_stage.h"
+#include "rvlio/formats/sensor_bag.h"
+#include "rvlio/formats/sensor_stream.h"
+#include "rvlio/outputs/summary_json.h"
 
 namespace rvlio::cli {
 
@@ -45,7 +45,7 @@ struct RunOutcome {
 int RunOdometryOnBag(const RunRequest& request, RunOutcome* outcome);
 
 // Creates `dir` if needed and proves it writable; false after printing the
-// error line of `command` if not (rvlio/io/output_stage.h PrepareOutputDir).
+// error line of `command` if not (rvlio/outputs/output_stage.h PrepareOutputDir).
 bool PrepareOutputDir(const std::string& command, const std::string& dir);
 
 }  // namespace rvlio::cli

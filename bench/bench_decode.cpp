@@ -8,7 +8,7 @@
 // estimator sees it.
 //
 // BM_ReadMcap/<compression> reads the same 20 sweeps + 400 IMU-sized
-// payloads from an MCAP file (io/mcap.h) with chunks uncompressed, zstd and
+// payloads from an MCAP file (formats/mcap.h) with chunks uncompressed, zstd and
 // lz4: the container's cost per message (decompression, CRC, copy; no CDR
 // decoding).
 //
@@ -18,7 +18,7 @@
 // reading cost of a compressed recording is this + the reader's own work.
 //
 // BM_Crc32/<0|1>: the CRC-32 the MCAP reader checks on every chunk
-// (src/io/mcap_records.h, libdeflate) and, for reference, zlib's crc32 on
+// (src/formats/mcap_records.h, libdeflate) and, for reference, zlib's crc32 on
 // the same 32 MiB.
 //
 //   build/bin/bench_decode --benchmark_filter='BM_ReadMcap|BM_ReadBag|BM_Decompress|BM_Crc32'
@@ -39,10 +39,10 @@
 #include <zlib.h>
 #include <zstd.h>
 
-#include "../src/io/mcap_records.h"
-#include "rvlio/io/mcap.h"
-#include "rvlio/io/pointcloud2.h"
-#include "rvlio/io/sensor_bag.h"
+#include "../src/formats/mcap_records.h"
+#include "rvlio/formats/mcap.h"
+#include "rvlio/formats/pointcloud2.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "bench_util.h"
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/ieskf/ieskf.h"
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/so3.h"

@@ -15,7 +15,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/constraints/plane_fit.h"
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/map/voxel_map.h"

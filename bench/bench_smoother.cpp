@@ -16,10 +16,10 @@
 #include "bench_util.h"
 
 #include "rvlio/imu/preintegration.h"
-#include "rvlio/smoother/imu_factor.h"
-#include "rvlio/smoother/manifolds.h"
-#include "rvlio/smoother/marginalization.h"
-#include "rvlio/smoother/plane_factor.h"
+#include "rvlio/factors/imu_factor.h"
+#include "rvlio/factors/manifolds.h"
+#include "rvlio/factors/marginalization.h"
+#include "rvlio/factors/plane_factor.h"
 
 namespace {
 

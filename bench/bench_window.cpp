@@ -19,10 +19,10 @@
 
 #include "bench_util.h"
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/map/voxel_map.h"
-#include "rvlio/smoother/window.h"
+#include "rvlio/window/window.h"
 
 namespace rvlio {
 namespace {

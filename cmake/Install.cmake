@@ -1,22 +1,27 @@
 # `cmake --install build --prefix P` (docs/library.md):
 #   P/bin/rvlio                             the command (RPATH $ORIGIN/../lib)
-#   P/lib/librvlio_core.so.X.Y.Z, librvlio_io.so.X.Y.Z (+ SONAME and dev links)
-#   P/include/rvlio/...                     the public headers + version.h
+#   P/lib/librvlio_{core,sim,io}.so.X.Y.Z (+ SONAME and dev links)
+#   P/include/rvlio/...                     the public headers (PublicHeaders.cmake) + version.h
 #   P/lib/cmake/rvlio/                      rvlioConfig.cmake, version file, targets
 #   P/share/rvlio/config/                   default.yaml, paper_*.yaml, sensors/, grids/
 #   P/share/rvlio/rvlio_plot.py             the plotting script `rvlio compare` runs
 set(RVLIO_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/rvlio CACHE STRING
     "Where rvlioConfig.cmake is installed, relative to the prefix")
 
-install(TARGETS rvlio_core rvlio_io EXPORT rvlioTargets
+install(TARGETS rvlio_core rvlio_sim rvlio_io EXPORT rvlioTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT dev
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
 install(TARGETS rvlio RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-# Every header of include/rvlio is public: none includes PCL, ROS, sqlite or
-# yaml-cpp (checked by scripts/install_test.sh); rvlio/io/config.h and
-# rvlio/api.h include nlohmann/json.hpp, part of rvlio::io's interface.
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/rvlio DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-  COMPONENT dev FILES_MATCHING PATTERN "*.h")
+# The public headers, an explicit list (cmake/PublicHeaders.cmake); none
+# includes PCL, ROS, sqlite or yaml-cpp (checked by scripts/install_test.sh);
+# rvlio/config/config.h and rvlio/api.h include nlohmann/json.hpp, part of
+# rvlio::io's interface.
+include(${CMAKE_CURRENT_LIST_DIR}/PublicHeaders.cmake)
+foreach(header ${rvlio_public_headers})
+  get_filename_component(header_dir ${header} DIRECTORY)
+  install(FILES ${PROJECT_SOURCE_DIR}/include/${header}
+    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/${header_dir} COMPONENT dev)
+endforeach()
 install(FILES ${PROJECT_BINARY_DIR}/include/rvlio/version.h
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rvlio COMPONENT dev)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${CMAKE_INSTALL_DATADIR}/rvlio/config

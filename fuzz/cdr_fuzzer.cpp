@@ -1,4 +1,4 @@
-// libFuzzer target: the CDR decoders of ROS 2 messages (io/cdr.h) on
+// libFuzzer target: the CDR decoders of ROS 2 messages (formats/cdr.h) on
 // arbitrary payloads, as the ROS 2 sensor reader calls them.
 //
 // Input layout: byte 0 picks the message (0 sensor_msgs/msg/PointCloud2, then
@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "rvlio/io/cdr.h"
-#include "rvlio/io/livox.h"
+#include "rvlio/formats/cdr.h"
+#include "rvlio/formats/livox.h"
 
 namespace {
 

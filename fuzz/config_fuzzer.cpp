@@ -1,5 +1,5 @@
 // libFuzzer target: the configuration loader of `rvlio run --config F --set
-// k=v` (io/config.h LoadOptions<OdometryOptions>: defaults, YAML, overrides,
+// k=v` (config/config.h LoadOptions<OdometryOptions>: defaults, YAML, overrides,
 // Validate, source attribution) on fuzzed YAML text and override strings.
 // Only ParseYamlFile's reading of the file is replaced by the text itself
 // (ApplyYamlText is ApplyYamlFile after the read).
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "rvlio/io/config.h"
+#include "rvlio/config/config.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// libFuzzer target: the MCAP reader (io/mcap.h) on arbitrary bytes, through
+// libFuzzer target: the MCAP reader (formats/mcap.h) on arbitrary bytes, through
 // Reader::OpenBuffer (the same code path as files). The input is the file.
 // An odd-sized input also sets a channel filter (the first channel).
 //
@@ -11,7 +11,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "rvlio/io/mcap.h"
+#include "rvlio/formats/mcap.h"
 
 namespace {
 

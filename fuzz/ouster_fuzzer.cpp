@@ -1,4 +1,4 @@
-// libFuzzer target: pcap captures (io/pcap.h) of Ouster packets (io/ouster.h).
+// libFuzzer target: pcap captures (formats/pcap.h) of Ouster packets (formats/ouster.h).
 //
 // Input: byte 0 picks the sensor (bits 0-2: lidar profile, bits 3-4: 32, 64
 // or 128 beams; 1024x10, the packet sizes of the real captures), the rest is
@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "rvlio/io/ouster.h"
-#include "rvlio/io/pcap.h"
+#include "rvlio/formats/ouster.h"
+#include "rvlio/formats/pcap.h"
 
 namespace {
 

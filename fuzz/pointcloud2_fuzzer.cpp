@@ -1,4 +1,4 @@
-// libFuzzer target: sensor_msgs/PointCloud2 decoding (io/pointcloud2.h), the
+// libFuzzer target: sensor_msgs/PointCloud2 decoding (formats/pointcloud2.h), the
 // entry points the bag reader calls (DetectPointCloud2Layout at open,
 // DecodePointCloud2 per message), on a message built from the fuzz bytes;
 // every decoded scan is also compared with DecodePointCloud2Generic's.
@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "rvlio/io/pointcloud2.h"
+#include "rvlio/formats/pointcloud2.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// libFuzzer target: TUM and KITTI trajectory parsing (io/trajectory_io.h), the
+// libFuzzer target: TUM and KITTI trajectory parsing (formats/trajectory_io.h), the
 // text parsers the file readers (ReadTum, ReadKitti, ReadTrajectory) use.
 //
 // Input layout (FuzzedDataProvider; fuzz/make_seeds.py writes the same): from
@@ -22,7 +22,7 @@
 #include <limits>
 #include <string>
 
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace {
 

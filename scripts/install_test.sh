@@ -6,11 +6,11 @@
 #   1. `cmake --install build --prefix P`: libraries with their SONAME,
 #      headers, version.h, CMake package, command, config files, plot script
 #   2. the installed `rvlio --version` and its libraries (from P, not build/)
-#   3. every installed rvlio::core header in one translation unit, compiled
-#      with only P + Eigen + Ceres include folders; the headers it pulls in
-#      include no PCL, ROS, yaml-cpp, sqlite, zstd, lz4 or nlohmann header;
-#      the rvlio::io headers likewise (nlohmann allowed there); the exported
-#      rvlio::core target names only Eigen and Ceres as interface libraries
+#   3. exactly the public headers of cmake/PublicHeaders.cmake are installed;
+#      each compiles on its own with only P + Eigen + Ceres include folders
+#      and opens no PCL, ROS, yaml-cpp, sqlite, zstd or lz4 header (nlohmann
+#      only in rvlio::io's); the exported rvlio::core target names only
+#      Eigen and Ceres as interface libraries
 #   4. examples/consumer configured (find_package(rvlio) with P only) and
 #      built in its own folder, without the source tree's include folder;
 #      ieskf_tunnel (rvlio::core) runs the IESKF on a simulated tunnel
@@ -54,60 +54,84 @@ installed_files() {
     lib/cmake/rvlio/rvlioConfig.cmake lib/cmake/rvlio/rvlioConfigVersion.cmake \
     lib/cmake/rvlio/rvlioTargets.cmake share/rvlio/config/default.yaml \
     share/rvlio/config/sensors/os1_32.yaml share/rvlio/rvlio_plot.py \
-    "lib/librvlio_core.so.$version" "lib/librvlio_io.so.$version" lib/librvlio_core.so; do
+    "lib/librvlio_core.so.$version" "lib/librvlio_sim.so.$version" "lib/librvlio_io.so.$version" \
+    lib/librvlio_core.so; do
     [[ -e $prefix/$f ]] || { echo "  missing: $f" >&2; return 1; }
   done
 }
 check "cmake --install puts the command, libraries, headers, CMake package, config and plot script under the prefix" installed_files
 soname_ok() {
   local lib so
-  for lib in core io; do
+  for lib in core sim io; do
     so=$(readelf -d "$prefix/lib/librvlio_$lib.so.$version" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')
     [[ $so == "librvlio_$lib.so.$soversion" && -L $prefix/lib/$so ]] ||
       { echo "  librvlio_$lib: SONAME '$so', expected librvlio_$lib.so.$soversion" >&2; return 1; }
   done
 }
-check "librvlio_core and librvlio_io carry the SONAME lib*.so.$soversion (version $version)" soname_ok
+check "librvlio_core, librvlio_sim and librvlio_io carry the SONAME lib*.so.$soversion (version $version)" soname_ok
 
 # 2. the installed command
 check "the installed rvlio --version prints $version" \
   bash -c "[[ \$('$prefix/bin/rvlio' --version) == 'rvlio $version' ]]"
 libs_from_prefix() {
   local found path n=0
-  found=$(ldd "$prefix/bin/rvlio" | grep -E 'librvlio_(core|io)' || true)
+  found=$(ldd "$prefix/bin/rvlio" | grep -E 'librvlio_(core|sim|io)' || true)
   for path in $(awk '{ print $3 }' <<<"$found"); do
     [[ $(realpath "$path") == "$prefix"/lib/* ]] && n=$((n + 1))
   done
-  [[ $n == 2 ]] || { echo "$found" >&2; return 1; }
+  [[ $n == 3 ]] || { echo "$found" >&2; return 1; }
 }
-check "the installed rvlio loads librvlio_core and librvlio_io from the prefix (RPATH \$ORIGIN/../lib)" libs_from_prefix
+check "the installed rvlio loads librvlio_core, _sim and _io from the prefix (RPATH \$ORIGIN/../lib)" libs_from_prefix
 
 # 3. the headers' dependencies
 eigen_inc=$(pkg-config --cflags-only-I eigen3)
 ceres_inc="-I/usr/include"  # Ceres and glog (Debian's libceres-dev)
 forbidden='/(pcl[^/]*|ros[^/]*|rosbag|sensor_msgs|yaml-cpp|nlohmann)/|sqlite3\.h|zstd\.h|lz4[a-z]*\.h'
-header_tu() {  # header_tu NAME EXCLUDE [HEADER...]: every installed header but EXCLUDE, + HEADERs
-  local name=$1 exclude=$2; shift 2
-  { (cd "$prefix/include" && find rvlio -name '*.h' | sort | grep -vE "$exclude")
-    if (($#)); then printf '%s\n' "$@"; fi; } | sed 's/.*/#include "&"/' >"$work/$name.cpp"
-  echo 'int main() { return 0; }' >>"$work/$name.cpp"
+# The public list (cmake/PublicHeaders.cmake): installed, and nothing else.
+public_list() {
+  sed -n '/^set(rvlio_public_headers/,/^)/p' cmake/PublicHeaders.cmake | grep -E '^ +rvlio/' |
+    tr -d ' ' | sort
 }
-compiles_alone() {  # compiles_alone NAME ALLOWED: syntax check, and the headers it opened
-  g++ -std=c++17 -fsyntax-only -H -I"$prefix/include" $eigen_inc $ceres_inc "$work/$1.cpp" \
-    2>"$work/$1.headers" || { cat "$work/$1.headers" >&2; return 1; }
-  local bad
-  bad=$(grep -E '^\.+ ' "$work/$1.headers" | grep -E "$forbidden" | grep -vE "${2:-^$}" || true)
-  [[ -z $bad ]] || { echo "  $1 pulls in: $(head -3 <<<"$bad")" >&2; return 1; }
+only_public_installed() {
+  local installed listed
+  installed=$(cd "$prefix/include" && find rvlio -name '*.h' ! -path rvlio/version.h | sort)
+  listed=$(public_list)
+  [[ -n $listed && $installed == "$listed" ]] ||
+    { diff <(echo "$listed") <(echo "$installed") | head -5 >&2; return 1; }
+  local private
+  private=$(cd include && find rvlio -name '*.h' | sort | comm -23 - <(echo "$listed") | wc -l)
+  ((private > 0)) || { echo "  every header of include/rvlio is listed as public" >&2; return 1; }
 }
-# rvlio::core: all but rvlio/api.h and rvlio/io/ (whose reader_options.h is a
-# plain options struct that the odometry options hold).
-header_tu core_headers '^rvlio/api\.h$|^rvlio/io/' rvlio/io/reader_options.h
-grep -q 'rvlio/api.h\|rvlio/io/config.h' "$work/core_headers.cpp" && fatal "core header list holds io headers"
-check "every rvlio::core header ($(grep -c include "$work/core_headers.cpp") of them) compiles with only the prefix, Eigen and Ceres, and pulls in no PCL/ROS/yaml-cpp/sqlite/zstd/lz4/nlohmann header" \
-  compiles_alone core_headers
-header_tu all_headers '^$'
-check "every installed header ($(grep -c include "$work/all_headers.cpp"), rvlio::io's too) compiles; none pulls in PCL/ROS/yaml-cpp/sqlite/zstd/lz4 (nlohmann is rvlio::io's)" \
-  compiles_alone all_headers '/nlohmann/'
+check "the install holds exactly the $(public_list | wc -l) public headers of cmake/PublicHeaders.cmake; the $(find include/rvlio -name '*.h' | wc -l) - $(public_list | wc -l) private ones stay out" \
+  only_public_installed
+# Each installed header compiles on its own from the prefix with only Eigen and
+# Ceres (so the public list is closed under #include), and opens no PCL, ROS,
+# yaml-cpp, sqlite, zstd or lz4 header; the rvlio::core and rvlio::sim headers
+# (all but rvlio/api.h, config/, formats/ and outputs/; formats/reader_options.h
+# is a plain options struct the odometry options hold) open no nlohmann either.
+is_io_header() {
+  [[ $1 == rvlio/api.h || $1 =~ ^rvlio/(api|config|formats|outputs)/ ]] &&
+    [[ $1 != rvlio/formats/reader_options.h ]]
+}
+compiles_alone() {  # compiles_alone HEADER: syntax check, and the headers it opened
+  local header=$1 tu allowed='^$' bad
+  tu="$work/tu/${header//\//_}.cpp"
+  mkdir -p "$work/tu"
+  printf '#include "%s"\nint main() { return 0; }\n' "$header" >"$tu"
+  g++ -std=c++17 -fsyntax-only -H -I"$prefix/include" $eigen_inc $ceres_inc "$tu" 2>"$tu.headers" ||
+    { echo "  $header does not compile alone:" >&2; grep -v '^\.' "$tu.headers" | head -5 >&2; return 1; }
+  is_io_header "$header" && allowed='/nlohmann/'
+  bad=$(grep -E '^\.+ ' "$tu.headers" | grep -E "$forbidden" | grep -vE "$allowed" || true)
+  [[ -z $bad ]] || { echo "  $header pulls in: $(head -3 <<<"$bad")" >&2; return 1; }
+}
+export -f compiles_alone is_io_header
+export prefix work eigen_inc ceres_inc forbidden
+every_header_alone() {
+  (cd "$prefix/include" && find rvlio -name '*.h' | sort) |
+    xargs -P "$jobs" -I{} bash -c 'compiles_alone "$1"' _ {}
+}
+check "every installed header ($(cd "$prefix/include" && find rvlio -name '*.h' | wc -l)) compiles on its own from the prefix and pulls in no PCL/ROS/yaml-cpp/sqlite/zstd/lz4 header (nlohmann only in rvlio::io's)" \
+  every_header_alone
 core_interface() {
   local libs
   libs=$(awk '/add_library\(rvlio::core /,/^\)/' "$prefix/lib/cmake/rvlio/rvlioTargets.cmake" |

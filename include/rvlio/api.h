@@ -13,7 +13,7 @@
 // Status::Internal; nothing is printed and the process is never exited. A
 // call that is stopped (`stop`) returns normally with `stopped` set.
 //
-// Configuration: LoadConfig (rvlio/io/config.h) gives OdometryOptions from
+// Configuration: LoadConfig (rvlio/config/config.h) gives OdometryOptions from
 // YAML files plus `key=value` overrides; DumpYaml / ToJson write it back.
 #include <cstdint>
 #include <functional>
@@ -25,15 +25,15 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
-#include "rvlio/eval/degeneracy.h"
+#include "rvlio/eval/degeneracy_scores.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
-#include "rvlio/io/config.h"
-#include "rvlio/io/sensor_stream.h"
+#include "rvlio/config/config.h"
+#include "rvlio/formats/sensor_stream.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/odometry.h"
 #include "rvlio/odometry/options.h"
-#include "rvlio/smoother/refine.h"
+#include "rvlio/refine/refine.h"
 #include "rvlio/version.h"
 
 namespace rvlio {
@@ -114,7 +114,7 @@ struct RefineArgs {
   StopFn stop;  // polled while reading and between rounds: the last completed round is the result
   std::function<void(const RefineRound&)> on_round;  // after each round
   std::function<void(int rounds_done)> on_resume;    // a checkpoint was loaded
-  // Chunk job (`rvlio refine --chunk K --of N`, smoother/refine_jobs.h): when
+  // Chunk job (`rvlio refine --chunk K --of N`, refine/refine_jobs.h): when
   // chunk_count > 0, refines only chunk `chunk` (1-based) of chunk_count
   // chunks of the initial trajectory's span, overlapping by
   // smoother.refine_job_overlap_s; only that chunk's scans (and the IMU
@@ -166,7 +166,7 @@ struct MergeResult {
 // InvalidInput (one line naming the folder or the chunk) for a folder without
 // a readable chunk.json, trajectory.tum or map.pcd, chunks of different N,
 // options, initial trajectory or overlap, a chunk given twice, a missing
-// chunk K, or neighbours that share too few poses (smoother/refine_jobs.h);
+// chunk K, or neighbours that share too few poses (refine/refine_jobs.h);
 // and for a `map` that is not the one the chunks were refined with (by
 // content) or chunks refined without one.
 StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args);
@@ -259,7 +259,7 @@ nlohmann::json DegeneracyEvalJson(const DegeneracyEvalResult& result);
 // eval --map: a map against a reference cloud (eval/map_metrics.h)
 // ---------------------------------------------------------------------------
 
-// Reads both clouds (PCD or PLY, io/point_cloud_file.h) and evaluates the
+// Reads both clouds (PCD or PLY, formats/point_cloud_file.h) and evaluates the
 // map against the reference. InvalidInput, one line naming the file(s), for
 // an unreadable, empty, truncated or NaN cloud, or clouds that do not
 // overlap. Reads only.

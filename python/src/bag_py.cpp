@@ -1,5 +1,5 @@
 // rvlio.read_bag: the IMU samples and decoded scans of a recording, as the
-// commands read them (io/sensor_stream.h: every storage kind and LiDAR layout,
+// commands read them (formats/sensor_stream.h: every storage kind and LiDAR layout,
 // lidar.time_offset applied, range-cropped finite points).
 #include "bag_py.h"
 
@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "config_py.h"
-#include "rvlio/io/sensor_stream.h"
+#include "rvlio/formats/sensor_stream.h"
 
 namespace rvlio::python {
 namespace {

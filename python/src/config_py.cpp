@@ -1,9 +1,9 @@
-// rvlio.Config: the odometry configuration of `rvlio run` (io/config.h).
+// rvlio.Config: the odometry configuration of `rvlio run` (config/config.h).
 #include "config_py.h"
 
 #include <pybind11/stl.h>
 
-#include "rvlio/io/config.h"
+#include "rvlio/config/config.h"
 
 namespace rvlio::python {
 namespace {

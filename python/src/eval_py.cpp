@@ -12,8 +12,8 @@
 #include "rvlio/api.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
-#include "rvlio/io/point_cloud_file.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio::python {
 namespace {

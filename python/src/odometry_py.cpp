@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "config_py.h"
-#include "rvlio/io/run_outputs.h"
+#include "rvlio/outputs/run_outputs.h"
 #include "rvlio/odometry/odometry.h"
 
 namespace rvlio::python {

@@ -1,6 +1,6 @@
 #include "rvlio/eval/evaluate.h"
 
-#include "rvlio/eval/associate.h"
+#include "rvlio/eval/time_matching.h"
 
 namespace rvlio {
 

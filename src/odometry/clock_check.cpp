@@ -1,3 +1,4 @@
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/odometry/clock_check.h"
 
 #include <algorithm>
@@ -5,7 +6,7 @@
 #include <limits>
 
 #include "rvlio/common/median.h"
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/math/so3.h"
 
 namespace rvlio {

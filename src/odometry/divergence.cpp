@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "rvlio/common/median.h"
-#include "rvlio/smoother/refine.h"
+#include "rvlio/refine/refine.h"
 
 namespace rvlio {
 

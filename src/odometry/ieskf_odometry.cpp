@@ -1,4 +1,5 @@
 // The IESKF backend of the odometry pipeline (paper-exact mode).
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/odometry/ieskf_odometry.h"
 
 #include <limits>
@@ -6,7 +7,7 @@
 
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/common/parallel.h"
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/lidar/deskew.h"
 
 namespace rvlio {

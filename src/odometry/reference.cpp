@@ -10,7 +10,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/constraints/robust_kernel.h"
 #include "rvlio/map/voxel_key.h"

@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "rvlio/math/so3.h"
-#include "rvlio/smoother/refine_states.h"
+#include "rvlio/refine/refine_states.h"
 
 namespace rvlio {
 namespace {

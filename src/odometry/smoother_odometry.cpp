@@ -1,11 +1,12 @@
 // The sliding-window smoother backend of the odometry pipeline.
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/odometry/smoother_odometry.h"
 
 #include <utility>
 
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/common/parallel.h"
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/imu/pose_history.h"
 #include "rvlio/imu/preintegration.h"

@@ -1,3 +1,4 @@
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/sim/simulator.h"
 
 #include <cmath>

@@ -11,8 +11,8 @@
 
 #include "../cli/cli_util.h"
 #include "rvlio/api.h"
-#include "rvlio/io/run_outputs.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/trajectory_io.h"
 #include "rvlio/odometry/scan_columns.h"
 
 namespace rvlio {

@@ -1,4 +1,4 @@
-// The one association routine (constraints/associate.h) over the two maps it
+// The one association routine (constraints/plane_association.h) over the two maps it
 // serves: the odometry's working map (VoxelMap) and the leave-one-out map of
 // batch refinement (RefineMap, seen by a scan none of whose points it holds).
 // Filled with the same points, both must give the same constraints, to the
@@ -11,11 +11,11 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/sim/presets.h"
 #include "rvlio/sim/simulator.h"
-#include "rvlio/smoother/refine_map.h"
+#include "rvlio/refine/refine_map.h"
 
 namespace rvlio {
 namespace {

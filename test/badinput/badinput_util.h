@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio::badinput {
 

@@ -1,4 +1,4 @@
-// ReadMapPcd (io/run_outputs.h), which `rvlio merge` uses on the chunks'
+// ReadMapPcd (outputs/run_outputs.h), which `rvlio merge` uses on the chunks'
 // maps: reads back what WriteMapPcd wrote, and refuses truncated, lying or
 // foreign files with InvalidInput naming the file instead of crashing or
 // allocating what the header claims.
@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/run_outputs.h"
+#include "rvlio/outputs/run_outputs.h"
 
 namespace rvlio {
 namespace {

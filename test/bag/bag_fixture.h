@@ -15,7 +15,7 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include "cloud_builder.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio::test {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "rvlio/io/pointcloud2.h"
+#include "rvlio/formats/pointcloud2.h"
 
 namespace rvlio::test {
 

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "cloud_builder.h"
-#include "rvlio/io/pointcloud2.h"
+#include "rvlio/formats/pointcloud2.h"
 
 namespace rvlio {
 namespace {

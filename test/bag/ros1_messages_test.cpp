@@ -1,5 +1,5 @@
 // The ROS1 wire parsers of sensor_msgs/PointCloud2 and sensor_msgs/Imu
-// (src/io/ros1_messages.h) against the bytes ROS's own serializer writes.
+// (src/formats/ros1_messages.h) against the bytes ROS's own serializer writes.
 #include <cstring>
 #include <vector>
 
@@ -7,7 +7,7 @@
 #include <ros/message_traits.h>
 #include <ros/serialization.h>
 
-#include "../../src/io/ros1_messages.h"
+#include "../../src/formats/ros1_messages.h"
 #include "bag_fixture.h"
 #include "cloud_builder.h"
 

@@ -13,8 +13,8 @@
 #include "cli_util.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
-#include "rvlio/io/point_cloud_file.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
 namespace {

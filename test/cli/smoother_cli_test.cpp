@@ -12,10 +12,10 @@
 
 #include "cli_util.h"
 #include "rvlio/eval/evaluate.h"
-#include "rvlio/io/config.h"
-#include "rvlio/io/run_outputs.h"
-#include "rvlio/io/sensor_bag.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/config/config.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/sensor_bag.h"
+#include "rvlio/formats/trajectory_io.h"
 #include "rvlio/odometry/odometry.h"
 
 namespace rvlio {

@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 
 #include "cli_util.h"
-#include "rvlio/io/run_outputs.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
 namespace {

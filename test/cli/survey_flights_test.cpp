@@ -17,9 +17,9 @@
 #include <gtest/gtest.h>
 
 #include "cli_util.h"
-#include "rvlio/io/run_outputs.h"
-#include "rvlio/io/trajectory_io.h"
-#include "rvlio/smoother/refine_states.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/trajectory_io.h"
+#include "rvlio/refine/refine_states.h"
 
 namespace rvlio {
 namespace {

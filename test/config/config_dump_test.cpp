@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "config_test_util.h"
-#include "rvlio/io/config.h"
+#include "rvlio/config/config.h"
 #include "rvlio/sim/options.h"
 
 namespace rvlio {

@@ -1,4 +1,4 @@
-// Loading order, value parsing and every error class of io/config.h.
+// Loading order, value parsing and every error class of config/config.h.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "config_test_util.h"
-#include "rvlio/io/config.h"
+#include "rvlio/config/config.h"
 
 namespace rvlio {
 namespace {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "config_test_util.h"
-#include "rvlio/io/config.h"
+#include "rvlio/config/config.h"
 
 namespace rvlio {
 namespace {

@@ -1,4 +1,4 @@
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 
 #include <algorithm>
 #include <cmath>

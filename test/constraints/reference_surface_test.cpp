@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 
 namespace rvlio {
 namespace {

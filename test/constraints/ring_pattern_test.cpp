@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/math/so3.h"
 #include "scene.h"
 

@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {

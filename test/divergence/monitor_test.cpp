@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/odometry/divergence.h"
-#include "rvlio/smoother/refine.h"
+#include "rvlio/refine/refine.h"
 
 namespace rvlio {
 namespace {

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/eval/align.h"
-#include "rvlio/eval/associate.h"
+#include "rvlio/eval/time_matching.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/metrics.h"
 #include "rvlio/eval/stats.h"

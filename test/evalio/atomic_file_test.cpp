@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/atomic_file.h"
+#include "rvlio/formats/atomic_file.h"
 
 namespace rvlio {
 namespace {

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rvlio/eval/evaluate.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
 namespace {

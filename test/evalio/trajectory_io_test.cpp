@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
 namespace {

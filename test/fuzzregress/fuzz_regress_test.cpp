@@ -13,9 +13,9 @@
 #include <string>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/config.h"
-#include "rvlio/io/pointcloud2.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/config/config.h"
+#include "rvlio/formats/pointcloud2.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
 namespace {

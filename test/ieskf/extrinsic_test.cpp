@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/ieskf/ieskf.h"
 #include "rvlio/map/voxel_map.h"

@@ -5,7 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/ieskf/ieskf.h"
 #include "rvlio/imu/integrator.h"
 #include "rvlio/map/voxel_map.h"

@@ -11,8 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/sensor_stream.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/sensor_stream.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
 namespace {

@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/livox.h"
-#include "rvlio/io/pointcloud2.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/livox.h"
+#include "rvlio/formats/pointcloud2.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {
@@ -126,7 +126,7 @@ TEST(LivoxDecode, TimesAreTimebasePlusOffsetAndInvalidPointsAreCounted) {
 }
 
 // The same points as an Ouster PointCloud2 are filtered and counted alike
-// (one filter, io/pointcloud2.h FilterPoint).
+// (one filter, formats/pointcloud2.h FilterPoint).
 TEST(LivoxDecode, FiltersExactlyLikePointCloud2) {
   const LivoxCustomMsg msg = SampleMsg();
   std::vector<uint8_t> data(msg.points.size() * 16);

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/sensor_stream.h"
+#include "rvlio/formats/sensor_stream.h"
 
 namespace rvlio {
 namespace {

@@ -1,9 +1,9 @@
-// Reading PCD and PLY clouds (io/point_cloud_file.h): files written by PCL's
+// Reading PCD and PLY clouds (formats/point_cloud_file.h): files written by PCL's
 // own writers in every encoding read back to the same points and fields;
 // hand-written files for the cases PCL does not write (big-endian PLY, an
 // element before the vertices); and every refusal, one line naming the file.
-#include "rvlio/io/point_cloud_file.h"
-#include "rvlio/io/run_outputs.h"
+#include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/outputs/run_outputs.h"
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>

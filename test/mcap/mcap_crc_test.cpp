@@ -1,4 +1,4 @@
-// CRC-32 of src/io/mcap_records.h (libdeflate) against known values: the
+// CRC-32 of src/formats/mcap_records.h (libdeflate) against known values: the
 // standard check value, values from python3's zlib.crc32 for every length
 // class the vectorized paths take, and the chunk CRC that the ROS 2 tools'
 // MCAP writer stored in the talker fixture.
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../../src/io/mcap_records.h"
+#include "../../src/formats/mcap_records.h"
 #include "mcap_test_util.h"
 
 namespace rvlio {

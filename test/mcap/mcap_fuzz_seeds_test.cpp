@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "mcap_test_util.h"
-#include "rvlio/io/mcap.h"
+#include "rvlio/formats/mcap.h"
 
 namespace rvlio {
 namespace {

@@ -8,7 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "mcap_test_util.h"
-#include "rvlio/io/mcap.h"
+#include "rvlio/formats/mcap.h"
 
 namespace rvlio {
 namespace {

@@ -15,7 +15,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/mcap.h"
+#include "rvlio/formats/mcap.h"
 
 namespace rvlio::mcap_test {
 

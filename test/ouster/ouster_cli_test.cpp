@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/pcap.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/pcap.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
 namespace {

@@ -13,8 +13,8 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/ouster.h"
-#include "rvlio/io/pcap.h"
+#include "rvlio/formats/ouster.h"
+#include "rvlio/formats/pcap.h"
 
 namespace rvlio {
 namespace {

@@ -15,9 +15,9 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/constraints/plane_fit.h"
-#include "rvlio/io/ouster.h"
+#include "rvlio/formats/ouster.h"
 #include "ouster_test_util.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {

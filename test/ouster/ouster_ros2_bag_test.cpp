@@ -17,10 +17,10 @@
 
 #include "../cli/cli_util.h"
 #include "ouster_test_util.h"
-#include "rvlio/io/cdr.h"
-#include "rvlio/io/mcap.h"
-#include "rvlio/io/pcap.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/cdr.h"
+#include "rvlio/formats/mcap.h"
+#include "rvlio/formats/pcap.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {

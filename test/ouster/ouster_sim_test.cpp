@@ -16,9 +16,9 @@
 
 #include "ouster_test_util.h"
 #include "rvlio/api.h"
-#include "rvlio/io/config.h"
-#include "rvlio/io/pcap.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/config/config.h"
+#include "rvlio/formats/pcap.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio::testing_ouster {
 

@@ -1,7 +1,7 @@
 // The measurement model on real scans: small_gicp's outdoor scan pair
 // (test/data/small_gicp_pair), aligned with rvlio's point-to-plane
 // association (the working map's k-NN, plane fit and validity tests,
-// constraints/associate.h) and a plain Gauss-Newton solve of those
+// constraints/plane_association.h) and a plain Gauss-Newton solve of those
 // constraints (no IMU, no RV), agrees with the transform small_gicp's own
 // registration finds. A deliberately wrong plane model (every plane moved
 // 10 cm along its normal) must fail the same tolerance, so the test can fail.
@@ -14,7 +14,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/constraints/robust_kernel.h"
 #include "rvlio/lidar/preprocess.h"

@@ -17,8 +17,8 @@
 
 #include "report_data.h"
 #include "report_html.h"
-#include "rvlio/io/run_outputs.h"
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio::cli::report {
 namespace {

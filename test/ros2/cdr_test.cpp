@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/cdr.h"
+#include "rvlio/formats/cdr.h"
 
 namespace rvlio {
 namespace {

@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include "rvlio/io/cdr.h"
-#include "rvlio/io/recording.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/cdr.h"
+#include "rvlio/formats/recording.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {

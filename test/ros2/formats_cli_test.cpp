@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/recording.h"
+#include "rvlio/formats/recording.h"
 
 namespace rvlio {
 namespace {

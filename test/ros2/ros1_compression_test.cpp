@@ -9,7 +9,7 @@
 #include <sensor_msgs/Imu.h>
 
 #include "../cli/cli_util.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "rvlio/io/trajectory_io.h"
+#include "rvlio/formats/trajectory_io.h"
 #include "signals_util.h"
 
 namespace rvlio::signals_test {

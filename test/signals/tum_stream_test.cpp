@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/trajectory_io.h"
-#include "rvlio/io/tum_stream.h"
+#include "rvlio/formats/trajectory_io.h"
+#include "rvlio/formats/tum_stream.h"
 #include "signals_util.h"
 
 namespace rvlio::signals_test {

@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/io/config.h"
-#include "rvlio/io/sensor_bag.h"
+#include "rvlio/config/config.h"
+#include "rvlio/formats/sensor_bag.h"
 #include "rvlio/odometry/options.h"
 #include "rvlio/sim/presets.h"
 #include "rvlio/sim/simulator.h"

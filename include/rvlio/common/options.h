@@ -5,7 +5,7 @@
 //   v.Field("eps0", eps0, Spec().Range(0.0, 1.0).Help("SCV threshold on |u . n_alpha|"));
 //   v.Section("rv", rv);   // a nested Options struct
 //
-// io/ walks the same list to load YAML, apply `--set a.b=value`, reject
+// config/ walks the same list to load YAML, apply `--set a.b=value`, reject
 // unknown keys and print the resolved configuration; ValidateFields() below
 // checks ranges and choices. Supported field types: bool, int, int64_t,
 // double, std::string, std::array<double, N>, and enums that list their
@@ -16,7 +16,7 @@
 //
 //   static constexpr DeprecatedName kDeprecatedNames[] = {{"huber_delta", "refine_huber_delta"}};
 //
-// and the config layer (io/config.h) then accepts the old name for the new
+// and the config layer (config/config.h) then accepts the old name for the new
 // field, with one warning line naming both.
 #include <array>
 #include <cstdint>
@@ -177,7 +177,7 @@ class ValidateVisitor {
   template <typename T>
   void Check(const std::string& key, const T& value, const Spec& s) {
     if constexpr (std::is_same_v<T, bool> || std::is_enum_v<T>) {
-      (void)key; (void)value; (void)s;  // enums: checked when parsed (io/config.h)
+      (void)key; (void)value; (void)s;  // enums: checked when parsed (config/config.h)
     } else if constexpr (std::is_arithmetic_v<T>) {
       CheckNumber(key, static_cast<double>(value), s);
     } else if constexpr (std::is_same_v<T, std::string>) {

@@ -6,7 +6,7 @@
 
 #include "rvlio/constraints/constraint.h"
 #include "rvlio/math/pose.h"
-#include "rvlio/math/state.h"
+#include "rvlio/imu/filter_state.h"
 
 namespace rvlio {
 

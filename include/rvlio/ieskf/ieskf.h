@@ -20,7 +20,7 @@
 #include "rvlio/imu/pose_history.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/math/extrinsic_excitation.h"
-#include "rvlio/math/state.h"
+#include "rvlio/imu/filter_state.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/rv/rv.h"
 

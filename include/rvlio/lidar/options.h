@@ -16,7 +16,7 @@ struct LidarOptions {
   double voxel_size = 0.5;            // m, scan downsampling before association
   int point_stride = 1;               // keep every n-th raw point before the voxel filter
   double time_offset = 0.0;           // s, t_imu_clock = t_lidar_stamp + time_offset
-  // Point-time sanity check (io/sensor_bag.h): the span of the point times of
+  // Point-time sanity check (formats/sensor_bag.h): the span of the point times of
   // a scan against the scan period, median over the first scans.
   double point_time_span_stop = 0.01;  // below this fraction reading stops (0: never)
   double point_time_span_warn = 0.5;   // below this fraction a warning

@@ -1,6 +1,6 @@
 #pragma once
 // The whole configuration of a run: one section per module. This is what
-// `--config` files and `--set key=value` fill (io/config.h).
+// `--config` files and `--set key=value` fill (config/config.h).
 #include <string>
 #include <utility>
 
@@ -9,13 +9,14 @@
 #include "rvlio/degeneracy/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
-#include "rvlio/io/reader_options.h"
+#include "rvlio/formats/reader_options.h"
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/options.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/reference.h"
 #include "rvlio/rv/options.h"
-#include "rvlio/smoother/options.h"
+#include "rvlio/window/options.h"
 
 namespace rvlio {
 

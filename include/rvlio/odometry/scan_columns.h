@@ -1,6 +1,6 @@
 #pragma once
 // The per-scan columns: one table of name, unit and how to compute each from
-// a scan's record. scans.csv (io/run_outputs.h, WriteScansCsv) and the Python
+// a scan's record. scans.csv (outputs/run_outputs.h, WriteScansCsv) and the Python
 // per-scan table (rvlio.run(...).scans) are both generated from it, so they
 // have the same columns in the same order (docs/outputs.md lists them).
 #include <string>

@@ -12,7 +12,7 @@
 #include <Eigen/Core>
 
 #include "rvlio/common/types.h"
-#include "rvlio/constraints/associate.h"
+#include "rvlio/constraints/plane_association.h"
 #include "rvlio/imu/integrator.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/imu/static_init.h"

@@ -1,6 +1,6 @@
 #pragma once
 // The sliding-window smoother backend of the odometry pipeline (see
-// odometry.h; docs/design.md "The backends"; the window itself: smoother/window.h).
+// odometry.h; docs/design.md "The backends"; the window itself: window/window.h).
 //
 // Per scan: Predict (IMU integration from the newest window state) ->
 // Downsample -> Deskew (with the predicted motion) -> add the state with the
@@ -36,7 +36,7 @@
 #include "rvlio/map/output_map.h"
 #include "rvlio/odometry/odometry.h"
 #include "rvlio/odometry/scan_frontend.h"
-#include "rvlio/smoother/window.h"
+#include "rvlio/window/window.h"
 
 namespace rvlio {
 

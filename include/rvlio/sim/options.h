@@ -12,6 +12,7 @@
 
 #include "rvlio/common/options.h"
 #include "rvlio/imu/options.h"
+#include "rvlio/lidar/extrinsics.h"
 
 namespace rvlio {
 

@@ -1,0 +1,19 @@
+#pragma once
+// --start / --duration of run, refine and compare: a time window of the
+// recording (formats/sensor_stream.h).
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "rvlio/formats/sensor_stream.h"
+
+namespace rvlio::cli {
+
+OptionSpec StartOption();
+OptionSpec DurationOption();
+// Fills *window from --start / --duration; "" or the error message.
+std::string ParseWindow(const Args& args, ReadWindow* window);
+// The same window as command-line arguments (for commands run in-process).
+std::vector<std::string> WindowArgs(const ReadWindow& window);
+
+}  // namespace rvlio::cli

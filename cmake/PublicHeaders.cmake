@@ -1,0 +1,71 @@
+# The public API: the headers `cmake --install` puts under include/rvlio
+# (docs/library.md "The public headers"). The entry points are rvlio/api.h
+# (whole recordings), config/config.h, odometry/odometry.h (scan by scan),
+# formats/sensor_stream.h and formats/trajectory_io.h (reading recordings and
+# trajectories), eval/evaluate.h, sim/simulator.h and sim/presets.h, and
+# math/so3.h; the rest of the list is what those include. Every other header
+# of include/rvlio is private: the libraries' own, the tests' and the
+# command's, free to change. scripts/install_test.sh compiles each listed
+# header on its own from the prefix (so the list is closed under #include)
+# and checks that no other header is installed. rvlio/version.h is generated.
+set(rvlio_public_headers
+  rvlio/api.h
+  rvlio/common/check.h
+  rvlio/common/options.h
+  rvlio/common/status.h
+  rvlio/common/time.h
+  rvlio/common/types.h
+  rvlio/config/config.h
+  rvlio/constraints/constraint.h
+  rvlio/constraints/options.h
+  rvlio/constraints/plane_fit.h
+  rvlio/constraints/reference_surface.h
+  rvlio/degeneracy/degeneracy.h
+  rvlio/degeneracy/options.h
+  rvlio/eval/align.h
+  rvlio/eval/degeneracy_scores.h
+  rvlio/eval/evaluate.h
+  rvlio/eval/map_metrics.h
+  rvlio/eval/metrics.h
+  rvlio/eval/options.h
+  rvlio/eval/stats.h
+  rvlio/factors/parameter_blocks.h
+  rvlio/formats/reader_options.h
+  rvlio/formats/sensor_bag.h
+  rvlio/formats/sensor_stream.h
+  rvlio/formats/trajectory_io.h
+  rvlio/ieskf/options.h
+  rvlio/imu/options.h
+  rvlio/lidar/extrinsics.h
+  rvlio/lidar/options.h
+  rvlio/lidar/preprocess.h
+  rvlio/map/options.h
+  rvlio/map/reference_map.h
+  rvlio/map/voxel_key.h
+  rvlio/map/voxel_map.h
+  rvlio/math/extrinsic_excitation.h
+  rvlio/math/pose.h
+  rvlio/math/so3.h
+  rvlio/math/time_offset_excitation.h
+  rvlio/odometry/deviation.h
+  rvlio/odometry/divergence.h
+  rvlio/odometry/odometry.h
+  rvlio/odometry/options.h
+  rvlio/odometry/reference.h
+  rvlio/refine/refine.h
+  rvlio/refine/refine_states.h
+  rvlio/rv/criterion.h
+  rvlio/rv/options.h
+  rvlio/rv/rv.h
+  rvlio/sim/geometry.h
+  rvlio/sim/lidar_sim.h
+  rvlio/sim/options.h
+  rvlio/sim/presets.h
+  rvlio/sim/random.h
+  rvlio/sim/simulator.h
+  rvlio/sim/survey.h
+  rvlio/sim/trajectory.h
+  rvlio/sim/world.h
+  rvlio/sim/world_builder.h
+  rvlio/window/options.h
+)

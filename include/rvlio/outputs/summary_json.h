@@ -1,0 +1,39 @@
+#pragma once
+// The pieces of summary.json shared by run, refine, compare and ablate, and
+// the process figures they report.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rvlio/imu/options.h"
+#include "rvlio/formats/sensor_bag.h"
+#include "rvlio/lidar/options.h"
+#include "rvlio/odometry/divergence.h"
+
+namespace rvlio {
+
+// JSON text for the outputs. Configuration strings come from the user (--set,
+// YAML files, bag topics) and need not be valid UTF-8; nlohmann's default
+// dump throws on such bytes, so every output replaces them (U+FFFD).
+inline std::string JsonText(const nlohmann::json& j, int indent = 2) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// The reader's counts of what it skipped or repaired (summary.json stats.reader).
+nlohmann::json ReaderStatsJson(const SensorReaderStats& stats);
+
+// One warning line per kind of input problem the reader skipped or repaired
+// (the counts are in summary.json stats.reader).
+std::vector<std::string> ReaderWarnings(const SensorReaderStats& stats, const LidarOptions& lidar,
+                                        const ImuOptions& imu);
+
+// {detected, first_time_s, scans_flagged, events: {kind: episodes}, episodes: [...]}.
+nlohmann::json DivergenceJson(const DivergenceReport& report);
+
+// Peak resident memory of this process, MB.
+double PeakMemoryMb();
+// Current resident memory of this process, MB (/proc/self/statm; 0 if unknown).
+double CurrentMemoryMb();
+
+}  // namespace rvlio

@@ -1,0 +1,294 @@
+// MergeRefineChunks (rvlio/api.h): the output folders of `rvlio refine
+// --chunk K --of N` into one trajectory and map (refine/refine_jobs.h for
+// the alignment and the blend). `rvlio merge` is this call plus arguments.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <optional>
+#include <set>
+#include <utility>
+
+#include "rvlio/api.h"
+#include "rvlio/formats/atomic_file.h"
+#include "rvlio/config/config.h"
+#include "rvlio/outputs/deviation_outputs.h"
+#include "rvlio/outputs/output_stage.h"
+#include "rvlio/formats/reference_map_file.h"
+#include "rvlio/api/refine_checkpoint.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/outputs/summary_json.h"
+#include "rvlio/formats/trajectory_io.h"
+#include "rvlio/map/output_map.h"
+#include "rvlio/refine/refine_jobs.h"
+
+namespace rvlio {
+namespace {
+
+using nlohmann::json;
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+// One chunk folder as read.
+struct ChunkFolder {
+  std::string dir;
+  json manifest;  // chunk.json
+  RefineJobTrajectory job;
+  std::vector<std::string> warnings;  // its summary.json "warnings"
+};
+
+// The whole file ("" when it cannot be read: the JSON parse then says so).
+std::string ReadFileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::string FilePath(const std::string& dir, const char* name) {
+  return (std::filesystem::path(dir) / name).string();
+}
+
+// chunk.json's fields as the merge needs them; InvalidInput naming the file.
+Status ParseManifest(const std::string& path, const json& m, RefineJobSpan* span) {
+  static const char* kKeys[] = {"chunk",    "of",          "overlap_s",    "core_begin_ns",
+                                "core_end_ns", "begin_ns", "end_ns",       "options_hash",
+                                "init_hash", "interrupted", "map_output_resolution"};
+  for (const char* key : kKeys)
+    if (!m.is_object() || !m.contains(key)) return Status::InvalidInput(path + ": no \"" + std::string(key) + "\"");
+  try {
+    span->chunk = m["chunk"].get<int>();
+    span->count = m["of"].get<int>();
+    span->core_begin_ns = m["core_begin_ns"].get<TimeNs>();
+    span->core_end_ns = m["core_end_ns"].get<TimeNs>();
+    span->begin_ns = m["begin_ns"].get<TimeNs>();
+    span->end_ns = m["end_ns"].get<TimeNs>();
+    (void)m["options_hash"].get<std::string>();
+    (void)m["init_hash"].get<std::string>();
+    (void)m["overlap_s"].get<double>();
+    (void)m["map_output_resolution"].get<double>();
+    if (m["interrupted"].get<bool>())
+      return Status::InvalidInput(path + ": chunk " + std::to_string(span->chunk) +
+                                  " was interrupted before its last round; run it again");
+  } catch (const json::exception& e) {
+    return Status::InvalidInput(path + ": " + e.what());
+  }
+  if (span->count < 1 || span->chunk < 1 || span->chunk > span->count)
+    return Status::InvalidInput(path + ": chunk " + std::to_string(span->chunk) + " of " +
+                                std::to_string(span->count) + " is not a chunk");
+  return Status::Ok();
+}
+
+// trajectory.tum must be the one the chunk wrote: as many poses as it refined,
+// from its first to its last stamp (a file cut short, or replaced, is refused).
+Status CheckTrajectoryAgainstManifest(const std::string& path, const json& m,
+                                      const Trajectory& trajectory) {
+  for (const char* key : {"scans_refined", "t_first_ns", "t_last_ns"})
+    if (!m.contains(key) || !m[key].is_number_integer())
+      return Status::InvalidInput(path + ": no integer \"" + std::string(key) + "\"");
+  const int64_t scans = m["scans_refined"].get<int64_t>();
+  const TimeNs first_ns = m["t_first_ns"].get<TimeNs>(), last_ns = m["t_last_ns"].get<TimeNs>();
+  const std::string tum = FilePath(std::filesystem::path(path).parent_path().string(), "trajectory.tum");
+  if (static_cast<int64_t>(trajectory.size()) != scans)
+    return Status::InvalidInput(tum + " has " + std::to_string(trajectory.size()) + " poses, but " +
+                                path + " records " + std::to_string(scans) +
+                                " refined scans: the trajectory is cut short or not this chunk's");
+  if (trajectory.front().t_ns != first_ns || trajectory.back().t_ns != last_ns)
+    return Status::InvalidInput(tum + " spans " + std::to_string(trajectory.front().t_ns) + " .. " +
+                                std::to_string(trajectory.back().t_ns) + " ns, but " + path +
+                                " records " + std::to_string(first_ns) + " .. " +
+                                std::to_string(last_ns) + ": not this chunk's trajectory");
+  return Status::Ok();
+}
+
+StatusOr<ChunkFolder> ReadChunkFolder(const std::string& dir) {
+  ChunkFolder c;
+  c.dir = dir;
+  const std::string manifest = FilePath(dir, "chunk.json");
+  if (!std::filesystem::exists(manifest))
+    return Status::InvalidInput(manifest + ": no such file (not the output of `rvlio refine --chunk K --of N`)");
+  c.manifest = json::parse(ReadFileText(manifest), nullptr, false);
+  if (c.manifest.is_discarded()) return Status::InvalidInput(manifest + ": not valid JSON");
+  if (Status s = ParseManifest(manifest, c.manifest, &c.job.span); !s.ok()) return s;
+  StatusOr<Trajectory> trajectory = ReadTum(FilePath(dir, "trajectory.tum"));
+  if (!trajectory.ok()) return trajectory.status();
+  c.job.trajectory = std::move(*trajectory);
+  if (Status s = CheckTrajectoryAgainstManifest(manifest, c.manifest, c.job.trajectory); !s.ok())
+    return s;
+  const json summary = json::parse(ReadFileText(FilePath(dir, "summary.json")), nullptr, false);
+  if (summary.is_object() && summary.contains("warnings") && summary["warnings"].is_array())
+    for (const json& w : summary["warnings"])
+      if (w.is_string()) c.warnings.push_back(w.get<std::string>());
+  return c;
+}
+
+// The chunks of one refinement, in order 1..N: InvalidInput naming what differs or is missing.
+Status CheckChunks(std::vector<ChunkFolder>* chunks) {
+  if (chunks->empty()) return Status::InvalidInput("no chunk folders to merge");
+  std::sort(chunks->begin(), chunks->end(),
+            [](const ChunkFolder& a, const ChunkFolder& b) { return a.job.span.chunk < b.job.span.chunk; });
+  const ChunkFolder& first = chunks->front();
+  const int n = first.job.span.count;
+  // map_hash: "" without --map (and in chunks written before it was recorded).
+  for (const char* key : {"of", "options_hash", "init_hash", "overlap_s", "map_hash"})
+    for (const ChunkFolder& c : *chunks)
+      if (c.manifest.value(key, json("")) != first.manifest.value(key, json("")))
+        return Status::InvalidInput(
+            "chunks of different refinements: " + FilePath(c.dir, "chunk.json") + " has " + key +
+            " " + c.manifest.value(key, json("")).dump() + ", " + FilePath(first.dir, "chunk.json") +
+            " " + first.manifest.value(key, json("")).dump() +
+            (std::string(key) == "options_hash" ? " (other --config/--set)"
+             : std::string(key) == "map_hash"   ? " (another --map)"
+                                                : ""));
+  std::set<int> have;
+  for (const ChunkFolder& c : *chunks)
+    if (!have.insert(c.job.span.chunk).second)
+      return Status::InvalidInput("chunk " + std::to_string(c.job.span.chunk) + " of " +
+                                  std::to_string(n) + " given twice (" + c.dir + ")");
+  std::string missing;
+  for (int k = 1; k <= n; ++k)
+    if (!have.count(k)) missing += (missing.empty() ? "" : ", ") + std::to_string(k);
+  if (!missing.empty())
+    return Status::InvalidInput("missing chunk " + missing + " of " + std::to_string(n) +
+                                " (have " + std::to_string(chunks->size()) + " folders)");
+  return Status::Ok();
+}
+
+// Each chunk's map carried into the merged frame, re-voxelized at the chunks' resolution.
+StatusOr<std::vector<Eigen::Vector3d>> MergeMaps(const std::vector<ChunkFolder>& chunks,
+                                                 const RefineJobMerge& merge) {
+  OutputMap output(chunks.front().manifest["map_output_resolution"].get<double>());
+  for (size_t k = 0; k < chunks.size(); ++k) {
+    StatusOr<std::vector<Eigen::Vector3d>> points = ReadMapPcd(FilePath(chunks[k].dir, "map.pcd"));
+    if (!points.ok()) return points.status();
+    const Pose3& T = merge.alignments[k].T_merged_chunk;
+    for (Eigen::Vector3d& p : *points) p = T * p;
+    output.Insert(*points);
+  }
+  return output.Points();
+}
+
+json AlignmentJson(const ChunkFolder& c, const RefineJobAlignment& a) {
+  return {{"chunk", a.chunk},
+          {"dir", c.dir},
+          {"scans", c.job.trajectory.size()},
+          {"shared_poses", a.shared_poses},
+          {"translation_m", a.T_merged_chunk.t.norm()},
+          {"rotation_deg", Eigen::AngleAxisd(a.T_merged_chunk.R).angle() * kRadToDeg},
+          {"residual_rms_m", a.rms_residual_m},
+          {"residual_max_m", a.max_residual_m},
+          {"residual_max_deg", a.max_residual_deg}};
+}
+
+json Summary(const std::vector<ChunkFolder>& chunks, const RefineJobMerge& merge,
+             const MergeResult& r) {
+  json j;
+  j["version"] = RVLIO_VERSION;
+  j["command"] = "merge";
+  j["of"] = chunks.front().job.span.count;
+  j["overlap_s"] = chunks.front().manifest["overlap_s"];
+  j["options_hash"] = chunks.front().manifest["options_hash"];
+  j["init_hash"] = chunks.front().manifest["init_hash"];
+  j["scan_count"] = r.trajectory.size();
+  j["sequence_duration_s"] = NsToSeconds(r.trajectory.back().t_ns - r.trajectory.front().t_ns);
+  j["map_points"] = r.map_points.size();
+  j["chunks"] = json::array();
+  for (size_t k = 0; k < chunks.size(); ++k)
+    j["chunks"].push_back(AlignmentJson(chunks[k], merge.alignments[k]));
+  j["warnings"] = r.warnings;
+  return j;
+}
+
+Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
+                    const MapDeviation* deviation) {
+  OutputStage stage(out_dir);  // all outputs or none
+  if (Status s = stage.Open(); !s.ok()) return s;
+  if (Status s = WriteTum(stage.Path("trajectory.tum"), r.trajectory); !s.ok())
+    return stage.Explain(s);
+  if (Status s = WriteMapOutputs(&stage, r.map_points, deviation); !s.ok()) return s;
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
+      !s.ok())
+    return stage.Explain(s);
+  return stage.Commit();
+}
+
+// The reference of `merge --map`, checked against the map the chunks were
+// refined with (chunk.json's map_hash: the file's content), and the chunks'
+// deviation options. Null without --map.
+struct MergeReference {
+  std::shared_ptr<const ReferenceMap> surface;
+  DeviationOptions options;
+};
+
+StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkFolder& first) {
+  MergeReference ref;
+  if (map.empty()) return ref;
+  const std::string manifest = FilePath(first.dir, "chunk.json");
+  const std::string chunk_hash = first.manifest.value("map_hash", std::string());
+  if (chunk_hash.empty())
+    return Status::InvalidInput("--map " + map + ": the chunks were refined without --map (" +
+                                manifest + ")");
+  StatusOr<uint64_t> hash = FileContentHash(map);
+  if (!hash.ok()) return Status::InvalidInput("--map " + hash.status().message());
+  if (HashText(*hash) != chunk_hash)
+    return Status::InvalidInput("--map " + map + ": not the map the chunks were refined with (" +
+                                manifest + " has map " +
+                                first.manifest.value("map", std::string()) + ", content hash " +
+                                chunk_hash + ")");
+  if (Status s = ApplyYamlText(ref.options, first.manifest.value("deviation", std::string()),
+                               manifest + " deviation");
+      !s.ok())
+    return s;
+  StatusOr<std::shared_ptr<const ReferenceMap>> surface = LoadReferenceSurface(map);
+  if (!surface.ok()) return surface.status();
+  ref.surface = std::move(*surface);
+  return ref;
+}
+
+}  // namespace
+
+StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
+  std::vector<ChunkFolder> chunks;
+  for (const std::string& dir : args.chunk_dirs) {
+    StatusOr<ChunkFolder> c = ReadChunkFolder(dir);
+    if (!c.ok()) return c.status();
+    chunks.push_back(std::move(*c));
+  }
+  if (Status s = CheckChunks(&chunks); !s.ok()) return s;
+  StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front());
+  if (!reference.ok()) return reference.status();
+  if (!args.out_dir.empty())
+    if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
+  std::vector<RefineJobTrajectory> jobs;
+  for (const ChunkFolder& c : chunks) jobs.push_back(c.job);
+  StatusOr<RefineJobMerge> merge = MergeRefineJobs(jobs);
+  if (!merge.ok()) return merge.status();
+  MergeResult r;
+  r.trajectory = merge->trajectory;
+  StatusOr<std::vector<Eigen::Vector3d>> map = MergeMaps(chunks, *merge);
+  if (!map.ok()) return map.status();
+  r.map_points = std::move(*map);
+  for (const ChunkFolder& c : chunks)
+    for (const std::string& w : c.warnings)
+      if (std::find(r.warnings.begin(), r.warnings.end(), w) == r.warnings.end())
+        r.warnings.push_back(w);
+  const std::string chunk_map = chunks.front().manifest.value("map", std::string());
+  if (args.map.empty() && !chunks.front().manifest.value("map_hash", std::string()).empty())
+    r.warnings.push_back("the chunks were refined with --map " + chunk_map +
+                         "; merge --map " + chunk_map + " writes the deviation from it");
+  r.summary = Summary(chunks, *merge, r);
+  std::optional<MapDeviation> deviation;
+  if (reference->surface != nullptr) {
+    deviation = ComputeMapDeviation(r.map_points, *reference->surface, r.trajectory,
+                                    reference->options);
+    r.summary["map"] = args.map;
+    r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  }
+  if (args.out_dir.empty()) return r;
+  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr); !s.ok())
+    return s;
+  r.written = true;
+  return r;
+}
+
+}  // namespace rvlio

@@ -1,0 +1,405 @@
+// RefineRecording (rvlio/api.h): reads the whole recording into memory
+// (downsampled scans and all IMU samples; a chunk job, RefineArgs::chunk,
+// only its chunk's scans and the IMU samples around them), batch-refines the initial
+// trajectory (refine/refine.h) and, given an output folder, writes
+// trajectory.tum, map.pcd and summary.json atomically. `rvlio refine` is this
+// call plus argument parsing, signals and the terminal lines.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <utility>
+
+#include "rvlio/common/cpu_time.h"
+#include "rvlio/api.h"
+#include "rvlio/formats/atomic_file.h"
+#include "rvlio/lidar/extrinsics.h"
+#include "rvlio/outputs/output_stage.h"
+#include "rvlio/outputs/deviation_outputs.h"
+#include "rvlio/formats/reference_map_file.h"
+#include "rvlio/api/refine_checkpoint.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/sensor_bag.h"
+#include "rvlio/outputs/summary_json.h"
+#include "rvlio/formats/trajectory_io.h"
+#include "rvlio/lidar/preprocess.h"
+#include "rvlio/refine/refine_jobs.h"
+
+namespace rvlio {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+RefineConfig ToRefineConfig(const OdometryOptions& o,
+                            std::shared_ptr<const VoxelMap> reference) {
+  RefineConfig c;
+  c.reference = std::move(reference);
+  c.imu = o.imu;
+  c.T_imu_lidar = ImuTLidar(o.extrinsics);
+  c.map = o.map;
+  c.constraints = o.constraints;
+  c.rv = EffectiveRvOptions(o.rv, o.degeneracy);
+  c.degeneracy = o.degeneracy;
+  c.smoother = o.smoother;
+  return c;
+}
+
+// What `stop` says now ("" goes on).
+std::string StopReason(const RefineArgs& args) { return args.stop ? args.stop() : std::string(); }
+
+// IMU samples kept around a chunk job's scans (before its first scan's
+// start, after its last scan's end).
+constexpr TimeNs kChunkImuMarginNs = 1000000000;  // 1 s
+
+// What the reader saw of the recording's scans (all of them, also those a
+// chunk job does not keep): the coverage of the initial trajectory.
+struct ScansSeen {
+  int64_t scans = 0;
+  TimeNs first_end_ns = 0, last_end_ns = 0;
+  int64_t outside_init = 0;  // end stamp outside the initial trajectory's span
+  int64_t chunk_first = -1, chunk_last = -1;  // recording index (0-based) of a chunk's kept scans
+};
+
+// A chunk job keeps the IMU samples around its scans and, as the whole
+// refinement, those of the recording's first imu.init_duration (from
+// `static_end_ns` on: the static alignment that gives gravity and the gyro
+// bias, refine_init.h), so every chunk starts from the same gravity vector.
+bool KeepImu(const RefineJobSpan* job, TimeNs static_end_ns, TimeNs t_ns) {
+  if (job == nullptr || t_ns <= static_end_ns) return true;
+  return (job->chunk == 1 || t_ns >= job->begin_ns - kChunkImuMarginNs) &&
+         (job->chunk == job->count || t_ns <= job->end_ns + kChunkImuMarginNs);
+}
+
+void CountScan(const Scan& scan, const Trajectory& init, ScansSeen* seen) {
+  if (seen->scans == 0) seen->first_end_ns = scan.t_end_ns;
+  seen->first_end_ns = std::min(seen->first_end_ns, scan.t_end_ns);
+  seen->last_end_ns = std::max(seen->last_end_ns, scan.t_end_ns);
+  if (scan.t_end_ns < init.front().t_ns || scan.t_end_ns > init.back().t_ns) ++seen->outside_init;
+  ++seen->scans;
+}
+
+// Every IMU sample and every scan, downsampled as the odometry does
+// (lidar/preprocess.h), so that a 100 s sequence stays small in memory; a
+// chunk job (`job`) keeps only its scans and the IMU samples around them.
+// Stops early (Ok, *stop_reason set) when `stop` says so.
+Status ReadBag(const RefineArgs& args, const RefineJobSpan* job, SensorBagReader* reader,
+               RefineInput* input, int64_t* raw_points, ScansSeen* seen,
+               std::string* stop_reason) {
+  ScanPreprocessor preprocessor(args.options.lidar);
+  ImuSample imu;
+  Scan scan;
+  TimeNs static_end_ns = 0;
+  while ((*stop_reason = StopReason(args)).empty()) {
+    StatusOr<SensorMessage> m = reader->Next(&imu, &scan);
+    if (!m.ok()) return m.status();
+    if (*m == SensorMessage::kEnd) return Status::Ok();
+    if (*m == SensorMessage::kImu) {
+      if (input->imu.empty()) static_end_ns = imu.t_ns + SecondsToNs(args.options.imu.init_duration);
+      if (KeepImu(job, static_end_ns, imu.t_ns)) input->imu.push_back(imu);
+      continue;
+    }
+    CountScan(scan, input->init, seen);
+    if (job != nullptr && !job->Contains(scan.t_end_ns)) continue;
+    if (seen->chunk_first < 0) seen->chunk_first = seen->scans - 1;
+    seen->chunk_last = seen->scans - 1;
+    *raw_points += static_cast<int64_t>(scan.points.size());
+    Scan small;
+    preprocessor.Downsample(scan, &small);
+    input->scans.push_back(std::move(small));
+  }
+  return Status::Ok();
+}
+
+std::string SecondsText(TimeNs t_ns) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3f", NsToSeconds(t_ns));
+  return buf;
+}
+
+// Scans the initial trajectory may leave out at the recording's start beyond
+// imu.init_duration (the odometry's static initialization has no poses) and
+// at its end, before refine says it covers only part of the recording.
+constexpr double kCoverageSlackS = 0.5;
+
+bool CoversRecording(const ScansSeen& seen, const Trajectory& init, double init_duration_s) {
+  if (seen.outside_init == 0) return true;
+  const double lead_s = NsToSeconds(init.front().t_ns - seen.first_end_ns);
+  const double tail_s = NsToSeconds(seen.last_end_ns - init.back().t_ns);
+  return lead_s <= init_duration_s + kCoverageSlackS && tail_s <= kCoverageSlackS;
+}
+
+// The warning when the initial trajectory leaves a part of the recording out
+// (empty when it covers it, CoversRecording).
+std::string CoverageWarning(const ScansSeen& seen, const Trajectory& init,
+                            double init_duration_s) {
+  if (CoversRecording(seen, init, init_duration_s)) return "";
+  return "the initial trajectory (" + SecondsText(init.front().t_ns) + " .. " +
+         SecondsText(init.back().t_ns) + " s) covers only part of the recording's scans (" +
+         SecondsText(seen.first_end_ns) + " .. " + SecondsText(seen.last_end_ns) + " s): " +
+         std::to_string(seen.outside_init) + " of " + std::to_string(seen.scans) +
+         " scans outside it are not refined";
+}
+
+nlohmann::json CoverageJson(const ScansSeen& seen, const Trajectory& init,
+                            double init_duration_s) {
+  return {{"init_begin_s", NsToSeconds(init.front().t_ns)},
+          {"init_end_s", NsToSeconds(init.back().t_ns)},
+          {"scans_begin_s", NsToSeconds(seen.first_end_ns)},
+          {"scans_end_s", NsToSeconds(seen.last_end_ns)},
+          {"recording_scans", seen.scans},
+          {"scans_outside_init", seen.outside_init},
+          {"complete", CoversRecording(seen, init, init_duration_s)}};
+}
+
+// chunk.json of a chunk job: what `rvlio merge` needs to check and merge it.
+nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const ScansSeen& seen,
+                         uint64_t init_hash, uint64_t map_hash, const RefineResult& res) {
+  return {{"format", 1},
+          {"chunk", job.chunk},
+          {"of", job.count},
+          {"overlap_s", args.options.smoother.refine_job_overlap_s},
+          {"core_begin_ns", job.core_begin_ns},
+          {"core_end_ns", job.core_end_ns},
+          {"begin_ns", job.begin_ns},
+          {"end_ns", job.end_ns},
+          {"recording_scan_first", seen.chunk_first},
+          {"recording_scan_last", seen.chunk_last},
+          {"scans_refined", res.trajectory.size()},
+          {"t_first_ns", res.trajectory.front().t_ns},
+          {"t_last_ns", res.trajectory.back().t_ns},
+          {"map_output_resolution", args.options.map.output_resolution},
+          {"options_hash", HashText(RefineOptionsHash(args.options))},
+          {"init_hash", HashText(init_hash)},
+          {"map_hash", args.map.empty() ? std::string() : HashText(map_hash)},
+          {"map", args.map},
+          {"deviation", DumpYaml(args.options.localization.deviation)},  // for merge --map
+          {"interrupted", res.stopped},
+          {"bag", args.bag},
+          {"init", args.init_path}};
+}
+
+std::string ShortChunk(const RefineJobSpan& job, size_t scans) {
+  return "--chunk " + std::to_string(job.chunk) + " --of " + std::to_string(job.count) +
+         ": the chunk (" + SecondsText(job.begin_ns) + " .. " + SecondsText(job.end_ns) +
+         " s) holds " + std::to_string(scans) + " scans, fewer than " +
+         std::to_string(kRefineJobMinScans) + "; use fewer chunks";
+}
+
+nlohmann::json StatsJson(const RefineStats& s, const SensorReaderStats& r, int64_t raw_points) {
+  return {{"scans_input", s.scans_input},
+          {"scans_refined", s.scans_refined},
+          {"scans_outside_init", s.scans_outside_init},
+          {"scans_without_imu", s.scans_without_imu},
+          {"scans_too_few_points", s.scans_too_few_points},
+          {"scans_out_of_order", s.scans_out_of_order},
+          {"imu_samples", s.imu_samples},
+          {"raw_points", raw_points},
+          {"map_entries", s.map_entries},
+          {"chunks", s.chunks},
+          {"gravity_from_static", s.gravity_from_static},
+          {"started_moving", s.started_moving},
+          {"reader", ReaderStatsJson(r)}};
+}
+
+struct Times {
+  double read_s = 0.0, checkpoint_s = 0.0, wall_s = 0.0;
+};
+
+nlohmann::json Summary(const RefineArgs& args, const RefineRunResult& r,
+                       const SensorReaderStats& reader_stats, int64_t raw_points,
+                       const Times& times) {
+  const RefineResult& res = r.refine;
+  nlohmann::json j;
+  j["version"] = RVLIO_VERSION;
+  j["command"] = "refine";
+  j["bag"] = args.bag;
+  j["init"] = args.init_path;
+  if (!args.map.empty()) j["map"] = args.map;
+  j["config"] = ToJson(args.options);
+  j["linear_solver"] = res.linear_solver;
+  j["threads"] = res.threads;
+  j["scan_count"] = res.trajectory.size();
+  j["sequence_duration_s"] =
+      NsToSeconds(res.trajectory.back().t_ns - res.trajectory.front().t_ns);
+  j["g_world"] = {res.g_world.x(), res.g_world.y(), res.g_world.z()};
+  j["rounds"] = nlohmann::json::array();
+  for (const RefineRound& round : res.rounds) j["rounds"].push_back(RoundJson(round));
+  // The last round's count, by degeneracy.method (the run's summary has the same key).
+  j["degenerate_scans"] = res.rounds.empty() ? 0 : res.rounds.back().degenerate_scans;
+  j["converged"] = res.converged;
+  j["interrupted"] = res.stopped;
+  if (res.stopped) j["signal"] = r.stop_reason;
+  j["map_points"] = res.map_points.size();
+  j["time_s"] = {{"read_bag", times.read_s},
+                 {"init_solve", res.init_solve_s},
+                 {"refine", res.total_s},
+                 {"checkpoint", times.checkpoint_s},  // fingerprint + writes (checkpoint_dir)
+                 {"wall", times.wall_s}};
+  j["peak_memory_mb"] = PeakMemoryMb();
+  j["stats"] = StatsJson(res.stats, reader_stats, raw_points);
+  j["warnings"] = res.warnings;
+  j["divergence"] = DivergenceJson(r.divergence);
+  return j;
+}
+
+Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
+                    const MapDeviation* deviation) {
+  OutputStage stage(out_dir);  // all outputs or none
+  if (Status s = stage.Open(); !s.ok()) return s;
+  if (!r.chunk.is_null())
+    if (Status s = WriteFileAtomically(stage.Path("chunk.json"), JsonText(r.chunk) + "\n"); !s.ok())
+      return stage.Explain(s);
+  if (Status s = WriteTum(stage.Path("trajectory.tum"), r.refine.trajectory); !s.ok())
+    return stage.Explain(s);
+  if (Status s = WriteMapOutputs(&stage, r.refine.map_points, deviation); !s.ok()) return s;
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
+      !s.ok())
+    return stage.Explain(s);
+  return stage.Commit();
+}
+
+// The refinement with its hooks: rounds, checkpoints, the stop flag.
+// *checkpoint_s: wall time of the fingerprint and the checkpoint writes.
+// map_hash: FileContentHash of --map (0 without one).
+StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input,
+                                       std::shared_ptr<const VoxelMap> reference, uint64_t map_hash,
+                                       std::string* stop_reason, double* checkpoint_s) {
+  RefineHooks hooks;
+  hooks.on_round = args.on_round;
+  hooks.stop = [&args, stop_reason] { return !(*stop_reason = StopReason(args)).empty(); };
+  const bool checkpoints = !args.checkpoint_dir.empty();
+  const auto t0 = Clock::now();
+  const uint64_t fingerprint = checkpoints ? RefineFingerprint(args.options, input, map_hash) : 0;
+  *checkpoint_s = checkpoints ? SecondsSince(t0) : 0.0;
+  if (checkpoints)
+    hooks.on_state = [&args, fingerprint, checkpoint_s](const RefineRoundState& state) {
+      const auto t_write = Clock::now();
+      Status s = WriteRefineCheckpoint(args.checkpoint_dir, fingerprint, state);
+      *checkpoint_s += SecondsSince(t_write);
+      return s;
+    };
+  if (!args.resume)
+    return Refine(ToRefineConfig(args.options, std::move(reference)), std::move(input), hooks);
+  StatusOr<RefineRoundState> resume = ReadRefineCheckpoint(args.checkpoint_dir, fingerprint);
+  if (!resume.ok()) return resume.status();
+  hooks.resume = &*resume;
+  if (args.on_resume) args.on_resume(resume->rounds_done);
+  return Refine(ToRefineConfig(args.options, std::move(reference)), std::move(input), hooks);
+}
+
+// The checkpoint folder: one to resume from must hold a checkpoint; a new
+// one is created. Checked before the recording is read.
+Status PrepareCheckpointDir(const RefineArgs& args) {
+  if (args.checkpoint_dir.empty()) {
+    if (args.resume) return Status::InvalidInput("resume needs a checkpoint folder");
+    return Status::Ok();
+  }
+  return args.resume ? CheckpointExists(args.checkpoint_dir)
+                     : PrepareOutputDir(args.checkpoint_dir);
+}
+
+}  // namespace
+
+StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
+  const auto t0 = Clock::now();
+  RefineArgs args = in;  // an Ouster recording may supply the default extrinsic
+  std::vector<std::string> notes;
+  if (Status s = ApplyRecordingExtrinsics(args.bag, args.options.lidar, &args.options.extrinsics,
+                                          &notes);
+      !s.ok())
+    return s;
+  RefineInput input;
+  if (!args.init.empty()) {
+    input.init = args.init;
+  } else {
+    StatusOr<Trajectory> init = ReadTum(args.init_path);
+    if (!init.ok()) return init.status();
+    input.init = std::move(*init);
+  }
+  std::optional<RefineJobSpan> job;
+  if (args.chunk_count > 0) {
+    StatusOr<RefineJobSpan> span =
+        MakeRefineJobSpan(input.init.front().t_ns, input.init.back().t_ns, args.chunk,
+                          args.chunk_count, args.options.smoother.refine_job_overlap_s);
+    if (!span.ok()) return span.status();
+    job = *span;
+  }
+  const uint64_t init_hash = job ? TrajectoryHash(input.init) : 0;
+  const Trajectory init_span = {input.init.front(), input.init.back()};
+  std::shared_ptr<const VoxelMap> reference;
+  std::shared_ptr<const ReferenceMap> surface;  // the full cloud, for the deviation
+  if (!args.map.empty()) {  // read before anything is written
+    StatusOr<std::shared_ptr<const VoxelMap>> loaded =
+        LoadReferenceMap(args.map, args.options.localization, &surface);
+    if (!loaded.ok()) return loaded.status();
+    reference = std::move(*loaded);
+  }
+  uint64_t map_hash = 0;  // what a checkpoint and chunk.json know the map by
+  if (!args.map.empty() && (job || !args.checkpoint_dir.empty())) {
+    StatusOr<uint64_t> hash = FileContentHash(args.map);
+    if (!hash.ok()) return Status::InvalidInput("--map " + hash.status().message());
+    map_hash = *hash;
+  }
+  if (Status s = PrepareCheckpointDir(args); !s.ok()) return s;
+  StatusOr<std::unique_ptr<SensorBagReader>> reader = OpenSensorStream(
+      args.bag, args.options.lidar, args.options.imu, args.window, args.options.io);
+  if (!reader.ok()) return reader.status();
+  const bool write = !args.out_dir.empty();
+  OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
+  if (write)
+    if (Status s = out_folder.Prepare(); !s.ok()) return s;
+
+  RefineRunResult r;
+  int64_t raw_points = 0;
+  ScansSeen seen;
+  if (Status s = ReadBag(args, job ? &*job : nullptr, reader->get(), &input, &raw_points, &seen,
+                         &r.stop_reason);
+      !s.ok())
+    return s;
+  if (!r.stop_reason.empty()) {  // stopped while reading: nothing refined or written
+    r.stopped = true;
+    r.read_complete = false;
+    return r;
+  }
+  if (job && static_cast<int64_t>(input.scans.size()) < kRefineJobMinScans)
+    return Status::InvalidInput(ShortChunk(*job, input.scans.size()));
+  Times times;
+  times.read_s = SecondsSince(t0);
+  StatusOr<RefineResult> refined =
+      RefineWithHooks(args, std::move(input), std::move(reference), map_hash, &r.stop_reason,
+                      &times.checkpoint_s);
+  if (!refined.ok()) {
+    const std::string what =
+        refined.status().message() + " (bag " + args.bag + ", init " + args.init_path + ")";
+    return refined.status().code() == StatusCode::kInternal ? Status::Internal(what)
+                                                            : Status::InvalidInput(what);
+  }
+  r.refine = std::move(*refined);
+  r.refine.warnings.insert(r.refine.warnings.begin(), notes.begin(), notes.end());
+  if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
+  if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
+  r.stopped = r.refine.stopped;
+  if (!r.stopped) r.stop_reason.clear();
+  r.divergence = CheckRefineResult(r.refine, args.options.divergence,
+                                   args.options.constraints.lidar_noise, args.options.imu.gravity);
+  times.wall_s = SecondsSince(t0);
+  r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
+  r.summary["truncated"] = (*reader)->truncated();
+  r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
+  if (job) r.summary["chunk"] = r.chunk;
+  std::optional<MapDeviation> deviation;
+  if (surface != nullptr && !r.refine.trajectory.empty()) {
+    deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
+                                    args.options.localization.deviation);
+    r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  }
+  if (!write) return r;
+  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr); !s.ok())
+    return s;
+  out_folder.Keep();
+  r.written = true;
+  return r;
+}
+
+}  // namespace rvlio

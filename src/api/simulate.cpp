@@ -1,0 +1,363 @@
+// SimulateRecording (rvlio/api.h): runs the deterministic tunnel simulator
+// (sim/) and writes
+//   DIR/NAME.bag     ROS1 bag: Ouster-layout PointCloud2 + sensor_msgs/Imu
+//                    (format mcap: DIR/NAME.mcap, db3: DIR/NAME.db3, ROS 2 CDR;
+//                    ouster-pcap: DIR/NAME.pcap + NAME.json, Ouster packets, and
+//                    DIR/NAME.bag with the same quantized data)
+//   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
+//   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
+//   DIR/localizability.csv  with localizability.enabled (default): the true
+//                    per-scan localizability (sim/localizability.h,
+//                    docs/degeneracy_truth.md)
+//   DIR/reference_map.pcd  with survey.enabled: a static survey of the world
+//                    (binary PCD, x y z float32, the ground truth's world frame)
+// `rvlio simulate` is this call plus argument parsing, signals and its line.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <sstream>
+
+#include "rvlio/api.h"
+#include "rvlio/common/cpu_time.h"
+#include "rvlio/common/text.h"
+#include "rvlio/formats/atomic_file.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/formats/ouster.h"
+#include "rvlio/formats/pcap.h"
+#include "rvlio/formats/sensor_bag.h"
+#include "rvlio/formats/trajectory_io.h"
+#include "rvlio/sim/localizability.h"
+#include "rvlio/sim/presets.h"
+#include "rvlio/sim/simulator.h"
+
+namespace rvlio {
+namespace {
+
+constexpr double kGroundTruthRate = 100.0;  // Hz
+constexpr const char* kReferenceMapFile = "reference_map.pcd";
+constexpr const char* kLocalizabilityFile = "localizability.csv";
+
+// Preset, then seed / duration, then each override (applied last), then
+// validation.
+Status ResolveOptions(const SimulateArgs& args, SimOptions* options) {
+  StatusOr<SimOptions> preset = sim::PresetOptions(args.preset);
+  if (!preset.ok()) return preset.status();
+  *options = *preset;
+  if (args.lidar_msg != "pointcloud2" && args.lidar_msg != "livox")
+    return Status::InvalidInput("lidar message type '" + args.lidar_msg +
+                                "' is not pointcloud2 or livox");
+  if (args.lidar_msg == "livox") {
+    options->lidar.topic = "/livox/lidar";
+    options->lidar.frame_id = "livox_frame";
+  }
+  if (args.seed) {
+    if (*args.seed < 0)
+      return Status::InvalidInput("seed " + std::to_string(*args.seed) + " is negative");
+    options->seed = *args.seed;
+  }
+  if (args.flight_seed) {
+    if (*args.flight_seed < 0)
+      return Status::InvalidInput("flight seed " + std::to_string(*args.flight_seed) +
+                                  " is negative");
+    options->flight_seed = *args.flight_seed;
+  }
+  if (args.reference_map || args.reference_map_only) options->survey.enabled = true;
+  if (args.duration_s) {
+    if (!(*args.duration_s > 0.0) || !std::isfinite(*args.duration_s))
+      return Status::InvalidInput("duration " + std::to_string(*args.duration_s) +
+                                  " s is not a positive number of seconds");
+    options->duration = *args.duration_s;
+  }
+  for (const std::string& assignment : args.overrides)
+    if (Status s = ApplyOverride(*options, assignment); !s.ok()) return s;
+  return options->Validate();
+}
+
+// The format and MCAP compression -> writer options and the file extension.
+Status ResolveFormat(const SimulateArgs& args, BagWriterOptions* format, std::string* extension) {
+  const std::string& name = args.format;
+  if (name != "bag" && name != "mcap" && name != "db3" && name != "ouster-pcap")
+    return Status::InvalidInput("format '" + name + "' is not one of bag, mcap, db3, ouster-pcap");
+  format->format = name == "bag" || name == "ouster-pcap" ? "ros1" : name;
+  *extension = name == "ouster-pcap" ? ".pcap" : "." + name;
+  format->mcap_compression = args.mcap_compression;
+  const std::string& c = format->mcap_compression;
+  if (c != "zstd" && c != "lz4" && c != "none" && c != "unchunked")
+    return Status::InvalidInput("MCAP compression '" + c +
+                                "' is not one of zstd, lz4, none, unchunked");
+  if (c != "zstd" && name != "mcap")
+    return Status::InvalidInput("MCAP compression '" + c + "' applies to format mcap only");
+  return Status::Ok();
+}
+
+// ", flight seed N" when the flight has its own seed ("" otherwise, which
+// keeps the files of a default run as they were).
+std::string FlightSeedNote(const SimOptions& o) {
+  return o.flight_seed >= 0 ? ", flight seed " + std::to_string(o.flight_seed) : "";
+}
+
+// The estimator's sensor keys (odometry/options.h) as simulated. The noise
+// densities must be positive there; a noise-free simulation gets a tiny value.
+std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
+                       const std::string& bag_file) {
+  auto density = [](double v) { return FormatG(std::max(v, 1e-9), 10); };
+  const auto& t = o.extrinsics.imu_T_lidar.translation;
+  const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
+  std::ostringstream y;
+  y << "# Sensor configuration of the simulated sequence '" << name << "' (rvlio simulate, seed "
+    << o.seed << FlightSeedNote(o) << ").\n# Use: rvlio run --bag " << bag_file << " --config "
+    << name << ".yaml --out DIR\n"
+    << "lidar:\n"
+    << "  topic: " << o.lidar.topic << "\n"
+    << (livox ? "  type: livox\n" : "  type: ouster\n  header_stamp: start\n")
+    << "  min_range: " << FormatG(o.lidar.min_range, 10) << "\n"
+    << "  max_range: " << FormatG(o.lidar.max_range, 10) << "\n"
+    << "imu:\n"
+    << "  topic: " << o.imu.topic << "\n"
+    << "  gyro_noise_density: " << density(o.imu.gyro_noise_density) << "\n"
+    << "  accel_noise_density: " << density(o.imu.accel_noise_density) << "\n"
+    << "  gyro_bias_random_walk: " << density(o.imu.gyro_bias_random_walk) << "\n"
+    << "  accel_bias_random_walk: " << density(o.imu.accel_bias_random_walk) << "\n"
+    << "  gravity: " << FormatG(o.imu.gravity, 10) << "\n"
+    << "extrinsics:\n"
+    << "  imu_T_lidar:\n"
+    << "    translation: [" << FormatG(t[0], 10) << ", " << FormatG(t[1], 10) << ", "
+    << FormatG(t[2], 10) << "]\n"
+    << "    rotation_xyzw: [" << FormatG(q[0], 10) << ", " << FormatG(q[1], 10) << ", "
+    << FormatG(q[2], 10) << ", " << FormatG(q[3], 10) << "]\n";
+  // The resolved simulator options, as comments, so the sequence can be
+  // reproduced (rvlio simulate --set KEY=VALUE for any of them).
+  y << "\n# Simulator options of this sequence:\n";
+  std::istringstream dump(DumpYaml(o));
+  for (std::string line; std::getline(dump, line);)
+    y << (line.empty() ? "#" : "#   " + line) << "\n";
+  return y.str();
+}
+
+// Streams the simulation into the bag; the first write error stops the run,
+// and so does `stop` (*stop_reason set). Either leaves no bag: the writer's
+// temporary file (path + ".tmp") is removed when the writer goes.
+Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
+                const BagWriterOptions& format, const sim::Simulator::TruthCallback& on_truth,
+                const StopFn& stop, std::string* stop_reason) {
+  StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
+  if (!writer.ok()) return writer.status();
+  const SimOptions& o = simulator.options();
+  Status error;
+  auto go_on = [&] { return error.ok() && (!stop || (*stop_reason = stop()).empty()); };
+  simulator.Run(
+      [&](const ImuSample& m) {
+        error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
+        return go_on();
+      },
+      [&](const Scan& scan, int rows, int cols) {
+        error = livox ? (*writer)->WriteLivoxScan(o.lidar.topic, o.lidar.frame_id, scan)
+                      : (*writer)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, scan, rows, cols);
+        return go_on();
+      },
+      on_truth);
+  if (error.ok() && stop_reason->empty()) error = (*writer)->Close();
+  writer->reset();  // removes the temporary file unless Close() renamed it
+  return error;
+}
+
+// The simulated sensor as Ouster metadata (formats/ouster.h), read back from its
+// own JSON text so that the writer uses exactly the values a reader parses.
+StatusOr<OusterMetadata> SimulatedMetadata(const sim::Simulator& simulator, std::string* json) {
+  const sim::LidarModel& lidar = simulator.lidar();
+  std::vector<double> altitude_deg;
+  for (int r = 0; r < lidar.rows(); ++r)
+    altitude_deg.push_back(std::asin(lidar.Direction(r, 0).z()) * 180.0 / M_PI);
+  const int rate_hz = static_cast<int>(std::lround(1e9 / static_cast<double>(lidar.period_ns())));
+  Eigen::Isometry3d imu_T_lidar = Eigen::Isometry3d::Identity();
+  imu_T_lidar.linear() = simulator.T_imu_lidar().R;
+  imu_T_lidar.translation() = simulator.T_imu_lidar().t;
+  StatusOr<OusterMetadata> meta = SimulatedOusterMetadata(altitude_deg, lidar.cols(), rate_hz, imu_T_lidar);
+  if (!meta.ok()) return meta.status();
+  *json = OusterMetadataJson(*meta);
+  return ParseOusterMetadata(*json, "simulated metadata");
+}
+
+// `rvlio simulate --format ouster-pcap`: NAME.pcap (lidar packets on port
+// 7502, IMU packets on 7503, IPv4-fragmented at a 1500-byte MTU), NAME.json
+// (the metadata) and NAME.bag, the same quantized data as PointCloud2 and
+// Imu messages (what the capture must decode to, bit for bit).
+Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pcap_path,
+                          const std::string& json_path, const std::string& bag_path,
+                          const sim::Simulator::TruthCallback& on_truth, const StopFn& stop,
+                          std::string* stop_reason) {
+  std::string json;
+  StatusOr<OusterMetadata> meta = SimulatedMetadata(simulator, &json);
+  if (!meta.ok()) return meta.status();
+  PcapWriter pcap;
+  if (Status s = pcap.Open(pcap_path); !s.ok()) return s;
+  StatusOr<std::unique_ptr<SensorBagWriter>> bag = SensorBagWriter::Create(bag_path);
+  if (!bag.ok()) return bag.status();
+  LidarOptions every_return;
+  every_return.min_range = 0.0;
+  every_return.max_range = 1e9;
+  OusterScanAssembler assembler(*meta, every_return);
+  const SimOptions& o = simulator.options();
+  Status error;
+  uint32_t frame_id = 0;
+  auto go_on = [&] { return error.ok() && (!stop || (*stop_reason = stop()).empty()); };
+  simulator.Run(
+      [&](const ImuSample& m) {
+        const OusterImuPacket packet = OusterImuPacketOf(m);
+        error = pcap.Write({m.t_ns, "", 7503, 7503, EncodeOusterImuPacket(packet)});
+        if (error.ok()) error = (*bag)->WriteImu(o.imu.topic, o.imu.frame_id, OusterImuToSample(packet));
+        return go_on();
+      },
+      [&](const Scan& scan, int rows, int cols) {
+        Scan decoded;
+        DecodeStats decode;
+        for (const OusterLidarPacket& p : OusterPacketsOfScan(*meta, scan, frame_id)) {
+          if (!error.ok()) break;
+          error = pcap.Write({p.columns.back().t_ns, "", 7502, 7502, EncodeOusterLidarPacket(*meta, p)});
+          assembler.Add(p, &decoded, &decode);
+        }
+        ++frame_id;
+        if (error.ok()) error = (*bag)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, decoded, rows, cols);
+        return go_on();
+      },
+      on_truth);
+  if (!error.ok() || !stop_reason->empty()) return error;
+  if (Status s = (*bag)->Close(); !s.ok()) return s;
+  if (Status s = WriteFileAtomically(json_path, json); !s.ok()) return s;
+  return pcap.Close();
+}
+
+std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
+  return "ground truth of '" + name + "' (rvlio simulate, seed " + std::to_string(o.seed) +
+         FlightSeedNote(o) +
+         "): T_world_imu, world = gravity-aligned, origin and yaw of the IMU at start";
+}
+
+// localizability.csv: one row per scan (sim/localizability.h). Eigenvalues
+// of the translation information per point (sum 1), the weak direction
+// (world, unit), lambda_min / lambda_max, the pose information's smallest
+// eigenvalue and eigenvector (rotation rad first, then translation m).
+Status WriteLocalizabilityCsv(const std::string& path,
+                              const std::vector<sim::ScanLocalizability>& scans) {
+  std::ostringstream os;
+  os.precision(9);
+  os << "t,points,lambda_min,lambda_mid,lambda_max,weak_dir_x,weak_dir_y,weak_dir_z,ratio,"
+        "pose_lambda_min,pose_weak_rx,pose_weak_ry,pose_weak_rz,pose_weak_tx,pose_weak_ty,"
+        "pose_weak_tz,degenerate\n";
+  for (const sim::ScanLocalizability& l : scans) {
+    os << FormatSeconds(l.t_ns) << ',' << l.points;
+    for (int i = 0; i < 3; ++i) os << ',' << l.eigenvalues[i];
+    for (int i = 0; i < 3; ++i) os << ',' << l.weak_dir_world[i];
+    os << ',' << l.ratio << ',' << l.pose_eigenvalue_min;
+    for (int i = 0; i < 6; ++i) os << ',' << l.pose_weak[i];
+    os << ',' << (l.degenerate ? 1 : 0) << '\n';
+  }
+  return WriteFileAtomically(path, os.str());
+}
+
+// The reference map (options.survey), surveyed before anything is written
+// so that a bad crop leaves no file.
+Status RunSurvey(const sim::Simulator& simulator, SimulateResult* r,
+                 std::vector<Eigen::Vector3d>* p_world) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  StatusOr<sim::SurveyResult> survey = simulator.Survey();
+  if (!survey.ok()) return survey.status();
+  r->reference_map_points = static_cast<int64_t>(survey->p_world.size());
+  r->reference_map_stations = static_cast<int>(survey->stations.size());
+  r->reference_map_s = SecondsSince(wall0);
+  *p_world = std::move(survey->p_world);
+  return Status::Ok();
+}
+
+}  // namespace
+
+std::string SimulatedRecordingPath(const SimulateArgs& args) {
+  const std::string name = args.name.empty() ? args.preset : args.name;
+  return (std::filesystem::path(args.out_dir) / (name + "." + args.format)).string();
+}
+
+StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
+  SimOptions options;
+  if (Status s = ResolveOptions(args, &options); !s.ok()) return s;
+  const std::string name = args.name.empty() ? args.preset : args.name;
+  if (name.empty() || name.find('/') != std::string::npos)
+    return Status::InvalidInput("name '" + name + "' must be a plain file stem");
+  const std::filesystem::path dir = args.out_dir;
+  std::error_code ec;
+  if (!args.out_dir.empty()) std::filesystem::create_directories(dir, ec);
+  if (args.out_dir.empty() || ec || !std::filesystem::is_directory(dir))
+    return Status::InvalidInput("cannot create output directory '" + dir.string() + "'" +
+                                (ec ? " (" + ec.message() + ")" : ""));
+  BagWriterOptions format;
+  std::string extension;
+  if (Status s = ResolveFormat(args, &format, &extension); !s.ok()) return s;
+  // The sensor configuration must be one that `rvlio run` accepts.
+  const bool livox = args.lidar_msg == "livox";
+  const std::string yaml = SensorYaml(options, name, livox, name + extension);
+  OdometryOptions check;
+  if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
+      !s.ok() || !(s = check.Validate()).ok())
+    return Status::Internal("generated sensor configuration is rejected: " + s.message());
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  StatusOr<std::unique_ptr<sim::Simulator>> simulator = sim::Simulator::Create(options);
+  if (!simulator.ok()) return simulator.status();
+  SimulateResult r;
+  std::vector<Eigen::Vector3d> reference_map;
+  if (options.survey.enabled) {
+    if (Status s = RunSurvey(**simulator, &r, &reference_map); !s.ok()) return s;
+  }
+  const std::string map_path = (dir / kReferenceMapFile).string();
+  if (args.reference_map_only) {
+    if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
+    r.reference_map_path = map_path;
+    r.wall_s = SecondsSince(wall0);
+    r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+    return r;
+  }
+  r.bag_path = (dir / (name + extension)).string();
+  sim::LocalizabilityTruth truth(options.localizability, options.lidar);
+  std::vector<sim::ScanLocalizability> localizability;
+  sim::Simulator::TruthCallback on_truth;
+  if (options.localizability.enabled)
+    on_truth = [&](const Scan& scan, std::vector<sim::SurfaceHit>* hits) {
+      localizability.push_back(truth.Compute((*simulator)->world(), scan, hits));
+    };
+  const Status written =
+      args.format == "ouster-pcap"
+          ? WriteOusterCapture(**simulator, r.bag_path, (dir / (name + ".json")).string(),
+                               (dir / (name + ".bag")).string(), on_truth, args.stop,
+                               &r.stop_reason)
+          : WriteBag(**simulator, r.bag_path, livox, format, on_truth, args.stop, &r.stop_reason);
+  if (!written.ok()) return written;
+  if ((r.stopped = !r.stop_reason.empty())) return r;
+  r.wall_s = SecondsSince(wall0);
+  r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+
+  r.gt_path = (dir / (name + "_gt.tum")).string();
+  const Trajectory gt = (*simulator)->GroundTruth(kGroundTruthRate);
+  if (Status s = WriteTum(r.gt_path, gt, GroundTruthHeader(options, name)); !s.ok()) return s;
+  r.config_path = (dir / (name + ".yaml")).string();
+  if (Status s = WriteFileAtomically(r.config_path, yaml); !s.ok()) return s;
+  if (options.localizability.enabled) {
+    r.localizability_path = (dir / kLocalizabilityFile).string();
+    if (Status s = WriteLocalizabilityCsv(r.localizability_path, localizability); !s.ok()) return s;
+    r.degenerate_scans = std::count_if(localizability.begin(), localizability.end(),
+                                       [](const sim::ScanLocalizability& l) { return l.degenerate; });
+  }
+  if (options.survey.enabled) {
+    if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
+    r.reference_map_path = map_path;
+  }
+  r.scans = (*simulator)->scan_count();
+  r.imu_samples = (*simulator)->imu_count();
+  r.rows = (*simulator)->lidar().rows();
+  r.cols = (*simulator)->lidar().cols();
+  r.duration_s = options.duration;
+  return r;
+}
+
+}  // namespace rvlio

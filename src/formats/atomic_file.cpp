@@ -1,0 +1,133 @@
+#include "rvlio/formats/atomic_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <utility>
+
+namespace rvlio {
+namespace {
+
+constexpr size_t kFlushBytes = 1 << 20;  // write in blocks of 1 MiB
+
+std::string ErrnoText(int err) { return std::strerror(err); }
+
+// Writes all of [data, data + size) to fd, retrying on EINTR and short writes.
+// Returns 0 or the errno of the failure.
+int WriteAll(int fd, const char* data, size_t size) {
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    if (n == 0) return EIO;
+    data += n;
+    size -= static_cast<size_t>(n);
+  }
+  return 0;
+}
+
+std::string ParentDirectory(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  if (slash == 0) return "/";
+  return path.substr(0, slash);
+}
+
+// Makes the rename durable. Best effort: some file systems refuse fsync on a
+// directory, which does not make the file itself incomplete.
+void SyncDirectory(const std::string& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  (void)::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+Status WriteFileAtomically(const std::string& path, const std::string& content) {
+  AtomicFileWriter writer;
+  Status s = writer.Open(path);
+  if (s.ok()) s = writer.Append(content);
+  if (s.ok()) s = writer.Commit();
+  return s;
+}
+
+AtomicFileWriter::~AtomicFileWriter() { Discard(); }
+
+AtomicFileWriter::AtomicFileWriter(AtomicFileWriter&& other) noexcept { *this = std::move(other); }
+
+AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept {
+  if (this != &other) {
+    Discard();
+    fd_ = std::exchange(other.fd_, -1);
+    path_ = std::move(other.path_);
+    temp_path_ = std::move(other.temp_path_);
+    buffer_ = std::move(other.buffer_);
+    error_ = std::move(other.error_);
+  }
+  return *this;
+}
+
+Status AtomicFileWriter::Open(const std::string& path) {
+  Discard();
+  error_ = Status::Ok();
+  path_ = path;
+  temp_path_ = path + ".tmp." + std::to_string(::getpid());
+  fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    const int err = errno;
+    temp_path_.clear();  // nothing was created
+    return Status::InvalidInput("cannot write '" + path + "': " + ErrnoText(err));
+  }
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::Append(std::string_view data) {
+  if (!error_.ok()) return error_;
+  RVLIO_CHECK_MSG(is_open(), "AtomicFileWriter::Append before Open");
+  buffer_.append(data.data(), data.size());
+  if (buffer_.size() >= kFlushBytes) return Flush();
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::Flush() {
+  const int err = WriteAll(fd_, buffer_.data(), buffer_.size());
+  buffer_.clear();
+  if (err != 0) return FailAndDiscard("cannot write", err);
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::Commit() {
+  if (!error_.ok()) return error_;
+  RVLIO_CHECK_MSG(is_open(), "AtomicFileWriter::Commit before Open");
+  if (Status s = Flush(); !s.ok()) return s;
+  if (::fsync(fd_) != 0) return FailAndDiscard("cannot sync", errno);
+  const int fd = std::exchange(fd_, -1);
+  if (::close(fd) != 0) return FailAndDiscard("cannot close", errno);
+  if (::rename(temp_path_.c_str(), path_.c_str()) != 0)
+    return FailAndDiscard("cannot rename", errno);
+  temp_path_.clear();
+  SyncDirectory(ParentDirectory(path_));
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::FailAndDiscard(const std::string& what, int err) {
+  Discard();
+  error_ = Status::InvalidInput(what + " '" + path_ + "': " + ErrnoText(err));
+  return error_;
+}
+
+void AtomicFileWriter::Discard() {
+  if (fd_ >= 0) ::close(std::exchange(fd_, -1));
+  if (!temp_path_.empty()) ::unlink(temp_path_.c_str());
+  temp_path_.clear();
+  buffer_.clear();
+}
+
+}  // namespace rvlio

@@ -1,0 +1,149 @@
+#include "rvlio/refine/refine_problem.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include <ceres/iteration_callback.h>
+
+#include "rvlio/imu/preintegration.h"
+#include "rvlio/factors/imu_factor.h"
+#include "rvlio/factors/prior_factor.h"
+
+namespace rvlio {
+namespace {
+
+constexpr int kVelocityBiasIterations = 20;  // the IMU-only solve converges in a few
+
+// Ends a Ceres solve when the refinement is asked to stop (the round is
+// dropped then, so the partial solve is never used).
+class StopCallback : public ceres::IterationCallback {
+ public:
+  explicit StopCallback(const std::function<bool()>& stop) : stop_(stop) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return stop_ && stop_() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::function<bool()>& stop_;
+};
+
+}  // namespace
+
+ceres::Problem::Options RefineProblemOptions() {
+  ceres::Problem::Options o;
+  o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // one shared PoseManifold
+  return o;
+}
+
+void AddRefineStateBlocks(const ScanRange& range, bool hold_poses, PoseManifold* pose_manifold,
+                          std::vector<RefineState>* states, ceres::Problem* problem) {
+  for (int k = range.begin; k < range.end; ++k) {
+    RefineState& s = (*states)[k];
+    problem->AddParameterBlock(s.pose.data(), 7, pose_manifold);
+    if (hold_poses) problem->SetParameterBlockConstant(s.pose.data());
+    problem->AddParameterBlock(s.speed_bias.data(), 9);
+  }
+}
+
+void AddRefineImuFactors(const RefineSequence& sequence, const ImuNoise& noise,
+                         const Eigen::Vector3d& g_world, const ScanRange& range,
+                         std::vector<RefineState>* states, ceres::Problem* problem) {
+  for (int k = range.begin + 1; k < range.end; ++k) {
+    RefineState& a = (*states)[k - 1];
+    RefineState& b = (*states)[k];
+    const SpeedBiasBlock sb = a.SpeedBias();
+    auto pre = ImuPreintegration::FromSamples(SliceImu(sequence.imu(), a.t_ns, b.t_ns), a.t_ns,
+                                              b.t_ns, noise, sb.bg, sb.ba);
+    problem->AddResidualBlock(
+        new ImuFactor(std::move(pre), g_world), nullptr,
+        {a.pose.data(), a.speed_bias.data(), b.pose.data(), b.speed_bias.data()});
+  }
+}
+
+void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noise,
+                             const Eigen::Vector3d& g_world, const ScanRange& chunk,
+                             bool hold_first_pose, std::vector<ScanFactors>* factors,
+                             PoseManifold* pose_manifold, std::vector<RefineState>* states,
+                             ceres::Problem* problem) {
+  AddRefineStateBlocks(chunk, false, pose_manifold, states, problem);
+  for (int k = chunk.begin; k < chunk.end; ++k) {
+    ScanFactors& f = (*factors)[k - chunk.begin];
+    double* pose_k = (*states)[k].pose.data();
+    if (f.fixed) problem->AddResidualBlock(f.fixed.release(), nullptr, pose_k);
+    for (auto& [j, pair] : f.pairs)
+      problem->AddResidualBlock(pair.release(), nullptr, pose_k, (*states)[j].pose.data());
+  }
+  AddRefineImuFactors(sequence, noise, g_world, chunk, states, problem);
+  if (hold_first_pose)  // gauge / previous chunk
+    problem->SetParameterBlockConstant((*states)[chunk.begin].pose.data());
+}
+
+void AddRefineDegeneracyPriors(const ScanRange& chunk, const std::vector<ScanFactors>& factors,
+                               const std::vector<PoseBlock>& anchors,
+                               std::vector<RefineState>* states, ceres::Problem* problem) {
+  for (int k = chunk.begin; k < chunk.end; ++k) {
+    const ScanFactors& f = factors[k - chunk.begin];
+    if (!f.has_degeneracy_prior) continue;
+    problem->AddResidualBlock(new PosePriorFactor(anchors[k], f.degeneracy_sqrt_information),
+                              nullptr, (*states)[k].pose.data());
+  }
+}
+
+RefineSolver RefineSolver::Make(int threads) {
+  RefineSolver s;
+  const bool suitesparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE);
+  s.sparse_library = suitesparse ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
+  s.name = suitesparse ? "SPARSE_NORMAL_CHOLESKY (SuiteSparse CHOLMOD)"
+                       : "SPARSE_NORMAL_CHOLESKY (Eigen sparse)";
+  s.threads = threads;
+  return s;
+}
+
+ceres::Solver::Options RefineSolver::Options(int iterations) const {
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  o.sparse_linear_algebra_library_type = sparse_library;
+  o.max_num_iterations = iterations;
+  o.num_threads = threads;
+  o.logging_type = ceres::SILENT;
+  o.minimizer_progress_to_stdout = false;
+  return o;
+}
+
+RefineSolveReport SolveRefineProblem(ceres::Problem* problem, ceres::Solver::Options options,
+                                     const ScanRange& range, const std::function<bool()>& stop,
+                                     std::vector<RefineState>* states) {
+  const std::vector<RefineState> before(states->begin() + range.begin, states->begin() + range.end);
+  StopCallback stop_callback(stop);
+  if (stop) options.callbacks.push_back(&stop_callback);
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, problem, &summary);
+  RefineSolveReport r;
+  r.message = summary.message;
+  r.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  const bool finite =
+      std::all_of(states->begin() + range.begin, states->begin() + range.end, AllFinite);
+  r.accepted = summary.IsSolutionUsable() && finite && std::isfinite(summary.final_cost);
+  if (!r.accepted) {
+    std::copy(before.begin(), before.end(), states->begin() + range.begin);
+    return r;
+  }
+  r.cost_before = summary.initial_cost;
+  r.cost_after = summary.final_cost;
+  return r;
+}
+
+RefineSolveReport SolveVelocityAndBias(const RefineSequence& sequence, const ImuNoise& noise,
+                                       const Eigen::Vector3d& g_world, const RefineSolver& solver,
+                                       std::vector<RefineState>* states) {
+  PoseManifold pose_manifold;
+  ceres::Problem problem(RefineProblemOptions());
+  const ScanRange all{0, static_cast<int>(states->size())};
+  AddRefineStateBlocks(all, true, &pose_manifold, states, &problem);
+  AddRefineImuFactors(sequence, noise, g_world, all, states, &problem);
+  return SolveRefineProblem(&problem, solver.Options(kVelocityBiasIterations), all, nullptr,
+                            states);
+}
+
+}  // namespace rvlio
