@@ -1,5 +1,5 @@
 // Cost of the RV pass (Alg. 1-3) on one scan's constraint list.
-// Target (issue 5): well under 10 % of a ~3 ms scan update for ~2000
+// Target: well under 10 % of a ~3 ms scan update for ~2000
 // constraints. BM_ApplyRv includes restoring the list from a copy each
 // iteration; BM_CopyList measures that copy alone so it can be subtracted.
 #include <cmath>

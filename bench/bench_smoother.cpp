@@ -1,4 +1,4 @@
-// Micro-benchmarks of the smoother's building blocks (issue 6):
+// Micro-benchmarks of the smoother's building blocks:
 // - preintegration cost per IMU sample (one Append: deltas, 9x9 covariance,
 //   bias Jacobians),
 // - one plane factor holding 2000 constraints: residuals only and residuals

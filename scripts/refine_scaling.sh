@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Refine scaling benchmark (docs/refine_scaling.md, issue 19): simulates
+# Refine scaling benchmark (docs/refine.md, "Memory and time"): simulates
 # OS0-32-like tunnel recordings (32 x 512 points, 10 Hz) of about SCANS scans
 # each, runs the IESKF odometry on each for the initial trajectory, then
 # `rvlio refine` under /usr/bin/time, and prints one table row per length:

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plots of rvlio run directories (issue 7): trajectories, RV profile, ablations.
+"""Plots of rvlio run directories: trajectories, RV profile, ablations.
 
 Usage:
   rvlio_plot.py trajectories --gt GT.tum --run LABEL=DIR [--run ...] --out PREFIX
@@ -11,7 +11,7 @@ Usage:
   rvlio_plot.py deviation    --run DIR --out PREFIX [--title TEXT]
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
 
-Inputs follow the run-directory contract of `rvlio run` (docs/design.md section 7):
+Inputs follow the run-directory contract of `rvlio run` (docs/design.md, "The command-line contract"):
 DIR/trajectory.tum (t x y z qx qy qz qw, seconds), DIR/scans.csv (one row per
 scan) and DIR/summary.json. Every plot is written as PREFIX_<kind>.png (150 dpi)
 and PREFIX_<kind>.pdf, atomically (temp file, then rename); a PREFIX ending in

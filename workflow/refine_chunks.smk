@@ -1,5 +1,5 @@
 # `rvlio refine` of one long recording as N chunk jobs, then `rvlio merge`
-# (docs/refine_chunks.md). One job per chunk (`rvlio refine --chunk K --of N`,
+# (docs/refine.md). One job per chunk (`rvlio refine --chunk K --of N`,
 # each keeping only its part of the recording in memory), then one merge job. Runs
 # locally or on Slurm through the same profile as the ablation grid:
 #

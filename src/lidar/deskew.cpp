@@ -19,8 +19,9 @@ void DeskewPoints(const std::vector<ImuPoseSample>& samples, const Pose3& T_imu_
   p_lidar_end->resize(n);
   // Spinning LiDARs stamp whole columns (Ouster: 1024 times for 32 x 1024
   // points), so the pose of a time is memoized in a small direct-mapped table
-  // (the interpolation, a binary search and an SO(3) exponential, was ~8% of
-  // a scan's instructions). The result is the same as without the table.
+  // (without it the interpolation per point, a binary search and an SO(3)
+  // exponential, about doubles the deskew's instructions; bench/RESULTS.md).
+  // The result is the same as without the table.
   constexpr int kMemoBits = 10;  // 1024 entries, indexed by a Fibonacci hash of the time
   struct Memo {
     TimeNs t_ns;

@@ -64,7 +64,8 @@ double ReinforcementCoefficient(const RvOptions& options, int num_scv, int num_c
   // one SCV at 1 / min_K. Without it a handful of SCVs among a thousand wall
   // vectors get K ~ 0.01, i.e. 100x weight, and one mis-associated feature
   // normal can then drag the estimate along the unobservable axis (measured on
-  // the corridor and loopback presets, README "RV defaults").
+  // the corridor and loopback presets, docs/rv_modules.md "How the defaults
+  // were chosen").
   return num_scv > 0 ? std::max(K, options.min_K) : K;
 }
 

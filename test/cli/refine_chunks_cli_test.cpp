@@ -2,7 +2,7 @@
 // `rvlio merge`: the merged trajectory agrees with the whole-sequence refine,
 // is more accurate than the initial trajectory, has no step at the chunk
 // borders, and bad chunk parameters, missing or foreign chunks and a partial
-// initial trajectory are reported as the docs say (docs/refine_chunks.md).
+// initial trajectory are reported as the docs say (docs/refine.md).
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -109,7 +109,7 @@ void RefineChunksCliTest::CheckMergeAgreesWithWhole() {
                ate_merged = Ate(out + "/trajectory.tum");
   std::printf("ATE init %.4f whole %.4f merged %.4f m; merged - whole RMS %.4f m\n", ate_init,
               ate_whole, ate_merged, rms_m);
-  // Measured (docs/refine_chunks.md): init 15.0 mm, whole 6.2 mm, merged 6.4 mm, RMS 3.8 mm.
+  // Measured (docs/refine.md, "Accuracy of chunk jobs"): init 15.0 mm, whole 6.2 mm, merged 6.4 mm, RMS 3.8 mm.
   EXPECT_LT(rms_m, 0.01);
   EXPECT_LT(ate_merged, ate_whole + 0.005);
   EXPECT_LT(ate_merged, 0.8 * ate_init);

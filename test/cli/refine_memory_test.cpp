@@ -1,4 +1,4 @@
-// Memory bound of `rvlio refine` (issue 19, docs/refine_scaling.md): the peak
+// Memory bound of `rvlio refine` (docs/refine.md, "Memory bound test"): the peak
 // resident memory of one refine of a 400-scan, 32 x 512 simulated tunnel,
 // per refined scan, stays under a generous bound. The refine runs as its own
 // process (fork + exec) so wait4 reports its peak alone. No timing asserted.
@@ -39,8 +39,8 @@ long PeakKib(const std::string& args, const std::string& scratch) {
 }
 
 // This refine (420 scans, 1 round, 2 threads) peaked at 332 MB (0.79 MB per
-// scan) with one residual per constraint (f8c4f0c) and at 214 MB (0.51 MB)
-// with summarized pair factors (docs/refine_scaling.md). The bound sits
+// scan) with one residual per constraint and at 214 MB (0.51 MB) with
+// summarized pair factors (docs/refine.md, "Memory bound test"). The bound sits
 // between them, ~25 % above the latter for allocator and library changes.
 constexpr double kMaxPeakMbPerScan = 0.65;
 

@@ -56,10 +56,10 @@ double Metric(const RvRun& run, const char* group, const char* stat) {
 
 // The tunnel preset as shipped (52 s, OS1-32 1024 columns). The defaults
 // (gated reinforcement, repair up to eps1 0.03) beat RV off on ATE and
-// along-axis RMSE and max on each of seeds 1-6 (README "RV defaults",
-// config/grids/rv_defaults.yaml: -6 to -23 % ATE); seed 3 is checked here
-// because the paper's ungated modules lose to RV off on it (ATE 0.0228 vs
-// 0.0199 m), so this test also guards the gate. No extra margin: the claim
+// along-axis RMSE and max on each of seeds 1-6 (docs/rv_modules.md "How the
+// defaults were chosen", config/grids/rv_defaults.yaml: -6 to -23 % ATE);
+// seed 3 is checked here because the paper's ungated modules lose to RV off
+// on it (ATE 0.0228 vs 0.0199 m), so this test also guards the gate. No extra margin: the claim
 // is "better", and the runs are deterministic.
 TEST_F(RvCliTest, TunnelRvOnBeatsRvOffOnAteAndAlongAxisError) {
   Simulate("tunnel", 52, /*seed=*/3, /*columns=*/1024);

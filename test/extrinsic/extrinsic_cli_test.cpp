@@ -5,7 +5,7 @@
 //   - a start error of 2 deg / 5 cm (smoother): the axes the flight excites
 //     move toward the truth, the others are reported held;
 //   - a tunnel flight with sway ("normal excitation"), start error 2 deg /
-//     5 cm, both backends: the convergence bounds of issue 15 where met, and
+//     5 cm, both backends: the convergence bounds (0.2 deg / 1 cm) where met, and
 //     all of them with map re-anchoring; scans.csv follows the estimate;
 //   - a motionless bag: nothing excited, the extrinsic stays exactly at its
 //     prior and summary.json says so.
@@ -193,7 +193,7 @@ TEST_F(ExtrinsicCliSway, PerturbedStartConvergesOnATunnelFlightWithSway) {
   EXPECT_LT(MaxTranslationErrorM(smoother), 0.015);
 }
 
-// Map re-anchoring (docs/extrinsics.md): both backends meet issue 15's
+// Map re-anchoring (docs/extrinsics.md): both backends meet the bounds of
 // 0.2 deg / 1 cm. Measured, seed 1: IESKF 0.12 deg, 0.45 cm; smoother
 // 0.04 deg, 0.73 cm.
 TEST_F(ExtrinsicCliSway, MapReanchoringMeetsTheConvergenceTarget) {

@@ -1,7 +1,8 @@
 #pragma once
 // All point-to-plane constraints of one scan as one Ceres cost function
-// (docs/design.md sections 4 and 6). One parameter block: the scan's pose
-// (PoseBlock, 7). Extrinsics are fixed (constructor argument).
+// (docs/design.md, "The shared measurement model" and "The backends"). One
+// parameter block: the scan's pose (PoseBlock, 7). Extrinsics are fixed
+// (constructor argument).
 //
 // For constraint i (paper Eq. 3, constraints/point_to_plane.h):
 //   residual_i = sqrt(weight_i) / sigma * u_i^T (R_world_imu (R_imu_lidar p_i + t_imu_lidar)

@@ -46,9 +46,7 @@
 //            optimization over the associations: with world-fixed planes only
 //            (window 0) a drift shared by the scans decays only slowly from
 //            round to round. The window bounds the fill-in of the sparse
-//            Cholesky factor (measured on a 100 s tunnel: window 100 solves
-//            in ~5 s per round with the accuracy of window 300 (~35 s);
-//            unbounded: ~270 s). The first pose is held fixed (gauge); linear
+//            Cholesky factor (docs/refine.md). The first pose is held fixed (gauge); linear
 //            solver SPARSE_NORMAL_CHOLESKY with SuiteSparse CHOLMOD (Eigen's
 //            sparse Cholesky if Ceres lacks SuiteSparse;
 //            RefineResult::linear_solver says which);
@@ -64,7 +62,8 @@
 //
 // The steps, each with its own header: refine_init.h (state
 // initialization), refine_association.h (deskew, map, association round),
-// refine_problem.h (problem build and solve), refine_chunks.h (chunking).
+// refine_problem.h (problem build and solve), refine_chunks.h (chunking);
+// how they fit, what they hold and cost: docs/refine.md.
 #include <array>
 #include <cstdint>
 #include <functional>

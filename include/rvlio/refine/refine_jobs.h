@@ -1,6 +1,6 @@
 #pragma once
 // Batch refinement as independent chunk jobs (`rvlio refine --chunk K --of N`,
-// `rvlio merge`; docs/refine_chunks.md). No I/O.
+// `rvlio merge`; docs/refine.md). No I/O.
 //
 // Chunk spans. The initial trajectory's time span [t0, t1] is cut into N
 // equal cores; chunk K (1-based) refines the scans ending inside its core

@@ -13,7 +13,7 @@ struct RvOptions {
   // our rough walls (slopes up to ~0.3) a wall normal's axial tilt is often
   // real geometry that pins the axis, and repairing up to 0.1 removed it
   // (full corridor ATE 0.042 -> 0.062 m); up to 0.03 it only removes the
-  // noise tilt (README "RV defaults").
+  // noise tilt (docs/rv_modules.md "How the defaults were chosen").
   double eps1 = 0.03;
   double k0 = 1.0;                // Eq. (19) coefficient
   double activation_ratio = 0.9;  // active when this fraction of d_i <= eps0

@@ -1,7 +1,7 @@
 #pragma once
 // The RV pass of one scan (one filter iteration): Alg. 1 criterion ->
 // Alg. 2 reinforcement -> Alg. 3 repair, applied in place to the constraint
-// list before the estimator uses it (docs/design.md sections 4-5).
+// list before the estimator uses it (docs/design.md, "The shared measurement model" and "The RV pass").
 #include <Eigen/Core>
 
 #include "rvlio/constraints/constraint.h"
