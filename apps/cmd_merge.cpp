@@ -30,7 +30,7 @@ int CmdMerge(int argc, char** argv) {
   req.out_dir = args.Get("out");
   req.map = args.Get("map");
   StatusOr<MergeResult> result = MergeRefineChunks(req);
-  if (!result.ok()) return Fail("merge", result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail("merge", result.status());
   for (const auto& w : result->warnings) std::fprintf(stderr, "rvlio merge: warning: %s\n", w.c_str());
   for (const auto& c : result->summary["chunks"])
     std::printf("rvlio merge: chunk %d: %d scans, %d shared with the previous, moved %.4f m %.4f deg, "

@@ -134,7 +134,7 @@ int CmdRefine(int argc, char** argv) {
   };
   req.stop = [] { return InterruptSignalName(); };
   StatusOr<RefineRunResult> result = RefineRecording(req);
-  if (!result.ok()) return Fail("refine", result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail("refine", result.status());
   if (!result->read_complete) {
     std::fprintf(stderr, "rvlio refine: interrupted by %s while reading the bag; nothing written\n",
                  result->stop_reason.c_str());

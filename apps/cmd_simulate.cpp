@@ -131,7 +131,7 @@ int CmdSimulate(int argc, char** argv) {
   SetAbortRemovePath(bag_path + ".tmp");
   StatusOr<SimulateResult> r = SimulateRecording(sim);
   SetAbortRemovePath("");
-  if (!r.ok()) return Fail(kSimulate, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kSimulate, r.status());
   if (r->stopped) {
     std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",
                  r->stop_reason.c_str());

@@ -215,7 +215,7 @@ void EvaluateRow(const Truth& truth, const std::string& dir, Row* row) {
   StatusOr<EvalResult> e = est.ok() ? Evaluate(truth.trajectory, *est, EvalOptions())
                                     : StatusOr<EvalResult>(est.status());
   if (!e.ok()) {
-    row->exit_code = e.status().exit_code();
+    row->exit_code = cli::ExitCode(e.status().code());
     row->error = "evaluation: " + e.status().message();
     std::fprintf(stderr, "rvlio %s: warning: %s: %s\n", kCompare, row->name.c_str(),
                  row->error.c_str());

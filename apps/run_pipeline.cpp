@@ -85,7 +85,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     WarnDivergence("run", *p.divergence, &divergence_warned);
   };
   StatusOr<RunResult> result = RunRecording(args);
-  if (!result.ok()) return Fail("run", result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail("run", result.status());
   if (result->scans.empty()) return ReportInterrupt(req, *result);  // stopped before a scan
   const TimingStats t = ComputeTimingStats(result->scans);
   outcome->scans = static_cast<int>(result->scans.size());

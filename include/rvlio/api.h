@@ -9,8 +9,9 @@
 // (rvlio::Odometry, target rvlio::core): AddImu / AddScan / Poll / Finish.
 //
 // Conventions (as everywhere in rvlio): errors are Status::InvalidInput (bad
-// input or configuration; the message names the file/topic/key) or
-// Status::Internal; nothing is printed and the process is never exited. A
+// input or configuration; the message names the file/topic/key),
+// Status::IoError (an output that cannot be written) or Status::Internal;
+// nothing is printed and the process is never exited. A
 // call that is stopped (`stop`) returns normally with `stopped` set.
 //
 // Configuration: LoadConfig (rvlio/io/config.h) gives OdometryOptions from

@@ -371,8 +371,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (!refined.ok()) {
     const std::string what =
         refined.status().message() + " (bag " + args.bag + ", init " + args.init_path + ")";
-    return refined.status().code() == StatusCode::kInternal ? Status::Internal(what)
-                                                            : Status::InvalidInput(what);
+    return refined.status().WithMessage(what);
   }
   r.refine = std::move(*refined);
   r.refine.warnings.insert(r.refine.warnings.begin(), notes.begin(), notes.end());
