@@ -169,12 +169,10 @@ int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
   outcome->sequence_duration_s =
       NsToSeconds(refined.trajectory.back().t_ns - refined.trajectory.front().t_ns);
   outcome->diverged = result->divergence.detected;
-  if (!result->chunk.is_null())
+  if (const std::optional<RefineJobSpan>& job = result->job)
     std::fprintf(out, "rvlio refine: chunk %d of %d: scans ending %.3f .. %.3f s (its own %.3f .. %.3f s)\n",
-                 req.chunk, req.chunk_count, result->chunk["begin_ns"].get<int64_t>() * 1e-9,
-                 result->chunk["end_ns"].get<int64_t>() * 1e-9,
-                 result->chunk["core_begin_ns"].get<int64_t>() * 1e-9,
-                 result->chunk["core_end_ns"].get<int64_t>() * 1e-9);
+                 job->chunk, job->count, job->begin_ns * 1e-9, job->end_ns * 1e-9,
+                 job->core_begin_ns * 1e-9, job->core_end_ns * 1e-9);
   std::fprintf(out, "rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
                refined.trajectory.size(), refined.rounds.size(),
                refined.converged ? " (converged)" : "", refined.linear_solver.c_str(),

@@ -376,6 +376,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   r.refine = std::move(*refined);
   r.refine.warnings.insert(r.refine.warnings.begin(), notes.begin(), notes.end());
   if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
+  r.job = job;
   if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
   r.stopped = r.refine.stopped;
   if (!r.stopped) r.stop_reason.clear();
