@@ -40,6 +40,20 @@ int Fail(const std::string& command, const std::string& message, int exit_code) 
   return exit_code;
 }
 
+int ExitCode(StatusCode code) {
+  switch (code) {
+    case StatusCode::kOk: return 0;
+    case StatusCode::kInvalidInput: return 2;
+    case StatusCode::kIoError: return 2;
+    case StatusCode::kInternal: return 1;
+  }
+  return 1;  // not reached: every code is listed above
+}
+
+int Fail(const std::string& command, const Status& status) {
+  return Fail(command, status.message(), ExitCode(status.code()));
+}
+
 int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out) {
   const OptionSpec* list = nullptr;  // the repeatable option whose values may follow
   for (int i = first; i < argc; ++i) {

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "rvlio/common/status.h"
+
 namespace rvlio::cli {
 
 struct OptionSpec {
@@ -43,6 +45,13 @@ bool ParseWholeNumber(const std::string& text, long long min, long long max, lon
 
 // One-line error on stderr in the contract's form: "rvlio CMD: error: MSG".
 int Fail(const std::string& command, const std::string& message, int exit_code = 2);
+
+// The command-line contract's exit status for a library error, the one place that maps
+// them: 2 bad input or an output that cannot be written, 1 internal failure (divergence,
+// 3, and signals, 130 / 143, are not Status errors: see divergence_cli.h, interrupt.h).
+int ExitCode(StatusCode code);
+// Fail with the status's message and ExitCode(status.code()).
+int Fail(const std::string& command, const Status& status);
 
 }  // namespace rvlio::cli
 

@@ -82,7 +82,7 @@ int ReadJobs(const Args& args, int* jobs) {
 
 int Summarize(const ablate::Plan& plan, const Args& args) {
   StatusOr<ablate::SummaryResult> r = ablate::WriteSummary(plan, !args.Has("no-plots"));
-  if (!r.ok()) return Fail(kAblate, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kAblate, r.status());
   std::cout << r->table_md;
   std::printf("rvlio ablate: %d cells: %d done, %d failed, %d not run -> %s/table.md\n", r->cells,
               r->done, r->failed, r->missing, plan.out_dir.c_str());
@@ -132,7 +132,7 @@ int CmdAblate(int argc, char** argv) {
   int64_t max_cells = 0;
   if (int rc = ReadMaxCells(args, &max_cells); rc != 0) return rc;
   StatusOr<ablate::Plan> plan = ablate::LoadPlan(args.Get("grid"), args.Get("out"), max_cells);
-  if (!plan.ok()) return Fail(kAblate, plan.status().message(), plan.status().exit_code());
+  if (!plan.ok()) return Fail(kAblate, plan.status());
   if (args.Has("plan")) {
     std::cout << JsonText(ablate::PlanJson(*plan)) << "\n";
     return 0;
@@ -146,7 +146,7 @@ int CmdAblate(int argc, char** argv) {
   if (Status s =
           WriteFileAtomically(plan->out_dir + "/plan.json", JsonText(ablate::PlanJson(*plan)) + "\n");
       !s.ok())
-    return Fail(kAblate, s.message(), s.exit_code());
+    return Fail(kAblate, s);
   if (options.progress)
     std::printf("rvlio ablate: the grid has %zu cells (%zu simulated sequences) -> %s\n",
                 plan->cells.size(), plan->data.size(), plan->out_dir.c_str());

@@ -111,7 +111,7 @@ int CmdCalibrateTime(int argc, char** argv) {
   for (const auto& w : warnings) std::fprintf(stderr, "rvlio %s: warning: %s\n", kCalibrateTime, w.c_str());
   Recording rec;
   if (Status s = Read(args.Get("bag"), *o, &rec); !s.ok())
-    return Fail(kCalibrateTime, s.message(), s.exit_code());
+    return Fail(kCalibrateTime, s);
   if (rec.scan_start_ns.empty() || rec.imu.empty())
     return Fail(kCalibrateTime, args.Get("bag") + ": no scans on lidar.topic '" + o->lidar.topic +
                            "' or no IMU samples on imu.topic '" + o->imu.topic + "'");

@@ -1,28 +1,19 @@
-// `rvlio demo`: simulates the default tunnel, then runs `rvlio compare` on it
-// in-process (IESKF and smoother with RV off and on, refine from the best) and
-// prints the table and where the plots are; with the simulator's reference
-// map (data/reference_map.pcd) the table has the map columns too.
+// `rvlio demo`: simulates the default tunnel (SimulateRecording, with `rvlio
+// simulate`'s lines), then runs `rvlio compare` on it in-process (IESKF and
+// smoother with RV off and on, refine from the best) and prints the table and
+// where the plots are; with the simulator's reference map
+// (data/reference_map.pcd) the table has the map columns too.
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <vector>
+#include <utility>
 
 #include "commands.h"
 #include "common_options.h"
 #include "compare_engine.h"
+#include "interrupt.h"
 
 namespace rvlio::cli {
-namespace {
-
-// Calls another subcommand in-process with the given arguments.
-int Invoke(int (*command)(int, char**), std::vector<std::string> args) {
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  return command(static_cast<int>(args.size()), argv.data());
-}
-
-}  // namespace
 
 int CmdDemo(int argc, char** argv) {
   CommandSpec spec{"demo",
@@ -45,14 +36,23 @@ int CmdDemo(int argc, char** argv) {
   compare.first_step = 2;
   compare.total_steps = 1 + CompareSteps(compare);
 
-  std::vector<std::string> sim_args = {"rvlio", "simulate", "--preset", preset, "--seed",
-                                       args.Get("seed", "1"), "--reference-map", "--out",
-                                       data_dir};
-  if (args.Has("duration")) sim_args.insert(sim_args.end(), {"--duration", args.Get("duration")});
+  SimulateArgs sim;
+  sim.preset = preset;
+  sim.name = preset;
+  sim.out_dir = data_dir;
+  sim.reference_map = true;
+  sim.seed = 1;
+  if (std::string err = ReadSeedOption(args, "seed", &sim.seed); !err.empty())
+    return Fail("demo", err);
+  if (std::string err = ReadDurationOption(args, &sim.duration_s); !err.empty())
+    return Fail("demo", err);
   std::printf("[1/%d] simulating preset '%s' into %s\n", compare.total_steps, preset.c_str(),
               data_dir.c_str());
   std::fflush(stdout);
-  if (int rc = Invoke(CmdSimulate, sim_args); rc != 0) return rc;
+  {
+    InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop, leave no half bag, exit 130/143
+    if (int rc = SimulateOnDisk(std::move(sim)); rc != 0) return rc;
+  }
   // The simulator's survey of the world (reference_map.pcd): the map columns.
   const std::string reference = data_dir + "/reference_map.pcd";
   if (std::filesystem::is_regular_file(reference)) compare.ref_map = reference;

@@ -183,7 +183,7 @@ int EvalDegeneracy(const Args& args) {
       (!ParseNumber(args.Get("truth-ratio"), &d.degenerate_ratio) || d.degenerate_ratio <= 0.0))
     return Fail(kEval, "--truth-ratio '" + args.Get("truth-ratio") + "' is not a positive number");
   StatusOr<DegeneracyEvalResult> r = EvaluateDegeneracyFiles(d);
-  if (!r.ok()) return Fail(kEval, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kEval, r.status());
   for (const std::string& w : r->scores.warnings)
     std::fprintf(stderr, "rvlio %s: warning: %s\n", kEval, w.c_str());
   if (args.Has("json"))
@@ -201,7 +201,7 @@ int EvalMap(const Args& args) {
   MapEvalOptions options;
   if (std::string error = ReadMapOptions(args, &options); !error.empty()) return Fail(kEval, error);
   StatusOr<MapEvalResult> r = EvaluateMapFiles(args.Get("map"), args.Get("ref-map"), options);
-  if (!r.ok()) return Fail(kEval, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kEval, r.status());
   if (args.Has("json"))
     std::cout << JsonText(MapEvalJson(*r), -1) << "\n";
   else
@@ -228,7 +228,7 @@ int CmdEval(int argc, char** argv) {
   if (std::string error = ReadOptions(args, &options); !error.empty()) return Fail(kEval, error);
 
   StatusOr<EvalResult> result = EvaluateFiles(args.Get("gt"), args.Get("est"), options);
-  if (!result.ok()) return Fail(kEval, result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail(kEval, result.status());
 
   for (const std::string& w : result->warnings)
     std::fprintf(stderr, "rvlio %s: warning: %s\n", kEval, w.c_str());

@@ -88,7 +88,7 @@ int CmdInfo(int argc, char** argv) {
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   StatusOr<BagInfo> info = ReadBagInfo(args.Get("bag"), args.Get("lidar-topic"), args.Get("ouster-metadata"));
-  if (!info.ok()) return Fail(spec.name, info.status().message(), info.status().exit_code());
+  if (!info.ok()) return Fail(spec.name, info.status());
   Print(*info);
   for (const std::string& w : info->warnings)
     std::cerr << "rvlio info: warning: " << w << "\n";

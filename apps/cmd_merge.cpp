@@ -30,14 +30,13 @@ int CmdMerge(int argc, char** argv) {
   req.out_dir = args.Get("out");
   req.map = args.Get("map");
   StatusOr<MergeResult> result = MergeRefineChunks(req);
-  if (!result.ok()) return Fail("merge", result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail("merge", result.status());
   for (const auto& w : result->warnings) std::fprintf(stderr, "rvlio merge: warning: %s\n", w.c_str());
-  for (const auto& c : result->summary["chunks"])
+  for (const MergedChunk& c : result->chunks)
     std::printf("rvlio merge: chunk %d: %d scans, %d shared with the previous, moved %.4f m %.4f deg, "
                 "residual RMS %.4f m\n",
-                c["chunk"].get<int>(), c["scans"].get<int>(), c["shared_poses"].get<int>(),
-                c["translation_m"].get<double>(), c["rotation_deg"].get<double>(),
-                c["residual_rms_m"].get<double>());
+                c.chunk, static_cast<int>(c.scans), c.shared_poses, c.translation_m,
+                c.rotation_deg, c.residual_rms_m);
   std::printf("rvlio merge: %zu chunks, %zu scans, %zu map points -> %s\n", req.chunk_dirs.size(),
               result->trajectory.size(), result->map_points.size(), req.out_dir.c_str());
   return 0;

@@ -28,15 +28,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void PrintRound(const RefineRound& r, int rounds) {
-  std::printf(
+void PrintRound(std::FILE* out, const RefineRound& r, int rounds) {
+  std::fprintf(out,
       "rvlio refine: round %d/%d: cost %.6g -> %.6g, %d iterations, max change %.4f m %.4f deg, "
       "%lld constraints, %d RV-active scans, %.1f s (deskew %.1f, map %.1f, associate %.1f, "
       "solve %.1f)\n",
       r.round, rounds, r.cost_before, r.cost_after, r.iterations, r.max_translation_change_m,
       r.max_rotation_change_deg, static_cast<long long>(r.constraints), r.rv_active_scans,
       r.total_s, r.deskew_s, r.map_s, r.associate_s, r.solve_s);
-  std::fflush(stdout);
+  std::fflush(out);
 }
 
 // --checkpoint DIR / --resume DIR (the same folder goes on receiving checkpoints).
@@ -107,34 +107,47 @@ int CmdRefine(int argc, char** argv) {
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   InterruptScope interrupt_scope;
-  RefineArgs req;
-  if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("refine", err);
+  RefineRequest req;
+  if (std::string err = ParseWindow(args, &req.args.window); !err.empty())
+    return Fail("refine", err);
+  req.args.bag = args.Get("bag");
+  req.args.init_path = args.Get("init");
+  req.args.out_dir = args.Get("out");
+  req.args.map = args.Get("map");
+  req.config_files = args.GetAll("config");
+  req.overrides = OverridesOf(args);
+  req.allow_divergence = args.Has("allow-divergence");
+  if (int rc = ReadCheckpointArgs(args, &req.args); rc != 0) return rc;
+  if (int rc = ReadChunkArgs(args, &req.args); rc != 0) return rc;
+  RefineOutcome outcome;
+  return RefineOnBag(std::move(req), &outcome);
+}
+
+int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
   const auto t0 = Clock::now();
-  req.bag = args.Get("bag");
-  req.init_path = args.Get("init");
-  req.out_dir = args.Get("out");
-  req.map = args.Get("map");
+  RefineArgs& req = request.args;
+  std::FILE* out = request.out;
   std::vector<std::string> config_warnings;
   StatusOr<OdometryOptions> options =
-      LoadConfig(args.GetAll("config"), OverridesOf(args), &config_warnings);
+      LoadConfig(request.config_files, request.overrides, &config_warnings);
   if (!options.ok()) return Fail("refine", options.status().message());
   for (const auto& w : config_warnings)
     std::fprintf(stderr, "rvlio refine: warning: %s\n", w.c_str());
   req.options = std::move(*options);
-  StatusOr<Trajectory> init = ReadTum(req.init_path);
-  if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
-  req.init = std::move(*init);
-  if (int rc = ReadCheckpointArgs(args, &req); rc != 0) return rc;
-  if (int rc = ReadChunkArgs(args, &req); rc != 0) return rc;
+  if (req.init.empty()) {
+    StatusOr<Trajectory> init = ReadTum(req.init_path);
+    if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
+    req.init = std::move(*init);
+  }
   const int rounds = req.options.smoother.refine_rounds;
-  req.on_round = [rounds](const RefineRound& r) { PrintRound(r, rounds); };
-  req.on_resume = [&req](int rounds_done) {
-    std::printf("rvlio refine: resuming after round %d from %s\n", rounds_done,
-                req.checkpoint_dir.c_str());
+  req.on_round = [out, rounds](const RefineRound& r) { PrintRound(out, r, rounds); };
+  req.on_resume = [out, &req](int rounds_done) {
+    std::fprintf(out, "rvlio refine: resuming after round %d from %s\n", rounds_done,
+                 req.checkpoint_dir.c_str());
   };
   req.stop = [] { return InterruptSignalName(); };
   StatusOr<RefineRunResult> result = RefineRecording(req);
-  if (!result.ok()) return Fail("refine", result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail("refine", result.status());
   if (!result->read_complete) {
     std::fprintf(stderr, "rvlio refine: interrupted by %s while reading the bag; nothing written\n",
                  result->stop_reason.c_str());
@@ -151,18 +164,22 @@ int CmdRefine(int argc, char** argv) {
                  req.out_dir.c_str());
     return InterruptExitCode();
   }
-  if (!result->chunk.is_null())
-    std::printf("rvlio refine: chunk %d of %d: scans ending %.3f .. %.3f s (its own %.3f .. %.3f s)\n",
-                req.chunk, req.chunk_count, result->chunk["begin_ns"].get<int64_t>() * 1e-9,
-                result->chunk["end_ns"].get<int64_t>() * 1e-9,
-                result->chunk["core_begin_ns"].get<int64_t>() * 1e-9,
-                result->chunk["core_end_ns"].get<int64_t>() * 1e-9);
-  std::printf("rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
-              refined.trajectory.size(), refined.rounds.size(),
-              refined.converged ? " (converged)" : "", refined.linear_solver.c_str(),
-              SecondsSince(t0), PeakMemoryMb(), req.out_dir.c_str());
+  outcome->scans = static_cast<int>(refined.trajectory.size());
+  outcome->refine_s = refined.total_s;
+  outcome->sequence_duration_s =
+      NsToSeconds(refined.trajectory.back().t_ns - refined.trajectory.front().t_ns);
+  outcome->diverged = result->divergence.detected;
+  if (const std::optional<RefineJobSpan>& job = result->job)
+    std::fprintf(out, "rvlio refine: chunk %d of %d: scans ending %.3f .. %.3f s (its own %.3f .. %.3f s)\n",
+                 job->chunk, job->count, job->begin_ns * 1e-9, job->end_ns * 1e-9,
+                 job->core_begin_ns * 1e-9, job->core_end_ns * 1e-9);
+  std::fprintf(out, "rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
+               refined.trajectory.size(), refined.rounds.size(),
+               refined.converged ? " (converged)" : "", refined.linear_solver.c_str(),
+               SecondsSince(t0), PeakMemoryMb(), req.out_dir.c_str());
+  std::fflush(out);
   if (result->divergence.detected)
-    return FinishDiverged("refine", result->divergence, req.out_dir, args.Has("allow-divergence"));
+    return FinishDiverged("refine", result->divergence, req.out_dir, request.allow_divergence);
   return 0;
 }
 

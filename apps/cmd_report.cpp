@@ -60,7 +60,7 @@ int CmdReport(int argc, char** argv) {
   options.gt = args.Get("gt");
   if (int rc = ReadMaxPoints(args, &options.max_points); rc != 0) return rc;
   StatusOr<report::WrittenReport> r = report::WriteReport(dir, args.Get("out"), options);
-  if (!r.ok()) return Fail(kReport, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kReport, r.status());
   std::printf("rvlio report: wrote %s (%.1f MB)\n", r->path.c_str(),
               static_cast<double>(r->bytes) / 1e6);
   return 0;

@@ -82,30 +82,36 @@ bool ParseInt64(const std::string& text, int64_t* value) {
   return !text.empty() && *end == '\0' && errno == 0;
 }
 
-// --seed, --duration, --format, --mcap-compression as they were written
-// (SimulateRecording checks the values); "" or the error message.
-std::string ReadArgs(const Args& args, SimulateArgs* sim) {
+}  // namespace
+
+std::string ReadSeedOption(const Args& args, const std::string& name,
+                           std::optional<int64_t>* seed) {
+  if (!args.Has(name)) return "";
+  int64_t value = 0;
+  if (!ParseInt64(args.Get(name), &value) || value < 0)
+    return "--" + name + " '" + args.Get(name) + "' is not a non-negative integer";
+  *seed = value;
+  return "";
+}
+
+std::string ReadDurationOption(const Args& args, std::optional<double>* duration_s) {
+  if (!args.Has("duration")) return "";
+  double value = 0.0;
+  if (!ParseDouble(args.Get("duration"), &value) || value <= 0.0)
+    return "--duration '" + args.Get("duration") + "' is not a positive number of seconds";
+  *duration_s = value;
+  return "";
+}
+
+std::string ReadSimulateArgs(const Args& args, SimulateArgs* sim) {
   sim->preset = args.Get("preset", "tunnel");
   sim->lidar_msg = args.Get("lidar-msg", "pointcloud2");
-  int64_t seed = 0;
-  if (args.Has("seed")) {
-    if (!ParseInt64(args.Get("seed"), &seed) || seed < 0)
-      return "--seed '" + args.Get("seed") + "' is not a non-negative integer";
-    sim->seed = seed;
-  }
-  if (args.Has("flight-seed")) {
-    if (!ParseInt64(args.Get("flight-seed"), &seed) || seed < 0)
-      return "--flight-seed '" + args.Get("flight-seed") + "' is not a non-negative integer";
-    sim->flight_seed = seed;
-  }
+  if (std::string err = ReadSeedOption(args, "seed", &sim->seed); !err.empty()) return err;
+  if (std::string err = ReadSeedOption(args, "flight-seed", &sim->flight_seed); !err.empty())
+    return err;
   sim->reference_map = args.Has("reference-map");
   sim->reference_map_only = args.Has("reference-map-only");
-  double duration = 0.0;
-  if (args.Has("duration")) {
-    if (!ParseDouble(args.Get("duration"), &duration) || duration <= 0.0)
-      return "--duration '" + args.Get("duration") + "' is not a positive number of seconds";
-    sim->duration_s = duration;
-  }
+  if (std::string err = ReadDurationOption(args, &sim->duration_s); !err.empty()) return err;
   sim->overrides = args.GetAll("set");
   sim->out_dir = args.Get("out");
   sim->name = args.Get("name", sim->preset);
@@ -116,22 +122,24 @@ std::string ReadArgs(const Args& args, SimulateArgs* sim) {
   return "";
 }
 
-}  // namespace
-
 int CmdSimulate(int argc, char** argv) {
   const CommandSpec spec = SimulateSpec();
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop, leave no half bag, exit 130/143
   SimulateArgs sim;
-  if (std::string err = ReadArgs(args, &sim); !err.empty()) return Fail(kSimulate, err);
+  if (std::string err = ReadSimulateArgs(args, &sim); !err.empty()) return Fail(kSimulate, err);
+  return SimulateOnDisk(std::move(sim));
+}
+
+int SimulateOnDisk(SimulateArgs sim) {
   sim.stop = [] { return InterruptSignalName(); };
   // A second signal aborts at once: the writer's temporary file goes with it.
   const std::string bag_path = SimulatedRecordingPath(sim);
   SetAbortRemovePath(bag_path + ".tmp");
   StatusOr<SimulateResult> r = SimulateRecording(sim);
   SetAbortRemovePath("");
-  if (!r.ok()) return Fail(kSimulate, r.status().message(), r.status().exit_code());
+  if (!r.ok()) return Fail(kSimulate, r.status());
   if (r->stopped) {
     std::fprintf(stderr, "rvlio simulate: interrupted by %s; no bag written\n",
                  r->stop_reason.c_str());

@@ -1,14 +1,9 @@
 #include "compare_engine.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iostream>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -76,41 +71,6 @@ struct Row {
   const char* StatusName() const {
     return interrupted ? "interrupted" : ok() ? "ok" : (measured() ? "diverged" : "failed");
   }
-};
-
-// Calls another subcommand in-process with the given arguments.
-int Invoke(int (*command)(int, char**), std::vector<std::string> args) {
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  return command(static_cast<int>(args.size()), argv.data());
-}
-
-// Sends this process's stdout into a file while alive (refine's round lines go
-// to OUT/refine/refine.log instead of between compare's step lines).
-class StdoutToFile {
- public:
-  explicit StdoutToFile(const std::string& path) {
-    std::cout.flush();
-    std::fflush(stdout);
-    const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) return;
-    saved_ = dup(STDOUT_FILENO);
-    if (saved_ >= 0) dup2(fd, STDOUT_FILENO);
-    close(fd);
-  }
-  ~StdoutToFile() {
-    if (saved_ < 0) return;
-    std::cout.flush();
-    std::fflush(stdout);
-    dup2(saved_, STDOUT_FILENO);
-    close(saved_);
-  }
-  StdoutToFile(const StdoutToFile&) = delete;
-  StdoutToFile& operator=(const StdoutToFile&) = delete;
-
- private:
-  int saved_ = -1;
 };
 
 class Steps {
@@ -215,7 +175,7 @@ void EvaluateRow(const Truth& truth, const std::string& dir, Row* row) {
   StatusOr<EvalResult> e = est.ok() ? Evaluate(truth.trajectory, *est, EvalOptions())
                                     : StatusOr<EvalResult>(est.status());
   if (!e.ok()) {
-    row->exit_code = e.status().exit_code();
+    row->exit_code = cli::ExitCode(e.status().code());
     row->error = "evaluation: " + e.status().message();
     std::fprintf(stderr, "rvlio %s: warning: %s: %s\n", kCompare, row->name.c_str(),
                  row->error.c_str());
@@ -280,19 +240,6 @@ const Row* BestRow(const std::vector<Row>& rows) {
   return best;
 }
 
-// Refine's timing from its summary.json: wall time of the batch solve.
-void ReadRefineTiming(const std::string& dir, Row* row) {
-  std::ifstream in(dir + "/summary.json");
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return;
-  const double refine_s = j.value(nlohmann::json::json_pointer("/time_s/refine"), kNaN);
-  const double duration_s = j.value("sequence_duration_s", kNaN);
-  row->scans = j.value("scan_count", 0);
-  if (row->scans > 0 && refine_s > 0) row->ms_per_scan = 1000.0 * refine_s / row->scans;
-  if (refine_s > 0) row->real_time_factor = duration_s / refine_s;
-  row->diverged = j.value(nlohmann::json::json_pointer("/divergence/detected"), false);
-}
-
 Row RunRefine(const CompareRequest& req, const Row& start, const Truth& truth, Steps* steps) {
   const std::string dir = req.out_dir + "/" + kRefine;
   steps->Say("rvlio refine from " + start.name + " (log: " + dir + "/refine.log)");
@@ -300,23 +247,33 @@ Row RunRefine(const CompareRequest& req, const Row& start, const Truth& truth, S
   row.name = kRefine;
   row.label = "refine (from " + start.label + ")";
   row.init = start.name;
-  std::vector<std::string> args = {"rvlio", "refine", "--bag", req.bag, "--init",
-                                   req.out_dir + "/" + start.name + "/trajectory.tum",
-                                   "--out", dir, "--allow-divergence"};
-  for (const auto& c : req.config_files) args.insert(args.end(), {"--config", c});
-  for (const auto& s : req.overrides) args.insert(args.end(), {"--set", s});
-  for (const auto& w : WindowArgs(req.window)) args.push_back(w);
+  RefineRequest refine;
+  refine.args.bag = req.bag;
+  refine.args.init_path = req.out_dir + "/" + start.name + "/trajectory.tum";
+  refine.args.out_dir = dir;
+  refine.args.window = req.window;
+  refine.config_files = req.config_files;
+  refine.overrides = req.overrides;
+  refine.allow_divergence = true;  // the row is marked instead
+  RefineOutcome outcome;
   const auto t0 = Clock::now();
   {
     std::error_code ec;
     fs::create_directories(dir, ec);  // for the log; refine itself reports a bad folder
-    StdoutToFile log(dir + "/refine.log");
-    row.exit_code = Invoke(CmdRefine, args);
+    // refine's round lines go to the log instead of between compare's step lines
+    std::FILE* log = std::fopen((dir + "/refine.log").c_str(), "w");
+    refine.out = log != nullptr ? log : stdout;
+    row.exit_code = RefineOnBag(std::move(refine), &outcome);
+    if (log != nullptr) std::fclose(log);
   }
   row.wall_s = SecondsSince(t0);
   row.interrupted = Interrupted() && IsInterruptExit(row.exit_code);
   if (row.exit_code == 0) {
-    ReadRefineTiming(dir, &row);
+    row.scans = outcome.scans;
+    if (outcome.scans > 0 && outcome.refine_s > 0)
+      row.ms_per_scan = 1000.0 * outcome.refine_s / outcome.scans;
+    if (outcome.refine_s > 0) row.real_time_factor = outcome.sequence_duration_s / outcome.refine_s;
+    row.diverged = outcome.diverged;
     EvaluateRow(truth, dir, &row);
   }
   steps->Detail(ResultLine(row));

@@ -85,13 +85,12 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     WarnDivergence("run", *p.divergence, &divergence_warned);
   };
   StatusOr<RunResult> result = RunRecording(args);
-  if (!result.ok()) return Fail("run", result.status().message(), result.status().exit_code());
+  if (!result.ok()) return Fail("run", result.status());
   if (result->scans.empty()) return ReportInterrupt(req, *result);  // stopped before a scan
-  const TimingStats t = ComputeTimingStats(result->scans);
   outcome->scans = static_cast<int>(result->scans.size());
   outcome->diverged = result->divergence.detected;
-  outcome->median_ms = t.median_ms;
-  outcome->real_time_factor = result->summary["real_time_factor"];
+  outcome->median_ms = result->per_scan.median_ms;
+  outcome->real_time_factor = result->real_time_factor;
   const Status& read_error = result->read_error;
   if (!read_error.ok())
     return Fail("run", read_error.message() + " (outputs hold the scans read before it)");

@@ -1,11 +1,13 @@
 #pragma once
-// `rvlio run` as a function, so that demo and compare reuse it in-process:
-// RunRecording (rvlio/api.h) with the command's signals, progress line and
-// messages.
+// `rvlio run` and `rvlio refine` as functions, so that demo and compare reuse
+// them in-process: RunRecording / RefineRecording (rvlio/api.h) with the
+// command's signals, progress and round lines and messages.
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "rvlio/api.h"
 #include "rvlio/outputs/output_stage.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/formats/sensor_stream.h"
@@ -43,6 +45,29 @@ struct RunOutcome {
 // monitor flagged writes every output and returns kExitDiverged
 // (divergence_cli.h) unless request.allow_divergence.
 int RunOdometryOnBag(const RunRequest& request, RunOutcome* outcome);
+
+struct RefineRequest {
+  // bag, init_path (read when init is empty), out_dir, window, map, checkpoint and
+  // chunk; the options come from config_files and overrides.
+  RefineArgs args;
+  std::vector<std::string> config_files;
+  std::vector<std::string> overrides;  // --set key=value
+  bool allow_divergence = false;       // exit 0 even if the checks of the result fired
+  std::FILE* out = stdout;             // the round lines and the closing line
+};
+
+struct RefineOutcome {
+  int scans = 0;
+  double refine_s = 0.0;             // the batch solve (summary.json time_s.refine)
+  double sequence_duration_s = 0.0;  // first to last refined pose
+  bool diverged = false;             // the checks of the result fired (summary.json divergence)
+};
+
+// `rvlio refine` after its arguments are parsed (cmd_refine.cpp): loads the
+// configuration and the initial trajectory, refines, writes the outputs and
+// prints the command's lines (warnings and errors on stderr). Returns the exit
+// status; the outcome is filled when the refinement finished.
+int RefineOnBag(RefineRequest request, RefineOutcome* outcome);
 
 // Creates `dir` if needed and proves it writable; false after printing the
 // error line of `command` if not (rvlio/outputs/output_stage.h PrepareOutputDir).

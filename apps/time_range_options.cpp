@@ -4,8 +4,6 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "rvlio/common/text.h"
-
 namespace rvlio::cli {
 namespace {
 
@@ -33,14 +31,6 @@ std::string ParseWindow(const Args& args, ReadWindow* window) {
                                window->duration_s <= 0.0))
     return "--duration '" + args.Get("duration") + "' is not a positive number of seconds";
   return "";
-}
-
-std::vector<std::string> WindowArgs(const ReadWindow& window) {
-  std::vector<std::string> args;
-  if (window.start_s > 0.0) args.insert(args.end(), {"--start", FormatG(window.start_s, 17)});
-  if (window.duration_s > 0.0)
-    args.insert(args.end(), {"--duration", FormatG(window.duration_s, 17)});
-  return args;
 }
 
 }  // namespace rvlio::cli

@@ -2,7 +2,6 @@
 // --start / --duration of run, refine and compare: a time window of the
 // recording (formats/sensor_stream.h).
 #include <string>
-#include <vector>
 
 #include "cli.h"
 #include "rvlio/formats/sensor_stream.h"
@@ -13,7 +12,5 @@ OptionSpec StartOption();
 OptionSpec DurationOption();
 // Fills *window from --start / --duration; "" or the error message.
 std::string ParseWindow(const Args& args, ReadWindow* window);
-// The same window as command-line arguments (for commands run in-process).
-std::vector<std::string> WindowArgs(const ReadWindow& window);
 
 }  // namespace rvlio::cli

@@ -9,8 +9,9 @@
 // (rvlio::Odometry, target rvlio::core): AddImu / AddScan / Poll / Finish.
 //
 // Conventions (as everywhere in rvlio): errors are Status::InvalidInput (bad
-// input or configuration; the message names the file/topic/key) or
-// Status::Internal; nothing is printed and the process is never exited. A
+// input or configuration; the message names the file/topic/key),
+// Status::IoError (an output that cannot be written) or Status::Internal;
+// nothing is printed and the process is never exited. A
 // call that is stopped (`stop`) returns normally with `stopped` set.
 //
 // Configuration: LoadConfig (rvlio/config/config.h) gives OdometryOptions from
@@ -33,7 +34,9 @@
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/odometry.h"
 #include "rvlio/odometry/options.h"
+#include "rvlio/outputs/run_outputs.h"
 #include "rvlio/refine/refine.h"
+#include "rvlio/refine/refine_jobs.h"
 #include "rvlio/version.h"
 
 namespace rvlio {
@@ -79,7 +82,16 @@ struct RunResult {
   std::vector<ScanResult> scans;  // one per processed scan (the rows of scans.csv)
   std::vector<double> rss_mb;     // process resident memory when each scan was done, MB
   Trajectory trajectory;          // T_world_imu at each scan end (trajectory.tum)
-  nlohmann::json summary;         // summary.json
+  // The figures summary.json writes under the same names, typed: read these,
+  // not the JSON.
+  double sequence_duration_s = 0.0;  // first to last message read
+  TimingStats per_scan;              // estimator time per scan (per_scan_ms, estimator_total_s)
+  double wall_s = 0.0;               // reading and estimating
+  double real_time_factor = 0.0;     // sequence duration / estimator time (0: none measured)
+  double real_time_factor_wall = 0.0;  // sequence duration / wall_s
+  // summary.json, serialized once from the fields above and the run's
+  // configuration, statistics and checks (for writing and for Python).
+  nlohmann::json summary;
   std::vector<std::string> warnings;  // reader, estimator and output warnings
   DivergenceReport divergence;
   std::string lidar_layout;       // the reader's name for the point layout
@@ -135,6 +147,7 @@ struct RefineRunResult {
   std::string stop_reason;
   bool read_complete = true;    // false: stopped while reading; nothing refined or written
   bool written = false;
+  std::optional<RefineJobSpan> job;  // a chunk job's span (chunk.json; none otherwise)
   nlohmann::json chunk;         // chunk.json of a chunk job (null otherwise)
 };
 
@@ -155,9 +168,25 @@ struct MergeArgs {
   std::string map;
 };
 
+// How one chunk was carried into the merged frame (summary.json "chunks", same names).
+struct MergedChunk {
+  int chunk = 1;  // 1-based
+  std::string dir;
+  size_t scans = 0;
+  int shared_poses = 0;         // with the previous chunk (0 for chunk 1)
+  double translation_m = 0.0;   // of the chunk's transform into the merged frame
+  double rotation_deg = 0.0;
+  double residual_rms_m = 0.0;  // over the shared poses after alignment
+  double residual_max_m = 0.0;
+  double residual_max_deg = 0.0;
+};
+// summary.json's entry of one chunk.
+nlohmann::json MergedChunkJson(const MergedChunk& chunk);
+
 struct MergeResult {
   Trajectory trajectory;                    // T_world_imu, the merged frame is chunk 1's
   std::vector<Eigen::Vector3d> map_points;  // the chunks' maps carried into that frame, re-voxelized
+  std::vector<MergedChunk> chunks;          // in order 1..N
   nlohmann::json summary;                   // summary.json
   std::vector<std::string> warnings;        // the chunks' warnings, each once
   bool written = false;

@@ -5,7 +5,14 @@
 namespace rvlio::python {
 
 void Raise(const Status& status) {
-  if (status.code() == StatusCode::kInternal) throw std::runtime_error(status.message());
+  switch (status.code()) {
+    case StatusCode::kInternal: throw std::runtime_error(status.message());
+    case StatusCode::kIoError:
+      PyErr_SetString(PyExc_OSError, status.message().c_str());
+      throw py::error_already_set();
+    case StatusCode::kOk:  // callers raise only errors; an ok Status here is a bug
+    case StatusCode::kInvalidInput: break;
+  }
   throw py::value_error(status.message());
 }
 

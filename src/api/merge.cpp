@@ -168,20 +168,21 @@ StatusOr<std::vector<Eigen::Vector3d>> MergeMaps(const std::vector<ChunkFolder>&
   return output.Points();
 }
 
-json AlignmentJson(const ChunkFolder& c, const RefineJobAlignment& a) {
-  return {{"chunk", a.chunk},
-          {"dir", c.dir},
-          {"scans", c.job.trajectory.size()},
-          {"shared_poses", a.shared_poses},
-          {"translation_m", a.T_merged_chunk.t.norm()},
-          {"rotation_deg", Eigen::AngleAxisd(a.T_merged_chunk.R).angle() * kRadToDeg},
-          {"residual_rms_m", a.rms_residual_m},
-          {"residual_max_m", a.max_residual_m},
-          {"residual_max_deg", a.max_residual_deg}};
+MergedChunk Merged(const ChunkFolder& c, const RefineJobAlignment& a) {
+  MergedChunk m;
+  m.chunk = a.chunk;
+  m.dir = c.dir;
+  m.scans = c.job.trajectory.size();
+  m.shared_poses = a.shared_poses;
+  m.translation_m = a.T_merged_chunk.t.norm();
+  m.rotation_deg = Eigen::AngleAxisd(a.T_merged_chunk.R).angle() * kRadToDeg;
+  m.residual_rms_m = a.rms_residual_m;
+  m.residual_max_m = a.max_residual_m;
+  m.residual_max_deg = a.max_residual_deg;
+  return m;
 }
 
-json Summary(const std::vector<ChunkFolder>& chunks, const RefineJobMerge& merge,
-             const MergeResult& r) {
+json Summary(const std::vector<ChunkFolder>& chunks, const MergeResult& r) {
   json j;
   j["version"] = RVLIO_VERSION;
   j["command"] = "merge";
@@ -193,8 +194,7 @@ json Summary(const std::vector<ChunkFolder>& chunks, const RefineJobMerge& merge
   j["sequence_duration_s"] = NsToSeconds(r.trajectory.back().t_ns - r.trajectory.front().t_ns);
   j["map_points"] = r.map_points.size();
   j["chunks"] = json::array();
-  for (size_t k = 0; k < chunks.size(); ++k)
-    j["chunks"].push_back(AlignmentJson(chunks[k], merge.alignments[k]));
+  for (const MergedChunk& c : r.chunks) j["chunks"].push_back(MergedChunkJson(c));
   j["warnings"] = r.warnings;
   return j;
 }
@@ -247,6 +247,18 @@ StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkF
 
 }  // namespace
 
+json MergedChunkJson(const MergedChunk& c) {
+  return {{"chunk", c.chunk},
+          {"dir", c.dir},
+          {"scans", c.scans},
+          {"shared_poses", c.shared_poses},
+          {"translation_m", c.translation_m},
+          {"rotation_deg", c.rotation_deg},
+          {"residual_rms_m", c.residual_rms_m},
+          {"residual_max_m", c.residual_max_m},
+          {"residual_max_deg", c.residual_max_deg}};
+}
+
 StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   std::vector<ChunkFolder> chunks;
   for (const std::string& dir : args.chunk_dirs) {
@@ -276,7 +288,9 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   if (args.map.empty() && !chunks.front().manifest.value("map_hash", std::string()).empty())
     r.warnings.push_back("the chunks were refined with --map " + chunk_map +
                          "; merge --map " + chunk_map + " writes the deviation from it");
-  r.summary = Summary(chunks, *merge, r);
+  for (size_t k = 0; k < chunks.size(); ++k)
+    r.chunks.push_back(Merged(chunks[k], merge->alignments[k]));
+  r.summary = Summary(chunks, r);
   std::optional<MapDeviation> deviation;
   if (reference->surface != nullptr) {
     deviation = ComputeMapDeviation(r.map_points, *reference->surface, r.trajectory,

@@ -372,12 +372,12 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (!refined.ok()) {
     const std::string what =
         refined.status().message() + " (bag " + args.bag + ", init " + args.init_path + ")";
-    return refined.status().code() == StatusCode::kInternal ? Status::Internal(what)
-                                                            : Status::InvalidInput(what);
+    return refined.status().WithMessage(what);
   }
   r.refine = std::move(*refined);
   r.refine.warnings.insert(r.refine.warnings.begin(), notes.begin(), notes.end());
   if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
+  r.job = job;
   if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
   r.stopped = r.refine.stopped;
   if (!r.stopped) r.stop_reason.clear();

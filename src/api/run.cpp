@@ -100,11 +100,21 @@ struct RunData {
   bool truncated = false;  // the recording was cut short (SensorBagReader::truncated)
 };
 
+// The typed figures of the result, which Summary writes.
+void SetFigures(const RunData& data, RunResult* result) {
+  const TimingStats t = ComputeTimingStats(result->scans);
+  const double duration_s = data.first_ns >= 0 ? NsToSeconds(data.last_ns - data.first_ns) : 0.0;
+  result->sequence_duration_s = duration_s;
+  result->per_scan = t;
+  result->wall_s = data.wall_s;
+  result->real_time_factor = t.total_ms > 0 ? duration_s / (t.total_ms / 1000.0) : 0.0;
+  result->real_time_factor_wall = data.wall_s > 0 ? duration_s / data.wall_s : 0.0;
+}
+
 nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
                        const SensorReaderStats& reader_stats, const RunData& data,
                        const RunResult& result) {
-  const TimingStats t = ComputeTimingStats(result.scans);
-  const double duration_s = data.first_ns >= 0 ? NsToSeconds(data.last_ns - data.first_ns) : 0.0;
+  const TimingStats& t = result.per_scan;
   nlohmann::json j;
   j["version"] = RVLIO_VERSION;
   j["command"] = "run";
@@ -113,12 +123,12 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   j["backend"] = EnumName(args.options.backend);
   j["config"] = ToJson(args.options);
   j["scan_count"] = result.scans.size();
-  j["sequence_duration_s"] = duration_s;
+  j["sequence_duration_s"] = result.sequence_duration_s;
   j["per_scan_ms"] = {{"median", t.median_ms}, {"p95", t.p95_ms}, {"max", t.max_ms}};
   j["estimator_total_s"] = t.total_ms / 1000.0;
-  j["wall_s"] = data.wall_s;
-  j["real_time_factor"] = t.total_ms > 0 ? duration_s / (t.total_ms / 1000.0) : 0.0;
-  j["real_time_factor_wall"] = data.wall_s > 0 ? duration_s / data.wall_s : 0.0;
+  j["wall_s"] = result.wall_s;
+  j["real_time_factor"] = result.real_time_factor;
+  j["real_time_factor_wall"] = result.real_time_factor_wall;
   j["peak_memory_mb"] = PeakMemoryMb();
   j["rv_active_scans"] = RvActiveScans(result.scans);
   j["degenerate_scans"] = DegenerateScans(result.scans);  // by degeneracy.method
@@ -343,6 +353,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
         NoScanMessage(args.bag, args.options, reader_stats, (*odo)->stats()));
   }
   result.trajectory = ToTrajectory(result.scans);
+  SetFigures(data, &result);
   result.summary = Summary(args, **odo, reader_stats, data, result);
   std::vector<Eigen::Vector3d> p_map;  // the output map, when written or compared
   if (write || reference != nullptr) p_map = (*odo)->MapPoints();

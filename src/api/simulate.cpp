@@ -288,8 +288,8 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   std::error_code ec;
   if (!args.out_dir.empty()) std::filesystem::create_directories(dir, ec);
   if (args.out_dir.empty() || ec || !std::filesystem::is_directory(dir))
-    return Status::InvalidInput("cannot create output directory '" + dir.string() + "'" +
-                                (ec ? " (" + ec.message() + ")" : ""));
+    return Status::IoError("cannot create output directory '" + dir.string() + "'" +
+                           (ec ? " (" + ec.message() + ")" : ""));
   BagWriterOptions format;
   std::string extension;
   if (Status s = ResolveFormat(args, &format, &extension); !s.ok()) return s;

@@ -83,7 +83,7 @@ Status AtomicFileWriter::Open(const std::string& path) {
   if (fd_ < 0) {
     const int err = errno;
     temp_path_.clear();  // nothing was created
-    return Status::InvalidInput("cannot write '" + path + "': " + ErrnoText(err));
+    return Status::IoError("cannot write '" + path + "': " + ErrnoText(err));
   }
   return Status::Ok();
 }
@@ -119,7 +119,7 @@ Status AtomicFileWriter::Commit() {
 
 Status AtomicFileWriter::FailAndDiscard(const std::string& what, int err) {
   Discard();
-  error_ = Status::InvalidInput(what + " '" + path_ + "': " + ErrnoText(err));
+  error_ = Status::IoError(what + " '" + path_ + "': " + ErrnoText(err));
   return error_;
 }
 

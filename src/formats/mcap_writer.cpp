@@ -40,7 +40,7 @@ class McapWriter : public Writer {
 
  private:
   Status Error(const std::string& what) const {
-    return Status::InvalidInput("cannot write '" + path_ + "': " + what);
+    return Status::IoError("cannot write '" + path_ + "': " + what);
   }
   // Appends bytes to the file (sticky failure), counting offset and CRC.
   Status Emit(std::string_view bytes);

@@ -65,7 +65,7 @@ class RosbagSensorWriter final : public SensorBagWriter {
       std::string ignored;
       (void)CloseBag(&ignored);  // a half-opened Bag may still hold the file
       std::remove(tmp_.c_str());
-      return Status::InvalidInput("cannot write bag '" + tmp_ + "' (" + e.what() + ")");
+      return Status::IoError("cannot write bag '" + tmp_ + "' (" + e.what() + ")");
     }
     open_ = true;
     return Status::Ok();
@@ -123,7 +123,7 @@ class RosbagSensorWriter final : public SensorBagWriter {
     open_ = false;
     if (std::string why; !CloseBag(&why)) {
       std::remove(tmp_.c_str());
-      return Status::InvalidInput("cannot write bag '" + path_ + "' (" + why + ")");
+      return Status::IoError("cannot write bag '" + path_ + "' (" + why + ")");
     }
     if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
       const std::string why = std::strerror(errno);
@@ -139,7 +139,7 @@ class RosbagSensorWriter final : public SensorBagWriter {
     try {
       bag_->write(topic, time, msg);
     } catch (const std::exception& e) {
-      return Status::InvalidInput("cannot write bag '" + path_ + "' (" + e.what() + ")");
+      return Status::IoError("cannot write bag '" + path_ + "' (" + e.what() + ")");
     }
     return Status::Ok();
   }

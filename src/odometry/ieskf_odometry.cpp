@@ -40,7 +40,7 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization locali
       localizer_(std::move(localization), options.localization, options.constraints) {}
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {
-  if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
+  if (!AcceptImu(imu, imu_buffer_, SecondsToNs(options_.imu.max_gap), &stats_)) return;
   scans_.NoteImu(imu.t_ns);
   if (!stats_.initialized) {
     TryInitialize(imu);

@@ -208,12 +208,13 @@ const VoxelMap& ReferenceLocalizer::Associate(const std::vector<Eigen::Vector3d>
   return working;
 }
 
-bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats) {
+bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, TimeNs max_gap_ns,
+               OdometryStats* stats) {
   if (!imu.acc_imu.allFinite() || !imu.gyro_imu.allFinite()) {
     ++stats->imu_non_finite;
     return false;
   }
-  if (!buffer.empty() && imu.t_ns - buffer.back().t_ns > kNominalScanPeriodNs)
+  if (!buffer.empty() && imu.t_ns - buffer.back().t_ns > max_gap_ns)
     ++stats->imu_gaps_over_scan;
   return true;
 }

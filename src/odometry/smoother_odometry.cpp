@@ -57,7 +57,7 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options, Localization 
       localizer_(std::move(localization), options.localization, options.constraints) {}
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
-  if (!AcceptImu(imu, imu_buffer_, &stats_)) return;
+  if (!AcceptImu(imu, imu_buffer_, SecondsToNs(options_.imu.max_gap), &stats_)) return;
   scans_.NoteImu(imu.t_ns);
   if (!stats_.initialized) {
     TryInitialize(imu);

@@ -17,10 +17,10 @@ namespace rvlio {
 Status PrepareOutputDir(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) return Status::InvalidInput("cannot create output folder " + dir + ": " + ec.message());
+  if (ec) return Status::IoError("cannot create output folder " + dir + ": " + ec.message());
   const std::string probe = (std::filesystem::path(dir) / ".rvlio_write_test").string();
   if (Status s = WriteFileAtomically(probe, "ok\n"); !s.ok())
-    return Status::InvalidInput("output folder " + dir + " is not writable: " + s.message());
+    return Status::IoError("output folder " + dir + " is not writable: " + s.message());
   std::filesystem::remove(probe, ec);
   return Status::Ok();
 }
@@ -68,7 +68,7 @@ Status OutputStage::Open() {
                          .string();
   if (::mkdtemp(name.data()) == nullptr) {
     const std::string why = std::strerror(errno);
-    return Status::InvalidInput("cannot write to output folder " + out_dir_ + ": " + why);
+    return Status::IoError("cannot write to output folder " + out_dir_ + ": " + why);
   }
   stage_dir_ = name;
   return Status::Ok();
@@ -84,8 +84,8 @@ Status OutputStage::Commit() {
     const std::string from = (std::filesystem::path(stage_dir_) / name).string();
     const std::string to = (std::filesystem::path(out_dir_) / name).string();
     if (std::rename(from.c_str(), to.c_str()) != 0)
-      return Status::InvalidInput("cannot move " + name + " into " + out_dir_ + ": " +
-                                  std::strerror(errno));
+      return Status::IoError("cannot move " + name + " into " + out_dir_ + ": " +
+                             std::strerror(errno));
   }
   return Status::Ok();
 }
@@ -96,8 +96,7 @@ Status OutputStage::Explain(const Status& s) const {
   const std::string final_dir = (std::filesystem::path(out_dir_) / "").string();
   for (size_t at = message.find(staged); at != std::string::npos; at = message.find(staged, at))
     message.replace(at, staged.size(), final_dir);
-  return s.code() == StatusCode::kInternal ? Status::Internal(message)
-                                           : Status::InvalidInput(message);
+  return s.WithMessage(message);
 }
 
 }  // namespace rvlio

@@ -291,6 +291,7 @@ TEST_F(BadBagTest, ImuGapIsBridgedCountedAndWarned) {
   ExpectCompleteOutputs(out);
   const auto s = Summary(out);
   EXPECT_EQ(s["stats"]["reader"]["imu_gaps"], 1);
+  EXPECT_EQ(s["stats"]["imu_gaps_over_scan"], 1);  // the estimator's count, same imu.max_gap
   EXPECT_NEAR(s["stats"]["reader"]["imu_max_gap_s"].get<double>(), 0.3, 1e-9);
   EXPECT_EQ(s["scan_count"], Summary(dir_ + "/clean")["scan_count"]);
   // 0.3 s of motion predicted from nothing but the scans: still on track.

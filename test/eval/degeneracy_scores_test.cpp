@@ -114,7 +114,7 @@ TEST(DegeneracyScore, BadInputIsAnError) {
   std::vector<DegeneracyLabel> not_unit = {Label(0, true, Eigen::Vector3d(2, 0, 0))};
   StatusOr<DegeneracyScores> s = ScoreDegeneracy(not_unit, truth, 0.01);
   ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.status().exit_code(), 2);
+  EXPECT_EQ(s.status().code(), StatusCode::kInvalidInput);
 }
 
 }  // namespace

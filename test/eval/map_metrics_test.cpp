@@ -183,7 +183,7 @@ TEST(MapMetrics, RefusesEmptyNonFiniteAndDisjointClouds) {
   EXPECT_NE(EvaluateMap(nan, ref, o).status().message().find("1 of 1000 points"), std::string::npos);
   const StatusOr<MapEvalResult> disjoint = EvaluateMap(far, ref, o);
   ASSERT_FALSE(disjoint.ok());
-  EXPECT_EQ(disjoint.status().exit_code(), 2);
+  EXPECT_EQ(disjoint.status().code(), StatusCode::kInvalidInput);
   EXPECT_NE(disjoint.status().message().find("do not overlap"), std::string::npos);
 }
 

@@ -45,7 +45,7 @@ TEST_F(AtomicFileTest, FailureNamesThePathAndLeavesNothing) {
   const std::string path = File("no_such_dir/out.txt");
   Status s = WriteFileAtomically(path, "x");
   ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
+  EXPECT_EQ(s.code(), StatusCode::kIoError);
   EXPECT_NE(s.message().find(path), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("No such file or directory"), std::string::npos) << s.message();
   // Rename onto a directory fails after the temporary file was written.

@@ -35,7 +35,7 @@ TEST(Presets, AllValidateAndUnknownNamesListThem) {
   }
   StatusOr<SimOptions> bad = PresetOptions("tunel");
   ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.status().exit_code(), 2);
+  EXPECT_EQ(bad.status().code(), StatusCode::kInvalidInput);
   for (const std::string& name : PresetNames())
     EXPECT_NE(bad.status().message().find(name), std::string::npos);
 }

@@ -123,7 +123,7 @@ TEST(Survey, CropKeepsStationsAndPointsInTheRange) {
   ASSERT_NE(outside, nullptr);
   StatusOr<SurveyResult> bad = outside->Survey();
   ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.status().exit_code(), 2);
+  EXPECT_EQ(bad.status().code(), StatusCode::kInvalidInput);
   EXPECT_NE(bad.status().message().find("survey.x_min"), std::string::npos);
   SimOptions reversed = CheapSurvey("tunnel", 5.0, 1.0);
   const Status s = reversed.Validate();

@@ -9,9 +9,20 @@
 
 namespace rvlio {
 
-enum class StatusCode { kOk = 0, kInvalidInput = 2, kInternal = 1 };
+// What went wrong, not how a program reports it: the command maps a code to its exit
+// status (apps/exit_status.h), the Python module to an exception type.
+enum class StatusCode {
+  kOk,
+  kInvalidInput,  // the caller's input is wrong: an option, configuration key or value, a
+                  // missing or malformed recording, map or trajectory
+  kIoError,       // the system refused a write: output folder or file cannot be created,
+                  // written, synced or renamed (permissions, full disk)
+  kInternal,      // a broken invariant or an estimate that cannot be formed: not the input
+};
 
-class Status {
+// Ignoring a Status loses the error: every result is handled or discarded explicitly
+// with a comment saying why ignoring it is right.
+class [[nodiscard]] Status {
  public:
   Status() = default;
   static Status Ok() { return Status(); }
@@ -21,11 +32,14 @@ class Status {
   static Status Internal(std::string message) {
     return Status(StatusCode::kInternal, std::move(message));
   }
+  static Status IoError(std::string message) {
+    return Status(StatusCode::kIoError, std::move(message));
+  }
   bool ok() const { return code_ == StatusCode::kOk; }
   StatusCode code() const { return code_; }
   const std::string& message() const { return message_; }
-  // Exit status of the command-line contract: 0 ok, 2 bad input, 1 internal.
-  int exit_code() const { return static_cast<int>(code_); }
+  // The same kind of error with another message (e.g. the context prepended).
+  Status WithMessage(std::string message) const { return Status(code_, std::move(message)); }
 
  private:
   Status(StatusCode code, std::string message) : code_(code), message_(std::move(message)) {}
@@ -35,7 +49,7 @@ class Status {
 
 // A value or the Status that explains why there is none.
 template <typename T>
-class StatusOr {
+class [[nodiscard]] StatusOr {
  public:
   StatusOr(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design
   StatusOr(Status status) : status_(std::move(status)) {  // NOLINT

@@ -111,7 +111,7 @@ struct OdometryStats {
   int64_t scans_too_few_points = 0;   // skipped: fewer than kMinScanPoints after preprocessing
   int64_t predict_only = 0;
   int64_t diverged_resets = 0;
-  int64_t imu_gaps_over_scan = 0;     // IMU gaps longer than the scan period
+  int64_t imu_gaps_over_scan = 0;     // IMU gaps longer than imu.max_gap (the name is kept for summary.json)
   bool initialized = false;
   bool started_moving = false;        // static initialization saw motion
   // Sliding-window smoother (backend: smoother); zero for the IESKF.

@@ -27,9 +27,6 @@
 
 namespace rvlio {
 
-constexpr TimeNs kNominalScanPeriodNs = 100000000;  // 10 Hz, for the IMU-gap warning
-
-
 // Collects IMU samples until they span init_duration_s, then aligns them
 // (imu/static_init.h).
 class StaticInitializer {
@@ -151,8 +148,10 @@ class ReferenceLocalizer {
 };
 
 // Screens one IMU sample for the buffer: false (and counted) for a non-finite
-// sample; a gap to the previous sample longer than a scan period is counted.
-bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, OdometryStats* stats);
+// sample; a gap to the previous sample longer than max_gap_ns (imu.max_gap, the
+// one IMU-gap threshold, which the readers count against too) is counted.
+bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, TimeNs max_gap_ns,
+               OdometryStats* stats);
 
 // Warnings for the scans the queue skipped (out of order, after the IMU's end).
 std::vector<std::string> QueueWarnings(const OdometryStats& stats);
