@@ -12,31 +12,31 @@
 namespace rvlio {
 namespace {
 
-constexpr TimeNs kT0 = 1000000000000;  // 1000 s
+constexpr TimeNs kJobsT0 = 1000000000000;  // 1000 s
 constexpr TimeNs kPeriod = 100000000;  // 10 Hz
 
 TEST(RefineJobSpan, CoresTileTheSpanAndNeighboursShareTheOverlap) {
-  const TimeNs t1 = kT0 + SecondsToNs(30.0);
+  const TimeNs t1 = kJobsT0 + SecondsToNs(30.0);
   const int n = 3;
-  TimeNs previous_core_end = kT0;
+  TimeNs previous_core_end = kJobsT0;
   for (int k = 1; k <= n; ++k) {
-    StatusOr<RefineJobSpan> s = MakeRefineJobSpan(kT0, t1, k, n, 4.0);
+    StatusOr<RefineJobSpan> s = MakeRefineJobSpan(kJobsT0, t1, k, n, 4.0);
     ASSERT_TRUE(s.ok()) << s.status().message();
     EXPECT_EQ(s->core_begin_ns, previous_core_end);
     EXPECT_NEAR(NsToSeconds(s->core_end_ns - s->core_begin_ns), 10.0, 1e-9);
-    EXPECT_EQ(s->begin_ns, k == 1 ? kT0 : s->core_begin_ns - SecondsToNs(2.0));
+    EXPECT_EQ(s->begin_ns, k == 1 ? kJobsT0 : s->core_begin_ns - SecondsToNs(2.0));
     EXPECT_EQ(s->end_ns, k == n ? t1 : s->core_end_ns + SecondsToNs(2.0));
     previous_core_end = s->core_end_ns;
   }
   EXPECT_EQ(previous_core_end, t1);
-  StatusOr<RefineJobSpan> one = MakeRefineJobSpan(kT0, t1, 1, 1, 100.0);  // one chunk: no overlap needed
+  StatusOr<RefineJobSpan> one = MakeRefineJobSpan(kJobsT0, t1, 1, 1, 100.0);  // one chunk: no overlap needed
   ASSERT_TRUE(one.ok());
-  EXPECT_EQ(one->begin_ns, kT0);
+  EXPECT_EQ(one->begin_ns, kJobsT0);
   EXPECT_EQ(one->end_ns, t1);
 }
 
 TEST(RefineJobSpan, BadChunkParametersAreInvalidInputNamingTheOption) {
-  const TimeNs t1 = kT0 + SecondsToNs(30.0);
+  const TimeNs t1 = kJobsT0 + SecondsToNs(30.0);
   struct Case {
     TimeNs t1;
     int chunk, count;
@@ -45,8 +45,8 @@ TEST(RefineJobSpan, BadChunkParametersAreInvalidInputNamingTheOption) {
   };
   for (const Case& c : {Case{t1, 1, 0, 4.0, "--of 0"}, Case{t1, 4, 3, 4.0, "--chunk 4"},
                         Case{t1, 0, 3, 4.0, "--chunk 0"}, Case{t1, 1, 10, 4.0, "shorter than their overlap"},
-                        Case{kT0, 1, 1, 4.0, "spans no time"}}) {
-    StatusOr<RefineJobSpan> s = MakeRefineJobSpan(kT0, c.t1, c.chunk, c.count, c.overlap_s);
+                        Case{kJobsT0, 1, 1, 4.0, "spans no time"}}) {
+    StatusOr<RefineJobSpan> s = MakeRefineJobSpan(kJobsT0, c.t1, c.chunk, c.count, c.overlap_s);
     ASSERT_FALSE(s.ok()) << c.names;
     EXPECT_EQ(s.status().code(), StatusCode::kInvalidInput);
     EXPECT_NE(s.status().message().find(c.names), std::string::npos) << s.status().message();
@@ -55,7 +55,7 @@ TEST(RefineJobSpan, BadChunkParametersAreInvalidInputNamingTheOption) {
 
 // A curving 30 s trajectory at 10 Hz.
 StampedPose TruthAt(TimeNs t_ns) {
-  const double t = NsToSeconds(t_ns - kT0);
+  const double t = NsToSeconds(t_ns - kJobsT0);
   StampedPose p;
   p.t_ns = t_ns;
   p.p_world_imu = Eigen::Vector3d(1.5 * t, 4.0 * std::sin(0.1 * t), 0.3 * std::cos(0.2 * t));
@@ -66,16 +66,16 @@ StampedPose TruthAt(TimeNs t_ns) {
 // The chunks of the truth, each in its own frame (a different rigid
 // transform per chunk) with `noise_m` of position noise.
 std::vector<RefineJobTrajectory> ChunksOfTruth(int n, double overlap_s, double noise_m) {
-  const TimeNs t1 = kT0 + SecondsToNs(30.0);
+  const TimeNs t1 = kJobsT0 + SecondsToNs(30.0);
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, noise_m);
   std::vector<RefineJobTrajectory> chunks;
   for (int k = 1; k <= n; ++k) {
     RefineJobTrajectory c;
-    c.span = MakeRefineJobSpan(kT0, t1, k, n, overlap_s).value();
+    c.span = MakeRefineJobSpan(kJobsT0, t1, k, n, overlap_s).value();
     const Pose3 T_chunk_world(Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * k, Eigen::Vector3d(1, 2, 3).normalized())),
                               Eigen::Vector3d(0.2 * k, -0.1 * k, 0.05 * k));
-    for (TimeNs t = kT0; t <= t1; t += kPeriod) {
+    for (TimeNs t = kJobsT0; t <= t1; t += kPeriod) {
       if (!c.span.Contains(t)) continue;
       StampedPose p = TruthAt(t);
       p.p_world_imu = T_chunk_world * p.p_world_imu +
@@ -133,7 +133,7 @@ TEST(MergeRefineJobs, AMissingChunkOrTooShortAnOverlapIsInvalidInput) {
 }
 
 TEST(BlendPoses, EndsAreTheInputsAndTheMiddleIsHalfway) {
-  StampedPose a = TruthAt(kT0), b = TruthAt(kT0 + SecondsToNs(10.0));
+  StampedPose a = TruthAt(kJobsT0), b = TruthAt(kJobsT0 + SecondsToNs(10.0));
   const StampedPose mid = BlendPoses(a, b, 0.5);
   EXPECT_TRUE(BlendPoses(a, b, 0.0).p_world_imu.isApprox(a.p_world_imu));
   EXPECT_TRUE(BlendPoses(a, b, 1.0).p_world_imu.isApprox(b.p_world_imu));
