@@ -39,6 +39,7 @@ set(rvlio_public_headers
   rvlio/lidar/extrinsics.h
   rvlio/lidar/options.h
   rvlio/lidar/preprocess.h
+  rvlio/lidar/range_window.h
   rvlio/map/options.h
   rvlio/map/reference_map.h
   rvlio/map/voxel_key.h

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <type_traits>
 
+#include "rvlio/lidar/range_window.h"
+
 namespace rvlio {
 namespace {
 
@@ -379,7 +381,7 @@ inline bool KeepPoint(double x, double y, double z, bool time_ok, const LidarOpt
     return false;
   }
   const double r2 = p_lidar->cast<double>().squaredNorm();
-  if (r2 < lidar.min_range * lidar.min_range || r2 > lidar.max_range * lidar.max_range) {
+  if (!RangeWindow(lidar).Contains(r2)) {
     ++stats->out_of_range_points;
     return false;
   }

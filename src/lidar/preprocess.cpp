@@ -8,7 +8,6 @@
 
 namespace rvlio {
 namespace {
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 int CountTrailingZeros(uint64_t bits) {  // bits != 0
 #if defined(__GNUC__) || defined(__clang__)
@@ -22,8 +21,7 @@ int CountTrailingZeros(uint64_t bits) {  // bits != 0
 }  // namespace
 
 ScanPreprocessor::ScanPreprocessor(const LidarOptions& options)
-    : min_range2_(options.min_range * options.min_range),
-      max_range2_(options.max_range * options.max_range),
+    : range_(options),
       voxel_size_(options.voxel_size),
       inv_voxel_size_(options.voxel_size > 0.0 ? 1.0 / options.voxel_size : 0.0),
       stride_(options.point_stride) {
@@ -96,7 +94,7 @@ void ScanPreprocessor::FilterPoints(const Scan& scan, std::vector<int>* indices)
     // r2 is finite iff the point is (float squares cannot overflow a double),
     // so one test passes the in-range points; the rare rest are sorted out.
     const double r2 = p.squaredNorm();
-    if (!(r2 >= min_range2_ && r2 <= max_range2_ && r2 < kInfinity)) {
+    if (!range_.Contains(r2)) {
       ++(std::isfinite(r2) ? stats_.num_out_of_range : stats_.num_invalid);
       continue;
     }

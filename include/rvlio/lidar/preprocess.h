@@ -1,6 +1,7 @@
 #pragma once
 // Scan preprocessing before association (docs/design.md "Modules and their dependencies", lidar/):
 // every point_stride-th raw point, range crop to [min_range, max_range]
+// (lidar/range_window.h)
 // (non-finite points dropped), then a voxel grid of edge voxel_size in the
 // LiDAR frame keeping one point per voxel: the one nearest the voxel centre
 // (a real return, with its own time for deskew, not an average). voxel_size 0
@@ -13,6 +14,7 @@
 
 #include "rvlio/common/types.h"
 #include "rvlio/lidar/options.h"
+#include "rvlio/lidar/range_window.h"
 #include "rvlio/map/voxel_key.h"
 
 namespace rvlio {
@@ -59,8 +61,7 @@ class ScanPreprocessor {
   void Grow();
   void CollectAscending(int n, std::vector<int>* indices);
 
-  double min_range2_;
-  double max_range2_;
+  RangeWindow range_;  // lidar.min_range .. max_range
   double voxel_size_;
   double inv_voxel_size_;
   int stride_;
