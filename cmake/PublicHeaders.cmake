@@ -53,7 +53,9 @@ set(rvlio_public_headers
   rvlio/odometry/odometry.h
   rvlio/odometry/options.h
   rvlio/odometry/reference.h
+  rvlio/outputs/run_outputs.h
   rvlio/refine/refine.h
+  rvlio/refine/refine_jobs.h
   rvlio/refine/refine_states.h
   rvlio/rv/criterion.h
   rvlio/rv/options.h

@@ -102,7 +102,9 @@ only_public_installed() {
   private=$(cd include && find rvlio -name '*.h' | sort | comm -23 - <(echo "$listed") | wc -l)
   ((private > 0)) || { echo "  every header of include/rvlio is listed as public" >&2; return 1; }
 }
-check "the install holds exactly the $(public_list | wc -l) public headers of cmake/PublicHeaders.cmake; the $(find include/rvlio -name '*.h' | wc -l) - $(public_list | wc -l) private ones stay out" \
+n_public=$(public_list | wc -l)
+n_private=$(($(find include/rvlio -name '*.h' | wc -l) - n_public))
+check "the install holds exactly the $n_public public headers of cmake/PublicHeaders.cmake; the $n_private private ones stay out" \
   only_public_installed
 # Each installed header compiles on its own from the prefix with only Eigen and
 # Ceres (so the public list is closed under #include), and opens no PCL, ROS,

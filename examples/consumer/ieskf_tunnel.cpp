@@ -32,7 +32,7 @@ rvlio::OdometryOptions SensorOptions(const rvlio::SimOptions& sim) {
 
 int Fail(const rvlio::Status& s) {
   std::fprintf(stderr, "ieskf_tunnel: error: %s\n", s.message().c_str());
-  return s.exit_code();
+  return s.code() == rvlio::StatusCode::kInternal ? 1 : 2;  // bad input or I/O: 2
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ namespace {
 
 int Fail(const char* step, const rvlio::Status& s) {
   std::fprintf(stderr, "run_recording: %s: %s\n", step, s.message().c_str());
-  return s.exit_code();
+  return s.code() == rvlio::StatusCode::kInternal ? 1 : 2;  // bad input or I/O: 2
 }
 
 }  // namespace
