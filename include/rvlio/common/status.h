@@ -10,7 +10,7 @@
 namespace rvlio {
 
 // What went wrong, not how a program reports it: the command maps a code to its exit
-// status (apps/exit_status.h), the Python module to an exception type.
+// status (cli::ExitCode, apps/cli.h), the Python module to an exception type.
 enum class StatusCode {
   kOk,
   kInvalidInput,  // the caller's input is wrong: an option, configuration key or value, a
