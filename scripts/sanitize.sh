@@ -64,6 +64,7 @@ ex=(
   CompareTest.FullCompareWritesTablesEqualToEvalAndPlots
   CompareTest.EveryVariantFailedIsExitOne
   CompareTest.RefMapAddsMapColumnsInTheGroundTruthFrame
+  DemoTest.ShortDemoSimulatesComparesAndWritesTheReport
   'AblateRunTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   'PresetsAndBackends/TimeOffsetMatrix\..*'
   DivergenceCli.UpsideDownLidarIsCaughtOnAShortFlight
