@@ -195,11 +195,10 @@ std::unique_ptr<SlidingWindow::Node> SlidingWindow::MakeNode(
   return node;
 }
 
-void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
-                          std::vector<Eigen::Vector3d> p_lidar) {
-  nodes_.clear();
-  marginal_prior_.reset();
-  state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, first_prior_);
+// The priors of the estimated calibration (extrinsic, time offset) at their
+// current values with their initial standard deviations: at the start, and
+// again when a failed marginalization dropped the information they held.
+void SlidingWindow::ResetCalibrationPriors() {
   if (estimate_extrinsics())
     extrinsic_prior_ = std::make_unique<PosePriorFactor>(
         PoseBlock::FromArray(extrinsic_), options_.smoother.extrinsic_rot_std,
@@ -208,6 +207,14 @@ void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlo
     time_offset_prior_ = TimeOffsetPrior(time_offset_[0], options_.lidar.time_offset_init_std);
     time_offset_std_s_ = options_.lidar.time_offset_init_std;
   }
+}
+
+void SlidingWindow::Start(TimeNs t_ns, const PoseBlock& pose, const SpeedBiasBlock& speed_bias,
+                          std::vector<Eigen::Vector3d> p_lidar) {
+  nodes_.clear();
+  marginal_prior_.reset();
+  state_prior_ = std::make_unique<StatePriorFactor>(pose, speed_bias, first_prior_);
+  ResetCalibrationPriors();
   nodes_.push_back(MakeNode(t_ns, pose, speed_bias, std::move(p_lidar)));
   nodes_.back()->td_lin_s = time_offset_[0];
 }
@@ -592,15 +599,8 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
     state_prior_ = std::make_unique<StatePriorFactor>(PoseBlock::FromArray(next.pose),
                                                       SpeedBiasBlock::FromArray(next.sb),
                                                       first_prior_);
-    // The extrinsic's information went with the failed prior: its prior again.
-    if (estimate_extrinsics())
-      extrinsic_prior_ = std::make_unique<PosePriorFactor>(
-          PoseBlock::FromArray(extrinsic_), options_.smoother.extrinsic_rot_std,
-          options_.smoother.extrinsic_pos_std);
-    if (estimate_time_offset()) {
-      time_offset_prior_ = TimeOffsetPrior(time_offset_[0], options_.lidar.time_offset_init_std);
-      time_offset_std_s_ = options_.lidar.time_offset_init_std;
-    }
+    // The calibration's information went with the failed prior: its priors again.
+    ResetCalibrationPriors();
   }
   ++stats_.marginalizations;
   next.imu.reset();

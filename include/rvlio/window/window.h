@@ -255,6 +255,7 @@ class SlidingWindow {
   void RejectOverflowingScan(Node* node);
   void TreatDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar, Node* node) const;
   void RefreshImuFactors();
+  void ResetCalibrationPriors();
   bool DropNewestImuFactor();
   bool SolveRound(WindowSolveReport* report);
   bool Healthy() const;
