@@ -246,6 +246,8 @@ LeastSquaresDegeneracy TreatLeastSquaresDegeneracy(const DegeneracyOptions& opti
                         constraints, T_world_imu, T_imu_lidar);
   out.report = t.report;
   out.sqrt_information = DegeneracyPriorSqrtInformation(options, t, &out.has_prior) / lidar_noise;
+  out.num_held = t.num_held;
+  out.held_pose = t.held_pose;
   return out;
 }
 

@@ -125,38 +125,36 @@ ScanFactors MakeScanFactors(const RefineAssociationWorkspace& w,
   return f;
 }
 
-// With a reference map: the scan's planes in it, world-fixed, appended to
-// w->fixed (Huber weights as the scans' own planes).
-void AddReferencePlanes(const RefineConfig& config, const std::vector<Eigen::Vector3d>& p_lidar,
+// With a reference map: the scan's planes in it, world-fixed (w->reference).
+void AssociateReference(const RefineConfig& config, const std::vector<Eigen::Vector3d>& p_lidar,
                         const Pose3& T_world_lidar, RefineAssociationWorkspace* w) {
+  w->reference.clear();
   if (config.reference == nullptr) return;
   AssociateWith(p_lidar, T_world_lidar, *config.reference, config.constraints, &w->reference,
                 nullptr);
-  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->reference);
-  w->fixed.insert(w->fixed.end(), w->reference.begin(), w->reference.end());
 }
 
 // remap, localizability, regularized: the scan's weak directions at its
-// current estimate (the weights of its plane factors) and the prior along
-// them (degeneracy/degeneracy.h).
-void TreatRefineDegeneracy(const RefineConfig& config, const Pose3& T_world_imu,
-                           RefineAssociationWorkspace* w, ScanFactors* f) {
-  f->degeneracy.method = config.degeneracy.method;
+// current estimate, from its own and its reference planes with the weights
+// before the robust kernel (the geometry, as the smoother), and the prior
+// along them (degeneracy/degeneracy.h).
+LeastSquaresDegeneracy AnalyzeRefineDegeneracy(const RefineConfig& config,
+                                               const Pose3& T_world_imu,
+                                               RefineAssociationWorkspace* w) {
+  LeastSquaresDegeneracy none;
+  none.report.method = config.degeneracy.method;
   if (config.degeneracy.method == DegeneracyMethod::kRv ||
       config.degeneracy.method == DegeneracyMethod::kNone)
-    return;
+    return none;
   const ConstraintList* all = &w->list;
-  if (config.reference != nullptr) {
+  if (!w->reference.empty()) {
     w->all = w->list;
     w->all.insert(w->all.end(), w->reference.begin(), w->reference.end());
     all = &w->all;
   }
-  if (static_cast<int>(all->size()) < kMinPoseConstraints) return;
-  const LeastSquaresDegeneracy d = TreatLeastSquaresDegeneracy(
-      config.degeneracy, *all, T_world_imu, config.T_imu_lidar, config.constraints.lidar_noise);
-  f->degeneracy = d.report;
-  f->has_degeneracy_prior = d.has_prior;
-  f->degeneracy_sqrt_information = d.sqrt_information;
+  if (static_cast<int>(all->size()) < kMinPoseConstraints) return none;
+  return TreatLeastSquaresDegeneracy(config.degeneracy, *all, T_world_imu, config.T_imu_lidar,
+                                     config.constraints.lidar_noise);
 }
 
 }  // namespace
@@ -169,21 +167,27 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
   AssociateScan(round.p_lidar_end[k], T_world_lidar, k, round.map, config.constraints, &w->list,
                 stats, &w->sources);
   *rv_active = false;
+  if (!w->list.empty()) *rv_active = ApplyRv(config.rv, T_world_lidar, &w->list, &w->rv).active;
+  AssociateReference(config, round.p_lidar_end[k], T_world_lidar, w);
+  const LeastSquaresDegeneracy degeneracy =
+      AnalyzeRefineDegeneracy(config, states[k].T_world_imu(), w);
+  // Huber weights at the association estimate (constraints/robust_kernel.h),
+  // the reference planes' as the scans' own.
+  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->list);
+  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->reference);
   w->fixed.clear();
   w->attached.clear();
-  if (!w->list.empty()) {
-    *rv_active = ApplyRv(config.rv, T_world_lidar, &w->list, &w->rv).active;
-    // Huber weights at the association estimate (constraints/robust_kernel.h).
-    ApplyHuberWeights(config.smoother.refine_huber_delta, &w->list);
+  if (!w->list.empty())
     SplitScanConstraints(k, chunk, config.smoother.refine_plane_window, w->list, w->sources,
                          states, round.map_poses, &w->fixed, &w->attached);
-  }
-  AddReferencePlanes(config, round.p_lidar_end[k], T_world_lidar, w);
+  w->fixed.insert(w->fixed.end(), w->reference.begin(), w->reference.end());
   ScanFactors f;
   if (!w->fixed.empty() || !w->attached.empty())
     f = MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise,
                         config.smoother.refine_summarize_pairs, states[k].T_world_imu().t);
-  TreatRefineDegeneracy(config, states[k].T_world_imu(), w, &f);
+  f.degeneracy = degeneracy.report;
+  f.has_degeneracy_prior = degeneracy.has_prior;
+  f.degeneracy_sqrt_information = degeneracy.sqrt_information;
   return f;
 }
 

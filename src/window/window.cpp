@@ -20,6 +20,7 @@
 #include "rvlio/factors/plane_extrinsic_factor.h"
 #include "rvlio/factors/plane_time_offset_factor.h"
 #include "rvlio/factors/plane_summary_factor.h"
+#include "rvlio/factors/pose_projected_factor.h"
 
 namespace rvlio {
 
@@ -42,6 +43,27 @@ struct SlidingWindow::Node {
   PoseBlock anchor;  // the initial value (IMU prediction): where a degeneracy prior holds the pose
   DegeneracyReport degeneracy;                          // of the last association
   std::unique_ptr<PosePriorFactor> degeneracy_prior;   // null: no weak direction treated
+  // remap (project form): the plane factor without its say along the held
+  // directions; null otherwise. degeneracy_prior then holds the hold form,
+  // used while the pose is tied to no other state (ScanCost).
+  std::unique_ptr<PoseProjectedFactor> plane_remapped;
+
+  // The plane factor there is (plane, plane_ext or plane_td), or null.
+  const ceres::CostFunction* PlaneFactor() const {
+    if (plane) return plane.get();
+    if (plane_ext) return plane_ext.get();
+    return plane_td.get();
+  }
+  // The cost of the given plane factor in a solve or a marginalization.
+  // tied: an IMU factor or a prior also ties the pose, so the projected form
+  // leaves no direction free; untied (IMU gaps on both sides), the remapped
+  // directions are held at the anchor instead.
+  ceres::CostFunction* ScanCost(ceres::CostFunction* plane_factor, bool tied) const {
+    return plane_remapped && tied ? plane_remapped.get() : plane_factor;
+  }
+  PosePriorFactor* DegeneracyPrior(bool tied) const {
+    return plane_remapped && tied ? nullptr : degeneracy_prior.get();
+  }
 
   Pose3 T_world_imu() const { return PoseBlock::FromArray(pose).ToPose3(); }
 };
@@ -320,7 +342,8 @@ int SlidingWindow::AssociateRound(const ScanAssociateFn& associate, WindowSolveR
   return associated;
 }
 
-// Associate -> RV (Alg. 1-3 on this scan's list) -> Huber weights -> factor.
+// Associate -> RV (Alg. 1-3 on this scan's list) -> the degeneracy method's
+// analysis -> Huber weights -> factor -> the method's treatment of it.
 void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) {
   const Pose3 T_world_imu = ScanPose(*node);  // the state's pose unless estimate_time_offset
   const Pose3 T_imu_lidar = this->T_imu_lidar();
@@ -328,56 +351,87 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   RemoveNonFinite(&node->constraints);
   node->rv = ApplyRv(options_.rv, T_world_imu * T_imu_lidar, &node->constraints, &rv_workspace_);
   RefreshResiduals(T_world_imu, T_imu_lidar, &node->constraints);
+  const LeastSquaresDegeneracy degeneracy = AnalyzeNodeDegeneracy(T_world_imu, T_imu_lidar, *node);
   ApplyHuberWeights(options_.smoother.sliding_window_huber_delta, &node->constraints);
   node->associated_at = node->T_world_imu();
   node->associated = true;
   node->plane.reset();
   node->plane_ext.reset();
   node->plane_td.reset();
-  node->degeneracy_prior.reset();
-  node->degeneracy = DegeneracyReport();
-  node->degeneracy.method = options_.degeneracy.method;
+  ClearDegeneracy(node);
   if (static_cast<int>(node->constraints.size()) < kMinPoseConstraints) return;
-  TreatDegeneracy(T_world_imu, T_imu_lidar, node);
+  if (!MakePlaneFactor(T_world_imu, node)) {
+    RejectOverflowingScan(node);
+    return;
+  }
+  TreatDegeneracy(degeneracy, node);
+}
+
+// The scan's plane factor at this association: a time-offset, extrinsic or
+// summary factor. False when its summary overflows.
+bool SlidingWindow::MakePlaneFactor(const Pose3& T_world_imu, Node* node) const {
   if (estimate_time_offset()) {
     node->plane_td = std::make_unique<PlaneTimeOffsetFactor>(
         node->constraints, options_.constraints.lidar_noise, T_imu_lidar_config_, node->motion,
         node->td_lin_s, T_world_imu.t);
-    if (!node->plane_td->finite()) RejectOverflowingScan(node);
-    return;
+    return node->plane_td->finite();
   }
   if (estimate_extrinsics()) {
     node->plane_ext = std::make_unique<PlaneExtrinsicFactor>(node->constraints, options_.constraints.lidar_noise);
-    return;
+    return true;
   }
   node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, T_imu_lidar_config_,
                                                      options_.constraints.lidar_noise, T_world_imu.t);
-  if (!node->plane->information().allFinite()) RejectOverflowingScan(node);
+  return node->plane->information().allFinite();
 }
 
 // remap, localizability, regularized: the scan's pose information at the
-// pose of this association (with the Huber weights the plane factor uses;
-// RV is off for these methods) -> the method's weak directions and prior (TreatLeastSquaresDegeneracy,
-// shared with refine) -> a prior at the node's anchor along them (sigma: the
-// plane factor's lidar_noise, so the prior is in the scan's units).
-void SlidingWindow::TreatDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar,
-                                    Node* node) const {
-  const LeastSquaresDegeneracy d =
-      TreatLeastSquaresDegeneracy(options_.degeneracy, node->constraints, T_world_imu,
-                                  T_imu_lidar, options_.constraints.lidar_noise);
+// pose of this association, with the weights before the robust kernel (the
+// geometry, not how well the prediction fits it; RV is off for these
+// methods) -> the method's weak directions and prior
+// (TreatLeastSquaresDegeneracy, shared with refine).
+LeastSquaresDegeneracy SlidingWindow::AnalyzeNodeDegeneracy(const Pose3& T_world_imu,
+                                                            const Pose3& T_imu_lidar,
+                                                            const Node& node) const {
+  if (static_cast<int>(node.constraints.size()) < kMinPoseConstraints) {
+    LeastSquaresDegeneracy none;
+    none.report.method = options_.degeneracy.method;
+    return none;
+  }
+  return TreatLeastSquaresDegeneracy(options_.degeneracy, node.constraints, T_world_imu,
+                                     T_imu_lidar, options_.constraints.lidar_noise);
+}
+
+// remap (degeneracy.remap_window_form project): the scan's plane factor
+// loses its say along the held directions (PoseProjectedFactor at the
+// association pose); the window's other factors place the pose there.
+// Otherwise (localizability, regularized, remap in the hold form): a prior
+// at the node's anchor along the held or damped directions (sigma: the plane
+// factor's lidar_noise, so the prior is in the scan's units).
+void SlidingWindow::TreatDegeneracy(const LeastSquaresDegeneracy& d, Node* node) const {
   node->degeneracy = d.report;
+  if (options_.degeneracy.method == DegeneracyMethod::kRemap &&
+      options_.degeneracy.remap_window_form == RemapWindowForm::kProject && d.num_held > 0)
+    node->plane_remapped = std::make_unique<PoseProjectedFactor>(
+        node->PlaneFactor(), PoseBlock(node->associated_at), d.held_pose.leftCols(d.num_held));
   if (d.has_prior)
     node->degeneracy_prior = std::make_unique<PosePriorFactor>(node->anchor, d.sqrt_information);
+}
+
+void SlidingWindow::ClearDegeneracy(Node* node) const {
+  node->plane_remapped.reset();
+  node->degeneracy_prior.reset();
+  node->degeneracy = DegeneracyReport();
+  node->degeneracy.method = options_.degeneracy.method;
 }
 
 // Finite but absurd records (a plane 1e300 m away) overflow the summary:
 // such a scan contributes nothing (and is associated again next round)
 // rather than a cost Ceres cannot evaluate.
 void SlidingWindow::RejectOverflowingScan(Node* node) {
+  ClearDegeneracy(node);
   node->plane.reset();
-  node->degeneracy_prior.reset();
-  node->degeneracy = DegeneracyReport();
-  node->degeneracy.method = options_.degeneracy.method;
+  node->plane_ext.reset();
   node->plane_td.reset();
   node->constraints.clear();
   node->associated = false;
@@ -404,6 +458,18 @@ void SlidingWindow::RefreshImuFactors() {
   }
 }
 
+// Whether a factor besides its scan's ties state k's pose: an IMU factor
+// from or to a neighbour, or (the oldest state) the start or marginal prior.
+bool SlidingWindow::PoseTied(size_t k) const {
+  if (k > 0 && nodes_[k]->imu) return true;
+  if (k + 1 < nodes_.size() && nodes_[k + 1]->imu) return true;
+  if (k > 0) return false;
+  if (state_prior_) return true;
+  if (!marginal_prior_) return false;
+  const std::vector<double*>& blocks = marginal_prior_->prior().blocks;
+  return std::find(blocks.begin(), blocks.end(), nodes_[0]->pose) != blocks.end();
+}
+
 bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   RefreshImuFactors();
   Backup();
@@ -412,19 +478,22 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   if (estimate_extrinsics()) AddExtrinsicBlock(&problem);
   for (size_t k = 0; k < nodes_.size(); ++k) {
     Node& n = *nodes_[k];
+    const bool tied = PoseTied(k);
     problem.AddParameterBlock(n.pose, PoseBlock::kNumParams, &pose_manifold_);
     problem.AddParameterBlock(n.sb, SpeedBiasBlock::kNumParams);
     if (n.plane) {
-      problem.AddResidualBlock(n.plane.get(), nullptr, n.pose);
+      problem.AddResidualBlock(n.ScanCost(n.plane.get(), tied), nullptr, n.pose);
       pose_used[k] = true;
     } else if (n.plane_ext) {
-      problem.AddResidualBlock(n.plane_ext.get(), nullptr, n.pose, extrinsic_);
+      problem.AddResidualBlock(n.ScanCost(n.plane_ext.get(), tied), nullptr, n.pose, extrinsic_);
       pose_used[k] = true;
     } else if (n.plane_td) {
-      problem.AddResidualBlock(n.plane_td.get(), nullptr, n.pose, n.sb, time_offset_);
+      problem.AddResidualBlock(n.ScanCost(n.plane_td.get(), tied), nullptr, n.pose, n.sb,
+                               time_offset_);
       pose_used[k] = true;
     }
-    if (n.degeneracy_prior) problem.AddResidualBlock(n.degeneracy_prior.get(), nullptr, n.pose);
+    if (PosePriorFactor* prior = n.DegeneracyPrior(tied))
+      problem.AddResidualBlock(prior, nullptr, n.pose);
     if (k == 0) continue;
     Node& p = *nodes_[k - 1];
     if (n.imu) {
@@ -535,6 +604,7 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   if (size() < options_.smoother.window_size || size() < 2) return std::nullopt;
   Node& old = *nodes_[0];
   Node& next = *nodes_[1];
+  const bool old_tied = PoseTied(0);
   MarginalizationInfo info;
   info.SetManifold(old.pose, &pose_manifold_);
   info.SetManifold(next.pose, &pose_manifold_);
@@ -563,12 +633,13 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
     info.AddResidualBlock(marginal_prior_.get(), nullptr, blocks, dropped(blocks));
   }
   if (state_prior_) info.AddResidualBlock(state_prior_.get(), nullptr, {old.pose, old.sb}, {0, 1});
-  if (old.plane) info.AddResidualBlock(old.plane.get(), nullptr, {old.pose}, {0});
+  if (old.plane) info.AddResidualBlock(old.ScanCost(old.plane.get(), old_tied), nullptr, {old.pose}, {0});
   if (old.plane_ext)
-    info.AddResidualBlock(old.plane_ext.get(), nullptr, {old.pose, extrinsic_}, {0});
+    info.AddResidualBlock(old.ScanCost(old.plane_ext.get(), old_tied), nullptr, {old.pose, extrinsic_},
+                          {0});
   if (extrinsic_prior_) info.AddResidualBlock(extrinsic_prior_.get(), nullptr, {extrinsic_}, {});
   if (old.plane_td)
-    info.AddResidualBlock(old.plane_td.get(), nullptr, {old.pose, old.sb, td_old},
+    info.AddResidualBlock(old.ScanCost(old.plane_td.get(), old_tied), nullptr, {old.pose, old.sb, td_old},
                           dropped({old.pose, old.sb, td_old}));
   if (time_offset_prior_)
     info.AddResidualBlock(time_offset_prior_.get(), nullptr, {td_old}, dropped({td_old}));

@@ -11,11 +11,17 @@
 //   well-constrained directions.
 //   Room: a closed box. No method finds a weak direction: the result equals
 //   the untreated one.
+//   Corridor with an IMU factor (constant velocity along x, exact samples):
+//   remap in its default form (degeneracy.remap_window_form project) leaves
+//   x to the IMU chain, which knows the truth; in the hold form it stays at
+//   the prediction, as localizability.
 #include <cmath>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "rvlio/imu/noise.h"
+#include "rvlio/imu/preintegration.h"
 #include "rvlio/window/window.h"
 #include "../degeneracy/degeneracy_scenes.h"
 #include "support/smoother_test_util.h"
@@ -90,18 +96,39 @@ PoseBlock::Tangent PredictionOffset() {
   return d;
 }
 
-Outcome Solve(const World& w, DegeneracyMethod method) {
+constexpr TimeNs kDegenT0 = 1000000000, kDegenDt = 100000000;
+
+// Exact samples of the motion from the origin to TruePose1 at constant
+// velocity, level, no rotation.
+ImuPreintegration ConstantVelocityImu(const WindowOptions& o) {
+  std::vector<ImuSample> samples;
+  for (TimeNs t = kDegenT0 - 5000000; t <= kDegenT0 + kDegenDt + 5000000; t += 5000000) {
+    ImuSample s;
+    s.t_ns = t;
+    s.acc_imu = -test::Gravity();
+    samples.push_back(s);
+  }
+  return ImuPreintegration::FromSamples(samples, kDegenT0, kDegenT0 + kDegenDt,
+                                        ImuNoise::FromOptions(o.imu), Vector3d::Zero(),
+                                        Vector3d::Zero());
+}
+
+Outcome Solve(const World& w, DegeneracyMethod method, bool with_imu = false,
+              RemapWindowForm remap_form = RemapWindowForm::kProject) {
   WindowOptions o;
   o.rv.enabled = false;
   o.smoother.sliding_window_huber_delta = 10.0;  // unit weights: the scene's symmetry holds
   o.smoother.max_solver_iterations = 30;
   o.degeneracy.method = method;
+  o.degeneracy.remap_window_form = remap_form;
   SlidingWindow window(o);
-  const TimeNs t0 = 1000000000, dt = 100000000;
   const PoseBlock T0;
   SpeedBiasBlock sb;
-  window.Start(t0, T0, sb, Observe(w, T0.ToPose3()));
-  window.Add(t0 + dt, Plus(TruePose1(), PredictionOffset()), sb, std::nullopt,
+  if (with_imu) sb.v_world_imu = TruePose1().p_world_imu / NsToSeconds(kDegenDt);
+  std::optional<ImuPreintegration> imu;
+  if (with_imu) imu = ConstantVelocityImu(o);
+  window.Start(kDegenT0, T0, sb, Observe(w, T0.ToPose3()));
+  window.Add(kDegenT0 + kDegenDt, Plus(TruePose1(), PredictionOffset()), sb, imu,
              Observe(w, TruePose1().ToPose3()));
   const WindowSolveReport report = window.Optimize(Associate(w));
   EXPECT_TRUE(report.ok);
@@ -146,6 +173,22 @@ TEST(WindowDegeneracy, RoomHasNoWeakDirectionAndIsLeftAlone) {
     EXPECT_FALSE(o.report.degenerate);
     EXPECT_EQ(o.report.num_weak, 0);
     EXPECT_EQ(o.error, none.error);  // the same problem: the same bits
+  }
+}
+
+TEST(WindowDegeneracy, RemapLeavesTheWeakAxisToTheImuChainOrHoldsItAtThePrediction) {
+  const World w = Corridor();
+  const double x_offset = PredictionOffset()(3);
+  const Outcome project = Solve(w, DegeneracyMethod::kRemap, true, RemapWindowForm::kProject);
+  ASSERT_TRUE(project.report.degenerate);
+  EXPECT_LT(std::abs(project.error(3)), 0.02 * x_offset) << project.error.transpose();
+  const Outcome hold = Solve(w, DegeneracyMethod::kRemap, true, RemapWindowForm::kHold);
+  ASSERT_TRUE(hold.report.degenerate);
+  EXPECT_NEAR(hold.error(3), x_offset, 0.02 * x_offset) << hold.error.transpose();
+  // The other directions: the scan and the IMU agree with the truth.
+  for (const Outcome* o : {&project, &hold}) {
+    EXPECT_LT(o->error.head<3>().norm(), 1e-4) << o->error.transpose();
+    EXPECT_LT(o->error.tail<2>().norm(), 1e-4) << o->error.transpose();
   }
 }
 

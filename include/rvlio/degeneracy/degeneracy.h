@@ -107,6 +107,11 @@ struct LeastSquaresDegeneracy {
   DegeneracyReport report;
   bool has_prior = false;
   PoseMatrix6d sqrt_information = PoseMatrix6d::Zero();
+  // remap, localizability: the held pose directions (DegeneracyTreatment),
+  // for a backend whose form of the method is not a prior (the smoother's
+  // remap: factors/pose_projected_factor.h).
+  int num_held = 0;
+  PoseMatrix6d held_pose = PoseMatrix6d::Zero();
 };
 LeastSquaresDegeneracy TreatLeastSquaresDegeneracy(const DegeneracyOptions& options,
                                                    const ConstraintList& constraints,

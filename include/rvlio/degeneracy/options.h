@@ -21,6 +21,19 @@ struct EnumNames<DegeneracyMethod> {
       {DegeneracyMethod::kNone, "none"}};
 };
 
+// How remap acts in the sliding-window smoother (docs/degeneracy.md
+// "Backends"): the scan's plane factor loses its say along the degenerate
+// directions and the window's IMU chain places the pose there (project), or
+// a stiff prior holds the pose at its IMU prediction there, as localizability
+// does (hold).
+enum class RemapWindowForm { kProject, kHold };
+
+template <>
+struct EnumNames<RemapWindowForm> {
+  static constexpr std::pair<RemapWindowForm, const char*> kNames[] = {
+      {RemapWindowForm::kProject, "project"}, {RemapWindowForm::kHold, "hold"}};
+};
+
 // Every threshold is on the information with sigma = 1 (sum of w_i h_i^T h_i
 // over the scan's point-to-plane rows: the estimator's H^T R^-1 H times
 // lidar_noise^2), so it does not move with constraints.lidar_noise.
@@ -50,6 +63,11 @@ struct DegeneracyOptions {
   // against a scan's own information (sums of 1e3-1e5), not so stiff that
   // the solver's normal equations lose precision.
   double hold_information = 1e6;
+  // remap in the smoother: project (default; the paper's "the degenerate
+  // directions come from the prior", the prior being the rest of the window)
+  // or hold (a prior at the IMU prediction, localizability's form). Refine
+  // always holds (its scan factors also tie pairs of scans).
+  RemapWindowForm remap_window_form = RemapWindowForm::kProject;
 
   template <class V>
   void Visit(V& v) {
@@ -67,6 +85,8 @@ struct DegeneracyOptions {
         .Help("regularized: Schur-block eigenvalues below lambda_max / this are damped up to it"));
     v.Field("hold_information", hold_information, Spec().Range(1.0, 1e12)
         .Help("smoother/refine, remap and localizability: information (sigma = 1) of the prior holding a weak direction"));
+    v.Field("remap_window_form", remap_window_form, Spec().Choices(EnumChoices<RemapWindowForm>())
+        .Help("smoother, remap: project (the scan's factor has no say along the degenerate directions) | hold (a prior at the IMU prediction)"));
   }
   Status Validate() { return ValidateFields(*this, "degeneracy"); }
 };

@@ -253,7 +253,12 @@ class SlidingWindow {
   int AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
   void AssociateNode(const ScanAssociateFn& associate, Node* node);
   void RejectOverflowingScan(Node* node);
-  void TreatDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar, Node* node) const;
+  bool MakePlaneFactor(const Pose3& T_world_imu, Node* node) const;
+  LeastSquaresDegeneracy AnalyzeNodeDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar,
+                                               const Node& node) const;
+  void TreatDegeneracy(const LeastSquaresDegeneracy& d, Node* node) const;
+  void ClearDegeneracy(Node* node) const;
+  bool PoseTied(size_t k) const;
   void RefreshImuFactors();
   void ResetCalibrationPriors();
   bool DropNewestImuFactor();

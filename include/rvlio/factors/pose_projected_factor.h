@@ -1,0 +1,43 @@
+#pragma once
+// PoseProjectedFactor: a factor on a pose block (and possibly other blocks)
+// that has no say along some pose directions: the sliding-window smoother's
+// form of solution remapping (degeneracy.method = remap, docs/degeneracy.md
+// "Backends"). With V (6 x k, orthonormal columns in the pose tangent
+// [dtheta, dp] of factors/parameter_blocks.h) and P = I - V V^T,
+//   r(x, y...) = inner(x', y...),   x' = pose0 [+] P (x [-] pose0),
+// so the factor is constant along V through pose0: the scan's constraints
+// neither pull nor hold the pose there, and the window's other factors (the
+// IMU chain, the marginal prior) alone place it, as the IESKF's remapped
+// update leaves those directions to the prediction. In every other
+// direction the factor is inner unchanged.
+// Tangent Jacobian at x (right perturbation), chain rule through x':
+//   J_t(x) = J_t'(x') blockdiag(Jr(d'_rot), I3) P blockdiag(JrInv(d_rot), I3),
+// d = x [-] pose0, d' = P d, J_t'(x') = J_a'(x') PlusJacobian(x') from inner's
+// ambient Jacobian; written back as J_t(x) MinusJacobian(x) (factors/manifolds.h).
+// The other blocks' Jacobians are inner's at x'. Does not own inner.
+#include <Eigen/Core>
+#include <ceres/cost_function.h>
+
+#include "rvlio/factors/parameter_blocks.h"
+
+namespace rvlio {
+
+class PoseProjectedFactor final : public ceres::CostFunction {
+ public:
+  using Directions = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+  // inner: its first parameter block is a pose (PoseBlock::kNumParams);
+  // must outlive this factor. held: orthonormal columns (0..6 of them).
+  PoseProjectedFactor(const ceres::CostFunction* inner, const PoseBlock& pose0,
+                      const Directions& held);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const ceres::CostFunction* inner_;
+  PoseBlock pose0_;
+  Eigen::Matrix<double, 6, 6> projector_;  // P = I - V V^T
+};
+
+}  // namespace rvlio
