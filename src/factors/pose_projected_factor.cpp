@@ -33,6 +33,10 @@ PoseProjectedFactor::PoseProjectedFactor(const ceres::CostFunction* inner, const
   projector_ = Eigen::Matrix<double, 6, 6>::Identity() - held * held.transpose();
 }
 
+PoseBlock PoseProjectedFactor::Projected(const PoseBlock& x) const {
+  return Plus(pose0_, projector_ * Minus(x, pose0_));
+}
+
 bool PoseProjectedFactor::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
   const PoseBlock x = PoseBlock::FromArray(parameters[0]);

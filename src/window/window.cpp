@@ -66,6 +66,12 @@ struct SlidingWindow::Node {
   }
 
   Pose3 T_world_imu() const { return PoseBlock::FromArray(pose).ToPose3(); }
+  // The pose the scan's factor sees: a remapped factor is blind along its
+  // held directions, so moving there does not make its constraints stale.
+  Pose3 SeenPose(bool tied) const {
+    if (!plane_remapped || !tied) return T_world_imu();
+    return plane_remapped->Projected(PoseBlock::FromArray(pose)).ToPose3();
+  }
 };
 
 namespace {
@@ -331,11 +337,12 @@ bool SlidingWindow::DropNewestImuFactor() {
 // Returns how many were (re-)associated.
 int SlidingWindow::AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report) {
   int associated = 0;
-  for (auto& node : nodes_) {
-    if (node->associated &&
-        Motion(node->associated_at, node->T_world_imu()) <= options_.smoother.reassociate_min_motion)
+  for (size_t k = 0; k < nodes_.size(); ++k) {
+    Node* node = nodes_[k].get();
+    if (node->associated && Motion(node->associated_at, node->SeenPose(PoseTied(k))) <=
+                                options_.smoother.reassociate_min_motion)
       continue;
-    AssociateNode(associate, node.get());
+    AssociateNode(associate, node);
     ++associated;
   }
   report->associations += associated;

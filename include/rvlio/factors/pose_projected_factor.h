@@ -34,6 +34,9 @@ class PoseProjectedFactor final : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // x' = pose0 [+] P (x [-] pose0): the pose the inner factor sees.
+  PoseBlock Projected(const PoseBlock& x) const;
+
  private:
   const ceres::CostFunction* inner_;
   PoseBlock pose0_;
