@@ -13,13 +13,15 @@
 //     plane_summary_factor.h). Per-point information = Constraint::weight / sigma^2
 //     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
 //     min(1, sliding_window_huber_delta / |r|) at the pose of association);
-//   - with degeneracy.method remap, localizability or regularized, a
-//     PosePriorFactor per state along the weak directions its scan's
-//     constraints leave (degeneracy/degeneracy.h
+//   - with degeneracy.method localizability or regularized (and remap in
+//     its hold form), a PosePriorFactor per state along the weak directions
+//     its scan's constraints leave (degeneracy/degeneracy.h
 //     DegeneracyPriorSqrtInformation), anchored at the state's initial value
-//     (the IMU prediction); analyzed at each association, at the scan's pose
-//     of that association; not marginalized (a statement about the solve,
-//     not information: docs/degeneracy.md);
+//     (the IMU prediction); not marginalized (a statement about the solve,
+//     not information: docs/degeneracy.md). With remap (project form) the
+//     plane factor instead has no say along those directions
+//     (factors/pose_projected_factor.h). Analyzed at each association, at
+//     the scan's pose of that association, with the weights before Huber;
 //   - the prior on the oldest state: a StatePriorFactor on the first state of
 //     the run, then the marginalization prior (marginalization.h), whose
 //     Jacobian stays at its linearization point (first-estimate Jacobians).
