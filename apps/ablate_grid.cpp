@@ -597,6 +597,12 @@ bool Plan::HasRefMap() const {
   return false;
 }
 
+bool Plan::HasSimulated() const {
+  for (const Cell& c : cells)
+    if (c.data_index >= 0) return true;
+  return false;
+}
+
 // The number of cells the grid expands to (a double: the product of the
 // ranges may exceed int64), and how it is made up.
 double CountCells(const Grid& grid, std::string* how) {

@@ -79,6 +79,7 @@ struct Plan {
   std::vector<Cell> cells;
   JobResources resources;
   bool HasRefMap() const;  // some cell has a ref_map: the tables get map columns
+  bool HasSimulated() const;  // some cell runs on simulated data: the tables get detection columns
 };
 
 // Cells a grid may expand to unless the caller allows more (`rvlio ablate

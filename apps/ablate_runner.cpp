@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "interrupt.h"
+#include "rvlio/api.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/formats/point_cloud_file.h"
@@ -290,6 +291,26 @@ std::string CollectMapMetrics(const Cell& cell, const Similarity3& T_ref_est, js
   return "";
 }
 
+// A simulated cell: the run's degeneracy detection against the simulator's
+// localizability.csv (as `rvlio eval --degeneracy`, its default truth
+// threshold). A scoring error is a warning, not a failed cell (the
+// trajectory metrics stand); the metrics stay null then.
+void CollectDetectionMetrics(const Cell& cell, json* metrics, json* warnings) {
+  if (cell.data_index < 0) return;
+  (*metrics)["detect_precision"] = (*metrics)["detect_recall"] = nullptr;
+  DegeneracyEvalArgs args;
+  args.run_dir = cell.RunDir();
+  args.truth_dir = fs::path(cell.gt).parent_path().string();
+  args.gt_path = cell.gt;
+  StatusOr<DegeneracyEvalResult> r = EvaluateDegeneracyFiles(args);
+  if (!r.ok()) {
+    warnings->push_back("detection: " + r.status().message());
+    return;
+  }
+  (*metrics)["detect_precision"] = Number(r->scores.precision);
+  (*metrics)["detect_recall"] = Number(r->scores.recall);
+}
+
 // Metrics from run/summary.json and the evaluation against ground truth
 // (and the reference cloud). Returns "" or why the cell failed after a
 // successful run.
@@ -304,6 +325,8 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   (*metrics)["rtf"] = summary.value("real_time_factor", 0.0);
   (*metrics)["rv_active_fraction"] =
       scans > 0 ? summary.value("rv_active_scans", 0.0) / scans : 0.0;
+  (*metrics)["degenerate_fraction"] =
+      scans > 0 ? summary.value("degenerate_scans", 0.0) / scans : 0.0;
   for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point"})
     (*metrics)[m] = nullptr;
   if (!cell.ref_map.empty()) (*metrics)["map_rms"] = (*metrics)["map_completeness"] = nullptr;
@@ -320,6 +343,7 @@ std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
   (*metrics)["axis_max"] = Number(r->along_axis.max_abs_m);
   (*metrics)["end_point"] = Number(r->end_point_error_m);
   *warnings = r->warnings;
+  CollectDetectionMetrics(cell, metrics, warnings);
   return CollectMapMetrics(cell, r->T_ref_est_poses, metrics);
 }
 
@@ -464,16 +488,21 @@ void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& 
 
 }  // namespace
 
-const std::vector<std::string>& MetricNames(bool with_map) {
+MetricSet MetricSetOf(const Plan& plan) { return {plan.HasRefMap(), plan.HasSimulated()}; }
+
+const std::vector<std::string>& MetricNames(MetricSet set) {
   static const std::vector<std::string> kNames = {
-      "ate_rmse",    "rpe_rmse", "axis_rmse",         "axis_max",
-      "end_point", "ms_per_scan", "rtf", "rv_active_fraction"};
-  static const std::vector<std::string> kWithMap = [] {
-    std::vector<std::string> names = kNames;
-    names.insert(names.end(), {"map_rms", "map_completeness"});
-    return names;
+      "ate_rmse",  "rpe_rmse",    "axis_rmse", "axis_max",          "end_point",
+      "ms_per_scan", "rtf", "rv_active_fraction", "degenerate_fraction"};
+  static const std::vector<std::vector<std::string>> kSets = [] {
+    std::vector<std::vector<std::string>> sets(4, kNames);
+    for (int i = 0; i < 4; ++i) {
+      if (i & 1) sets[i].insert(sets[i].end(), {"map_rms", "map_completeness"});
+      if (i & 2) sets[i].insert(sets[i].end(), {"detect_precision", "detect_recall"});
+    }
+    return sets;
   }();
-  return with_map ? kWithMap : kNames;
+  return kSets[(set.map ? 1 : 0) + (set.detection ? 2 : 0)];
 }
 
 json ReadCellRecord(const Cell& cell) {

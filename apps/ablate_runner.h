@@ -44,8 +44,14 @@ bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& option
 // null when there is none.
 nlohmann::json ReadCellRecord(const Cell& cell);
 
-// The metric fields of cell.json "metrics", in table order (with_map: plus
-// map_rms and map_completeness, for grids with a ref_map).
-const std::vector<std::string>& MetricNames(bool with_map = false);
+// Which optional metric groups a grid's tables carry.
+struct MetricSet {
+  bool map = false;        // map_rms, map_completeness: some cell has a ref_map
+  bool detection = false;  // detect_precision, detect_recall: some sequence is simulated
+};
+MetricSet MetricSetOf(const Plan& plan);
+
+// The metric fields of cell.json "metrics", in table order.
+const std::vector<std::string>& MetricNames(MetricSet set = MetricSet());
 
 }  // namespace rvlio::cli::ablate

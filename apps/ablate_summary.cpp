@@ -17,9 +17,9 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Metrics of the grouped table and their Markdown headers (with_map: the
-// map columns of a grid with a ref_map too).
-const std::vector<std::pair<std::string, std::string>>& TableMetrics(bool with_map) {
+// Metrics of the grouped table and their Markdown headers (the map and the
+// detection columns when the grid has them).
+const std::vector<std::pair<std::string, std::string>>& TableMetrics(MetricSet set) {
   static const std::vector<std::pair<std::string, std::string>> kMetrics = {
       {"ate_rmse", "ATE [m]"},
       {"rpe_rmse", "RPE [m]"},
@@ -28,13 +28,19 @@ const std::vector<std::pair<std::string, std::string>>& TableMetrics(bool with_m
       {"end_point", "end [m]"},
       {"ms_per_scan", "ms/scan"},
       {"rtf", "RTF"},
-      {"rv_active_fraction", "RV active"}};
-  static const std::vector<std::pair<std::string, std::string>> kWithMap = [] {
-    auto metrics = kMetrics;
-    metrics.insert(metrics.end(), {{"map_rms", "map RMS [m]"}, {"map_completeness", "completeness"}});
-    return metrics;
+      {"rv_active_fraction", "RV active"},
+      {"degenerate_fraction", "degenerate"}};
+  static const std::vector<std::vector<std::pair<std::string, std::string>>> kSets = [] {
+    std::vector<std::vector<std::pair<std::string, std::string>>> sets(4, kMetrics);
+    for (int i = 0; i < 4; ++i) {
+      if (i & 1)
+        sets[i].insert(sets[i].end(), {{"map_rms", "map RMS [m]"}, {"map_completeness", "completeness"}});
+      if (i & 2)
+        sets[i].insert(sets[i].end(), {{"detect_precision", "precision"}, {"detect_recall", "recall"}});
+    }
+    return sets;
   }();
-  return with_map ? kWithMap : kMetrics;
+  return kSets[(set.map ? 1 : 0) + (set.detection ? 2 : 0)];
 }
 
 std::string Csv(const std::string& s) {
@@ -82,7 +88,7 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
   o << "id,sequence,variant,seed";
   for (const auto& k : plan.param_keys) o << "," << Csv(k);
   o << ",status,exit_code";
-  for (const auto& m : MetricNames(plan.HasRefMap())) o << "," << m;
+  for (const auto& m : MetricNames(MetricSetOf(plan))) o << "," << m;
   o << ",wall_s,error\n";
   for (size_t i = 0; i < plan.cells.size(); ++i) {
     const Cell& c = plan.cells[i];
@@ -94,7 +100,7 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
     o << "," << status << ","
       << (r.is_object() && r["exit_code"].is_number() ? std::to_string(r["exit_code"].get<int>())
                                                       : "");
-    for (const auto& m : MetricNames(plan.HasRefMap()))
+    for (const auto& m : MetricNames(MetricSetOf(plan)))
       o << "," << FormatFinite(r.is_object() ? MetricOf(r, m) : NAN, 12);
     o << "," << FormatFinite(r.is_object() ? r.value("wall_s", NAN) : NAN, 12) << ","
       << Csv(r.is_object() && r["error"].is_string() ? r["error"].get<std::string>() : "") << "\n";
@@ -121,7 +127,7 @@ std::vector<Group> GroupCells(const Plan& plan, const std::vector<json>& records
     if (status == "diverged") ++g.diverged;
     if (status != "done") continue;
     ++g.done;
-    for (const auto& [m, header] : TableMetrics(plan.HasRefMap())) {
+    for (const auto& [m, header] : TableMetrics(MetricSetOf(plan))) {
       const double v = MetricOf(r, m);
       if (std::isfinite(v)) g.values[m].push_back(v);
     }
@@ -134,14 +140,14 @@ std::string TableCsv(const Plan& plan, const std::vector<Group>& groups) {
   o << "sequence,variant";
   for (const auto& k : plan.param_keys) o << "," << Csv(k);
   o << ",cells,n,failed,diverged";
-  const bool with_map = plan.HasRefMap();
-  for (const auto& [m, header] : TableMetrics(with_map)) o << "," << m << "_mean," << m << "_std";
+  const MetricSet set = MetricSetOf(plan);
+  for (const auto& [m, header] : TableMetrics(set)) o << "," << m << "_mean," << m << "_std";
   o << "\n";
   for (const Group& g : groups) {
     o << Csv(g.first->sequence) << "," << Csv(g.first->label);
     for (const auto& [k, v] : g.first->params) o << "," << Csv(v);
     o << "," << g.cells << "," << g.done << "," << g.failed << "," << g.diverged;
-    for (const auto& [m, header] : TableMetrics(with_map)) {
+    for (const auto& [m, header] : TableMetrics(set)) {
       const Stats s = Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>());
       o << "," << FormatFinite(s.mean, 12) << "," << FormatFinite(s.std, 12);
     }
@@ -160,19 +166,22 @@ std::string MeanStd(const Stats& s, int precision) {
   return buf;
 }
 
-std::string TableMarkdown(const std::vector<Group>& groups, bool with_map) {
+std::string TableMarkdown(const std::vector<Group>& groups, MetricSet set) {
   std::ostringstream o;
   o << "| sequence | variant | n | failed | diverged |";
-  for (const auto& [m, header] : TableMetrics(with_map)) o << " " << header << " |";
+  for (const auto& [m, header] : TableMetrics(set)) o << " " << header << " |";
   o << "\n|---|---|---|---|---|";
-  for (size_t i = 0; i < TableMetrics(with_map).size(); ++i) o << "---|";
+  for (size_t i = 0; i < TableMetrics(set).size(); ++i) o << "---|";
   o << "\n";
   for (const Group& g : groups) {
     o << "| " << g.first->sequence << " | " << g.first->label << " | " << g.done << " | "
       << g.failed << " | " << g.diverged << " |";
-    for (const auto& [m, header] : TableMetrics(with_map)) {
+    for (const auto& [m, header] : TableMetrics(set)) {
       const int precision =
-          m == "ms_per_scan" || m == "rtf" ? 2 : (m == "rv_active_fraction" ? 2 : 4);
+          m == "ate_rmse" || m == "rpe_rmse" || m.rfind("axis", 0) == 0 || m == "end_point" ||
+                  m == "map_rms" || m == "map_completeness"
+              ? 4
+              : 2;
       o << " "
         << MeanStd(Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>()), precision)
         << " |";
@@ -189,6 +198,8 @@ std::string MakePlots(const Plan& plan, const SummaryResult& result) {
                                    prefix, "--metric", "ate_rmse", "--metric", "axis_max",
                                    "--metric", "ms_per_scan"};
   if (plan.HasRefMap()) args.insert(args.end(), {"--metric", "map_rms"});
+  if (plan.HasSimulated())
+    args.insert(args.end(), {"--metric", "detect_precision", "--metric", "detect_recall"});
   const PlotResult p = RunPlotScript(args);
   if (!p.ran) return "plots skipped: " + p.message;
   if (!p.ok) return "plots failed: " + p.message;
@@ -214,7 +225,7 @@ StatusOr<SummaryResult> WriteSummary(const Plan& plan, bool plots) {
       ++result.failed;
   }
   const std::vector<Group> groups = GroupCells(plan, records);
-  result.table_md = TableMarkdown(groups, plan.HasRefMap());
+  result.table_md = TableMarkdown(groups, MetricSetOf(plan));
   const fs::path out(plan.out_dir);
   for (const auto& [name, text] :
        {std::pair<const char*, std::string>{"summary.csv", SummaryCsv(plan, records)},

@@ -420,6 +420,46 @@ void CheckTable(const json& plan, const std::string& out) {
   EXPECT_EQ(page["table"]["rows"].size(), 6u);
 }
 
+// Simulated cells: the degenerate fraction is the summary's, and the
+// detection scores are those of `rvlio eval --degeneracy` on the cell's run
+// against its simulation (null where undefined); the table averages them.
+void CheckDetection(const json& plan, const std::string& dir,
+                    const std::vector<std::map<std::string, std::string>>& rows) {
+  std::map<std::string, std::vector<double>> precision;  // variant -> defined values
+  for (const json& c : plan["cells"]) {
+    if (c["sequence"] != "tunnel") continue;
+    const json m = json::parse(ReadFile(c["cell_json"]))["metrics"];
+    const std::string run = c["dir"].get<std::string>() + "/run";
+    const json summary = json::parse(ReadFile(run + "/summary.json"));
+    EXPECT_DOUBLE_EQ(m["degenerate_fraction"].get<double>(),
+                     summary["degenerate_scans"].get<double>() / summary["scan_count"].get<double>());
+    const std::string truth = c["eval_argv"][2].get<std::string>();  // --gt DATA/tunnel_gt.tum
+    const ToolRun eval = RunTool("eval --degeneracy " + run + " --truth " +
+                                     fs::path(truth).parent_path().string() + " --json", dir);
+    ASSERT_EQ(eval.exit_code, 0) << eval.err;
+    const json scores = json::parse(eval.out);
+    for (const char* key : {"precision", "recall"}) {
+      const json& mine = m[std::string("detect_") + key];
+      ASSERT_EQ(mine.is_null(), scores[key].is_null()) << key << " " << eval.out;
+      if (mine.is_number()) {
+        EXPECT_DOUBLE_EQ(mine.get<double>(), scores[key].get<double>()) << key;
+      }
+    }
+    if (scores["precision"].is_number()) {
+      precision[c["variant"]].push_back(scores["precision"].get<double>());
+    }
+  }
+  // rv_on flags scans (RV active), so its precision is defined on both seeds;
+  // rv_off flags none.
+  ASSERT_EQ(precision["rv_on"].size(), 2u);
+  EXPECT_TRUE(precision["rv_off"].empty());
+  const auto* row = FindRow(rows, "tunnel", "rv_on");
+  ASSERT_NE(row, nullptr);
+  EXPECT_NEAR(std::stod(row->at("detect_precision_mean")),
+              0.5 * (precision["rv_on"][0] + precision["rv_on"][1]), 1e-9);
+  EXPECT_EQ(FindRow(rows, "tunnel", "rv_off")->at("detect_precision_mean"), "");
+}
+
 void CheckResume(const json& plan, const std::string& dir) {
   const std::string out = dir + "/out", grid = dir + "/grid.yaml";
   std::map<std::string, int64_t> mtimes;
@@ -477,6 +517,7 @@ TEST_F(AblateRunTest, RecordsFailuresSummarizesOverSeedsAndResumes) {
   ASSERT_EQ(plan["cells"].size(), 6u);
   CheckCells(first_, plan);
   CheckTable(plan, Out());
+  CheckDetection(plan, dir_, ReadCsv(Out() + "/table.csv"));
   CheckResume(plan, dir_);
 }
 
