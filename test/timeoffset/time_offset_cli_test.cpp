@@ -53,6 +53,15 @@ std::vector<std::string> SplitCsvLine(const std::string& line) {
   return cells;
 }
 
+// The stamps of a trajectory.tum (comments skipped).
+std::vector<double> TumStamps(const std::string& out) {
+  std::istringstream in(ReadFile(out + "/trajectory.tum"));
+  std::vector<double> stamps;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line));
+  return stamps;
+}
+
 class TimeOffsetCliTest : public ::testing::Test {
  protected:
   static constexpr double kOffsetS = 0.03;
@@ -146,6 +155,46 @@ TEST_F(TimeOffsetCliTest, IeskfMapHoldKeepsTheAccuracy) {
   EXPECT_LE(t["map_hold_scans"].get<int>(), 10) << t.dump();
   EXPECT_NEAR(t["estimate_s"].get<double>(), kOffsetS, 0.002) << t.dump();
   EXPECT_LT(Ate("off30", on), 1.2 * Ate("sync", sync));
+}
+
+// The IESKF replay (lidar.time_offset_replay, on by default): on the +30 ms
+// bag the scans from the start of the motion to the offset's convergence
+// (about 0.5 s at 10 Hz) are processed again with the converged offset;
+// every scan's pose is written once, in increasing time, as many as without
+// the replay (the shift moves no scan before the state at +30 ms).
+TEST_F(TimeOffsetCliTest, IeskfReplayEmitsEachScanOnceInOrder) {
+  const std::string est = "--set backend=ieskf --set lidar.estimate_time_offset=true";
+  const std::string on = dir_ + "/replay_on", off = dir_ + "/replay_off";
+  ASSERT_EQ(Run("off30", on, est).exit_code, 0);
+  ASSERT_EQ(Run("off30", off, est + " --set lidar.time_offset_replay=0").exit_code, 0);
+  const nlohmann::json t = TimeOffset(on);
+  EXPECT_GE(t["replayed_scans"].get<int>(), 1) << t.dump();
+  EXPECT_LE(t["replayed_scans"].get<int>(), 20) << t.dump();
+  EXPECT_EQ(TimeOffset(off)["replayed_scans"].get<int>(), 0);
+  const std::vector<double> stamps_on = TumStamps(on), stamps_off = TumStamps(off);
+  EXPECT_EQ(stamps_on.size(), stamps_off.size());
+  for (size_t i = 1; i < stamps_on.size(); ++i) EXPECT_GT(stamps_on[i], stamps_on[i - 1]) << i;
+}
+
+// A hold that ends without replay leaves the results as they were: a give-up
+// after one scan of motion (time_offset_replay 0.05 s) and the end of input
+// inside the hold (3.3 s: 0.3 s after the 3 s static start, before the
+// offset converges) write the trajectory of the run without the replay, byte
+// for byte.
+TEST_F(TimeOffsetCliTest, IeskfReplayGiveUpKeepsTheResults) {
+  const std::string est = "--set backend=ieskf --set lidar.estimate_time_offset=true";
+  const std::string off = dir_ + "/giveup_off", early = dir_ + "/giveup_early";
+  ASSERT_EQ(Run("off30", off, est + " --set lidar.time_offset_replay=0").exit_code, 0);
+  ASSERT_EQ(Run("off30", early, est + " --set lidar.time_offset_replay=0.05").exit_code, 0);
+  EXPECT_EQ(TimeOffset(early)["replayed_scans"].get<int>(), 0);
+  EXPECT_EQ(ReadFile(early + "/trajectory.tum"), ReadFile(off + "/trajectory.tum"));
+  const std::string cut_off = dir_ + "/finish_off", cut_on = dir_ + "/finish_on";
+  const std::string cut = est + " --duration 3.3";
+  ASSERT_EQ(Run("off30", cut_off, cut + " --set lidar.time_offset_replay=0").exit_code, 0);
+  ASSERT_EQ(Run("off30", cut_on, cut).exit_code, 0);
+  EXPECT_EQ(TimeOffset(cut_on)["replayed_scans"].get<int>(), 0);
+  EXPECT_EQ(ReadFile(cut_on + "/trajectory.tum"), ReadFile(cut_off + "/trajectory.tum"));
+  EXPECT_GT(TumStamps(cut_on).size(), 30u);
 }
 
 // A drifting LiDAR clock (simulator lidar.time_offset_drift, 200 ppm: the
