@@ -178,8 +178,8 @@ TEST_F(TimeOffsetCliTest, IeskfReplayEmitsEachScanOnceInOrder) {
 
 // A hold that ends without replay leaves the results as they were: a give-up
 // after one scan of motion (time_offset_replay 0.05 s) and the end of input
-// inside the hold (3.3 s: 0.3 s after the 3 s static start, before the
-// offset converges) write the trajectory of the run without the replay, byte
+// inside the hold (--duration 3.6: four scans of motion, the offset's
+// 1-sigma still 1.9 ms, above lidar.time_offset_map_std) write the trajectory of the run without the replay, byte
 // for byte.
 TEST_F(TimeOffsetCliTest, IeskfReplayGiveUpKeepsTheResults) {
   const std::string est = "--set backend=ieskf --set lidar.estimate_time_offset=true";
@@ -189,12 +189,12 @@ TEST_F(TimeOffsetCliTest, IeskfReplayGiveUpKeepsTheResults) {
   EXPECT_EQ(TimeOffset(early)["replayed_scans"].get<int>(), 0);
   EXPECT_EQ(ReadFile(early + "/trajectory.tum"), ReadFile(off + "/trajectory.tum"));
   const std::string cut_off = dir_ + "/finish_off", cut_on = dir_ + "/finish_on";
-  const std::string cut = est + " --duration 3.3";
+  const std::string cut = est + " --duration 3.6";
   ASSERT_EQ(Run("off30", cut_off, cut + " --set lidar.time_offset_replay=0").exit_code, 0);
   ASSERT_EQ(Run("off30", cut_on, cut).exit_code, 0);
   EXPECT_EQ(TimeOffset(cut_on)["replayed_scans"].get<int>(), 0);
   EXPECT_EQ(ReadFile(cut_on + "/trajectory.tum"), ReadFile(cut_off + "/trajectory.tum"));
-  EXPECT_GT(TumStamps(cut_on).size(), 30u);
+  EXPECT_GT(TumStamps(cut_on).size(), 20u);
 }
 
 // A drifting LiDAR clock (simulator lidar.time_offset_drift, 200 ppm: the
