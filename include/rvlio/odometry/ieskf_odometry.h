@@ -97,7 +97,8 @@ class IeskfPipeline {
 // Once the offset's 1-sigma is below lidar.time_offset_map_std, the pipeline
 // continues from the snapshot with the converged offset (re-processing the
 // kept input) and the held results are dropped; after time_offset_replay
-// seconds without convergence (or at a stop) the held results are emitted.
+// seconds without convergence (or at a stop) the held results are emitted
+// and the next scan that shows the offset starts a new hold. One replay per run.
 // Each scan's result is emitted once, in order.
 class IeskfOdometry : public Odometry {
  public:
