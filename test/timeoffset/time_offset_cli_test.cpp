@@ -4,7 +4,7 @@
 //     keeps the offset out of the configuration it writes;
 //   - online estimation, both backends, on a +30 ms bag: the estimate within
 //     2 ms of the truth once excited, ATE within 20 % of the synchronized run;
-//   - estimation on with synchronized clocks: ATE at most 15 % worse (target 5 %);
+//   - estimation on with synchronized clocks: ATE at most 10 % worse (target 5 %);
 //   - `rvlio calibrate-time` finds the offset within 3 ms, and says "not
 //     enough rotation" on a flight that never turns;
 //   - a drifting clock offset: both backends follow the drift;
@@ -130,10 +130,11 @@ TEST_F(TimeOffsetCliTest, EstimationWithSynchronizedClocksKeepsTheAccuracy) {
   ASSERT_EQ(Run("sync", off, "--set backend=ieskf").exit_code, 0);
   ASSERT_EQ(Run("sync", on, "--set backend=ieskf --set lidar.estimate_time_offset=true").exit_code,
             0);
-  // The target is 5 %; over seeds 3 to 13 of the tunnel and the hall the
-  // measured ratio is 0.97 to 1.15, this seed's 1.10 (docs/time_offset.md):
-  // the bound guards against regressions without claiming the target.
-  EXPECT_LT(Ate("sync", on), 1.15 * Ate("sync", off));
+  // The target is 5 %; with the replay, over seeds 3 to 13 of the tunnel and
+  // the hall the measured ratio is 0.96 to 1.10 (mean 1.02 tunnel, 1.05
+  // hall), this seed's 1.00 (docs/time_offset.md): the bound guards against
+  // regressions without claiming the target on every seed.
+  EXPECT_LT(Ate("sync", on), 1.10 * Ate("sync", off));
   EXPECT_NEAR(TimeOffset(on)["estimate_s"].get<double>(), 0.0, 0.002);
 }
 
@@ -320,9 +321,10 @@ TEST_P(TimeOffsetMatrix, EstimatesEveryOffsetAndKeepsTheAccuracy) {
                 t["std_s"].get<double>(), t["excited"].get<bool>() ? 1 : 0, ate, ate_sync);
     EXPECT_TRUE(t["excited"].get<bool>()) << offset_s;
     EXPECT_NEAR(t["estimate_s"].get<double>(), offset_s, 0.002) << preset << " " << backend;
-    // The target is 1.2x the synchronized ATE; the IESKF at +100 ms reaches
-    // 1.3-1.5x (docs/time_offset.md), so this regression bound is 2x.
-    EXPECT_LT(ate, 2.0 * ate_sync) << preset << " " << backend << " " << offset_s;
+    // The target is 1.2x the synchronized ATE; the IESKF (with the replay)
+    // reaches 1.25x in the hall at +100 ms, 1.08x at most elsewhere
+    // (docs/time_offset.md), so this regression bound is 1.4x.
+    EXPECT_LT(ate, 1.4 * ate_sync) << preset << " " << backend << " " << offset_s;
   }
   std::filesystem::remove_all(dir);
 }
