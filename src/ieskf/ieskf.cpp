@@ -263,6 +263,25 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
 }
 
 double Ieskf::time_offset_std_s() const { return std::sqrt(std::max(P_td_td_, 0.0)); }
+
+void Ieskf::SetTimeOffset(double td_s, double std_s) {
+  td_s_ = td_lin_s_ = td_s;
+  P_x_td_.setZero();
+  P_td_td_ = std_s * std_s;
+}
+
+// A copy of the filter is propagated as Predict would: the state Update
+// would judge the offset's observability on.
+bool Ieskf::TimeOffsetObservableAt(const std::deque<ImuSample>& imu, TimeNs t_end_ns) const {
+  Ieskf probe = *this;
+  probe.ClearPoseHistory();
+  for (const ImuSample& s : imu) {
+    if (s.t_ns > t_end_ns) break;
+    probe.Propagate(s);
+  }
+  probe.PropagateTo(t_end_ns);
+  return TimeOffsetObservable(probe.x_.v_world_imu, probe.MotionAtStateTime());
+}
 void Ieskf::ChangeWorldFrame(const Pose3& T_new_old) {
   x_.R_world_imu = T_new_old.R * x_.R_world_imu;
   x_.p_world_imu = T_new_old * x_.p_world_imu;

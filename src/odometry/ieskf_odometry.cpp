@@ -28,6 +28,82 @@ DivergenceOptions MonitorOptions(const OdometryOptions& options) {
 }  // namespace
 
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization localization)
+    : options_(options), live_(options, std::move(localization)) {
+  if (options.lidar.estimate_time_offset && options.lidar.time_offset_replay > 0.0)
+    phase_ = ReplayPhase::kWaitingForMotion;
+}
+
+void IeskfOdometry::AddImu(const ImuSample& imu) {
+  live_.AddImu(imu);
+  if (snapshot_) snapshot_->AddImu(imu);
+}
+
+void IeskfOdometry::AddScan(Scan scan) {
+  if (snapshot_) snapshot_->AddScan(scan);
+  live_.AddScan(std::move(scan));
+}
+
+void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
+  while (Step(false, out)) {
+  }
+}
+
+// At the end of input a hold ends with the results there are: the held ones
+// when the offset has not converged by then.
+void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
+  live_.StartFinishing();
+  if (snapshot_) snapshot_->StartFinishing();
+  while (Step(true, out)) {
+  }
+  if (phase_ == ReplayPhase::kHolding) GiveUpReplay(out);
+}
+
+// One scan of the live pipeline; the snapshot is taken before the first scan
+// that shows the offset, the results of the hold go to held_.
+bool IeskfOdometry::Step(bool finishing, std::vector<ScanResult>* out) {
+  if (phase_ == ReplayPhase::kWaitingForMotion && live_.NextScanShowsTimeOffset(finishing)) {
+    snapshot_ = live_;
+    hold_start_ns_ = live_.filter().time_ns();
+    phase_ = ReplayPhase::kHolding;
+  }
+  const bool holding = phase_ == ReplayPhase::kHolding;
+  if (!live_.ProcessNext(finishing, holding ? &held_ : out)) return false;
+  if (holding) EndHoldIfDue(out);
+  return true;
+}
+
+void IeskfOdometry::EndHoldIfDue(std::vector<ScanResult>* out) {
+  if (!live_.status().ok()) return GiveUpReplay(out);
+  if (live_.filter().time_offset_std_s() < options_.lidar.time_offset_map_std) return Replay();
+  if (NsToSeconds(live_.filter().time_ns() - hold_start_ns_) >= options_.lidar.time_offset_replay)
+    GiveUpReplay(out);
+}
+
+// The snapshot continues with the converged estimate, keeping its 1-sigma
+// (uncorrelated with the state at the snapshot, which the scans at rest
+// did not tie to it); the following Steps re-process the kept input.
+void IeskfOdometry::Replay() {
+  const Ieskf& converged = live_.filter();
+  snapshot_->SetTimeOffset(converged.time_offset_s(), converged.time_offset_std_s());
+  snapshot_->SetReplayedScans(static_cast<int64_t>(held_.size()));
+  live_ = std::move(*snapshot_);
+  snapshot_.reset();
+  held_.clear();
+  phase_ = ReplayPhase::kOver;
+}
+
+// The held results are emitted as they are, and the next scan that shows the
+// offset starts a new hold: a scan at rest whose noise passed the motion test
+// (tunnel seed 5: at 1.3 s of a 3 s static start) must not use up the replay
+// of the real start of the motion. Each hold keeps at most one window.
+void IeskfOdometry::GiveUpReplay(std::vector<ScanResult>* out) {
+  for (ScanResult& r : held_) out->push_back(std::move(r));
+  held_.clear();
+  snapshot_.reset();
+  phase_ = ReplayPhase::kWaitingForMotion;
+}
+
+IeskfPipeline::IeskfPipeline(const OdometryOptions& options, Localization localization)
     : options_(options),
       filter_(options.ieskf, options.imu, options.constraints, options.rv, options.lidar,
               options.degeneracy),
@@ -39,7 +115,7 @@ IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization locali
       initializer_(options.imu.init_duration),
       localizer_(std::move(localization), options.localization, options.constraints) {}
 
-void IeskfOdometry::AddImu(const ImuSample& imu) {
+void IeskfPipeline::AddImu(const ImuSample& imu) {
   if (!AcceptImu(imu, imu_buffer_, SecondsToNs(options_.imu.max_gap), &stats_)) return;
   scans_.NoteImu(imu.t_ns);
   if (!stats_.initialized) {
@@ -50,7 +126,7 @@ void IeskfOdometry::AddImu(const ImuSample& imu) {
 }
 
 // Static alignment once imu.init_duration of samples has been collected.
-void IeskfOdometry::TryInitialize(const ImuSample& imu) {
+void IeskfPipeline::TryInitialize(const ImuSample& imu) {
   const std::optional<StaticAlignment> a = initializer_.Add(imu);
   if (!a) return;
   FilterState x0;
@@ -65,13 +141,13 @@ void IeskfOdometry::TryInitialize(const ImuSample& imu) {
   if (a->moving) warnings_.push_back(MovingStartWarning(*a));
 }
 
-std::vector<std::string> IeskfOdometry::warnings() const {
+std::vector<std::string> IeskfPipeline::warnings() const {
   std::vector<std::string> w = warnings_;
   for (std::string& q : QueueWarnings(stats_)) w.push_back(std::move(q));
   return w;
 }
 
-void IeskfOdometry::AddScan(Scan scan) {
+void IeskfPipeline::AddScan(Scan scan) {
   // The filter's time is on the IMU clock, the queued scans' on the reader's
   // (before the estimated shift): the state is at the last processed scan's end
   // moved by that scan's shift.
@@ -79,20 +155,33 @@ void IeskfOdometry::AddScan(Scan scan) {
              &stats_);
 }
 
-void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
-  while (status_.ok() && scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) ProcessFrontScan(out);
+bool IeskfPipeline::ProcessNext(bool finishing, std::vector<ScanResult>* out) {
+  if (!status_.ok() || scans_.empty()) return false;
+  if (!finishing && !scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) return false;
+  ProcessFrontScan(out);
+  return true;
 }
 
-void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
+void IeskfPipeline::StartFinishing() {
   scans_.DropPastImu(SecondsToNs(options_.imu.max_gap), &stats_);
-  while (status_.ok() && !scans_.empty()) ProcessFrontScan(out);
+}
+
+bool IeskfPipeline::NextScanShowsTimeOffset(bool finishing) const {
+  if (!status_.ok() || scans_.empty() || map_.Empty()) return false;
+  if (!finishing && !scans_.FrontReady(imu_buffer_, ScanTimeShiftNs())) return false;
+  return filter_.TimeOffsetObservableAt(imu_buffer_, scans_.front().t_end_ns + ScanTimeShiftNs());
+}
+
+void IeskfPipeline::SetTimeOffset(double td_s, double std_s) {
+  filter_.SetTimeOffset(td_s, std_s);
+  scans_.DropStartingBefore(filter_.time_ns() - ScanTimeShiftNs(), &stats_);
 }
 
 // The scan is moved onto the IMU clock by the current estimate (prediction
 // and deskew at the moved times); the update then refines the estimate
 // (Ieskf::Update, ScanTimeMotion). The result's stamp and pose are the
 // filter's: the IMU at the moved scan end.
-void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
+void IeskfPipeline::ProcessFrontScan(std::vector<ScanResult>* out) {
   Scan scan = scans_.PopFront();
   const double start_ms = WorkCpuMs();  // association helpers included
   if (options_.lidar.estimate_time_offset) {
@@ -130,7 +219,7 @@ void IeskfOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
 
 // Propagates with every buffered IMU sample up to the scan end, then to the
 // scan end itself.
-Eigen::Vector3d IeskfOdometry::Predict(TimeNs t_end_ns) {
+Eigen::Vector3d IeskfPipeline::Predict(TimeNs t_end_ns) {
   Eigen::Vector3d acc_sum = Eigen::Vector3d::Zero();
   int n = 0;
   while (!imu_buffer_.empty() && imu_buffer_.front().t_ns <= t_end_ns) {
@@ -153,7 +242,7 @@ Eigen::Vector3d IeskfOdometry::Predict(TimeNs t_end_ns) {
 // working map when it overlaps the reference too little at the prediction
 // (ReferenceLocalizer::Associate; its search fills the cache, which the
 // first iteration then reuses).
-ScanStatus IeskfOdometry::Correct(ScanResult* r) {
+ScanStatus IeskfPipeline::Correct(ScanResult* r) {
   AssociationCache cache(options_.constraints.reuse_distance);
   const VoxelMap& search = localizer_.enabled() ? ChooseMap(&cache, r) : map_.map();
   const AssociateFn associate = [this, &cache, &search](const FilterState& x,
@@ -184,7 +273,7 @@ ScanStatus IeskfOdometry::Correct(ScanResult* r) {
   return ScanStatus::kUpdated;
 }
 
-const VoxelMap& IeskfOdometry::ChooseMap(AssociationCache* cache, ScanResult* r) {
+const VoxelMap& IeskfPipeline::ChooseMap(AssociationCache* cache, ScanResult* r) {
   const FilterState& x = filter_.state();
   return localizer_.Associate(p_lidar_end_, x.T_world_imu(), x.T_imu_lidar(), map_.map(), cache,
                               ResolveThreads(options_.constraints.threads), &choice_, r);
@@ -193,7 +282,7 @@ const VoxelMap& IeskfOdometry::ChooseMap(AssociationCache* cache, ScanResult* r)
 // The first scan aligned to the reference from the initial pose; the whole
 // state follows into the reference frame. False (status_ set) when it does
 // not align.
-bool IeskfOdometry::StartInReference() {
+bool IeskfPipeline::StartInReference() {
   const FilterState& x = filter_.state();
   StatusOr<Pose3> T_ref_world =
       localizer_.Start(filter_.time_ns(), p_lidar_end_, x.T_world_imu(), x.T_imu_lidar());
@@ -205,7 +294,7 @@ bool IeskfOdometry::StartInReference() {
   return true;
 }
 
-void IeskfOdometry::ReportExtrinsic(ScanResult* r) {
+void IeskfPipeline::ReportExtrinsic(ScanResult* r) {
   if (!options_.ieskf.estimate_extrinsics) return;
   filter_.CountExcitationScan();
   r->T_imu_lidar = filter_.state().T_imu_lidar();
@@ -214,12 +303,12 @@ void IeskfOdometry::ReportExtrinsic(ScanResult* r) {
   stats_.extrinsic.map_rebuilds = map_.rebuilds();
 }
 
-TimeNs IeskfOdometry::ScanTimeShiftNs() const {
+TimeNs IeskfPipeline::ScanTimeShiftNs() const {
   if (!options_.lidar.estimate_time_offset) return 0;
   return SecondsToNs(filter_.time_offset_s() - options_.lidar.time_offset);
 }
 
-void IeskfOdometry::ReportTimeOffset(ScanResult* r) {
+void IeskfPipeline::ReportTimeOffset(ScanResult* r) {
   if (!options_.lidar.estimate_time_offset) return;
   const bool was_at_bound = stats_.time_offset.at_bound;
   if (!filter_.pose_history().empty())
@@ -231,6 +320,7 @@ void IeskfOdometry::ReportTimeOffset(ScanResult* r) {
       MakeTimeOffsetReport(time_offset_excitation_, options_.lidar, filter_.time_offset_s(),
                            filter_.time_offset_std_s(), filter_.time_offset_at_bound());
   stats_.time_offset.map_hold_scans = map_hold_scans_;
+  stats_.time_offset.replayed_scans = replayed_scans_;
   if (stats_.time_offset.at_bound && !was_at_bound)
     warnings_.push_back(TimeOffsetAtBoundWarning(options_.lidar, filter_.time_ns()));
 }
@@ -247,7 +337,7 @@ void IeskfOdometry::ReportTimeOffset(ScanResult* r) {
 // it, and the scans from then on rebuild it. If the offset does not converge
 // within time_offset_map_hold seconds of motion, the provisional scans stay.
 // Memory: one copy of the working map, once per run.
-bool IeskfOdometry::ProvisionalInMap(TimeNs t_ns) {
+bool IeskfPipeline::ProvisionalInMap(TimeNs t_ns) {
   if (map_hold_over_ || !options_.lidar.estimate_time_offset ||
       options_.lidar.time_offset_map_hold <= 0.0 || map_.Empty())
     return false;
@@ -270,7 +360,7 @@ bool IeskfOdometry::ProvisionalInMap(TimeNs t_ns) {
 
 // The scan's points were deskewed to its end on the LiDAR clock, which the
 // estimated offset puts at the filter's ScanTimeImuPose().
-void IeskfOdometry::InsertIntoMap(TimeNs t_ns, bool provisional) {
+void IeskfPipeline::InsertIntoMap(TimeNs t_ns, bool provisional) {
   const FilterState& x = filter_.state();
   const Pose3 T_world_imu =
       options_.lidar.estimate_time_offset ? filter_.ScanTimeImuPose() : x.T_world_imu();

@@ -255,6 +255,13 @@ std::vector<std::string> QueueWarnings(const OdometryStats& stats) {
   return w;
 }
 
+void ScanQueue::DropStartingBefore(TimeNs state_time_ns, OdometryStats* stats) {
+  while (!scans_.empty() && scans_.front().t_start_ns < state_time_ns) {
+    scans_.pop_front();
+    ++stats->scans_before_imu;
+  }
+}
+
 Scan ScanQueue::PopFront() {
   Scan scan = std::move(scans_.front());
   scans_.pop_front();

@@ -52,6 +52,7 @@ nlohmann::json TimeOffsetJson(const TimeOffsetReport& r) {
           {"max_velocity_spread_m_s", r.max_velocity_spread_m_s},
           {"trustworthy", r.trustworthy},
           {"map_hold_scans", r.map_hold_scans},
+          {"replayed_scans", r.replayed_scans},
           {"note", r.trustworthy ? "put estimate_s in lidar.time_offset"
                    : r.excited   ? "not trustworthy: the estimate is not settled (1-sigma above "
                                    "lidar.time_offset_excited_std, or at the bound)"

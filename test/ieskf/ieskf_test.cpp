@@ -1,5 +1,6 @@
 // IESKF tests: IMU propagation against the analytic oracle, the iterated
 // update on a synthetic room, and behaviour in a degenerate corridor.
+#include <deque>
 #include <random>
 
 #include <Eigen/Eigenvalues>
@@ -90,6 +91,41 @@ TEST(IeskfPropagation, CovarianceStaysSymmetricPositiveAndGrows) {
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix24d>(P).eigenvalues().minCoeff(), 0.0);
   EXPECT_GT(P(FilterState::kPos, FilterState::kPos), pos_var0);
   EXPECT_GT(P(FilterState::kVel, FilterState::kVel), 0.1 * 0.1);  // above init_vel_std^2
+}
+
+// lidar.time_offset_replay's two hooks: the motion test of the next scan
+// leaves the filter where it was, and SetTimeOffset sets the estimate and its
+// 1-sigma.
+TEST(IeskfTimeOffset, ObservableAtJudgesTheNextScanWithoutMovingTheFilter) {
+  LidarOptions lidar;
+  lidar.estimate_time_offset = true;
+  RvOptions rv;
+  rv.enabled = false;
+  Ieskf moving(IeskfOptions(), ImuOptions(), ConstraintOptions(), rv, lidar);
+  const Motion m;  // 0.37 rad/s, about 1 m/s
+  moving.Initialize(m.State(0.0), 0, m.Sample(0.0));
+  std::deque<ImuSample> imu;
+  for (int k = 1; k <= 20; ++k) imu.push_back(m.Sample(k * 5e-3));
+  EXPECT_TRUE(moving.TimeOffsetObservableAt(imu, SecondsToNs(0.1)));
+  EXPECT_EQ(moving.time_ns(), 0);
+  EXPECT_TRUE(moving.state().p_world_imu.isApprox(m.p(0.0)));
+
+  Ieskf rest(IeskfOptions(), ImuOptions(), ConstraintOptions(), rv, lidar);
+  FilterState x;
+  x.g_world = m.g_world;
+  ImuSample still;
+  still.acc_imu = -m.g_world;
+  rest.Initialize(x, 0, still);
+  std::deque<ImuSample> still_imu;
+  for (int k = 1; k <= 20; ++k) {
+    still.t_ns = SecondsToNs(k * 5e-3);
+    still_imu.push_back(still);
+  }
+  EXPECT_FALSE(rest.TimeOffsetObservableAt(still_imu, SecondsToNs(0.1)));
+
+  rest.SetTimeOffset(0.0421, 0.0007);
+  EXPECT_DOUBLE_EQ(rest.time_offset_s(), 0.0421);
+  EXPECT_NEAR(rest.time_offset_std_s(), 0.0007, 1e-12);
 }
 
 TEST(IeskfPropagation, PoseHistoryCoversTheIntervalInOrder) {

@@ -4,7 +4,7 @@
 //     keeps the offset out of the configuration it writes;
 //   - online estimation, both backends, on a +30 ms bag: the estimate within
 //     2 ms of the truth once excited, ATE within 20 % of the synchronized run;
-//   - estimation on with synchronized clocks: ATE at most 15 % worse (target 5 %);
+//   - estimation on with synchronized clocks: ATE at most 10 % worse (target 5 %);
 //   - `rvlio calibrate-time` finds the offset within 3 ms, and says "not
 //     enough rotation" on a flight that never turns;
 //   - a drifting clock offset: both backends follow the drift;
@@ -51,6 +51,15 @@ std::vector<std::string> SplitCsvLine(const std::string& line) {
   std::istringstream in(line);
   for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
   return cells;
+}
+
+// The stamps of a trajectory.tum (comments skipped).
+std::vector<double> TumStamps(const std::string& out) {
+  std::istringstream in(ReadFile(out + "/trajectory.tum"));
+  std::vector<double> stamps;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line));
+  return stamps;
 }
 
 class TimeOffsetCliTest : public ::testing::Test {
@@ -121,31 +130,80 @@ TEST_F(TimeOffsetCliTest, EstimationWithSynchronizedClocksKeepsTheAccuracy) {
   ASSERT_EQ(Run("sync", off, "--set backend=ieskf").exit_code, 0);
   ASSERT_EQ(Run("sync", on, "--set backend=ieskf --set lidar.estimate_time_offset=true").exit_code,
             0);
-  // The target is 5 %; over seeds 3 to 13 of the tunnel and the hall the
-  // measured ratio is 0.97 to 1.15, this seed's 1.10 (docs/time_offset.md):
-  // the bound guards against regressions without claiming the target.
-  EXPECT_LT(Ate("sync", on), 1.15 * Ate("sync", off));
+  // The target is 5 %; with the replay, over seeds 3 to 13 of the tunnel and
+  // the hall the measured ratio is 0.96 to 1.10 (mean 1.02 tunnel, 1.05
+  // hall), this seed's 1.00 (docs/time_offset.md): the bound guards against
+  // regressions without claiming the target on every seed.
+  EXPECT_LT(Ate("sync", on), 1.10 * Ate("sync", off));
   EXPECT_NEAR(TimeOffset(on)["estimate_s"].get<double>(), 0.0, 0.002);
 }
 
-// The IESKF map hold (lidar.time_offset_map_hold): on the +30 ms bag the
-// first moving scans are provisional until the offset converges (about 0.5 s
-// of motion at 10 Hz: between 1 and 10 scans), the estimate is as accurate
-// and the ATE within 20 % of the synchronized run (measured 1.02,
-// docs/time_offset.md "Map hold"). Off by default: no provisional scans.
+// The IESKF map hold (lidar.time_offset_map_hold), without the replay
+// (time_offset_replay 0): on the +30 ms bag the first moving scans are
+// provisional until the offset converges (about 0.5 s of motion at 10 Hz:
+// between 1 and 10 scans), the estimate is as accurate and the ATE within
+// 20 % of the synchronized run (measured 1.02, docs/time_offset.md "Map
+// hold"). Off by default: no provisional scans. With the replay the hold
+// ends at the first replayed scan (the offset converged): none either.
 TEST_F(TimeOffsetCliTest, IeskfMapHoldKeepsTheAccuracy) {
   const std::string sync = dir_ + "/hold_sync", off = dir_ + "/hold_off", on = dir_ + "/hold_on";
+  const std::string replayed = dir_ + "/hold_replayed";
   ASSERT_EQ(Run("sync", sync, "--set backend=ieskf").exit_code, 0);
   const std::string est = "--set backend=ieskf --set lidar.estimate_time_offset=true";
-  ASSERT_EQ(Run("off30", off, est).exit_code, 0);
-  const ToolRun r = Run("off30", on, est + " --set lidar.time_offset_map_hold=1");
+  const std::string hold = " --set lidar.time_offset_map_hold=1";
+  ASSERT_EQ(Run("off30", off, est + " --set lidar.time_offset_replay=0").exit_code, 0);
+  const ToolRun r = Run("off30", on, est + hold + " --set lidar.time_offset_replay=0");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(Run("off30", replayed, est + hold).exit_code, 0);
   EXPECT_EQ(TimeOffset(off)["map_hold_scans"].get<int>(), 0);
+  EXPECT_EQ(TimeOffset(replayed)["map_hold_scans"].get<int>(), 0);
   const nlohmann::json t = TimeOffset(on);
   EXPECT_GE(t["map_hold_scans"].get<int>(), 1) << t.dump();
   EXPECT_LE(t["map_hold_scans"].get<int>(), 10) << t.dump();
   EXPECT_NEAR(t["estimate_s"].get<double>(), kOffsetS, 0.002) << t.dump();
   EXPECT_LT(Ate("off30", on), 1.2 * Ate("sync", sync));
+}
+
+// The IESKF replay (lidar.time_offset_replay, on by default): on the +30 ms
+// bag the scans from the start of the motion to the offset's convergence
+// (about 0.5 s at 10 Hz) are processed again with the converged offset;
+// every scan's pose is written once, in increasing time, as many as without
+// the replay (the shift moves no scan before the state at +30 ms).
+TEST_F(TimeOffsetCliTest, IeskfReplayEmitsEachScanOnceInOrder) {
+  const std::string est = "--set backend=ieskf --set lidar.estimate_time_offset=true";
+  const std::string on = dir_ + "/replay_on", off = dir_ + "/replay_off";
+  ASSERT_EQ(Run("off30", on, est).exit_code, 0);
+  ASSERT_EQ(Run("off30", off, est + " --set lidar.time_offset_replay=0").exit_code, 0);
+  const nlohmann::json t = TimeOffset(on);
+  EXPECT_GE(t["replayed_scans"].get<int>(), 1) << t.dump();
+  EXPECT_LE(t["replayed_scans"].get<int>(), 20) << t.dump();
+  EXPECT_EQ(TimeOffset(off)["replayed_scans"].get<int>(), 0);
+  const std::vector<double> stamps_on = TumStamps(on), stamps_off = TumStamps(off);
+  EXPECT_EQ(stamps_on.size(), stamps_off.size());
+  for (size_t i = 1; i < stamps_on.size(); ++i) EXPECT_GT(stamps_on[i], stamps_on[i - 1]) << i;
+}
+
+// A hold that ends without replay leaves the results as they were: holds
+// that never converge (time_offset_map_std 1e-6 s; each given up after one
+// scan, time_offset_replay 0.05 s, then a new one starts) and the end of input
+// inside the hold (--duration 3.6: four scans of motion, the offset's
+// 1-sigma still 1.9 ms, above lidar.time_offset_map_std) write the trajectory of the run without the replay, byte
+// for byte.
+TEST_F(TimeOffsetCliTest, IeskfReplayGiveUpKeepsTheResults) {
+  const std::string est = "--set backend=ieskf --set lidar.estimate_time_offset=true";
+  const std::string off = dir_ + "/giveup_off", early = dir_ + "/giveup_early";
+  ASSERT_EQ(Run("off30", off, est + " --set lidar.time_offset_replay=0").exit_code, 0);
+  ASSERT_EQ(Run("off30", early, est + " --set lidar.time_offset_replay=0.05 --set lidar.time_offset_map_std=1e-6")
+                .exit_code, 0);
+  EXPECT_EQ(TimeOffset(early)["replayed_scans"].get<int>(), 0);
+  EXPECT_EQ(ReadFile(early + "/trajectory.tum"), ReadFile(off + "/trajectory.tum"));
+  const std::string cut_off = dir_ + "/finish_off", cut_on = dir_ + "/finish_on";
+  const std::string cut = est + " --duration 3.6";
+  ASSERT_EQ(Run("off30", cut_off, cut + " --set lidar.time_offset_replay=0").exit_code, 0);
+  ASSERT_EQ(Run("off30", cut_on, cut).exit_code, 0);
+  EXPECT_EQ(TimeOffset(cut_on)["replayed_scans"].get<int>(), 0);
+  EXPECT_EQ(ReadFile(cut_on + "/trajectory.tum"), ReadFile(cut_off + "/trajectory.tum"));
+  EXPECT_GT(TumStamps(cut_on).size(), 20u);
 }
 
 // A drifting LiDAR clock (simulator lidar.time_offset_drift, 200 ppm: the
@@ -269,9 +327,10 @@ TEST_P(TimeOffsetMatrix, EstimatesEveryOffsetAndKeepsTheAccuracy) {
                 t["std_s"].get<double>(), t["excited"].get<bool>() ? 1 : 0, ate, ate_sync);
     EXPECT_TRUE(t["excited"].get<bool>()) << offset_s;
     EXPECT_NEAR(t["estimate_s"].get<double>(), offset_s, 0.002) << preset << " " << backend;
-    // The target is 1.2x the synchronized ATE; the IESKF at +100 ms reaches
-    // 1.3-1.5x (docs/time_offset.md), so this regression bound is 2x.
-    EXPECT_LT(ate, 2.0 * ate_sync) << preset << " " << backend << " " << offset_s;
+    // The target is 1.2x the synchronized ATE; the IESKF (with the replay)
+    // reaches 1.25x in the hall at +100 ms, 1.08x at most elsewhere
+    // (docs/time_offset.md), so this regression bound is 1.4x.
+    EXPECT_LT(ate, 1.4 * ate_sync) << preset << " " << backend << " " << offset_s;
   }
   std::filesystem::remove_all(dir);
 }

@@ -4,6 +4,7 @@
 // covariance, and the iterated point-to-plane update of paper Eq. (1) with
 // re-association and the RV modules inside every iteration (Alg. 3).
 #include <array>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <vector>
@@ -109,6 +110,12 @@ class Ieskf {
   // True when the last update estimated the offset: the motion showed it
   // (not at rest; estimate_time_offset only).
   bool time_offset_observed() const { return td_observed_; }
+  // True when a scan predicted to t_end_ns from the current state would show
+  // the offset (the test Update applies; const: the filter is not moved).
+  bool TimeOffsetObservableAt(const std::deque<ImuSample>& imu, TimeNs t_end_ns) const;
+  // Sets the offset's estimate and 1-sigma, uncorrelated with the rest of the
+  // state (lidar.time_offset_replay: the converged estimate at the snapshot).
+  void SetTimeOffset(double td_s, double std_s);
   // The IMU pose at the time of the last updated scan (the state's pose when
   // the offset is not estimated; see ScanTimeMotion).
   Pose3 ScanTimeImuPose() const { return ScanTimePose(x_, scan_motion_, td_s_ - td_lin_s_); }

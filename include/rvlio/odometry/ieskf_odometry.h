@@ -13,22 +13,34 @@
 
 namespace rvlio {
 
-class IeskfOdometry : public Odometry {
+// The IESKF's processing of the input, one scan at a time. Copyable: a copy
+// is the whole evolving state (filter, maps, queued input, statistics), the
+// snapshot lidar.time_offset_replay returns to.
+class IeskfPipeline {
  public:
-  IeskfOdometry(const OdometryOptions& options, Localization localization = {});
+  IeskfPipeline(const OdometryOptions& options, Localization localization);
 
-  void AddImu(const ImuSample& imu) override;
-  void AddScan(Scan scan) override;
-  void Poll(std::vector<ScanResult>* out) override;
-  void Finish(std::vector<ScanResult>* out) override;
+  void AddImu(const ImuSample& imu);
+  void AddScan(Scan scan);
+  // Processes the oldest queued scan when the IMU covers it (finishing: the
+  // end of input, every queued scan); false when there was none.
+  bool ProcessNext(bool finishing, std::vector<ScanResult>* out);
+  // The end of input: drops the scans the IMU does not reach (call once).
+  void StartFinishing();
+  // True when ProcessNext would process a scan whose update estimates the
+  // offset (the motion shows it, Ieskf::TimeOffsetObservableAt).
+  bool NextScanShowsTimeOffset(bool finishing) const;
+  // Replay: the offset's estimate and 1-sigma, the queued scans moved by it
+  // (those that now start before the state are dropped, as AddScan would).
+  void SetTimeOffset(double td_s, double std_s);
+  void SetReplayedScans(int64_t n) { stats_.time_offset.replayed_scans = replayed_scans_ = n; }
 
-  const OdometryStats& stats() const override { return stats_; }
-  std::vector<std::string> warnings() const override;
-  const DivergenceReport& divergence() const override { return monitor_.report(); }
-  std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
-  const Status& status() const override { return status_; }
-
-  const FilterState& state() const { return filter_.state(); }
+  const OdometryStats& stats() const { return stats_; }
+  std::vector<std::string> warnings() const;
+  const DivergenceReport& divergence() const { return monitor_.report(); }
+  std::vector<Eigen::Vector3d> MapPoints() const { return output_map_.Points(); }
+  const Status& status() const { return status_; }
+  const Ieskf& filter() const { return filter_; }
 
  private:
   void TryInitialize(const ImuSample& imu);
@@ -49,6 +61,7 @@ class IeskfOdometry : public Odometry {
   bool map_hold_over_ = false;
   std::optional<WorkingMap> map_before_motion_;  // the map at the first moving scan
   int64_t map_hold_scans_ = 0;
+  int64_t replayed_scans_ = 0;
   void ReportExtrinsic(ScanResult* r);  // ieskf.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
   // lidar.estimate_time_offset: how far the scans are moved beyond
   // lidar.time_offset (the reader's shift) onto the IMU clock (0 when off).
@@ -75,6 +88,48 @@ class IeskfOdometry : public Odometry {
   Scan downsampled_;
   std::vector<Eigen::Vector3d> p_lidar_end_;
   ConstraintList choice_;  // the association that chose the map (reference runs)
+};
+
+// The IESKF backend. With lidar.estimate_time_offset and
+// lidar.time_offset_replay (docs/time_offset.md "Replay"): before the first
+// scan that shows the offset, a snapshot of the pipeline is taken and the
+// input from then on is also given to it; the results meanwhile are held.
+// Once the offset's 1-sigma is below lidar.time_offset_map_std, the pipeline
+// continues from the snapshot with the converged offset (re-processing the
+// kept input) and the held results are dropped; after time_offset_replay
+// seconds without convergence (or at a stop) the held results are emitted
+// and the next scan that shows the offset starts a new hold. One replay per run.
+// Each scan's result is emitted once, in order.
+class IeskfOdometry : public Odometry {
+ public:
+  IeskfOdometry(const OdometryOptions& options, Localization localization = {});
+
+  void AddImu(const ImuSample& imu) override;
+  void AddScan(Scan scan) override;
+  void Poll(std::vector<ScanResult>* out) override;
+  void Finish(std::vector<ScanResult>* out) override;
+
+  const OdometryStats& stats() const override { return live_.stats(); }
+  std::vector<std::string> warnings() const override { return live_.warnings(); }
+  const DivergenceReport& divergence() const override { return live_.divergence(); }
+  std::vector<Eigen::Vector3d> MapPoints() const override { return live_.MapPoints(); }
+  const Status& status() const override { return live_.status(); }
+
+  const FilterState& state() const { return live_.filter().state(); }
+
+ private:
+  enum class ReplayPhase { kWaitingForMotion, kHolding, kOver };
+  bool Step(bool finishing, std::vector<ScanResult>* out);
+  void EndHoldIfDue(std::vector<ScanResult>* out);
+  void Replay();
+  void GiveUpReplay(std::vector<ScanResult>* out);
+
+  OdometryOptions options_;
+  IeskfPipeline live_;
+  ReplayPhase phase_ = ReplayPhase::kOver;
+  std::optional<IeskfPipeline> snapshot_;  // kHolding: before the first moving scan, with the input since
+  TimeNs hold_start_ns_ = 0;               // kHolding: the state's time at the snapshot
+  std::vector<ScanResult> held_;           // kHolding: the live results since the snapshot
 };
 
 }  // namespace rvlio

@@ -95,6 +95,7 @@ struct TimeOffsetReport {
   double max_velocity_spread_m_s = 0.0;
   bool trustworthy = false;  // excited, 1-sigma under time_offset_excited_std, not at the bound
   int64_t map_hold_scans = 0;  // IESKF: lidar.time_offset_map_hold (0 for the smoother)
+  int64_t replayed_scans = 0;  // IESKF: lidar.time_offset_replay (0 for the smoother)
 };
 
 // The report of a backend's time-offset estimate (estimate_s, std_s) and

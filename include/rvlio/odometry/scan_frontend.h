@@ -179,7 +179,11 @@ class ScanQueue {
            imu_buffer.back().t_ns >= scans_.front().t_end_ns + shift_ns;
   }
   bool empty() const { return scans_.empty(); }
+  const Scan& front() const { return scans_.front(); }
   Scan PopFront();
+  // Drops (and counts in scans_before_imu) the queued scans that start before
+  // state_time_ns, as Add would have (after the estimated shift changed).
+  void DropStartingBefore(TimeNs state_time_ns, OdometryStats* stats);
 
  private:
   std::deque<Scan> scans_;
