@@ -74,7 +74,7 @@ bool IeskfOdometry::Step(bool finishing, std::vector<ScanResult>* out) {
 
 void IeskfOdometry::EndHoldIfDue(std::vector<ScanResult>* out) {
   if (!live_.status().ok()) return GiveUpReplay(out);
-  if (live_.filter().time_offset_std_s() < options_.lidar.time_offset_map_std) return Replay();
+  if (live_.filter().time_offset_std_s() < options_.lidar.time_offset_replay_std) return Replay();
   if (NsToSeconds(live_.filter().time_ns() - hold_start_ns_) >= options_.lidar.time_offset_replay)
     GiveUpReplay(out);
 }

@@ -36,10 +36,13 @@ struct LidarOptions {
   double time_offset_map_std = 0.001;   // s
   // IESKF replay (docs/time_offset.md "Replay"): the input from the start of
   // the motion is kept with a snapshot of the filter; once the estimate's
-  // 1-sigma falls below time_offset_map_std, the filter returns to the
+  // 1-sigma falls below time_offset_replay_std, the filter returns to the
   // snapshot with the converged offset and re-processes it. Given up after
-  // this many seconds of motion without convergence (0: off).
-  double time_offset_replay = 2.0;      // s (0: off)
+  // time_offset_replay seconds of motion without convergence (0: off). The
+  // early 1-sigma is optimistic (hall, +100 ms: 0.75 ms while the estimate is
+  // still 30 ms off), hence a threshold well below time_offset_map_std.
+  double time_offset_replay = 2.0;        // s (0: off)
+  double time_offset_replay_std = 1e-4;   // s
 
   template <class V>
   void Visit(V& v) {
@@ -91,13 +94,15 @@ struct LidarOptions {
                 "(time_offset_map_std), for at most this long; 0: off"));
     v.Field("time_offset_map_std", time_offset_map_std,
             Spec().Unit("s").Range(1e-6, 1.0).Help(
-                "IESKF map hold and replay: the estimate counts as converged once its 1-sigma "
-                "is below this"));
+                "IESKF map hold: the estimate counts as converged once its 1-sigma is below this"));
     v.Field("time_offset_replay", time_offset_replay,
             Spec().Unit("s").Range(0.0, 60.0).Help(
                 "IESKF with estimate_time_offset: once the estimate converges "
-                "(time_offset_map_std), the scans since the motion started are processed again "
+                "(time_offset_replay_std), the scans since the motion started are processed again "
                 "with it; given up after this long without convergence; 0: off"));
+    v.Field("time_offset_replay_std", time_offset_replay_std,
+            Spec().Unit("s").Range(1e-7, 1.0).Help(
+                "IESKF replay: the estimate counts as converged once its 1-sigma is below this"));
   }
   Status Validate() {
     Status s = ValidateFields(*this, "lidar");
