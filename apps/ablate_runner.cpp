@@ -490,15 +490,20 @@ void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& 
 
 MetricSet MetricSetOf(const Plan& plan) { return {plan.HasRefMap(), plan.HasSimulated()}; }
 
-const std::vector<std::string>& MetricNames(MetricSet set) {
-  static const std::vector<std::string> kNames = {
-      "ate_rmse",  "rpe_rmse",    "axis_rmse", "axis_max",          "end_point",
-      "ms_per_scan", "rtf", "rv_active_fraction", "degenerate_fraction"};
-  static const std::vector<std::vector<std::string>> kSets = [] {
-    std::vector<std::vector<std::string>> sets(4, kNames);
+const std::vector<MetricColumn>& MetricColumns(MetricSet set) {
+  static const std::vector<MetricColumn> kAlways = {
+      {"ate_rmse", "ATE [m]"},       {"rpe_rmse", "RPE [m]"},
+      {"axis_rmse", "axis RMSE [m]"}, {"axis_max", "axis max [m]"},
+      {"end_point", "end [m]"},       {"ms_per_scan", "ms/scan"},
+      {"rtf", "RTF"},                 {"rv_active_fraction", "RV active"},
+      {"degenerate_fraction", "degenerate"}};
+  static const std::vector<std::vector<MetricColumn>> kSets = [] {
+    std::vector<std::vector<MetricColumn>> sets(4, kAlways);
     for (int i = 0; i < 4; ++i) {
-      if (i & 1) sets[i].insert(sets[i].end(), {"map_rms", "map_completeness"});
-      if (i & 2) sets[i].insert(sets[i].end(), {"detect_precision", "detect_recall"});
+      if (i & 1)
+        sets[i].insert(sets[i].end(), {{"map_rms", "map RMS [m]"}, {"map_completeness", "completeness"}});
+      if (i & 2)
+        sets[i].insert(sets[i].end(), {{"detect_precision", "precision"}, {"detect_recall", "recall"}});
     }
     return sets;
   }();

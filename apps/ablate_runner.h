@@ -51,7 +51,11 @@ struct MetricSet {
 };
 MetricSet MetricSetOf(const Plan& plan);
 
-// The metric fields of cell.json "metrics", in table order.
-const std::vector<std::string>& MetricNames(MetricSet set = MetricSet());
+// The metric fields of cell.json "metrics" (name) and the Markdown table's
+// header of each, in table order.
+struct MetricColumn {
+  std::string name, header;
+};
+const std::vector<MetricColumn>& MetricColumns(MetricSet set = MetricSet());
 
 }  // namespace rvlio::cli::ablate

@@ -17,32 +17,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Metrics of the grouped table and their Markdown headers (the map and the
-// detection columns when the grid has them).
-const std::vector<std::pair<std::string, std::string>>& TableMetrics(MetricSet set) {
-  static const std::vector<std::pair<std::string, std::string>> kMetrics = {
-      {"ate_rmse", "ATE [m]"},
-      {"rpe_rmse", "RPE [m]"},
-      {"axis_rmse", "axis RMSE [m]"},
-      {"axis_max", "axis max [m]"},
-      {"end_point", "end [m]"},
-      {"ms_per_scan", "ms/scan"},
-      {"rtf", "RTF"},
-      {"rv_active_fraction", "RV active"},
-      {"degenerate_fraction", "degenerate"}};
-  static const std::vector<std::vector<std::pair<std::string, std::string>>> kSets = [] {
-    std::vector<std::vector<std::pair<std::string, std::string>>> sets(4, kMetrics);
-    for (int i = 0; i < 4; ++i) {
-      if (i & 1)
-        sets[i].insert(sets[i].end(), {{"map_rms", "map RMS [m]"}, {"map_completeness", "completeness"}});
-      if (i & 2)
-        sets[i].insert(sets[i].end(), {{"detect_precision", "precision"}, {"detect_recall", "recall"}});
-    }
-    return sets;
-  }();
-  return kSets[(set.map ? 1 : 0) + (set.detection ? 2 : 0)];
-}
-
 std::string Csv(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string q = "\"";
@@ -88,7 +62,7 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
   o << "id,sequence,variant,seed";
   for (const auto& k : plan.param_keys) o << "," << Csv(k);
   o << ",status,exit_code";
-  for (const auto& m : MetricNames(MetricSetOf(plan))) o << "," << m;
+  for (const MetricColumn& m : MetricColumns(MetricSetOf(plan))) o << "," << m.name;
   o << ",wall_s,error\n";
   for (size_t i = 0; i < plan.cells.size(); ++i) {
     const Cell& c = plan.cells[i];
@@ -100,8 +74,8 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
     o << "," << status << ","
       << (r.is_object() && r["exit_code"].is_number() ? std::to_string(r["exit_code"].get<int>())
                                                       : "");
-    for (const auto& m : MetricNames(MetricSetOf(plan)))
-      o << "," << FormatFinite(r.is_object() ? MetricOf(r, m) : NAN, 12);
+    for (const MetricColumn& m : MetricColumns(MetricSetOf(plan)))
+      o << "," << FormatFinite(r.is_object() ? MetricOf(r, m.name) : NAN, 12);
     o << "," << FormatFinite(r.is_object() ? r.value("wall_s", NAN) : NAN, 12) << ","
       << Csv(r.is_object() && r["error"].is_string() ? r["error"].get<std::string>() : "") << "\n";
   }
@@ -127,7 +101,7 @@ std::vector<Group> GroupCells(const Plan& plan, const std::vector<json>& records
     if (status == "diverged") ++g.diverged;
     if (status != "done") continue;
     ++g.done;
-    for (const auto& [m, header] : TableMetrics(MetricSetOf(plan))) {
+    for (const auto& [m, header] : MetricColumns(MetricSetOf(plan))) {
       const double v = MetricOf(r, m);
       if (std::isfinite(v)) g.values[m].push_back(v);
     }
@@ -141,13 +115,13 @@ std::string TableCsv(const Plan& plan, const std::vector<Group>& groups) {
   for (const auto& k : plan.param_keys) o << "," << Csv(k);
   o << ",cells,n,failed,diverged";
   const MetricSet set = MetricSetOf(plan);
-  for (const auto& [m, header] : TableMetrics(set)) o << "," << m << "_mean," << m << "_std";
+  for (const auto& [m, header] : MetricColumns(set)) o << "," << m << "_mean," << m << "_std";
   o << "\n";
   for (const Group& g : groups) {
     o << Csv(g.first->sequence) << "," << Csv(g.first->label);
     for (const auto& [k, v] : g.first->params) o << "," << Csv(v);
     o << "," << g.cells << "," << g.done << "," << g.failed << "," << g.diverged;
-    for (const auto& [m, header] : TableMetrics(set)) {
+    for (const auto& [m, header] : MetricColumns(set)) {
       const Stats s = Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>());
       o << "," << FormatFinite(s.mean, 12) << "," << FormatFinite(s.std, 12);
     }
@@ -169,14 +143,14 @@ std::string MeanStd(const Stats& s, int precision) {
 std::string TableMarkdown(const std::vector<Group>& groups, MetricSet set) {
   std::ostringstream o;
   o << "| sequence | variant | n | failed | diverged |";
-  for (const auto& [m, header] : TableMetrics(set)) o << " " << header << " |";
+  for (const auto& [m, header] : MetricColumns(set)) o << " " << header << " |";
   o << "\n|---|---|---|---|---|";
-  for (size_t i = 0; i < TableMetrics(set).size(); ++i) o << "---|";
+  for (size_t i = 0; i < MetricColumns(set).size(); ++i) o << "---|";
   o << "\n";
   for (const Group& g : groups) {
     o << "| " << g.first->sequence << " | " << g.first->label << " | " << g.done << " | "
       << g.failed << " | " << g.diverged << " |";
-    for (const auto& [m, header] : TableMetrics(set)) {
+    for (const auto& [m, header] : MetricColumns(set)) {
       const int precision =
           m == "ate_rmse" || m == "rpe_rmse" || m.rfind("axis", 0) == 0 || m == "end_point" ||
                   m == "map_rms" || m == "map_completeness"
