@@ -95,12 +95,15 @@ void IeskfOdometry::Replay() {
 // The held results are emitted as they are, and the next scan that shows the
 // offset starts a new hold: a scan at rest whose noise passed the motion test
 // (tunnel seed 5: at 1.3 s of a 3 s static start) must not use up the replay
-// of the real start of the motion. Each hold keeps at most one window.
+// of the real start of the motion. Each hold keeps at most one window, and
+// at most kMaxReplayHolds are made: on a recording whose estimate never
+// converges, the pipeline (its maps) is not copied every window to the end.
 void IeskfOdometry::GiveUpReplay(std::vector<ScanResult>* out) {
   for (ScanResult& r : held_) out->push_back(std::move(r));
   held_.clear();
   snapshot_.reset();
-  phase_ = ReplayPhase::kWaitingForMotion;
+  ++holds_given_up_;
+  phase_ = holds_given_up_ < kMaxReplayHolds ? ReplayPhase::kWaitingForMotion : ReplayPhase::kOver;
 }
 
 IeskfPipeline::IeskfPipeline(const OdometryOptions& options, Localization localization)

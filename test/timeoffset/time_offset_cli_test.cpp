@@ -184,7 +184,7 @@ TEST_F(TimeOffsetCliTest, IeskfReplayEmitsEachScanOnceInOrder) {
 
 // A hold that ends without replay leaves the results as they were: holds
 // that never converge (time_offset_replay_std 1e-7 s; each given up after one
-// scan, time_offset_replay 0.05 s, then a new one starts) and the end of input
+// scan, time_offset_replay 0.05 s, then a new one starts, three in all) and the end of input
 // inside the hold (--duration 3.6: four scans of motion, the offset's 1-sigma
 // still 1.9 ms, above lidar.time_offset_replay_std) write the trajectory of
 // the run without the replay, byte for byte.

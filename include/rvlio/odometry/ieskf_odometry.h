@@ -98,7 +98,8 @@ class IeskfPipeline {
 // continues from the snapshot with the converged offset (re-processing the
 // kept input) and the held results are dropped; after time_offset_replay
 // seconds without convergence (or at a stop) the held results are emitted
-// and the next scan that shows the offset starts a new hold. One replay per run.
+// and the next scan that shows the offset starts a new hold (at most three
+// holds). One replay per run.
 // Each scan's result is emitted once, in order.
 class IeskfOdometry : public Odometry {
  public:
@@ -130,6 +131,8 @@ class IeskfOdometry : public Odometry {
   std::optional<IeskfPipeline> snapshot_;  // kHolding: before the first moving scan, with the input since
   TimeNs hold_start_ns_ = 0;               // kHolding: the state's time at the snapshot
   std::vector<ScanResult> held_;           // kHolding: the live results since the snapshot
+  static constexpr int kMaxReplayHolds = 3;  // holds per run (GiveUpReplay)
+  int holds_given_up_ = 0;
 };
 
 }  // namespace rvlio
