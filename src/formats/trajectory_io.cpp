@@ -239,6 +239,15 @@ Status AssignKittiTimes(const std::string& path, const KittiTimes& times,
                                   " poses: the stamps would overflow");
     for (size_t i = 0; i < trajectory->size(); ++i)
       (*trajectory)[i].t_ns = SecondsToNs(static_cast<double>(i) / rate_hz);
+    // Stamps are whole nanoseconds: above ~1 GHz two poses would share one,
+    // and the trajectory would not read back (nor interpolate).
+    for (size_t i = 1; i < trajectory->size(); ++i)
+      if ((*trajectory)[i].t_ns <= (*trajectory)[i - 1].t_ns)
+        return Status::InvalidInput("KITTI rate " + FormatG(rate_hz) + " Hz is too high: poses " +
+                                    std::to_string(i) + " and " + std::to_string(i + 1) +
+                                    " would share the time stamp " +
+                                    std::to_string((*trajectory)[i].t_ns) +
+                                    " ns (stamps are whole nanoseconds)");
     return Status::Ok();
   }
   StatusOr<std::vector<DataLine>> lines = times.load(times_path, times.text);

@@ -183,6 +183,34 @@ TEST(TrajectoryFuzzRegress, KittiRateTooLowForThePosesIsAnError) {
   EXPECT_LT(std::llabs((*slow)[2].t_ns - 2000000000000000000), 1000);
 }
 
+// Found by CI's fuzz stage: a fuzzed rate of ~1e12 Hz gave every pose the
+// stamp 0 ns. The KITTI reader took it, but the TUM file written from it did
+// not read back (three equal stamps in a row).
+TEST(TrajectoryFuzzRegress, KittiRateTooHighForNanosecondStampsIsAnError) {
+  const std::string identity = "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  const std::string three = identity + identity + identity;
+  const StatusOr<Trajectory> t = ParseKittiText(three, "k.txt", 1e12);
+  ASSERT_FALSE(t.ok());
+  EXPECT_EQ(t.status().code(), StatusCode::kInvalidInput);
+  EXPECT_EQ(t.status().message(),
+            "KITTI rate 1e+12 Hz is too high: poses 1 and 2 would share the time stamp 0 ns "
+            "(stamps are whole nanoseconds)");
+  const StatusOr<Trajectory> detected = ParseTrajectoryText(three, "k.txt", 1.5e9);
+  ASSERT_FALSE(detected.ok());
+  EXPECT_EQ(detected.status().message(),
+            "KITTI rate 1.5e+09 Hz is too high: poses 2 and 3 would share the time stamp 1 ns "
+            "(stamps are whole nanoseconds)");
+  // 1 GHz is one pose per nanosecond, and reads back as TUM.
+  const StatusOr<Trajectory> ghz = ParseKittiText(three, "k.txt", 1e9);
+  ASSERT_TRUE(ghz.ok()) << ghz.status().message();
+  EXPECT_EQ((*ghz)[2].t_ns, 2);
+  std::string tum;
+  for (const auto& pose : *ghz) tum += FormatTumLine(pose);
+  const StatusOr<Trajectory> back = ParseTumText(tum, "back.tum");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ((*back)[2].t_ns, 2);
+}
+
 // Found by CI's fuzz stage: the quaternion of "0e200 1e260 1e000 1e200"
 // (after scaling) has a rotation matrix with entries of ~1e-320; our KITTI
 // writer prints them and strtod flags such subnormals with ERANGE, which the
