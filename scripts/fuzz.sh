@@ -5,13 +5,13 @@
 #   bash scripts/fuzz.sh [--seconds N] [--ci] [TARGET ...]
 #
 #   --seconds N   fuzzing time per target (default: $RVLIO_FUZZ_SECONDS or 60)
-#   --ci          reproducible run (what scripts/test.sh uses): libFuzzer seed 1
-#                 and a fixed number of inputs per target (about a minute here),
-#                 starting from the committed seeds only, so CI's verdict is the
-#                 same on every machine (a slower machine stops at --seconds
-#                 after a prefix of the same inputs). Without --ci the seed is
+#   --ci          what scripts/test.sh uses: libFuzzer seed 1 and a fixed number
+#                 of inputs per target (about a minute here), starting from the
+#                 committed seeds only. The inputs tried are nearly, not exactly,
+#                 the same on every machine: CI once found an input that a local
+#                 --ci run of the same commit did not. Without --ci the seed is
 #                 random and new inputs accumulate: use that to hunt for bugs.
-#   TARGET        pointcloud2, config, trajectory, mcap, cdr (default: all five)
+#   TARGET        pointcloud2, config, trajectory, mcap, cdr, ouster (default: all six)
 #
 # Seeds: fuzz/corpus/<target>/ (read only; refresh with fuzz/make_seeds.py).
 # New interesting inputs go to build-fuzz/corpus/<target>/, which later runs
