@@ -2,6 +2,7 @@
 #include "rvlio/lidar/extrinsics.h"
 #include "rvlio/odometry/ieskf_odometry.h"
 
+#include <algorithm>
 #include <limits>
 #include <utility>
 
@@ -67,8 +68,12 @@ bool IeskfOdometry::Step(bool finishing, std::vector<ScanResult>* out) {
     phase_ = ReplayPhase::kHolding;
   }
   const bool holding = phase_ == ReplayPhase::kHolding;
+  const size_t first_new = out->size();
   if (!live_.ProcessNext(finishing, holding ? &held_ : out)) return false;
-  if (holding) EndHoldIfDue(out);
+  if (holding)
+    EndHoldIfDue(out);
+  else if (!held_cost_ms_.empty())
+    AddHeldCost(first_new, out);
   return true;
 }
 
@@ -86,10 +91,36 @@ void IeskfOdometry::Replay() {
   const Ieskf& converged = live_.filter();
   snapshot_->SetTimeOffset(converged.time_offset_s(), converged.time_offset_std_s());
   snapshot_->SetReplayedScans(static_cast<int64_t>(held_.size()));
+  // The snapshot queues the scans the hold processed (less those the new
+  // shift dropped) and those the live pipeline still queues.
+  const size_t queued_in_both = live_.queued_scans();
+  const size_t queued_in_snapshot = snapshot_->queued_scans();
+  CarryHeldCost(queued_in_snapshot > queued_in_both ? queued_in_snapshot - queued_in_both : 0);
   live_ = std::move(*snapshot_);
   snapshot_.reset();
   held_.clear();
   phase_ = ReplayPhase::kOver;
+}
+
+// A replayed scan's `ms` is both its processings: the held result's CPU time
+// (dropped with it) plus the replay's. The scans the new shift dropped are
+// the oldest; their cost goes to the first replayed result, so the run's
+// total CPU time (summary.json per_scan_ms, total) keeps the whole replay.
+void IeskfOdometry::CarryHeldCost(size_t replayed_scans) {
+  held_cost_ms_.clear();
+  for (const ScanResult& r : held_) held_cost_ms_.push_back(r.ms);
+  while (held_cost_ms_.size() > std::max<size_t>(replayed_scans, 1)) {
+    const double dropped_ms = held_cost_ms_.front();
+    held_cost_ms_.pop_front();
+    held_cost_ms_.front() += dropped_ms;
+  }
+}
+
+void IeskfOdometry::AddHeldCost(size_t first_new, std::vector<ScanResult>* out) {
+  for (size_t i = first_new; i < out->size() && !held_cost_ms_.empty(); ++i) {
+    (*out)[i].ms += held_cost_ms_.front();
+    held_cost_ms_.pop_front();
+  }
 }
 
 // The held results are emitted as they are, and the next scan that shows the

@@ -34,6 +34,7 @@ class IeskfPipeline {
   // (those that now start before the state are dropped, as AddScan would).
   void SetTimeOffset(double td_s, double std_s);
   void SetReplayedScans(int64_t n) { stats_.time_offset.replayed_scans = replayed_scans_ = n; }
+  size_t queued_scans() const { return scans_.size(); }
 
   const OdometryStats& stats() const { return stats_; }
   std::vector<std::string> warnings() const;
@@ -94,9 +95,10 @@ class IeskfPipeline {
 // lidar.time_offset_replay (docs/time_offset.md "Replay"): before the first
 // scan that shows the offset, a snapshot of the pipeline is taken and the
 // input from then on is also given to it; the results meanwhile are held.
-// Once the offset's 1-sigma is below lidar.time_offset_map_std, the pipeline
-// continues from the snapshot with the converged offset (re-processing the
-// kept input) and the held results are dropped; after time_offset_replay
+// Once the offset's 1-sigma is below lidar.time_offset_replay_std, the
+// pipeline continues from the snapshot with the converged offset
+// (re-processing the kept input) and the held results are dropped, their CPU
+// time added to the replayed results' `ms`; after time_offset_replay
 // seconds without convergence (or at a stop) the held results are emitted
 // and the next scan that shows the offset starts a new hold (at most three
 // holds). One replay per run.
@@ -124,6 +126,8 @@ class IeskfOdometry : public Odometry {
   void EndHoldIfDue(std::vector<ScanResult>* out);
   void Replay();
   void GiveUpReplay(std::vector<ScanResult>* out);
+  void CarryHeldCost(size_t replayed_scans);
+  void AddHeldCost(size_t first_new, std::vector<ScanResult>* out);
 
   OdometryOptions options_;
   IeskfPipeline live_;
@@ -131,6 +135,9 @@ class IeskfOdometry : public Odometry {
   std::optional<IeskfPipeline> snapshot_;  // kHolding: before the first moving scan, with the input since
   TimeNs hold_start_ns_ = 0;               // kHolding: the state's time at the snapshot
   std::vector<ScanResult> held_;           // kHolding: the live results since the snapshot
+  // After a replay: the CPU ms of the dropped first processing of each scan
+  // still to be replayed, oldest first (added to its replayed result's ms).
+  std::deque<double> held_cost_ms_;
   static constexpr int kMaxReplayHolds = 3;  // holds per run (GiveUpReplay)
   int holds_given_up_ = 0;
 };

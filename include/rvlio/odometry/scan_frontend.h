@@ -179,6 +179,7 @@ class ScanQueue {
            imu_buffer.back().t_ns >= scans_.front().t_end_ns + shift_ns;
   }
   bool empty() const { return scans_.empty(); }
+  size_t size() const { return scans_.size(); }
   const Scan& front() const { return scans_.front(); }
   Scan PopFront();
   // Drops (and counts in scans_before_imu) the queued scans that start before
