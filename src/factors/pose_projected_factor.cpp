@@ -1,5 +1,7 @@
 #include "rvlio/factors/pose_projected_factor.h"
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 #include "rvlio/common/check.h"
@@ -25,38 +27,65 @@ Eigen::Matrix<double, 6, 6> RotationBlock(const Eigen::Matrix3d& J_rot) {
 
 PoseProjectedFactor::PoseProjectedFactor(const ceres::CostFunction* inner, const PoseBlock& pose0,
                                          const Directions& held)
-    : inner_(inner), pose0_(pose0) {
-  RVLIO_CHECK(inner != nullptr && !inner->parameter_block_sizes().empty() &&
-              inner->parameter_block_sizes()[0] == PoseBlock::kNumParams);
-  *mutable_parameter_block_sizes() = inner->parameter_block_sizes();
+    : PoseProjectedFactor(inner, {BlockProjection{0, pose0, held}}) {}
+
+PoseProjectedFactor::PoseProjectedFactor(const ceres::CostFunction* inner,
+                                         const std::vector<BlockProjection>& projections)
+    : inner_(inner) {
+  RVLIO_CHECK(inner != nullptr && !projections.empty() &&
+              projections.size() <= static_cast<size_t>(kMaxProjectedBlocks));
+  const std::vector<int32_t>& sizes = inner->parameter_block_sizes();
+  for (const BlockProjection& b : projections) {
+    RVLIO_CHECK(b.block >= 0 && b.block < static_cast<int>(sizes.size()) &&
+                sizes[b.block] == PoseBlock::kNumParams);
+    for (const Projection& p : projections_) RVLIO_CHECK(p.block != b.block);
+    projections_.push_back(
+        {b.block, b.pose0, Eigen::Matrix<double, 6, 6>::Identity() - b.held * b.held.transpose()});
+  }
+  *mutable_parameter_block_sizes() = sizes;
   set_num_residuals(inner->num_residuals());
-  projector_ = Eigen::Matrix<double, 6, 6>::Identity() - held * held.transpose();
 }
 
 PoseBlock PoseProjectedFactor::Projected(const PoseBlock& x) const {
-  return Plus(pose0_, projector_ * Minus(x, pose0_));
+  const Projection& p = projections_.front();
+  return Plus(p.pose0, p.projector * Minus(x, p.pose0));
 }
 
 bool PoseProjectedFactor::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  const PoseBlock x = PoseBlock::FromArray(parameters[0]);
-  const PoseBlock::Tangent d = Minus(x, pose0_);
-  const PoseBlock::Tangent d_proj = projector_ * d;
-  double x_proj[PoseBlock::kNumParams];
-  Plus(pose0_, d_proj).ToArray(x_proj);
-  std::vector<const double*> params(parameters, parameters + parameter_block_sizes().size());
-  params[0] = x_proj;
-  if (jacobians == nullptr || jacobians[0] == nullptr)
-    return inner_->Evaluate(params.data(), residuals, jacobians);
+  const size_t n = projections_.size();
   const int rows = num_residuals();
-  AmbientJacobian J_a_proj(rows, PoseBlock::kNumParams);
-  std::vector<double*> inner_jacobians(jacobians, jacobians + params.size());
-  inner_jacobians[0] = J_a_proj.data();
-  if (!inner_->Evaluate(params.data(), residuals, inner_jacobians.data())) return false;
-  const TangentJacobian J_t_proj = J_a_proj * PlusJacobian(PoseBlock::FromArray(x_proj));
-  const TangentJacobian J_t = J_t_proj * RotationBlock(so3::Jr(d_proj.segment<3>(PoseBlock::kRot))) *
-                              projector_ * RotationBlock(so3::JrInv(d.segment<3>(PoseBlock::kRot)));
-  PoseTangentToAmbientJacobian(parameters[0], J_t, jacobians[0]);
+  std::array<PoseBlock::Tangent, kMaxProjectedBlocks> d, d_proj;
+  std::array<std::array<double, PoseBlock::kNumParams>, kMaxProjectedBlocks> x_proj;
+  std::array<AmbientJacobian, kMaxProjectedBlocks> J_a_proj;
+  std::vector<const double*> params(parameters, parameters + parameter_block_sizes().size());
+  std::vector<double*> inner_jacobians;
+  if (jacobians != nullptr) inner_jacobians.assign(jacobians, jacobians + params.size());
+  for (size_t i = 0; i < n; ++i) {
+    const Projection& p = projections_[i];
+    d[i] = Minus(PoseBlock::FromArray(parameters[p.block]), p.pose0);
+    d_proj[i] = p.projector * d[i];
+    Plus(p.pose0, d_proj[i]).ToArray(x_proj[i].data());
+    params[p.block] = x_proj[i].data();
+    if (jacobians != nullptr && jacobians[p.block] != nullptr) {
+      J_a_proj[i].resize(rows, PoseBlock::kNumParams);
+      inner_jacobians[p.block] = J_a_proj[i].data();
+    }
+  }
+  if (!inner_->Evaluate(params.data(), residuals,
+                        jacobians != nullptr ? inner_jacobians.data() : nullptr))
+    return false;
+  for (size_t i = 0; i < n; ++i) {
+    const Projection& p = projections_[i];
+    if (jacobians == nullptr || jacobians[p.block] == nullptr) continue;
+    const TangentJacobian J_t_proj =
+        J_a_proj[i] * PlusJacobian(PoseBlock::FromArray(x_proj[i].data()));
+    const TangentJacobian J_t = J_t_proj *
+                                RotationBlock(so3::Jr(d_proj[i].segment<3>(PoseBlock::kRot))) *
+                                p.projector *
+                                RotationBlock(so3::JrInv(d[i].segment<3>(PoseBlock::kRot)));
+    PoseTangentToAmbientJacobian(parameters[p.block], J_t, jacobians[p.block]);
+  }
   return true;
 }
 

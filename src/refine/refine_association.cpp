@@ -157,6 +157,17 @@ LeastSquaresDegeneracy AnalyzeRefineDegeneracy(const RefineConfig& config,
                                      config.constraints.lidar_noise);
 }
 
+// remap in the project form (degeneracy.remap_refine_form), as in the
+// smoother: the scan's factors lose their say along the weak directions and
+// the IMU chain places the poses there. A chunk of one scan has no IMU factor
+// to do that; it holds instead.
+bool ProjectRemappedScan(const DegeneracyOptions& options, const LeastSquaresDegeneracy& d,
+                         const ScanRange& chunk) {
+  return options.method == DegeneracyMethod::kRemap &&
+         options.remap_refine_form == RemapWindowForm::kProject && d.num_held > 0 &&
+         chunk.size() > 1;
+}
+
 }  // namespace
 
 ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap& round,
@@ -188,6 +199,11 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
   f.degeneracy = degeneracy.report;
   f.has_degeneracy_prior = degeneracy.has_prior;
   f.degeneracy_sqrt_information = degeneracy.sqrt_information;
+  if (ProjectRemappedScan(config.degeneracy, degeneracy, chunk)) {
+    f.has_degeneracy_prior = false;
+    f.remap_held = degeneracy.held_pose.leftCols(degeneracy.num_held);
+    f.remap_pose0 = PoseBlock(states[k].T_world_imu());
+  }
   return f;
 }
 

@@ -43,7 +43,7 @@ SharedPoses FindShared(const std::map<TimeNs, StampedPose>& merged, const Trajec
 // aligned), then the mean of p_m - R p_c.
 Pose3 AlignShared(const SharedPoses& s) {
   Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-  Eigen::Quaterniond first;
+  Eigen::Quaterniond first = Eigen::Quaterniond::Identity();  // set at i = 0
   for (size_t i = 0; i < s.merged.size(); ++i) {
     Eigen::Quaterniond q = s.merged[i].q_world_imu.normalized() * s.chunk[i].q_world_imu.normalized().conjugate();
     if (i == 0) first = q;

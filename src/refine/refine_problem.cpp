@@ -8,6 +8,7 @@
 
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/factors/imu_factor.h"
+#include "rvlio/factors/pose_projected_factor.h"
 #include "rvlio/factors/prior_factor.h"
 
 namespace rvlio {
@@ -27,6 +28,37 @@ class StopCallback : public ceres::IterationCallback {
  private:
   const std::function<bool()>& stop_;
 };
+
+// The weak directions of scan k (pose tangent of k: body-frame rotation,
+// world translation) as directions of pose j's tangent: the same world
+// rotation axes in j's body frame, the same world translations.
+PoseProjectedFactor::Directions TransportedDirections(const PoseProjectedFactor::Directions& held_k,
+                                                      const PoseBlock& pose_k,
+                                                      const PoseBlock& pose_j) {
+  PoseProjectedFactor::Directions held_j = held_k;
+  const Eigen::Matrix3d R_j_k =
+      (pose_j.q_world_imu.conjugate() * pose_k.q_world_imu).toRotationMatrix();
+  held_j.middleRows<3>(PoseBlock::kRot) = R_j_k * held_k.middleRows<3>(PoseBlock::kRot);
+  return held_j;
+}
+
+// The cost of one of scan k's factors (pose_k its first block; a pair's
+// second block is pose_j, the scan whose planes it uses): the factor itself,
+// handed to the problem; or, remap in the project form, a PoseProjectedFactor
+// around it, which stays with f. A pair factor is projected in both poses,
+// each at its estimate of the association (the states are not solved yet):
+// the scan's constraints then say nothing along its weak directions, neither
+// about its own pose nor about the scans that hold its planes.
+ceres::CostFunction* ScanCost(const ScanFactors& f, std::unique_ptr<ceres::CostFunction>* factor,
+                              const RefineState* source = nullptr) {
+  if (f.remap_held.cols() == 0) return factor->release();
+  if (source == nullptr) return new PoseProjectedFactor(factor->get(), f.remap_pose0, f.remap_held);
+  const PoseBlock pose_j = PoseBlock::FromArray(source->pose.data());
+  return new PoseProjectedFactor(
+      factor->get(),
+      {{0, f.remap_pose0, f.remap_held},
+       {1, pose_j, TransportedDirections(f.remap_held, f.remap_pose0, pose_j)}});
+}
 
 }  // namespace
 
@@ -70,9 +102,10 @@ void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noi
   for (int k = chunk.begin; k < chunk.end; ++k) {
     ScanFactors& f = (*factors)[k - chunk.begin];
     double* pose_k = (*states)[k].pose.data();
-    if (f.fixed) problem->AddResidualBlock(f.fixed.release(), nullptr, pose_k);
+    if (f.fixed) problem->AddResidualBlock(ScanCost(f, &f.fixed), nullptr, pose_k);
     for (auto& [j, pair] : f.pairs)
-      problem->AddResidualBlock(pair.release(), nullptr, pose_k, (*states)[j].pose.data());
+      problem->AddResidualBlock(ScanCost(f, &pair, &(*states)[j]), nullptr, pose_k,
+                                (*states)[j].pose.data());
   }
   AddRefineImuFactors(sequence, noise, g_world, chunk, states, problem);
   if (hold_first_pose)  // gauge / previous chunk

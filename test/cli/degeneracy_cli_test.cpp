@@ -160,6 +160,20 @@ TEST_F(DegeneracyCliTest, EveryMethodRunsInTheSmootherAndInRefine) {
     ASSERT_TRUE(rate.is_object());
     EXPECT_LT(rate["ape"]["rmse"].get<double>(), 0.05);
   }
+  // remap's project form in refine (degeneracy.remap_refine_form).
+  const std::string projected = dir_ + "/refine_remap_project";
+  const ToolRun p = RunTool("refine --bag " + data_ + ".bag --config " + data_ + ".yaml --init " +
+                                base + "/trajectory.tum --set smoother.refine_rounds=2 " +
+                                "--set degeneracy.method=remap --set degeneracy.remap_refine_form=project --out " +
+                                projected,
+                            dir_);
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  const nlohmann::json ps = nlohmann::json::parse(ReadFile(projected + "/summary.json"), nullptr, false);
+  ASSERT_FALSE(ps.is_discarded());
+  EXPECT_GT(ps["degenerate_scans"].get<int>(), 0);
+  const nlohmann::json pate = testing_cli::EvalJson(gt, projected + "/trajectory.tum", dir_);
+  ASSERT_TRUE(pate.is_object());
+  EXPECT_LT(pate["ape"]["rmse"].get<double>(), 0.05);
 }
 
 }  // namespace

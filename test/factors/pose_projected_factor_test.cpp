@@ -1,7 +1,8 @@
 // PoseProjectedFactor (the smoother's remap): along the held pose directions
 // the wrapped factor is constant through pose0; across them it is the inner
 // factor of the projected pose; its Jacobians match numeric differences
-// through the manifold, for a one-block and a two-block inner factor.
+// through the manifold, for a one-block and a two-block inner factor, and
+// with both pose blocks of a two-block factor projected (refine's pairs).
 #include <random>
 
 #include <Eigen/QR>
@@ -102,6 +103,50 @@ TEST(PoseProjectedFactor, JacobiansMatchNumericDifferences) {
     const PoseProjectedFactor two(&with_extrinsic, pose0, V);
     const auto ext = test::ToVector(Near(rng, PoseBlock(Pose3()), 0.05));
     EXPECT_LT(test::TangentJacobianError(two, {x, ext}, {&m, &m}), 1e-5) << "trial " << trial;
+  }
+}
+
+// Refine's pair factors: both pose blocks projected, each through its own
+// pose0 and directions. The factor is constant along each block's
+// directions, its Jacobians match numeric differences, and a constant first
+// block (no Jacobian asked for it, as Ceres does for a held pose) leaves the
+// second block's Jacobian as it is.
+TEST(PoseProjectedFactor, TwoProjectedBlocksAreEachConstantAlongTheirDirections) {
+  std::mt19937 rng(75);
+  const PoseManifold m;
+  for (int trial = 0; trial < 10; ++trial) {
+    const ConstraintList list = test::RandomConstraints(rng, 30);
+    const PlaneExtrinsicFactor inner(list, 0.02);
+    const PoseBlock pose0 = test::RandomPose(rng);
+    const PoseBlock ext0 = Near(rng, PoseBlock(Pose3()), 0.05);
+    const HeldDirections V0 = RandomHeld(rng, 1 + trial % 3), V1 = RandomHeld(rng, 1 + trial % 2);
+    const PoseProjectedFactor f(&inner, {{0, pose0, V0}, {1, ext0, V1}});
+    const auto x = test::ToVector(Near(rng, pose0, 0.05));
+    const auto e = test::ToVector(Near(rng, ext0, 0.05));
+    const Eigen::VectorXd r = test::EvaluateCost(f, {x, e});
+    const PoseBlock::Tangent d0 = Minus(PoseBlock::FromArray(x.data()), pose0);
+    const PoseBlock::Tangent d1 = Minus(PoseBlock::FromArray(e.data()), ext0);
+    const Eigen::VectorXd along0 = V0 * Eigen::VectorXd::Random(V0.cols());
+    const Eigen::VectorXd along1 = V1 * Eigen::VectorXd::Random(V1.cols());
+    const auto x_moved = test::ToVector(Plus(pose0, d0 + 0.3 * along0));
+    const auto e_moved = test::ToVector(Plus(ext0, d1 + 0.3 * along1));
+    const Eigen::VectorXd r_moved = test::EvaluateCost(f, {x_moved, e_moved});
+    EXPECT_LT((r_moved - r).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, r.norm())) << trial;
+    // Not constant across: the inner factor of the projected poses.
+    const Eigen::VectorXd r_inner = test::EvaluateCost(
+        inner, {test::ToVector(f.Projected(PoseBlock::FromArray(x.data()))),
+                test::ToVector(Plus(ext0, d1 - V1 * (V1.transpose() * d1)))});
+    EXPECT_LT((r - r_inner).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, r.norm())) << trial;
+    EXPECT_LT(test::TangentJacobianError(f, {x, e}, {&m, &m}), 1e-5) << trial;
+    std::vector<test::RowMajorMatrix> J;
+    test::EvaluateCost(f, {x, e}, &J);
+    test::RowMajorMatrix J1(f.num_residuals(), PoseBlock::kNumParams);
+    Eigen::VectorXd r_held(f.num_residuals());
+    const double* params[2] = {x.data(), e.data()};
+    double* jacobians[2] = {nullptr, J1.data()};
+    ASSERT_TRUE(f.Evaluate(params, r_held.data(), jacobians));
+    EXPECT_EQ(r_held, r);
+    EXPECT_LT((J1 - J[1]).cwiseAbs().maxCoeff(), 1e-12 * std::max(1.0, J[1].cwiseAbs().maxCoeff()));
   }
 }
 

@@ -336,6 +336,7 @@ TEST(RefineProblem, DegeneracyPriorsHoldThePosesAtTheirInitialValues) {
   // Every direction held, and the same chunk without the priors.
   RefineConfig config = Config();
   config.degeneracy.method = DegeneracyMethod::kRemap;
+  ASSERT_EQ(config.degeneracy.remap_refine_form, RemapWindowForm::kHold);  // the default
   config.degeneracy.remap_min_eigenvalue = 1e15;  // every direction degenerate
   double moved[2] = {0.0, 0.0};                    // largest motion from the anchors, m
   for (bool with_priors : {false, true}) {
@@ -368,6 +369,54 @@ TEST(RefineProblem, DegeneracyPriorsHoldThePosesAtTheirInitialValues) {
   // the pull of the IMU factors, stiffer here than the scans.
   EXPECT_GT(moved[0], 0.05);
   EXPECT_LT(moved[1], 0.05 * moved[0]);
+}
+
+// remap in the project form (degeneracy.remap_refine_form): with every
+// direction weak, each scan's factors are constant in its own pose and in
+// the poses of the scans whose planes it uses, so they cannot move any; the
+// poses follow the IMU chain from the held first pose, as in the same chunk
+// without any scan factor. No prior is added. A chunk of one scan has no IMU
+// chain and gets the hold prior instead.
+TEST(RefineProblem, RemapProjectFormLeavesTheWeakDirectionsToTheImuChain) {
+  RefineConfig config = Config();
+  config.degeneracy.method = DegeneracyMethod::kRemap;
+  config.degeneracy.remap_min_eigenvalue = 1e15;  // every direction degenerate
+  config.degeneracy.remap_refine_form = RemapWindowForm::kProject;
+  const ScanRange chunk{0, 6};
+  std::vector<RefineState> solved[2];  // projected scans; IMU chain only
+  for (bool imu_only : {false, true}) {
+    Round r = MakeRound(6);
+    RefineRoundMap round(config.map);
+    PrepareRound(r, config, 1, &round);
+    ChunkAssociation a = AssociateRefineChunk(config, round, r.states, chunk, 1, nullptr);
+    EXPECT_EQ(a.degenerate_scans, 6);
+    for (ScanFactors& f : a.factors) {
+      EXPECT_FALSE(f.has_degeneracy_prior);
+      EXPECT_EQ(f.remap_held.cols(), 6);
+      if (imu_only) f = ScanFactors();
+    }
+    PoseManifold manifold;
+    ceres::Problem problem(RefineProblemOptions());
+    BuildRefineChunkProblem(r.sequence, ImuNoise::FromOptions(config.imu), test::Gravity(), chunk,
+                            /*hold_first_pose=*/true, &a.factors, &manifold, &r.states, &problem);
+    ASSERT_TRUE(SolveRefineProblem(&problem, RefineSolver::Make(1).Options(10), chunk, nullptr,
+                                   &r.states)
+                    .accepted);
+    solved[imu_only] = r.states;
+  }
+  for (int k = 1; k < 6; ++k) {
+    const PoseBlock::Tangent d = Minus(PoseBlock::FromArray(solved[0][k].pose.data()),
+                                       PoseBlock::FromArray(solved[1][k].pose.data()));
+    EXPECT_LT(d.norm(), 1e-6) << k;
+  }
+  // One scan: no IMU factor would place it, so the pose is held.
+  Round r = MakeRound(6);
+  RefineRoundMap round(config.map);
+  PrepareRound(r, config, 1, &round);
+  const ChunkAssociation one = AssociateRefineChunk(config, round, r.states, {2, 3}, 1, nullptr);
+  ASSERT_EQ(one.factors.size(), 1u);
+  EXPECT_TRUE(one.factors[0].has_degeneracy_prior);
+  EXPECT_EQ(one.factors[0].remap_held.cols(), 0);
 }
 
 // A residual whose evaluation fails: Ceres gives no usable solution.

@@ -65,9 +65,13 @@ struct DegeneracyOptions {
   double hold_information = 1e6;
   // remap in the smoother: project (default; the paper's "the degenerate
   // directions come from the prior", the prior being the rest of the window)
-  // or hold (a prior at the IMU prediction, localizability's form). Refine
-  // always holds (its scan factors also tie pairs of scans).
+  // or hold (a prior at the IMU prediction, localizability's form).
   RemapWindowForm remap_window_form = RemapWindowForm::kProject;
+  // remap in refine: hold (default; a prior at the --init pose, which is
+  // Zhang et al.'s remap of an iterative solve started there) or project
+  // (the scan's pair factors have no say along the weak directions in either
+  // pose, and the IMU chain places the poses; docs/degeneracy.md "Backends").
+  RemapWindowForm remap_refine_form = RemapWindowForm::kHold;
 
   template <class V>
   void Visit(V& v) {
@@ -87,6 +91,8 @@ struct DegeneracyOptions {
         .Help("smoother/refine, remap and localizability: information (sigma = 1) of the prior holding a weak direction"));
     v.Field("remap_window_form", remap_window_form, Spec().Choices(EnumChoices<RemapWindowForm>())
         .Help("smoother, remap: project (the scan's factor has no say along the degenerate directions) | hold (a prior at the IMU prediction)"));
+    v.Field("remap_refine_form", remap_refine_form, Spec().Choices(EnumChoices<RemapWindowForm>())
+        .Help("refine, remap: hold (a prior at the --init pose) | project (the scan's factors have no say along the degenerate directions, in its pose and in the poses of the scans whose planes it uses)"));
   }
   Status Validate() { return ValidateFields(*this, "degeneracy"); }
 };
