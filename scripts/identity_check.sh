@@ -110,6 +110,9 @@ else
   if diff -r "$ref" "$norm" > "$work/diff.txt"; then
     echo "identity_check.sh: identical ($(find "$ref" -type f | wc -l) files)"
   else
-    head -40 "$work/diff.txt"; echo "identity_check.sh: DIFFERENT outputs" >&2; exit 1
+    head -40 "$work/diff.txt"
+    echo "identity_check.sh: the files that differ:"
+    diff -rq "$ref" "$norm" | sed "s#$norm/##" || true
+    echo "identity_check.sh: DIFFERENT outputs" >&2; exit 1
   fi
 fi
