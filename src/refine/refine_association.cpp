@@ -202,7 +202,6 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
   if (ProjectRemappedScan(config.degeneracy, degeneracy, chunk)) {
     f.has_degeneracy_prior = false;
     f.remap_held = degeneracy.held_pose.leftCols(degeneracy.num_held);
-    f.remap_pose0 = PoseBlock(states[k].T_world_imu());
   }
   return f;
 }

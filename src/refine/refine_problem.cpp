@@ -45,19 +45,20 @@ PoseProjectedFactor::Directions TransportedDirections(const PoseProjectedFactor:
 // The cost of one of scan k's factors (pose_k its first block; a pair's
 // second block is pose_j, the scan whose planes it uses): the factor itself,
 // handed to the problem; or, remap in the project form, a PoseProjectedFactor
-// around it, which stays with f. A pair factor is projected in both poses,
-// each at its estimate of the association (the states are not solved yet):
-// the scan's constraints then say nothing along its weak directions, neither
-// about its own pose nor about the scans that hold its planes.
+// around it, which stays with f. The poses are projected at their estimates
+// of the association (the chunk's states are not solved yet); a pair factor
+// in both poses, so the scan's constraints say nothing along its weak
+// directions, neither about its own pose nor about the scans that hold its
+// planes.
 ceres::CostFunction* ScanCost(const ScanFactors& f, std::unique_ptr<ceres::CostFunction>* factor,
-                              const RefineState* source = nullptr) {
+                              const RefineState& scan, const RefineState* source = nullptr) {
   if (f.remap_held.cols() == 0) return factor->release();
-  if (source == nullptr) return new PoseProjectedFactor(factor->get(), f.remap_pose0, f.remap_held);
+  const PoseBlock pose_k = PoseBlock::FromArray(scan.pose.data());
+  if (source == nullptr) return new PoseProjectedFactor(factor->get(), pose_k, f.remap_held);
   const PoseBlock pose_j = PoseBlock::FromArray(source->pose.data());
   return new PoseProjectedFactor(
-      factor->get(),
-      {{0, f.remap_pose0, f.remap_held},
-       {1, pose_j, TransportedDirections(f.remap_held, f.remap_pose0, pose_j)}});
+      factor->get(), {{0, pose_k, f.remap_held},
+                      {1, pose_j, TransportedDirections(f.remap_held, pose_k, pose_j)}});
 }
 
 }  // namespace
@@ -102,9 +103,10 @@ void BuildRefineChunkProblem(const RefineSequence& sequence, const ImuNoise& noi
   for (int k = chunk.begin; k < chunk.end; ++k) {
     ScanFactors& f = (*factors)[k - chunk.begin];
     double* pose_k = (*states)[k].pose.data();
-    if (f.fixed) problem->AddResidualBlock(ScanCost(f, &f.fixed), nullptr, pose_k);
+    const RefineState& scan = (*states)[k];
+    if (f.fixed) problem->AddResidualBlock(ScanCost(f, &f.fixed, scan), nullptr, pose_k);
     for (auto& [j, pair] : f.pairs)
-      problem->AddResidualBlock(ScanCost(f, &pair, &(*states)[j]), nullptr, pose_k,
+      problem->AddResidualBlock(ScanCost(f, &pair, scan, &(*states)[j]), nullptr, pose_k,
                                 (*states)[j].pose.data());
   }
   AddRefineImuFactors(sequence, noise, g_world, chunk, states, problem);

@@ -21,7 +21,6 @@
 #include "rvlio/degeneracy/degeneracy.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/rv.h"
-#include "rvlio/factors/parameter_blocks.h"
 #include "rvlio/factors/plane_factor.h"
 #include "rvlio/factors/plane_summary_factor.h"
 #include "rvlio/factors/pose_projected_factor.h"
@@ -83,11 +82,10 @@ struct ScanFactors {
   bool has_degeneracy_prior = false;
   PoseMatrix6d degeneracy_sqrt_information = PoseMatrix6d::Zero();
   // remap in the project form (degeneracy.remap_refine_form): the weak
-  // directions (columns; none: not projected) and the pose of the
-  // association; the scan's factors then see pose_k projected off them
-  // (PoseProjectedFactor), and fixed and pairs stay here, outliving the problem.
+  // directions of pose_k (columns; none: not projected); the scan's factors
+  // then see the poses projected off them at the association estimate
+  // (BuildRefineChunkProblem), and fixed and pairs stay here, outliving the problem.
   PoseProjectedFactor::Directions remap_held = PoseProjectedFactor::Directions(6, 0);
-  PoseBlock remap_pose0;
 };
 
 // Where the planes of scan k's constraints live. A plane whose source scan j
