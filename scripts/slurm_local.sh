@@ -108,11 +108,29 @@ PartitionName=$partition Nodes=$host Default=YES MaxTime=INFINITE State=UP
 EOF
 }
 
+# Whether process PID exists and is not a zombie (field 3 of /proc/PID/stat,
+# after the command name in parentheses, which may hold spaces).
+running() {
+  local st
+  st=$(cat "/proc/$1/stat" 2>/dev/null) || return 1
+  st=${st##*) }
+  [[ -n $st && ${st%% *} != Z ]]
+}
+
 # Starts one daemon in the foreground mode, in its own session, and records its pid.
+# Until the forked shell has exec'd the daemon, $! is a copy of this script,
+# whose command line does not name our folder, so our_pid would call the
+# daemon gone: wait (at most 5 s) until it names the folder or has exited.
 start_daemon() {
-  local name=$1; shift
+  local name=$1 pid i; shift
   setsid "$@" >"$dir/log/$name.out" 2>&1 </dev/null &
-  echo $! >"$dir/$name.pid"
+  pid=$!
+  echo "$pid" >"$dir/$name.pid"
+  for ((i = 0; i < 100; i++)); do
+    [[ -n $(our_pid "$name") ]] && return 0
+    running "$pid" || return 0
+    sleep 0.05
+  done
 }
 
 show_logs() {
@@ -234,6 +252,9 @@ do_status() {
   fi
   return $up
 }
+
+# Sourced (scripts/slurm_test.sh checks start_daemon): functions only.
+[[ ${BASH_SOURCE[0]} == "$0" ]] || return 0
 
 case "${1:-}" in
   up) do_up ;;

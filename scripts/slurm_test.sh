@@ -62,6 +62,28 @@ if [[ ! -x $rvlio ]]; then
 fi
 command -v snakemake >/dev/null || fatal "snakemake is not installed (bash scripts/install_deps.sh --with-test-tools)"
 
+# slurm_local.sh knows its daemons by their command line (our_pid); right
+# after the fork, $! is still a copy of the script (CI once saw "munged
+# exited at start" so). 40 starts of a stand-in daemon: when start_daemon
+# returns, the recorded pid's command line names the folder. Read with
+# builtins only, at once (our_pid's own forks would give the exec time).
+start_daemon_knows_its_daemon() (
+  RVLIO_SLURM_DIR=$work/start-probe
+  source scripts/slurm_local.sh
+  mkdir -p "$dir/log"
+  local i pid missed=0 args
+  for ((i = 0; i < 40; i++)); do
+    start_daemon probe bash -c 'sleep 30 & wait' "$dir/probe"
+    pid=$(<"$dir/probe.pid")
+    args=()
+    mapfile -d '' args <"/proc/$pid/cmdline" || true
+    [[ " ${args[*]} " == *" $dir/probe "* ]] || missed=$((missed + 1))
+    kill -- "-$pid" 2>/dev/null || true
+  done
+  [[ $missed -eq 0 ]] || { echo "start_daemon: $missed of 40 starts not known as ours at once" >&2; return 1; }
+)
+check "a daemon just started is known as ours (no exec race)" start_daemon_knows_its_daemon
+
 if ! up_out=$(bash scripts/slurm_local.sh up 2>&1); then
   echo "$up_out" >&2
   fatal "the Slurm daemons did not start (scripts/slurm_local.sh up; see its message and logs above)"
