@@ -63,10 +63,11 @@ fi
 command -v snakemake >/dev/null || fatal "snakemake is not installed (bash scripts/install_deps.sh --with-test-tools)"
 
 # slurm_local.sh knows its daemons by their command line (our_pid); right
-# after the fork, $! is still a copy of the script (CI once saw "munged
-# exited at start" so). 40 starts of a stand-in daemon: when start_daemon
-# returns, the recorded pid's command line names the folder. Read with
-# builtins only, at once (our_pid's own forks would give the exec time).
+# after the fork, $! is still a copy of the script ("munged exited at
+# start" for a munged that was starting). 40 starts of a stand-in daemon:
+# when start_daemon returns, the recorded pid's command line names the
+# folder. Read with builtins only, at once (our_pid's own forks would give
+# the exec time).
 start_daemon_knows_its_daemon() (
   RVLIO_SLURM_DIR=$work/start-probe
   source scripts/slurm_local.sh
@@ -78,7 +79,7 @@ start_daemon_knows_its_daemon() (
     args=()
     mapfile -d '' args <"/proc/$pid/cmdline" || true
     [[ " ${args[*]} " == *" $dir/probe "* ]] || missed=$((missed + 1))
-    kill -- "-$pid" 2>/dev/null || true
+    kill -- "-$pid" 2>/dev/null || kill "$pid" 2>/dev/null || true
   done
   [[ $missed -eq 0 ]] || { echo "start_daemon: $missed of 40 starts not known as ours at once" >&2; return 1; }
 )
