@@ -90,12 +90,14 @@ void IeskfOdometry::EndHoldIfDue(std::vector<ScanResult>* out) {
 void IeskfOdometry::Replay() {
   const Ieskf& converged = live_.filter();
   snapshot_->SetTimeOffset(converged.time_offset_s(), converged.time_offset_std_s());
-  snapshot_->SetReplayedScans(static_cast<int64_t>(held_.size()));
   // The snapshot queues the scans the hold processed (less those the new
-  // shift dropped) and those the live pipeline still queues.
+  // shift dropped) and those the live pipeline still queues: the difference
+  // is the scans processed again.
   const size_t queued_in_both = live_.queued_scans();
   const size_t queued_in_snapshot = snapshot_->queued_scans();
-  CarryHeldCost(queued_in_snapshot > queued_in_both ? queued_in_snapshot - queued_in_both : 0);
+  const size_t replayed = queued_in_snapshot > queued_in_both ? queued_in_snapshot - queued_in_both : 0;
+  snapshot_->SetReplayedScans(static_cast<int64_t>(replayed));
+  CarryHeldCost(replayed);
   live_ = std::move(*snapshot_);
   snapshot_.reset();
   held_.clear();
