@@ -55,14 +55,6 @@ int ReportInterrupt(const RunRequest& req, const RunResult& r) {
 
 }  // namespace
 
-bool PrepareOutputDir(const std::string& command, const std::string& dir) {
-  if (Status s = rvlio::PrepareOutputDir(dir); !s.ok()) {
-    Fail(command, s.message());
-    return false;
-  }
-  return true;
-}
-
 int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   std::vector<std::string> config_warnings;
   StatusOr<OdometryOptions> options =

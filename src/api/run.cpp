@@ -307,10 +307,9 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
                        args.options.io);
   if (!reader.ok()) return reader.status();
   const bool write = !args.out_dir.empty();
-  std::error_code ec;
-  const bool out_dir_existed = write && std::filesystem::exists(args.out_dir, ec);
+  OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
   if (write)
-    if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
+    if (Status s = out_folder.Prepare(); !s.ok()) return s;
 
   RunResult result;
   RunData data;
@@ -326,10 +325,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   data.wall_s = SecondsSince(t0);
   data.truncated = (*reader)->truncated();
   if (!(*odo)->status().ok()) {  // nothing new in the output folder
-    if (write) {
-      partial.Remove();
-      if (!out_dir_existed) std::filesystem::remove(args.out_dir, ec);  // only if empty
-    }
+    if (write) partial.Remove();
     return Status::InvalidInput("--map " + args.map + ": " + (*odo)->status().message());
   }
 
@@ -343,10 +339,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   result.divergence = (*odo)->divergence();
   result.lidar_layout = (*reader)->lidar_layout();
   if (result.scans.empty()) {  // nothing to write: nothing new in the output folder
-    if (write) {
-      partial.Remove();
-      if (!out_dir_existed) std::filesystem::remove(args.out_dir, ec);  // only if empty
-    }
+    if (write) partial.Remove();
     if (result.stopped) return result;
     if (!result.read_error.ok()) return result.read_error;
     return Status::InvalidInput(
@@ -367,7 +360,8 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   const Status written =
       WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr);
   partial.Remove();  // the complete outputs (or the folder as it was) replace it
-  if (!written.ok()) return written;
+  if (!written.ok()) return written;  // out_folder removes a folder it created
+  out_folder.Keep();
   result.written = true;
   return result;
 }
