@@ -301,9 +301,11 @@ nlohmann::json DegeneracyEvalJson(const DegeneracyEvalResult& result);
 // Reads both clouds (PCD or PLY, formats/point_cloud_file.h) and evaluates the
 // map against the reference. InvalidInput, one line naming the file(s), for
 // an unreadable, empty, truncated or NaN cloud, or clouds that do not
-// overlap. Reads only.
+// overlap, or a profile step giving more than kMaxProfileBins bins. Reads
+// only. `progress` (optional): the share of the searches done.
 StatusOr<MapEvalResult> EvaluateMapFiles(const std::string& map_path, const std::string& ref_path,
-                                         const MapEvalOptions& options);
+                                         const MapEvalOptions& options,
+                                         const MapEvalProgress& progress = nullptr);
 // `rvlio eval --map --json`: map_points, ref_points, max_distance, inliers,
 // no_plane, outlier_fraction, accuracy and nearest {count, mean, rms, median,
 // p95, max}, completeness, chamfer, chamfer_definition, axis {origin,

@@ -216,15 +216,17 @@ void StreamNewPoses(const std::vector<ScanResult>& results, size_t* streamed, Tu
   }
 }
 
-// Reports progress against the recording's time span (read once, only when
-// someone listens).
+// Reports progress against the time span asked for: the recording's, cut to
+// --start / --duration (read once, only when someone listens).
 class ProgressReporter {
  public:
   ProgressReporter(const RunArgs& args, Clock::time_point t0) : fn_(args.progress), t0_(t0) {
     if (!fn_) return;
     StatusOr<BagInfo> info = ReadBagSpan(args.bag);
-    start_s_ = info.ok() ? info->start_s : 0.0;
-    end_s_ = info.ok() ? info->end_s : 1.0;
+    if (!info.ok()) return;
+    const WindowSpan span = SpanOfWindow(info->start_s, info->end_s, args.window);
+    start_s_ = span.first_s;
+    end_s_ = span.last_s;
   }
   void Report(int scans, TimeNs t_ns, const DivergenceReport& divergence) const {
     if (!fn_) return;

@@ -27,6 +27,7 @@
 //   completeness of the REF points falling into it.
 // Points are searched in single precision (map/reference_map.h).
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -95,12 +96,22 @@ struct ChainageAxis {
 };
 ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points);
 
+// The profile holds at most this many bins: a profile_step that gives more
+// over the reference's extent along its axis is refused (a 1 m step covers
+// 100 km; the --json output of that many bins is about 20 MB).
+inline constexpr size_t kMaxProfileBins = 100000;
+
+// Called with the share of the nearest-point searches done (0..1), from the
+// calling thread, after each block of 4096 points.
+using MapEvalProgress = std::function<void(double fraction)>;
+
 // Evaluates map_points against ref_points (same frame, m). InvalidInput
 // (message without file names; the caller adds them) for an empty cloud, a
-// non-finite point, or clouds that do not overlap (no MAP point within D of
-// REF).
+// non-finite point, a profile_step giving more than kMaxProfileBins bins, or
+// clouds that do not overlap (no MAP point within D of REF).
 StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
                                     const std::vector<Eigen::Vector3d>& ref_points,
-                                    const MapEvalOptions& options);
+                                    const MapEvalOptions& options,
+                                    const MapEvalProgress& progress = nullptr);
 
 }  // namespace rvlio
