@@ -242,6 +242,7 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
     const ReferenceMap map(map_points, map_order, options.search);
     ref_nearest = ReferenceToMap(ref_points, ref_order, map, options, &progress);
   }
+  if (progress_fn) progress_fn(1.0);
   size_t covered = 0;
   double chamfer_ref = 0.0;
   for (double e : ref_nearest) {

@@ -102,7 +102,7 @@ ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points);
 inline constexpr size_t kMaxProfileBins = 100000;
 
 // Called with the share of the nearest-point searches done (0..1), from the
-// calling thread, after each block of 4096 points.
+// calling thread, after blocks of 4096 points, and with 1 when all are done.
 using MapEvalProgress = std::function<void(double fraction)>;
 
 // Evaluates map_points against ref_points (same frame, m). InvalidInput
