@@ -200,6 +200,16 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
                                     const MapEvalProgress& progress_fn) {
   if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
   if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+  if (!(options.max_distance <= kMaxDistanceVoxels * options.search.voxel_size)) {
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "max distance %g m is more than %g search voxels (search.voxel_size %g m): "
+                  "a point without a neighbour that near would visit every voxel within it; "
+                  "at most %g m",
+                  options.max_distance, kMaxDistanceVoxels, options.search.voxel_size,
+                  kMaxDistanceVoxels * options.search.voxel_size);
+    return Status::InvalidInput(text);
+  }
   const ChainageAxis axis = PrincipalAxis(ref_points);
   StatusOr<size_t> bins = ProfileBins(MaxChainage(ref_points, axis), options.profile_step);
   if (!bins.ok()) return bins.status();

@@ -90,7 +90,8 @@ StatusOr<std::string> ResolveOutputFile(const std::string& path) {
     if (n < 0 || static_cast<size_t>(n) >= sizeof(link))
       return Refuse(path, target, n < 0 ? ErrnoText(errno) : "link target too long");
     const std::string next(link, static_cast<size_t>(n));
-    target = next[0] == '/' ? next : ParentDirectory(target) + "/" + next;
+    const bool here = next[0] == '/' || target.find('/') == std::string::npos;
+    target = here ? next : ParentDirectory(target) + "/" + next;
   }
 }
 

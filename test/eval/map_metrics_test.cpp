@@ -220,6 +220,24 @@ TEST(MapMetrics, ProfileStepGivingTooManyBinsIsRefused) {
   EXPECT_LE(at_bound->profile.size(), kMaxProfileBins);
 }
 
+// A max distance beyond kMaxDistanceVoxels search voxels is refused (its
+// cost would grow with its cube for every point without a neighbour).
+TEST(MapMetrics, MaxDistanceBeyondTheSearchBoundIsRefused) {
+  const std::vector<Eigen::Vector3d> ref = Plane(2000, 0.0, 0.0, 1);
+  MapEvalOptions o;
+  o.max_distance = 1000.0;
+  const StatusOr<MapEvalResult> refused = EvaluateMap(ref, ref, o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kInvalidInput);
+  EXPECT_NE(refused.status().message().find("max distance 1000 m is more than 10 search voxels"),
+            std::string::npos) << refused.status().message();
+  o.max_distance = kMaxDistanceVoxels * o.search.voxel_size;  // at the bound
+  EXPECT_TRUE(EvaluateMap(ref, ref, o).ok());
+  o.search.voxel_size = 1.0;  // coarser voxels allow a larger D
+  o.max_distance = 5.0;
+  EXPECT_TRUE(EvaluateMap(ref, ref, o).ok());
+}
+
 TEST(MapMetrics, ProgressReachesOneFromTheCallingThread) {
   const std::vector<Eigen::Vector3d> ref = Plane(20000, 0.0, 0.0, 1);
   const std::vector<Eigen::Vector3d> map = Plane(10000, 0.01, 0.0, 2);
