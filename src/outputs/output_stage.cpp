@@ -21,7 +21,7 @@ Status PrepareOutputDir(const std::string& dir) {
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec)) {
     const std::string kind = SpecialFileKind(dir);
     return Status::InvalidInput("output folder " + dir + " is " +
-                                (kind.empty() ? "a file" : kind) + ", not a folder");
+                                (kind.empty() ? "a regular file" : kind) + ", not a folder");
   }
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::IoError("cannot create output folder " + dir + ": " + ec.message());
