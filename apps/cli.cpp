@@ -1,5 +1,8 @@
 #include "cli.h"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -52,6 +55,25 @@ int ExitCode(StatusCode code) {
 
 int Fail(const std::string& command, const Status& status) {
   return Fail(command, status.message(), ExitCode(status.code()));
+}
+
+ProgressLine::ProgressLine(bool enabled) : enabled_(enabled && isatty(STDERR_FILENO)) {}
+
+ProgressLine::~ProgressLine() {
+  if (printed_) std::fprintf(stderr, "\n");
+}
+
+bool ProgressLine::Due(double wall_s) const {
+  return enabled_ && wall_s >= 3.0 && wall_s - last_print_s_ >= 0.5;
+}
+
+void ProgressLine::Update(double wall_s, double fraction, const std::string& what) {
+  if (!Due(wall_s)) return;
+  last_print_s_ = wall_s;
+  const double done = std::clamp(fraction, 0.0, 1.0);
+  const double eta_s = done > 0.01 ? wall_s * (1.0 - done) / done : 0.0;
+  std::fprintf(stderr, "\r  %s  %3.0f%%  ETA %.0f s   ", what.c_str(), 100.0 * done, eta_s);
+  printed_ = true;
 }
 
 int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out) {

@@ -53,6 +53,26 @@ int ExitCode(StatusCode code);
 // Fail with the status's message and ExitCode(status.code()).
 int Fail(const std::string& command, const Status& status);
 
+// A progress line on stderr for long work, only when stderr is a terminal:
+// from 3 s on, at most every 0.5 s, "  WHAT  NN%  ETA S s", rewritten in
+// place; the destructor ends the line. `fraction` is the share of the work
+// asked for (0..1).
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool enabled);
+  ~ProgressLine();
+  ProgressLine(const ProgressLine&) = delete;
+  ProgressLine& operator=(const ProgressLine&) = delete;
+  // True when the line is printed now (the caller may skip building `what`).
+  bool Due(double wall_s) const;
+  void Update(double wall_s, double fraction, const std::string& what);
+
+ private:
+  bool enabled_;
+  double last_print_s_ = 0.0;
+  bool printed_ = false;
+};
+
 }  // namespace rvlio::cli
 
 namespace rvlio::cli {

@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "ablate_grid.h"
+#include "rvlio/outputs/output_stage.h"
 #include "rvlio/outputs/summary_json.h"
 #include "ablate_runner.h"
 #include "ablate_summary.h"
@@ -137,7 +138,8 @@ int CmdAblate(int argc, char** argv) {
     std::cout << JsonText(ablate::PlanJson(*plan)) << "\n";
     return 0;
   }
-  if (!PrepareOutputDir(kAblate, plan->out_dir)) return 2;
+  OutputFolder out_folder(plan->out_dir);  // removed again when it stays empty
+  if (Status s = out_folder.Prepare(); !s.ok()) return Fail(kAblate, s);
   if (args.Has("summarize")) return Summarize(*plan, args);
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: finished cells stay, the rest run next time
   if (args.Has("cell")) return RunSingle(*plan, args.Get("cell"), options);

@@ -4,6 +4,7 @@
 // EvaluateFiles / EvaluateMapFiles and EvalJson / MapEvalJson (rvlio/api.h)
 // do the work.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cli.h"
 #include "commands.h"
 #include "rvlio/outputs/summary_json.h"
 #include "common_options.h"
@@ -200,7 +202,15 @@ int EvalMap(const Args& args) {
     return Fail(kEval, "map mode needs both --map FILE and --ref-map FILE");
   MapEvalOptions options;
   if (std::string error = ReadMapOptions(args, &options); !error.empty()) return Fail(kEval, error);
-  StatusOr<MapEvalResult> r = EvaluateMapFiles(args.Get("map"), args.Get("ref-map"), options);
+  StatusOr<MapEvalResult> r = Status::Internal("not evaluated");
+  {
+    ProgressLine line(true);  // ends its line before the table is printed
+    const auto t0 = std::chrono::steady_clock::now();
+    r = EvaluateMapFiles(args.Get("map"), args.Get("ref-map"), options, [&](double fraction) {
+      const std::chrono::duration<double> wall = std::chrono::steady_clock::now() - t0;
+      line.Update(wall.count(), fraction, "map eval: nearest-point searches");
+    });
+  }
   if (!r.ok()) return Fail(kEval, r.status());
   if (args.Has("json"))
     std::cout << JsonText(MapEvalJson(*r), -1) << "\n";

@@ -134,9 +134,10 @@ int CmdSimulate(int argc, char** argv) {
 
 int SimulateOnDisk(SimulateArgs sim) {
   sim.stop = [] { return InterruptSignalName(); };
-  // A second signal aborts at once: the writer's temporary file goes with it.
-  const std::string bag_path = SimulatedRecordingPath(sim);
-  SetAbortRemovePath(bag_path + ".tmp");
+  // A second signal aborts at once: the writer's temporary file goes with it
+  // (the staging folder around it is removed by the next command that stages
+  // in this folder).
+  sim.staged = [](const std::string& staged) { SetAbortRemovePath(staged + ".tmp"); };
   StatusOr<SimulateResult> r = SimulateRecording(sim);
   SetAbortRemovePath("");
   if (!r.ok()) return Fail(kSimulate, r.status());

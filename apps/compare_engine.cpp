@@ -25,6 +25,7 @@
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/config/config.h"
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/outputs/output_stage.h"
 #include "rvlio/outputs/summary_json.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/formats/trajectory_io.h"
@@ -141,7 +142,7 @@ int CheckInputs(const CompareRequest& req, Truth* truth) {
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(req.bag, options->lidar, options->imu, req.window, inline_io);
   if (!reader.ok()) return Fail(kCompare, reader.status().message());
-  return PrepareOutputDir(kCompare, req.out_dir) ? 0 : 2;
+  return 0;
 }
 
 // ---------------------------------------------------------------------------
@@ -581,6 +582,8 @@ int RunCompare(const CompareRequest& req) {
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: stop the running variant, tabulate, 130/143
   Truth truth;
   if (int rc = CheckInputs(req, &truth); rc != 0) return rc;
+  OutputFolder out_folder(req.out_dir);  // removed again when it stays empty
+  if (Status s = out_folder.Prepare(); !s.ok()) return Fail(kCompare, s);
   Steps steps(req);
   std::vector<Row> rows;
   for (const Variant& v : StandardVariants())

@@ -1,7 +1,5 @@
 #include "run_pipeline.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdio>
 
@@ -14,29 +12,19 @@
 namespace rvlio::cli {
 namespace {
 
-// A progress line on stderr for long runs, only when stderr is a terminal.
+// The run's progress line: scans, their rate, the share of the window read.
 class Progress {
  public:
-  explicit Progress(bool enabled) : enabled_(enabled && isatty(STDERR_FILENO)) {}
+  explicit Progress(bool enabled) : line_(enabled) {}
   void Update(const RunProgress& p) {
-    if (!enabled_) return;
-    const double wall = p.wall_s;
-    if (wall < 3.0 || wall - last_print_ < 0.5) return;
-    last_print_ = wall;
-    const double done = p.fraction;
-    const double eta = done > 0.01 ? wall * (1.0 - done) / done : 0.0;
-    std::fprintf(stderr, "\r  scans %d  %.1f scans/s  %3.0f%%  ETA %.0f s   ", p.scans,
-                 p.scans / wall, 100.0 * std::min(1.0, done), eta);
-    printed_ = true;
-  }
-  ~Progress() {
-    if (printed_) std::fprintf(stderr, "\n");
+    if (!line_.Due(p.wall_s)) return;
+    char what[64];
+    std::snprintf(what, sizeof(what), "scans %d  %.1f scans/s", p.scans, p.scans / p.wall_s);
+    line_.Update(p.wall_s, p.fraction, what);
   }
 
  private:
-  bool enabled_;
-  double last_print_ = 0.0;
-  bool printed_ = false;
+  ProgressLine line_;
 };
 
 // The one line of an interrupted run; returns its exit status (130 / 143).
@@ -54,14 +42,6 @@ int ReportInterrupt(const RunRequest& req, const RunResult& r) {
 }
 
 }  // namespace
-
-bool PrepareOutputDir(const std::string& command, const std::string& dir) {
-  if (Status s = rvlio::PrepareOutputDir(dir); !s.ok()) {
-    Fail(command, s.message());
-    return false;
-  }
-  return true;
-}
 
 int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   std::vector<std::string> config_warnings;

@@ -69,8 +69,4 @@ struct RefineOutcome {
 // status; the outcome is filled when the refinement finished.
 int RefineOnBag(RefineRequest request, RefineOutcome* outcome);
 
-// Creates `dir` if needed and proves it writable; false after printing the
-// error line of `command` if not (rvlio/outputs/output_stage.h PrepareOutputDir).
-bool PrepareOutputDir(const std::string& command, const std::string& dir);
-
 }  // namespace rvlio::cli

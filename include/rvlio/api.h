@@ -218,7 +218,17 @@ struct SimulateArgs {
   std::string format = "bag";            // bag (ROS1) | mcap | db3
   std::string mcap_compression = "zstd"; // zstd | lz4 | none | unchunked (mcap only)
   StopFn stop;                           // a stop leaves no recording
+  // Called with the path the recording is written to before it is moved
+  // into out_dir (a staging folder inside it), e.g. to remove its temporary
+  // file when the process is aborted.
+  std::function<void(const std::string& staged_recording)> staged;
 };
+
+// What `rvlio simulate` simulated, in OUT_DIR/simulation.json: preset, name,
+// seed, flight_seed, duration_s, start_time_s, recording (file name),
+// recording_hash (FileContentHash, 16 hex digits), scans,
+// localizability_scans and localizability_stamps_s {first, last}.
+inline constexpr const char* kSimulationFile = "simulation.json";
 
 struct SimulateResult {
   std::string bag_path, gt_path, config_path;  // NAME.bag|mcap|db3, NAME_gt.tum, NAME.yaml
@@ -291,9 +301,11 @@ nlohmann::json DegeneracyEvalJson(const DegeneracyEvalResult& result);
 // Reads both clouds (PCD or PLY, formats/point_cloud_file.h) and evaluates the
 // map against the reference. InvalidInput, one line naming the file(s), for
 // an unreadable, empty, truncated or NaN cloud, or clouds that do not
-// overlap. Reads only.
+// overlap, or a profile step giving more than kMaxProfileBins bins. Reads
+// only. `progress` (optional): the share of the searches done.
 StatusOr<MapEvalResult> EvaluateMapFiles(const std::string& map_path, const std::string& ref_path,
-                                         const MapEvalOptions& options);
+                                         const MapEvalOptions& options,
+                                         const MapEvalProgress& progress = nullptr);
 // `rvlio eval --map --json`: map_points, ref_points, max_distance, inliers,
 // no_plane, outlier_fraction, accuracy and nearest {count, mean, rms, median,
 // p95, max}, completeness, chamfer, chamfer_definition, axis {origin,

@@ -6,8 +6,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 #include "rvlio/api.h"
+#include "rvlio/api/refine_checkpoint.h"
+#include "rvlio/eval/time_matching.h"
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
@@ -144,13 +147,14 @@ nlohmann::json EvalJson(const EvalResult& r) {
 }
 
 StatusOr<MapEvalResult> EvaluateMapFiles(const std::string& map_path, const std::string& ref_path,
-                                         const MapEvalOptions& options) {
+                                         const MapEvalOptions& options,
+                                         const MapEvalProgress& progress) {
   const PointCloudReadOptions xyz_only{false};
   StatusOr<PointCloudFile> map = ReadPointCloud(map_path, xyz_only);
   if (!map.ok()) return map.status();
   StatusOr<PointCloudFile> ref = ReadPointCloud(ref_path, xyz_only);
   if (!ref.ok()) return ref.status();
-  StatusOr<MapEvalResult> r = EvaluateMap(map->points, ref->points, options);
+  StatusOr<MapEvalResult> r = EvaluateMap(map->points, ref->points, options, progress);
   if (!r.ok()) return Status::InvalidInput(map_path + " vs " + ref_path + ": " + r.status().message());
   return r;
 }
@@ -183,6 +187,76 @@ nlohmann::json MapEvalJson(const MapEvalResult& r) {
           {"profile", profile}};
 }
 
+namespace {
+
+nlohmann::json ReadJsonOrNull(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return nullptr;
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_discarded() ? nlohmann::json() : j;
+}
+
+// The recording RUN_DIR/summary.json says the run read, when that file is
+// still there (a relative path is taken from the current folder).
+std::string RunRecording(const std::string& run_dir) {
+  const nlohmann::json summary = ReadJsonOrNull((fs::path(run_dir) / "summary.json").string());
+  if (!summary.is_object() || !summary.contains("bag") || !summary["bag"].is_string()) return "";
+  std::error_code ec;
+  const std::string bag = summary["bag"].get<std::string>();
+  return fs::exists(bag, ec) ? bag : "";
+}
+
+// SIM_DIR/simulation.json (written by `rvlio simulate`, api.h
+// kSimulationFile) against the truth read and the run's recording: the
+// truth's scan count must be the one simulated, and the recording the run
+// read (summary.json's bag, when it still exists) must be the simulated one:
+// the same file, or one of the same content (recording_hash). A folder
+// without simulation.json (older simulations) passes to the stamp check.
+Status CheckSimulationRecord(const std::string& run_dir, const std::string& truth_dir,
+                             const std::string& truth_path, size_t truth_scans) {
+  const std::string record_path = (fs::path(truth_dir) / kSimulationFile).string();
+  const nlohmann::json record = ReadJsonOrNull(record_path);
+  if (record.is_null()) return Status::Ok();
+  const size_t simulated = record.value("localizability_scans", size_t{0});
+  if (simulated != truth_scans)
+    return Status::InvalidInput(truth_path + " has " + std::to_string(truth_scans) + " scans, " +
+                                record_path + " records " + std::to_string(simulated) +
+                                ": the folder mixes files of two simulations");
+  const std::string read = RunRecording(run_dir);
+  if (read.empty()) return Status::Ok();
+  const std::string simulated_file = (fs::path(truth_dir) / record.value("recording", "")).string();
+  std::error_code ec;
+  if (fs::equivalent(read, simulated_file, ec)) return Status::Ok();
+  StatusOr<uint64_t> hash = FileContentHash(read);
+  if (hash.ok() && HashText(*hash) == record.value("recording_hash", "")) return Status::Ok();
+  return Status::InvalidInput(
+      run_dir + " is a run of " + read + ", not of the recording " + simulated_file +
+      " that " + truth_dir + " simulated (preset " + record.value("preset", "?") + ", seed " +
+      record.value("seed", nlohmann::json()).dump() + "): the truth is of another simulation");
+}
+
+// Every scan of the run must have a truth scan at its stamp (the run's scans
+// are the simulation's, less those it dropped): a run scan without one means
+// a truth of another recording (another duration, start or rate).
+Status CheckStampsAgree(const std::vector<DegeneracyLabel>& run,
+                        const std::vector<DegeneracyLabel>& truth, double max_dt_s,
+                        const std::string& scans_path, const std::string& truth_path) {
+  Trajectory run_stamps(run.size()), truth_stamps(truth.size());
+  for (size_t i = 0; i < run.size(); ++i) run_stamps[i].t_ns = run[i].t_ns;
+  for (size_t i = 0; i < truth.size(); ++i) truth_stamps[i].t_ns = truth[i].t_ns;
+  StatusOr<Association> a = Associate(run_stamps, truth_stamps, max_dt_s);
+  const size_t matched = a.ok() ? a->size() : 0;
+  if (matched == run.size()) return Status::Ok();
+  char dt[32];
+  std::snprintf(dt, sizeof(dt), "%g", max_dt_s);
+  return Status::InvalidInput(
+      std::to_string(run.size() - matched) + " of the " + std::to_string(run.size()) +
+      " scans of " + scans_path + " have no scan of " + truth_path + " within " + dt +
+      " s (" + std::to_string(truth.size()) + " there): the truth is of another recording");
+}
+
+}  // namespace
+
 StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const DegeneracyEvalArgs& args) {
   const std::string &run_dir = args.run_dir, &truth_dir = args.truth_dir;
   if (!(args.degenerate_ratio >= 0.0))
@@ -204,6 +278,11 @@ StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const DegeneracyEvalArgs&
   if (args.degenerate_ratio > 0.0) {
     if (Status s = Rethreshold(r.truth_path, args.degenerate_ratio, &*truth); !s.ok()) return s;
   }
+  if (Status s = CheckSimulationRecord(run_dir, truth_dir, r.truth_path, truth->size()); !s.ok())
+    return s;
+  if (Status s = CheckStampsAgree(*detected, *truth, args.eval.max_dt, r.scans_path, r.truth_path);
+      !s.ok())
+    return s;
   r.gt_path = args.gt_path;
   if (r.gt_path.empty()) {
     StatusOr<std::string> found = FindGroundTruth(truth_dir);

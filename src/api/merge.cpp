@@ -269,8 +269,9 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   if (Status s = CheckChunks(&chunks); !s.ok()) return s;
   StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front());
   if (!reference.ok()) return reference.status();
+  OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
   if (!args.out_dir.empty())
-    if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
+    if (Status s = out_folder.Prepare(); !s.ok()) return s;
   std::vector<RefineJobTrajectory> jobs;
   for (const ChunkFolder& c : chunks) jobs.push_back(c.job);
   StatusOr<RefineJobMerge> merge = MergeRefineJobs(jobs);
@@ -301,6 +302,7 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   if (args.out_dir.empty()) return r;
   if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr); !s.ok())
     return s;
+  out_folder.Keep();
   r.written = true;
   return r;
 }

@@ -216,15 +216,17 @@ void StreamNewPoses(const std::vector<ScanResult>& results, size_t* streamed, Tu
   }
 }
 
-// Reports progress against the recording's time span (read once, only when
-// someone listens).
+// Reports progress against the time span asked for: the recording's, cut to
+// --start / --duration (read once, only when someone listens).
 class ProgressReporter {
  public:
   ProgressReporter(const RunArgs& args, Clock::time_point t0) : fn_(args.progress), t0_(t0) {
     if (!fn_) return;
     StatusOr<BagInfo> info = ReadBagSpan(args.bag);
-    start_s_ = info.ok() ? info->start_s : 0.0;
-    end_s_ = info.ok() ? info->end_s : 1.0;
+    if (!info.ok()) return;
+    const WindowSpan span = SpanOfWindow(info->start_s, info->end_s, args.window);
+    start_s_ = span.first_s;
+    end_s_ = span.last_s;
   }
   void Report(int scans, TimeNs t_ns, const DivergenceReport& divergence) const {
     if (!fn_) return;
@@ -307,10 +309,9 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
                        args.options.io);
   if (!reader.ok()) return reader.status();
   const bool write = !args.out_dir.empty();
-  std::error_code ec;
-  const bool out_dir_existed = write && std::filesystem::exists(args.out_dir, ec);
+  OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
   if (write)
-    if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
+    if (Status s = out_folder.Prepare(); !s.ok()) return s;
 
   RunResult result;
   RunData data;
@@ -326,10 +327,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   data.wall_s = SecondsSince(t0);
   data.truncated = (*reader)->truncated();
   if (!(*odo)->status().ok()) {  // nothing new in the output folder
-    if (write) {
-      partial.Remove();
-      if (!out_dir_existed) std::filesystem::remove(args.out_dir, ec);  // only if empty
-    }
+    if (write) partial.Remove();
     return Status::InvalidInput("--map " + args.map + ": " + (*odo)->status().message());
   }
 
@@ -343,10 +341,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   result.divergence = (*odo)->divergence();
   result.lidar_layout = (*reader)->lidar_layout();
   if (result.scans.empty()) {  // nothing to write: nothing new in the output folder
-    if (write) {
-      partial.Remove();
-      if (!out_dir_existed) std::filesystem::remove(args.out_dir, ec);  // only if empty
-    }
+    if (write) partial.Remove();
     if (result.stopped) return result;
     if (!result.read_error.ok()) return result.read_error;
     return Status::InvalidInput(
@@ -367,7 +362,8 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   const Status written =
       WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr);
   partial.Remove();  // the complete outputs (or the folder as it was) replace it
-  if (!written.ok()) return written;
+  if (!written.ok()) return written;  // out_folder removes a folder it created
+  out_folder.Keep();
   result.written = true;
   return result;
 }

@@ -23,7 +23,10 @@
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/common/text.h"
 #include "rvlio/formats/atomic_file.h"
+#include "rvlio/outputs/output_stage.h"
 #include "rvlio/outputs/run_outputs.h"
+#include "rvlio/outputs/summary_json.h"
+#include "rvlio/api/refine_checkpoint.h"
 #include "rvlio/formats/ouster.h"
 #include "rvlio/formats/pcap.h"
 #include "rvlio/formats/sensor_bag.h"
@@ -271,6 +274,35 @@ Status RunSurvey(const sim::Simulator& simulator, SimulateResult* r,
   return Status::Ok();
 }
 
+// simulation.json: what this folder simulated (rvlio/api.h
+// kSimulationFile), so that `eval --degeneracy` can tell whether a run read
+// this folder's recording. `recording_file` is the staged recording, hashed
+// as written (FileContentHash).
+StatusOr<nlohmann::json> SimulationIdentity(const SimulateArgs& args, const SimOptions& o,
+                                            const std::string& name, const std::string& recording,
+                                            const std::string& recording_file,
+                                            const std::vector<sim::ScanLocalizability>& truth,
+                                            const SimulateResult& r) {
+  StatusOr<uint64_t> hash = FileContentHash(recording_file);
+  if (!hash.ok()) return hash.status();
+  nlohmann::json j = {{"command", "simulate"},
+                      {"version", RVLIO_VERSION},
+                      {"preset", args.preset},
+                      {"name", name},
+                      {"seed", o.seed},
+                      {"flight_seed", o.flight_seed},
+                      {"duration_s", o.duration},
+                      {"start_time_s", o.start_time},
+                      {"recording", recording},
+                      {"recording_hash", HashText(*hash)},
+                      {"scans", r.scans},
+                      {"localizability_scans", truth.size()}};
+  if (!truth.empty())
+    j["localizability_stamps_s"] = {{"first", NsToSeconds(truth.front().t_ns)},
+                                    {"last", NsToSeconds(truth.back().t_ns)}};
+  return j;
+}
+
 }  // namespace
 
 std::string SimulatedRecordingPath(const SimulateArgs& args) {
@@ -284,12 +316,10 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   const std::string name = args.name.empty() ? args.preset : args.name;
   if (name.empty() || name.find('/') != std::string::npos)
     return Status::InvalidInput("name '" + name + "' must be a plain file stem");
+  if (args.out_dir.empty()) return Status::IoError("cannot create output directory ''");
   const std::filesystem::path dir = args.out_dir;
-  std::error_code ec;
-  if (!args.out_dir.empty()) std::filesystem::create_directories(dir, ec);
-  if (args.out_dir.empty() || ec || !std::filesystem::is_directory(dir))
-    return Status::IoError("cannot create output directory '" + dir.string() + "'" +
-                           (ec ? " (" + ec.message() + ")" : ""));
+  OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
+  if (Status s = out_folder.Prepare(); !s.ok()) return s;
   BagWriterOptions format;
   std::string extension;
   if (Status s = ResolveFormat(args, &format, &extension); !s.ok()) return s;
@@ -310,15 +340,26 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   if (options.survey.enabled) {
     if (Status s = RunSurvey(**simulator, &r, &reference_map); !s.ok()) return s;
   }
+  // Every file is written into a staging folder and moved into place when all
+  // are complete: a failure (disk full, file-size limit, a stop) leaves the
+  // folder as it was, and a folder this call created is removed again.
+  OutputStage stage(args.out_dir);
+  if (Status s = stage.Open(); !s.ok()) return s;
   const std::string map_path = (dir / kReferenceMapFile).string();
   if (args.reference_map_only) {
-    if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
+    if (Status s = WriteMapPcd(stage.Path(kReferenceMapFile), reference_map); !s.ok())
+      return stage.Explain(s);
+    if (Status s = stage.Commit(); !s.ok()) return s;
+    out_folder.Keep();
     r.reference_map_path = map_path;
     r.wall_s = SecondsSince(wall0);
     r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
     return r;
   }
-  r.bag_path = (dir / (name + extension)).string();
+  const std::string recording = name + extension;
+  r.bag_path = (dir / recording).string();
+  const std::string staged_recording = stage.Path(recording);
+  if (args.staged) args.staged(staged_recording);
   sim::LocalizabilityTruth truth(options.localizability, options.lidar);
   std::vector<sim::ScanLocalizability> localizability;
   sim::Simulator::TruthCallback on_truth;
@@ -328,28 +369,34 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
     };
   const Status written =
       args.format == "ouster-pcap"
-          ? WriteOusterCapture(**simulator, r.bag_path, (dir / (name + ".json")).string(),
-                               (dir / (name + ".bag")).string(), on_truth, args.stop,
-                               &r.stop_reason)
-          : WriteBag(**simulator, r.bag_path, livox, format, on_truth, args.stop, &r.stop_reason);
-  if (!written.ok()) return written;
+          ? WriteOusterCapture(**simulator, staged_recording, stage.Path(name + ".json"),
+                               stage.Path(name + ".bag"), on_truth, args.stop, &r.stop_reason)
+          : WriteBag(**simulator, staged_recording, livox, format, on_truth, args.stop,
+                     &r.stop_reason);
+  if (!written.ok()) return stage.Explain(written);
   if ((r.stopped = !r.stop_reason.empty())) return r;
   r.wall_s = SecondsSince(wall0);
   r.cpu_s = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
 
   r.gt_path = (dir / (name + "_gt.tum")).string();
   const Trajectory gt = (*simulator)->GroundTruth(kGroundTruthRate);
-  if (Status s = WriteTum(r.gt_path, gt, GroundTruthHeader(options, name)); !s.ok()) return s;
+  if (Status s = WriteTum(stage.Path(name + "_gt.tum"), gt, GroundTruthHeader(options, name));
+      !s.ok())
+    return stage.Explain(s);
   r.config_path = (dir / (name + ".yaml")).string();
-  if (Status s = WriteFileAtomically(r.config_path, yaml); !s.ok()) return s;
+  if (Status s = WriteFileAtomically(stage.Path(name + ".yaml"), yaml); !s.ok())
+    return stage.Explain(s);
   if (options.localizability.enabled) {
     r.localizability_path = (dir / kLocalizabilityFile).string();
-    if (Status s = WriteLocalizabilityCsv(r.localizability_path, localizability); !s.ok()) return s;
+    if (Status s = WriteLocalizabilityCsv(stage.Path(kLocalizabilityFile), localizability);
+        !s.ok())
+      return stage.Explain(s);
     r.degenerate_scans = std::count_if(localizability.begin(), localizability.end(),
                                        [](const sim::ScanLocalizability& l) { return l.degenerate; });
   }
   if (options.survey.enabled) {
-    if (Status s = WriteMapPcd(map_path, reference_map); !s.ok()) return s;
+    if (Status s = WriteMapPcd(stage.Path(kReferenceMapFile), reference_map); !s.ok())
+      return stage.Explain(s);
     r.reference_map_path = map_path;
   }
   r.scans = (*simulator)->scan_count();
@@ -357,6 +404,14 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   r.rows = (*simulator)->lidar().rows();
   r.cols = (*simulator)->lidar().cols();
   r.duration_s = options.duration;
+  StatusOr<nlohmann::json> identity =
+      SimulationIdentity(args, options, name, recording, staged_recording, localizability, r);
+  if (!identity.ok()) return stage.Explain(identity.status());
+  if (Status s = WriteFileAtomically(stage.Path(kSimulationFile), JsonText(*identity) + "\n");
+      !s.ok())
+    return stage.Explain(s);
+  if (Status s = stage.Commit(); !s.ok()) return s;
+  out_folder.Keep();
   return r;
 }
 

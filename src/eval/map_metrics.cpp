@@ -1,7 +1,9 @@
 #include "rvlio/eval/map_metrics.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -23,10 +25,27 @@ struct MapPointDistances {
   std::vector<double> nearest_m, plane_m;
 };
 
+// Counts the points searched (from every thread) and reports the share of
+// `total` done, from the calling thread only (ParallelFor's slot 0), so the
+// callback needs no locking.
+class SearchProgress {
+ public:
+  SearchProgress(const MapEvalProgress& fn, size_t total) : fn_(fn), total_(total) {}
+  void Done(size_t points, int slot) {
+    const size_t done = done_.fetch_add(points) + points;
+    if (fn_ && slot == 0) fn_(static_cast<double>(done) / static_cast<double>(total_));
+  }
+
+ private:
+  const MapEvalProgress& fn_;
+  const size_t total_;
+  std::atomic<size_t> done_{0};
+};
+
 // order: VoxelOrder(map_points, options.search.voxel_size).
 MapPointDistances MapToReference(const std::vector<Eigen::Vector3d>& map_points,
                                  const std::vector<uint32_t>& order, const ReferenceMap& ref,
-                                 const MapEvalOptions& options) {
+                                 const MapEvalOptions& options, SearchProgress* progress) {
   MapPointDistances d;
   const size_t n = map_points.size();
   d.nearest_m.assign(n, kNoValue);
@@ -38,16 +57,18 @@ MapPointDistances MapToReference(const std::vector<Eigen::Vector3d>& map_points,
   // reference voxels in the cache; each result goes to its own index, so the
   // numbers do not depend on the order.
   const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
-  ParallelFor(0, chunks, options.threads, [&](int chunk, int) {
+  ParallelFor(0, chunks, options.threads, [&](int chunk, int slot) {
     NeighborBuffer neighbors;
-    const size_t end = std::min(n, static_cast<size_t>(chunk + 1) * kChunk);
-    for (size_t j = static_cast<size_t>(chunk) * kChunk; j < end; ++j) {
+    const size_t begin = static_cast<size_t>(chunk) * kChunk;
+    const size_t end = std::min(n, begin + kChunk);
+    for (size_t j = begin; j < end; ++j) {
       PrefetchAhead(map_points, order, j);
       const size_t i = order[j];
       const SurfaceDistance s = QueryReferenceSurface(ref, map_points[i], surface, &neighbors);
       d.nearest_m[i] = s.nearest_m;
       if (s.has_surface()) d.plane_m[i] = std::abs(s.signed_m);
     }
+    progress->Done(end - begin, slot);
   });
   return d;
 }
@@ -57,19 +78,21 @@ MapPointDistances MapToReference(const std::vector<Eigen::Vector3d>& map_points,
 // that order as above.
 std::vector<double> ReferenceToMap(const std::vector<Eigen::Vector3d>& ref_points,
                                    const std::vector<uint32_t>& order, const ReferenceMap& map,
-                                   const MapEvalOptions& options) {
+                                   const MapEvalOptions& options, SearchProgress* progress) {
   const size_t n = ref_points.size();
   std::vector<double> nearest_m(n, kNoValue);
   const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
-  ParallelFor(0, chunks, options.threads, [&](int chunk, int) {
+  ParallelFor(0, chunks, options.threads, [&](int chunk, int slot) {
     NeighborBuffer neighbors;
-    const size_t end = std::min(n, static_cast<size_t>(chunk + 1) * kChunk);
-    for (size_t j = static_cast<size_t>(chunk) * kChunk; j < end; ++j) {
+    const size_t begin = static_cast<size_t>(chunk) * kChunk;
+    const size_t end = std::min(n, begin + kChunk);
+    for (size_t j = begin; j < end; ++j) {
       PrefetchAhead(ref_points, order, j);
       const size_t i = order[j];
       if (map.KNearest(ref_points[i], 1, options.max_distance, &neighbors) == 1)
         nearest_m[i] = std::sqrt(neighbors.dist2[0]);
     }
+    progress->Done(end - begin, slot);
   });
   return nearest_m;
 }
@@ -78,13 +101,33 @@ size_t BinOf(double chainage_m, double step_m) {
   return static_cast<size_t>(std::max(0.0, std::floor(chainage_m / step_m)));
 }
 
+double MaxChainage(const std::vector<Eigen::Vector3d>& points, const ChainageAxis& axis) {
+  double max_chainage = 0.0;
+  for (const Eigen::Vector3d& p : points) max_chainage = std::max(max_chainage, axis.Chainage(p));
+  return max_chainage;
+}
+
+// The profile's bin count, refused beyond kMaxProfileBins (before any work:
+// a tiny step would allocate bins by the billion).
+StatusOr<size_t> ProfileBins(double max_chainage_m, double step_m) {
+  const double bins = std::floor(max_chainage_m / step_m) + 1.0;  // double: no overflow
+  if (!(bins <= static_cast<double>(kMaxProfileBins))) {
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "profile step %g m gives %.3g bins over the reference's %.6g m along its "
+                  "principal axis; at most %zu (a step of at least %.3g m)",
+                  step_m, bins, max_chainage_m, kMaxProfileBins,
+                  max_chainage_m / static_cast<double>(kMaxProfileBins - 1));
+    return Status::InvalidInput(text);
+  }
+  return static_cast<size_t>(bins);
+}
+
 std::vector<MapProfileBin> Profile(const std::vector<Eigen::Vector3d>& map_points,
                                    const std::vector<Eigen::Vector3d>& ref_points,
                                    const MapPointDistances& d, const std::vector<double>& ref_nearest,
-                                   const ChainageAxis& axis, const MapEvalOptions& options) {
-  double max_chainage = 0.0;
-  for (const Eigen::Vector3d& p : ref_points) max_chainage = std::max(max_chainage, axis.Chainage(p));
-  const size_t bins = BinOf(max_chainage, options.profile_step) + 1;
+                                   const ChainageAxis& axis, size_t bins,
+                                   const MapEvalOptions& options) {
   std::vector<MapProfileBin> profile(bins);
   std::vector<std::vector<double>> plane(bins);
   std::vector<size_t> covered(bins, 0);
@@ -153,9 +196,24 @@ ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points) {
 
 StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
                                     const std::vector<Eigen::Vector3d>& ref_points,
-                                    const MapEvalOptions& options) {
+                                    const MapEvalOptions& options,
+                                    const MapEvalProgress& progress_fn) {
   if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
   if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+  if (!(options.max_distance <= kMaxDistanceVoxels * options.search.voxel_size)) {
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "max distance %g m is more than %g search voxels (search.voxel_size %g m): "
+                  "a point without a neighbour that near would visit every voxel within it; "
+                  "at most %g m",
+                  options.max_distance, kMaxDistanceVoxels, options.search.voxel_size,
+                  kMaxDistanceVoxels * options.search.voxel_size);
+    return Status::InvalidInput(text);
+  }
+  const ChainageAxis axis = PrincipalAxis(ref_points);
+  StatusOr<size_t> bins = ProfileBins(MaxChainage(ref_points, axis), options.profile_step);
+  if (!bins.ok()) return bins.status();
+  SearchProgress progress(progress_fn, map_points.size() + ref_points.size());
   const double D = options.max_distance;
   MapEvalResult r;
   r.map_points = map_points.size();
@@ -169,7 +227,7 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
   MapPointDistances d;
   {
     const ReferenceMap ref(ref_points, ref_order, options.search);
-    d = MapToReference(map_points, map_order, ref, options);
+    d = MapToReference(map_points, map_order, ref, options, &progress);
   }  // the reference's search structure is freed before the map's is built
   std::vector<double> plane, nearest;
   double chamfer_map = 0.0;
@@ -192,8 +250,9 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
   std::vector<double> ref_nearest;
   {
     const ReferenceMap map(map_points, map_order, options.search);
-    ref_nearest = ReferenceToMap(ref_points, ref_order, map, options);
+    ref_nearest = ReferenceToMap(ref_points, ref_order, map, options, &progress);
   }
+  if (progress_fn) progress_fn(1.0);
   size_t covered = 0;
   double chamfer_ref = 0.0;
   for (double e : ref_nearest) {
@@ -203,10 +262,9 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
   r.completeness = static_cast<double>(covered) / r.ref_points;
   r.chamfer_m = 0.5 * (chamfer_map / r.map_points + chamfer_ref / r.ref_points);
 
-  const ChainageAxis axis = PrincipalAxis(ref_points);
   r.axis_origin = axis.origin;
   r.axis_direction = axis.direction;
-  r.profile = Profile(map_points, ref_points, d, ref_nearest, axis, options);
+  r.profile = Profile(map_points, ref_points, d, ref_nearest, axis, *bins, options);
   return r;
 }
 

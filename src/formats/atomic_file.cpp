@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <utility>
@@ -13,6 +14,7 @@ namespace rvlio {
 namespace {
 
 constexpr size_t kFlushBytes = 1 << 20;  // write in blocks of 1 MiB
+constexpr int kMaxLinkHops = 40;         // as the kernel's own limit (ELOOP)
 
 std::string ErrnoText(int err) { return std::strerror(err); }
 
@@ -48,7 +50,50 @@ void SyncDirectory(const std::string& dir) {
   ::close(fd);
 }
 
+const char* KindOf(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  return "not a regular file";
+}
+
+Status Refuse(const std::string& path, const std::string& target, const std::string& why) {
+  const std::string via = target == path ? "" : " (through the link to '" + target + "')";
+  return Status::InvalidInput("cannot write '" + path + "'" + via + ": " + why +
+                              "; an output must be a regular file or a new path");
+}
+
 }  // namespace
+
+std::string SpecialFileKind(const std::string& path) {
+  struct stat st;
+  if (::lstat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return "";
+  return KindOf(st.st_mode);
+}
+
+StatusOr<std::string> ResolveOutputFile(const std::string& path) {
+  std::string target = path;
+  for (int hops = 0;; ++hops) {
+    struct stat st;
+    if (::lstat(target.c_str(), &st) != 0) {
+      if (errno == ENOENT) return target;  // a new file; open() reports a missing folder
+      return Refuse(path, target, ErrnoText(errno));
+    }
+    if (S_ISREG(st.st_mode)) return target;
+    if (!S_ISLNK(st.st_mode)) return Refuse(path, target, std::string("it is ") + KindOf(st.st_mode));
+    if (hops == kMaxLinkHops) return Refuse(path, target, "too many levels of symbolic links");
+    char link[PATH_MAX];
+    const ssize_t n = ::readlink(target.c_str(), link, sizeof(link));
+    if (n < 0 || static_cast<size_t>(n) >= sizeof(link))
+      return Refuse(path, target, n < 0 ? ErrnoText(errno) : "link target too long");
+    const std::string next(link, static_cast<size_t>(n));
+    const bool here = next[0] == '/' || target.find('/') == std::string::npos;
+    target = here ? next : ParentDirectory(target) + "/" + next;
+  }
+}
 
 Status WriteFileAtomically(const std::string& path, const std::string& content) {
   AtomicFileWriter writer;
@@ -67,6 +112,7 @@ AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept
     Discard();
     fd_ = std::exchange(other.fd_, -1);
     path_ = std::move(other.path_);
+    target_ = std::move(other.target_);
     temp_path_ = std::move(other.temp_path_);
     buffer_ = std::move(other.buffer_);
     error_ = std::move(other.error_);
@@ -78,7 +124,10 @@ Status AtomicFileWriter::Open(const std::string& path) {
   Discard();
   error_ = Status::Ok();
   path_ = path;
-  temp_path_ = path + ".tmp." + std::to_string(::getpid());
+  StatusOr<std::string> target = ResolveOutputFile(path);
+  if (!target.ok()) return target.status();
+  target_ = *target;
+  temp_path_ = target_ + ".tmp." + std::to_string(::getpid());
   fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     const int err = errno;
@@ -110,10 +159,10 @@ Status AtomicFileWriter::Commit() {
   if (::fsync(fd_) != 0) return FailAndDiscard("cannot sync", errno);
   const int fd = std::exchange(fd_, -1);
   if (::close(fd) != 0) return FailAndDiscard("cannot close", errno);
-  if (::rename(temp_path_.c_str(), path_.c_str()) != 0)
+  if (::rename(temp_path_.c_str(), target_.c_str()) != 0)
     return FailAndDiscard("cannot rename", errno);
   temp_path_.clear();
-  SyncDirectory(ParentDirectory(path_));
+  SyncDirectory(ParentDirectory(target_));
   return Status::Ok();
 }
 

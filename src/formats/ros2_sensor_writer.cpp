@@ -10,6 +10,7 @@
 
 #include <sqlite3.h>
 
+#include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/cdr.h"
 #include "rvlio/formats/livox.h"
 #include "rvlio/formats/mcap.h"
@@ -102,7 +103,7 @@ constexpr const char* kDb3Schema =
 
 class Db3Storage final : public Ros2Storage {
  public:
-  Db3Storage(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp") {}
+  Db3Storage(std::string path) : path_(std::move(path)), target_(path_), tmp_(path_ + ".tmp") {}
   ~Db3Storage() override {
     if (db_ == nullptr) return;
     CloseDb();
@@ -110,6 +111,11 @@ class Db3Storage final : public Ros2Storage {
   }
 
   Status Init() {
+    // The file replaced: the path or a link's final target (never a FIFO or a device).
+    StatusOr<std::string> target = ResolveOutputFile(path_);
+    if (!target.ok()) return target.status();
+    target_ = *target;
+    tmp_ = target_ + ".tmp";
     std::remove(tmp_.c_str());  // a leftover of an interrupted run
     if (sqlite3_open_v2(tmp_.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
                         nullptr) != SQLITE_OK)
@@ -160,7 +166,7 @@ class Db3Storage final : public Ros2Storage {
     Status s = Exec("COMMIT");
     const bool closed = CloseDb();
     if (s.ok() && !closed) s = Status::InvalidInput("cannot close db3 '" + tmp_ + "'");
-    if (s.ok() && std::rename(tmp_.c_str(), path_.c_str()) != 0)
+    if (s.ok() && std::rename(tmp_.c_str(), target_.c_str()) != 0)
       s = Status::InvalidInput("cannot rename '" + tmp_ + "' to '" + path_ +
                                "': " + std::strerror(errno));
     if (!s.ok()) std::remove(tmp_.c_str());
@@ -196,7 +202,7 @@ class Db3Storage final : public Ros2Storage {
     return ok;
   }
 
-  std::string path_, tmp_;
+  std::string path_, target_, tmp_;
   sqlite3* db_ = nullptr;
   sqlite3_stmt* insert_ = nullptr;
   int64_t topics_ = 0;

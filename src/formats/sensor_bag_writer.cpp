@@ -15,6 +15,7 @@
 
 #include "livox_ros1.h"
 #include "rosbag_common.h"
+#include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "sensor_writer_common.h"
 
@@ -49,7 +50,8 @@ void ToRosCloud(const bag_detail::OwnedCloud& cloud, sensor_msgs::PointCloud2* m
 
 class RosbagSensorWriter final : public SensorBagWriter {
  public:
-  explicit RosbagSensorWriter(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp") {}
+  explicit RosbagSensorWriter(std::string path)
+      : path_(std::move(path)), target_(path_), tmp_(path_ + ".tmp") {}
   ~RosbagSensorWriter() override {
     if (!open_) return;
     std::string why;
@@ -58,6 +60,11 @@ class RosbagSensorWriter final : public SensorBagWriter {
   }
 
   Status Init() {
+    // The file replaced: the path or a link's final target (never a FIFO or a device).
+    StatusOr<std::string> target = ResolveOutputFile(path_);
+    if (!target.ok()) return target.status();
+    target_ = *target;
+    tmp_ = target_ + ".tmp";
     bag_ = std::make_unique<rosbag::Bag>();
     try {
       bag_->open(tmp_, rosbag::bagmode::Write);
@@ -125,7 +132,7 @@ class RosbagSensorWriter final : public SensorBagWriter {
       std::remove(tmp_.c_str());
       return Status::IoError("cannot write bag '" + path_ + "' (" + why + ")");
     }
-    if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    if (std::rename(tmp_.c_str(), target_.c_str()) != 0) {
       const std::string why = std::strerror(errno);
       std::remove(tmp_.c_str());
       return Status::InvalidInput("cannot rename '" + tmp_ + "' to '" + path_ + "': " + why);
@@ -160,7 +167,7 @@ class RosbagSensorWriter final : public SensorBagWriter {
     }
   }
 
-  std::string path_, tmp_;
+  std::string path_, target_, tmp_;
   std::unique_ptr<rosbag::Bag> bag_;
   bool open_ = false;
 };

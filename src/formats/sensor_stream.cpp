@@ -296,6 +296,17 @@ class ThreadedReader final : public SensorBagReader {
   bool ended_ = false;
 };
 
+}  // namespace
+
+WindowSpan SpanOfWindow(double start_s, double end_s, const ReadWindow& window) {
+  WindowSpan span;
+  span.first_s = std::min(end_s, start_s + window.start_s);
+  span.last_s = window.duration_s > 0.0 ? std::min(end_s, span.first_s + window.duration_s) : end_s;
+  return span;
+}
+
+namespace {
+
 // InvalidInput when the window starts at or after the recording's end.
 // *first_receive_ns: the recording's first receive time (start > 0 only).
 Status CheckWindow(const std::string& path, const ReadWindow& window, TimeNs* first_receive_ns) {

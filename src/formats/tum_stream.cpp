@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
@@ -15,9 +16,11 @@ TumStream::~TumStream() {
 }
 
 Status TumStream::Open(const std::string& path, double sync_period_s) {
-  path_ = path;
   sync_period_s_ = sync_period_s;
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  StatusOr<std::string> target = ResolveOutputFile(path);  // never a FIFO or a device
+  if (!target.ok()) return error_ = target.status();
+  path_ = *target;
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) return Fail("cannot create", errno);
   last_sync_ = Clock::now();
   return WriteLine(kTumColumnsComment);  // as WriteTum: the file is a prefix of its output

@@ -530,14 +530,25 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
   // shells up to floor(max_d / s) + 1 can hold points within max_d.
   const int max_shell =
       std::min(static_cast<int>(std::floor(max_d / s)) + 1, max_search_shell_);
-  const double width = 2.0 * max_shell + 1.0;
-  if (width * width * width > static_cast<double>(slots_.size())) {
-    ScanAllVoxels(q_world, q, &c);
-  } else {
-    for (int r = 0; r <= max_shell; ++r) {
-      if (ShellGap(r, q_local, s) > c.limit()) break;  // nothing closer remains
-      VisitShell(r, home, q_local, q, &c);
+  // Shells are visited while the cube they cover has no more voxels than the
+  // table has slots (past that one pass over every voxel costs less). They
+  // settle a query as soon as the next shell lies beyond the k-th candidate,
+  // usually within a few shells whatever max_dist is; only a query they leave
+  // open (fewer than k points that near) scans every voxel, from scratch.
+  const int cube_shell =
+      static_cast<int>((std::cbrt(static_cast<double>(slots_.size())) - 1.0) / 2.0);
+  bool settled = true;
+  for (int r = 0; r <= max_shell; ++r) {
+    if (ShellGap(r, q_local, s) > c.limit()) break;  // nothing closer remains
+    if (r > cube_shell) {
+      settled = false;
+      break;
     }
+    VisitShell(r, home, q_local, q, &c);
+  }
+  if (!settled) {
+    c = Candidates(k, static_cast<float>(max_d * max_d));
+    ScanAllVoxels(q_world, q, &c);
   }
 
   out->size = c.size();

@@ -2,6 +2,7 @@
 
 #include <signal.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -16,6 +17,12 @@ namespace rvlio {
 
 Status PrepareOutputDir(const std::string& dir) {
   std::error_code ec;
+  // A link to a folder is followed; anything else that is not a folder is refused.
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec)) {
+    const std::string kind = SpecialFileKind(dir);
+    return Status::InvalidInput("output folder " + dir + " is " +
+                                (kind.empty() ? "a regular file" : kind) + ", not a folder");
+  }
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::IoError("cannot create output folder " + dir + ": " + ec.message());
   const std::string probe = (std::filesystem::path(dir) / ".rvlio_write_test").string();
@@ -25,16 +32,38 @@ Status PrepareOutputDir(const std::string& dir) {
   return Status::Ok();
 }
 
-Status OutputFolder::Prepare() {
+// The folders create_directories(dir) will create, innermost first: dir and
+// each missing parent (a dangling link is not a missing folder: nothing of it
+// is created here, so it is not listed).
+static std::vector<std::string> MissingFolders(const std::string& dir) {
+  std::vector<std::string> missing;
   std::error_code ec;
-  created_ = !std::filesystem::exists(dir_, ec);
-  return PrepareOutputDir(dir_);
+  for (std::filesystem::path p = std::filesystem::path(dir).lexically_normal();
+       !p.empty() && p.has_relative_path(); p = p.parent_path()) {
+    if (p.filename().empty()) continue;  // "a/b/" normalizes to "a/b/": its last element is ""
+    if (std::filesystem::symlink_status(p, ec).type() != std::filesystem::file_type::not_found)
+      break;
+    missing.push_back(p.string());
+  }
+  return missing;
+}
+
+Status OutputFolder::Prepare() {
+  created_ = MissingFolders(dir_);
+  Status s = PrepareOutputDir(dir_);
+  if (!s.ok()) RemoveCreated();
+  return s;
+}
+
+void OutputFolder::RemoveCreated() {
+  std::error_code ec;
+  for (const std::string& folder : created_)
+    if (!std::filesystem::remove(folder, ec)) break;  // only when empty
+  created_.clear();
 }
 
 OutputFolder::~OutputFolder() {
-  if (!created_ || keep_) return;
-  std::error_code ec;
-  std::filesystem::remove(dir_, ec);  // only when empty
+  if (!keep_) RemoveCreated();
 }
 
 OutputStage::~OutputStage() {
@@ -79,12 +108,36 @@ std::string OutputStage::Path(const std::string& name) {
   return (std::filesystem::path(stage_dir_) / name).string();
 }
 
+// The file each staged output replaces (ResolveOutputFile of OUT/name), all
+// checked before the first is moved so that a refused one moves none. A link
+// is followed only within the stage's file system (a rename cannot cross it).
+static Status StageTargets(const std::string& stage_dir, const std::string& out_dir,
+                           const std::vector<std::string>& names, std::vector<std::string>* targets) {
+  struct stat stage;
+  if (::stat(stage_dir.c_str(), &stage) != 0)
+    return Status::IoError("cannot write to output folder " + out_dir + ": " + std::strerror(errno));
+  for (const std::string& name : names) {
+    const std::string path = (std::filesystem::path(out_dir) / name).string();
+    StatusOr<std::string> target = ResolveOutputFile(path);
+    if (!target.ok()) return target.status();
+    const std::string folder = std::filesystem::path(*target).parent_path().string();
+    struct stat st;
+    if (*target != path && (::stat(folder.empty() ? "." : folder.c_str(), &st) != 0 ||
+                            st.st_dev != stage.st_dev))
+      return Status::InvalidInput("cannot write '" + path + "': it links to '" + *target +
+                                  "', which is not on the output folder's file system");
+    targets->push_back(*target);
+  }
+  return Status::Ok();
+}
+
 Status OutputStage::Commit() {
-  for (const std::string& name : names_) {
-    const std::string from = (std::filesystem::path(stage_dir_) / name).string();
-    const std::string to = (std::filesystem::path(out_dir_) / name).string();
-    if (std::rename(from.c_str(), to.c_str()) != 0)
-      return Status::IoError("cannot move " + name + " into " + out_dir_ + ": " +
+  std::vector<std::string> targets;
+  if (Status s = StageTargets(stage_dir_, out_dir_, names_, &targets); !s.ok()) return s;
+  for (size_t i = 0; i < names_.size(); ++i) {
+    const std::string from = (std::filesystem::path(stage_dir_) / names_[i]).string();
+    if (std::rename(from.c_str(), targets[i].c_str()) != 0)
+      return Status::IoError("cannot move " + names_[i] + " into " + out_dir_ + ": " +
                              std::strerror(errno));
   }
   return Status::Ok();

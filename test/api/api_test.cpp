@@ -159,6 +159,20 @@ TEST_F(ApiTest, StopEndsTheRunAndRecordsTheReason) {
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/stopped_early"));
 }
 
+// The progress is the share of the work asked for: with --start/--duration
+// it ends near 100 %, not at the share of the whole recording.
+TEST_F(ApiTest, ProgressCountsTheWindowAskedFor) {
+  RunArgs args = Run("");
+  args.window.start_s = 1.0;
+  args.window.duration_s = 2.0;  // of the 5 s recording
+  double last = -1.0;
+  args.progress = [&last](const RunProgress& p) { last = p.fraction; };
+  StatusOr<RunResult> r = RunRecording(args);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_GT(last, 0.9);
+  EXPECT_LT(last, 1.1);
+}
+
 TEST_F(ApiTest, RefineFromAnInMemoryTrajectory) {
   StatusOr<RunResult> run = RunRecording(Run(""));
   ASSERT_TRUE(run.ok()) << run.status().message();

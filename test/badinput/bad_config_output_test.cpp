@@ -4,6 +4,8 @@
 // limit (RLIMIT_FSIZE, which binds root as well): a failed write exits 2 with
 // one line naming the file, leaves no half or temporary file, and leaves the
 // complete outputs of an earlier run in that folder untouched.
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <fstream>
 
@@ -69,8 +71,8 @@ TEST_F(BadConfigOutputTest, OutputFolderThatCannotBeWrittenStopsEvenForRoot) {
   const ToolRun itself = Run(Bag(), file);
   EXPECT_EQ(itself.exit_code, 2) << itself.err;
   EXPECT_EQ(Lines(itself.err), 1) << itself.err;
-  EXPECT_EQ(itself.err.rfind("rvlio run: error: cannot create output folder " + file + ": ", 0), 0u)
-      << itself.err;
+  EXPECT_EQ(itself.err, "rvlio run: error: output folder " + file +
+                            " is a regular file, not a folder\n");
   EXPECT_EQ(ReadFile(file), "keep me\n");
 }
 
@@ -94,7 +96,7 @@ TEST_F(BadConfigOutputTest, DiskFullDuringTrajectoryWriteLeavesNoFile) {
                                 dir_, "", "", 1000);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(r.err, "rvlio run: error: cannot write '" + out + "/trajectory.tum': File too large\n");
-  EXPECT_TRUE(Entries(out).empty()) << Entries(out).front();
+  EXPECT_FALSE(fs::exists(out)) << "the folder the failed run created is removed";
   // The same folder takes the next run that has room.
   const ToolRun ok = Run(Bag(), out);
   ASSERT_EQ(ok.exit_code, 0) << ok.err;
@@ -113,8 +115,44 @@ TEST_F(BadConfigOutputTest, DiskFullWhileSimulatingLeavesNoHalfBag) {
     EXPECT_EQ(r.err.rfind("rvlio simulate: error: cannot write bag '" + out + "/tunnel.bag", 0), 0u)
         << r.err;
     EXPECT_NE(r.err.find("Error writing to file"), std::string::npos) << r.err;
-    EXPECT_TRUE(Entries(out).empty()) << Entries(out).front();
+    EXPECT_FALSE(fs::exists(out)) << "the folder the failed simulation created is removed";
   }
+  // Into a folder that holds an earlier simulation: a failure leaves every
+  // file as it was.
+  const std::string earlier = dir_ + "/full_sim_earlier";
+  fs::create_directories(earlier);
+  for (const auto& e : fs::directory_iterator(dir_ + "/data")) fs::copy(e.path(), earlier);
+  const std::vector<std::string> before = Entries(earlier);
+  const ToolRun r = RunToolWith("simulate --preset tunnel --seed 3 --duration 4 --set "
+                                "lidar.columns=512 --out " + earlier,
+                                dir_, "", "", 2000000);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("rvlio simulate: error: cannot write bag '" + earlier + "/", 0), 0u)
+      << r.err;
+  EXPECT_EQ(Entries(earlier), before) << "no staging or half file may stay";
+  for (const std::string& f : before)
+    EXPECT_EQ(ReadFile(earlier + "/" + f), ReadFile(dir_ + "/data/" + f)) << f;
+}
+
+// Special files named as outputs (docs/outputs.md "What an output path may
+// be"): refused with one line and left as they were; a link is followed.
+TEST_F(BadConfigOutputTest, ReportOutThatIsAFifoOrALink) {
+  const std::string fifo = dir_ + "/report_fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  const ToolRun refused = RunToolWith("report " + Clean("") + " --out " + fifo, dir_);
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_EQ(refused.err, "rvlio report: error: cannot write '" + fifo +
+                             "': it is a FIFO (named pipe); an output must be a regular file "
+                             "or a new path\n");
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  std::ofstream(dir_ + "/report_target.html") << "old";
+  fs::create_symlink("report_target.html", dir_ + "/report_link.html");
+  const ToolRun followed =
+      RunToolWith("report " + Clean("") + " --out " + dir_ + "/report_link.html", dir_);
+  EXPECT_EQ(followed.exit_code, 0) << followed.err;
+  EXPECT_TRUE(fs::is_symlink(dir_ + "/report_link.html"));
+  EXPECT_GT(fs::file_size(dir_ + "/report_target.html"), 1000u);
 }
 
 TEST_F(BadConfigOutputTest, DiskFullDuringRefineLeavesTheEarlierRunIntact) {

@@ -181,5 +181,32 @@ TEST_F(DegeneracyEvalCli, BadInputIsOneLineExit2) {
             0);
 }
 
+// The truth must be of the run's recording: a simulation of another
+// duration (stamps disagree) or of another seed (same stamps; its
+// simulation.json names another recording) is refused with one line. A copy
+// of the right folder, or an older one without simulation.json, is scored.
+TEST_F(DegeneracyEvalCli, TruthOfAnotherSimulationIsRefused) {
+  const std::string base = "eval --degeneracy " + dir_ + "/run --truth ";
+  const ToolRun shorter = testing_cli::CachedSimulate(
+      "--preset featureless --seed 4 --duration 3 --set lidar.columns=512", dir_ + "/sim_3s", dir_);
+  ASSERT_EQ(shorter.exit_code, 0) << shorter.err;
+  testing_cli::ExpectOneErrorLine(RunTool(base + dir_ + "/sim_3s", dir_), "eval",
+                                  "the truth is of another recording");
+  const ToolRun seed = testing_cli::CachedSimulate(
+      "--preset featureless --seed 5 --duration 6 --set lidar.columns=512", dir_ + "/sim_seed5",
+      dir_);
+  ASSERT_EQ(seed.exit_code, 0) << seed.err;
+  testing_cli::ExpectOneErrorLine(RunTool(base + dir_ + "/sim_seed5", dir_), "eval",
+                                  "the truth is of another simulation");
+
+  const std::string copy = dir_ + "/sim_copy";
+  std::filesystem::copy(dir_ + "/sim", copy, std::filesystem::copy_options::recursive);
+  EXPECT_EQ(RunTool(base + copy, dir_).exit_code, 0);
+  const std::string older = dir_ + "/sim_older";
+  std::filesystem::copy(dir_ + "/sim", older, std::filesystem::copy_options::recursive);
+  ASSERT_TRUE(std::filesystem::remove(older + "/simulation.json"));
+  EXPECT_EQ(RunTool(base + older, dir_).exit_code, 0);
+}
+
 }  // namespace
 }  // namespace rvlio

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -194,6 +195,64 @@ TEST(MapMetrics, PrincipalAxisStartsAtTheSmallestProjection) {
   EXPECT_NEAR(axis.direction.x(), 1.0, 1e-6);
   EXPECT_NEAR(axis.Chainage(p.front()), 0.0, 1e-9);
   EXPECT_NEAR(axis.Chainage(p.back()), 10.0, 1e-6);
+}
+
+// A profile step far below the reference's extent would allocate bins by the
+// billion: refused before any search, one line naming the bound and the
+// smallest step it allows; a step at the bound works.
+TEST(MapMetrics, ProfileStepGivingTooManyBinsIsRefused) {
+  std::vector<Eigen::Vector3d> ref;
+  for (int i = 0; i <= 1000; ++i) ref.emplace_back(0.01 * i, 0.01 * (i % 7), 0.0);  // 10 m
+  MapEvalOptions o;
+  o.profile_step = 1e-5;  // 10^6 bins
+  const StatusOr<MapEvalResult> refused = EvaluateMap(ref, ref, o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kInvalidInput);
+  EXPECT_NE(refused.status().message().find("profile step 1e-05 m gives 1e+06 bins"),
+            std::string::npos) << refused.status().message();
+  EXPECT_NE(refused.status().message().find("at most 100000"), std::string::npos);
+  o.profile_step = 1e-300;  // the bin count does not even fit an integer
+  EXPECT_FALSE(EvaluateMap(ref, ref, o).ok());
+  const double extent_m = PrincipalAxis(ref).Chainage(ref.back());
+  o.profile_step = extent_m / static_cast<double>(kMaxProfileBins - 1);
+  const StatusOr<MapEvalResult> at_bound = EvaluateMap(ref, ref, o);
+  ASSERT_TRUE(at_bound.ok()) << at_bound.status().message();
+  EXPECT_LE(at_bound->profile.size(), kMaxProfileBins);
+}
+
+// A max distance beyond kMaxDistanceVoxels search voxels is refused (its
+// cost would grow with its cube for every point without a neighbour).
+TEST(MapMetrics, MaxDistanceBeyondTheSearchBoundIsRefused) {
+  const std::vector<Eigen::Vector3d> ref = Plane(2000, 0.0, 0.0, 1);
+  MapEvalOptions o;
+  o.max_distance = 1000.0;
+  const StatusOr<MapEvalResult> refused = EvaluateMap(ref, ref, o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kInvalidInput);
+  EXPECT_NE(refused.status().message().find("max distance 1000 m is more than 10 search voxels"),
+            std::string::npos) << refused.status().message();
+  o.max_distance = kMaxDistanceVoxels * o.search.voxel_size;  // at the bound
+  EXPECT_TRUE(EvaluateMap(ref, ref, o).ok());
+  o.search.voxel_size = 1.0;  // coarser voxels allow a larger D
+  o.max_distance = 5.0;
+  EXPECT_TRUE(EvaluateMap(ref, ref, o).ok());
+}
+
+TEST(MapMetrics, ProgressReachesOneFromTheCallingThread) {
+  const std::vector<Eigen::Vector3d> ref = Plane(20000, 0.0, 0.0, 1);
+  const std::vector<Eigen::Vector3d> map = Plane(10000, 0.01, 0.0, 2);
+  MapEvalOptions o;
+  o.threads = 2;
+  std::vector<double> seen;
+  const std::thread::id caller = std::this_thread::get_id();
+  const StatusOr<MapEvalResult> r = EvaluateMap(map, ref, o, [&](double fraction) {
+    EXPECT_EQ(std::this_thread::get_id(), caller);
+    seen.push_back(fraction);
+  });
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  ASSERT_FALSE(seen.empty());
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(seen.back(), 1.0);
 }
 
 }  // namespace

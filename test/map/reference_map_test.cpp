@@ -1,11 +1,14 @@
 #include "rvlio/map/reference_map.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "rvlio/common/cpu_time.h"
 
 namespace rvlio {
 namespace {
@@ -52,6 +55,46 @@ TEST(ReferenceMap, KNearestMatchesBruteForce) {
     while (expected < 8 && d2[expected] <= max_dist * max_dist) ++expected;
     ASSERT_EQ(n, expected);
     for (int i = 0; i < n; ++i) EXPECT_NEAR(nb.dist2[i], d2[i], 1e-6);
+  }
+}
+
+// Points on the plane z = 0 over [-extent, extent]^2.
+std::vector<Eigen::Vector3d> PlaneCloud(int n, double extent_m, unsigned seed) {
+  std::vector<Eigen::Vector3d> p = RandomCloud(n, extent_m, seed);
+  for (Eigen::Vector3d& x : p) x.z() = 0.0;
+  return p;
+}
+
+// The search radius beyond which the shells around a query cover more
+// voxels than the map has slots: queries with neighbours close by still end
+// after a few shells (the cost does not follow max_dist), the others scan
+// every voxel; both are exact.
+TEST(ReferenceMap, KNearestCostDoesNotFollowALargeRadius) {
+  const std::vector<Eigen::Vector3d> p = PlaneCloud(30000, 2.0, 5);
+  const ReferenceMap map(p, ReferenceMapOptions{0.1});
+  const std::vector<Eigen::Vector3d> near = PlaneCloud(30000, 2.0, 6);
+  auto cpu_ms = [&](double max_dist) {
+    NeighborBuffer nb;
+    const double t0 = ThreadCpuMs();
+    int found = 0;
+    for (const Eigen::Vector3d& q : near) found += map.KNearest(q, 8, max_dist, &nb);
+    EXPECT_EQ(found, 8 * static_cast<int>(near.size()));
+    return ThreadCpuMs() - t0;
+  };
+  const double small_ms = cpu_ms(0.3);
+  const double large_ms = cpu_ms(1000.0);
+  EXPECT_LT(large_ms, 3.0 * small_ms + 30.0) << small_ms << " ms at 0.3 m";
+
+  // Exact on both paths: settled by the shells, and a query 3 m off the
+  // plane that they leave open (a scan of every voxel).
+  NeighborBuffer nb;
+  for (const Eigen::Vector3d& q : {Eigen::Vector3d(0.3, -0.2, 0.01), Eigen::Vector3d(0.5, 0.5, 3.0),
+                                   Eigen::Vector3d(9.0, 0.0, 0.0)}) {
+    std::vector<double> d2;
+    for (const Eigen::Vector3d& x : p) d2.push_back((x.cast<float>().cast<double>() - q).squaredNorm());
+    std::sort(d2.begin(), d2.end());
+    ASSERT_EQ(map.KNearest(q, 8, 1000.0, &nb), 8);
+    for (int i = 0; i < 8; ++i) EXPECT_NEAR(nb.dist2[i], d2[i], 1e-4) << q.transpose();
   }
 }
 

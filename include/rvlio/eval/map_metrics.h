@@ -27,6 +27,7 @@
 //   completeness of the REF points falling into it.
 // Points are searched in single precision (map/reference_map.h).
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -95,12 +96,30 @@ struct ChainageAxis {
 };
 ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points);
 
+// The profile holds at most this many bins: a profile_step that gives more
+// over the reference's extent along its axis is refused (a 1 m step covers
+// 100 km; the --json output of that many bins is about 20 MB).
+inline constexpr size_t kMaxProfileBins = 100000;
+
+// D is at most this many search voxels (search.voxel_size; 1 m at the
+// default 0.1 m). A point with a neighbour within a few voxels costs the same
+// for any D (VoxelMap::KNearest ends after a few shells), but one without
+// (an unmapped stretch of the reference, a stray map point) visits every
+// voxel within D: (2 D / voxel_size + 3)^3 of them, 12 167 at this bound.
+inline constexpr double kMaxDistanceVoxels = 10.0;
+
+// Called with the share of the nearest-point searches done (0..1), from the
+// calling thread, after blocks of 4096 points, and with 1 when all are done.
+using MapEvalProgress = std::function<void(double fraction)>;
+
 // Evaluates map_points against ref_points (same frame, m). InvalidInput
 // (message without file names; the caller adds them) for an empty cloud, a
-// non-finite point, or clouds that do not overlap (no MAP point within D of
-// REF).
+// non-finite point, a max_distance beyond kMaxDistanceVoxels search voxels,
+// a profile_step giving more than kMaxProfileBins bins, or
+// clouds that do not overlap (no MAP point within D of REF).
 StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
                                     const std::vector<Eigen::Vector3d>& ref_points,
-                                    const MapEvalOptions& options);
+                                    const MapEvalOptions& options,
+                                    const MapEvalProgress& progress = nullptr);
 
 }  // namespace rvlio

@@ -1,7 +1,7 @@
 #pragma once
 // Atomic file output (docs/design.md "The command-line contract": "outputs are written
-// atomically"). Content goes to `<path>.tmp.<pid>`, is fsync'ed and then renamed over
-// `<path>`, so a reader sees either the old file or the complete new one, never
+// atomically"). Content goes to `<target>.tmp.<pid>`, is fsync'ed and then renamed over
+// `<target>` (the path, or the final target of a link: ResolveOutputFile), so a reader sees either the old file or the complete new one, never
 // a half-written file. On any failure the temporary file is removed and an
 // InvalidInput status names the path and the system error text.
 #include <string>
@@ -11,10 +11,25 @@
 
 namespace rvlio {
 
+// What an output path may name (docs/outputs.md "What an output path may
+// be"), for every file any command writes: a new path in an existing folder,
+// or a regular file, which is replaced. A symbolic link is followed (a chain
+// of links too) and its final target is written in the target's own folder;
+// the link itself stays. A dangling link makes its target a new file.
+// Anything else is refused before a byte is written: a folder, a character or
+// block device, a FIFO, a socket, a link loop (InvalidInput, one line naming
+// `path` and what it is). Returns the path to write: `path` itself or the
+// link's final target.
+StatusOr<std::string> ResolveOutputFile(const std::string& path);
+
+// "a FIFO", "a folder", ... : what the file at `path` is, "" when it does not
+// exist or is a regular file (lstat: a link is "a symbolic link").
+std::string SpecialFileKind(const std::string& path);
+
 // Writes `content` to `path` atomically.
 Status WriteFileAtomically(const std::string& path, const std::string& content);
 
-// Streaming variant for large outputs:
+// Streaming variant for large outputs (its target: ResolveOutputFile(path)):
 //
 //   AtomicFileWriter w;
 //   Status s = w.Open(path);
@@ -40,7 +55,8 @@ class AtomicFileWriter {
   void Discard();
 
   bool is_open() const { return fd_ >= 0; }
-  const std::string& path() const { return path_; }
+  const std::string& path() const { return path_; }        // as the caller named it
+  const std::string& target() const { return target_; }    // the file replaced
   const std::string& temp_path() const { return temp_path_; }
 
  private:
@@ -49,6 +65,7 @@ class AtomicFileWriter {
 
   int fd_ = -1;
   std::string path_;
+  std::string target_;
   std::string temp_path_;
   std::string buffer_;  // pending bytes, flushed in large blocks
   Status error_;        // sticky failure after Append()

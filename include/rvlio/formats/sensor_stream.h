@@ -28,6 +28,15 @@ struct ReadWindow {
 };
 inline constexpr double kImuLeadInS = 1.0;
 
+// The part of a recording spanning [start_s, end_s] (s, its first and last
+// message) that `window` asks for, [first, last]: from start_s +
+// window.start_s to window.duration_s later, or to end_s when that comes
+// first. What a progress line counts against.
+struct WindowSpan {
+  double first_s = 0.0, last_s = 0.0;
+};
+WindowSpan SpanOfWindow(double start_s, double end_s, const ReadWindow& window);
+
 // Opens `path`. InvalidInput for everything SensorBagReader::Open rejects, a
 // negative start or duration, and a start at or past the end of the recording
 // (one line naming the recording, its length and the start). stats() counts

@@ -22,7 +22,9 @@ class TumStream {
   TumStream(const TumStream&) = delete;
   TumStream& operator=(const TumStream&) = delete;
 
-  // Creates (truncates) `path`. InvalidInput naming the path if that fails.
+  // Creates (truncates) `path`, or the final target of a link
+  // (ResolveOutputFile; a FIFO, device or folder is refused). InvalidInput
+  // naming the path if that fails.
   Status Open(const std::string& path, double sync_period_s = 1.0);
   // Appends one pose line. On a write error the stream closes and every
   // later call is a no-op returning that error.

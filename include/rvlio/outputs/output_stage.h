@@ -8,14 +8,18 @@
 
 namespace rvlio {
 
-// Creates `dir` if needed and proves it writable (InvalidInput naming it if not).
+// Creates `dir` if needed and proves it writable (InvalidInput naming it if
+// not, or if it exists as something else than a folder or a link to one).
 Status PrepareOutputDir(const std::string& dir);
 
-// The output folder of a command that can still fail before it writes
-// anything: Prepare() creates it at once (an unwritable folder fails before
-// the work), and the destructor removes it again, unless Keep() was called,
-// when Prepare() created it and it is still empty, so that a rejected
-// command leaves no new folder behind.
+// The output folder of every command that writes one (run, refine, merge,
+// simulate, compare, ablate, calibrate-time): Prepare() creates it at once
+// (an unwritable folder fails before the work), and the destructor removes
+// again, unless Keep() was called, the folders Prepare() created (the output
+// folder and its missing parents) that are still empty, so that a command
+// that failed (bad input, disk full, file-size limit) leaves no new folder
+// behind. A folder that existed before is never removed; one that holds
+// anything is kept.
 class OutputFolder {
  public:
   explicit OutputFolder(std::string dir) : dir_(std::move(dir)) {}
@@ -24,10 +28,14 @@ class OutputFolder {
   OutputFolder& operator=(const OutputFolder&) = delete;
   Status Prepare();
   void Keep() { keep_ = true; }
+  const std::string& dir() const { return dir_; }
 
  private:
+  void RemoveCreated();
+
   std::string dir_;
-  bool created_ = false, keep_ = false;
+  std::vector<std::string> created_;  // innermost first
+  bool keep_ = false;
 };
 
 // A command's outputs are written (each atomically) into a private folder
@@ -46,7 +54,9 @@ class OutputStage {
   Status Open();
   // Where to write output `name` (a plain file name); Commit() moves it.
   std::string Path(const std::string& name);
-  // Renames every staged file into the output folder.
+  // Renames every staged file into the output folder, once every one of
+  // them is known to be allowed there (ResolveOutputFile: a link to a regular
+  // file is followed, a FIFO, device, socket or folder refuses them all).
   Status Commit();
   // A writer's error names the staged file; this one names the output.
   Status Explain(const Status& s) const;
