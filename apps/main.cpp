@@ -35,6 +35,8 @@ constexpr Subcommand kSubcommands[] = {
     {"demo", "simulate the default tunnel and show what rvlio does with it", rvlio::cli::CmdDemo},
     {"report", "one self-contained report.html for a compare, demo, ablate or run folder",
      rvlio::cli::CmdReport},
+    {"export", "convert a map PCD into LAS 1.4 (intensity, GPS time, extra bytes, CRS)",
+     rvlio::cli::CmdExport},
 };
 
 void PrintHelp() {

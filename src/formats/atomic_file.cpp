@@ -69,6 +69,7 @@ AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept
     path_ = std::move(other.path_);
     temp_path_ = std::move(other.temp_path_);
     buffer_ = std::move(other.buffer_);
+    size_ = std::exchange(other.size_, 0);
     error_ = std::move(other.error_);
   }
   return *this;
@@ -77,6 +78,7 @@ AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept
 Status AtomicFileWriter::Open(const std::string& path) {
   Discard();
   error_ = Status::Ok();
+  size_ = 0;
   path_ = path;
   temp_path_ = path + ".tmp." + std::to_string(::getpid());
   fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -92,7 +94,23 @@ Status AtomicFileWriter::Append(std::string_view data) {
   if (!error_.ok()) return error_;
   RVLIO_CHECK_MSG(is_open(), "AtomicFileWriter::Append before Open");
   buffer_.append(data.data(), data.size());
+  size_ += data.size();
   if (buffer_.size() >= kFlushBytes) return Flush();
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::WriteAt(uint64_t offset, std::string_view data) {
+  if (!error_.ok()) return error_;
+  RVLIO_CHECK_MSG(is_open(), "AtomicFileWriter::WriteAt before Open");
+  RVLIO_CHECK_MSG(offset + data.size() <= size_, "AtomicFileWriter::WriteAt past the end");
+  if (Status s = Flush(); !s.ok()) return s;
+  while (!data.empty()) {
+    const ssize_t n = ::pwrite(fd_, data.data(), data.size(), static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return FailAndDiscard("cannot write", n < 0 ? errno : EIO);
+    data.remove_prefix(static_cast<size_t>(n));
+    offset += static_cast<uint64_t>(n);
+  }
   return Status::Ok();
 }
 

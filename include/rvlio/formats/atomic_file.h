@@ -4,6 +4,7 @@
 // `<path>`, so a reader sees either the old file or the complete new one, never
 // a half-written file. On any failure the temporary file is removed and an
 // InvalidInput status names the path and the system error text.
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -35,6 +36,10 @@ class AtomicFileWriter {
 
   Status Open(const std::string& path);
   Status Append(std::string_view data);
+  // Replaces bytes already appended, from `offset` on (a header whose counts
+  // are known only at the end: formats/las_writer.h). offset + size must not
+  // pass the bytes appended so far.
+  Status WriteAt(uint64_t offset, std::string_view data);
   Status Commit();
   // Removes the temporary file; the target is untouched. Safe to call twice.
   void Discard();
@@ -51,6 +56,7 @@ class AtomicFileWriter {
   std::string path_;
   std::string temp_path_;
   std::string buffer_;  // pending bytes, flushed in large blocks
+  uint64_t size_ = 0;   // bytes appended (written and pending)
   Status error_;        // sticky failure after Append()
 };
 
