@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the independent LAS readers of package-lock.json (npm ci) into
-# DEST/node_modules, once: a later call with the same lock file does nothing.
+# DEST/node_modules, once (a later call with the same lock file installs
+# nothing), and copies read_las.mjs beside them.
 # Used by test/las/las_reader_test.cpp (docs/testing.md "Independent LAS readers").
 #
 #   bash test/las_reader/install.sh DEST
@@ -8,6 +9,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 dest=${1:?usage: install.sh DEST}
 mkdir -p "$dest"
+cp "$here/read_las.mjs" "$dest/"  # ES modules find their packages beside them
 stamp="$dest/node_modules/.rvlio-package-lock.json"
 if [[ -f "$stamp" ]] && cmp -s "$stamp" "$here/package-lock.json"; then
   exit 0
