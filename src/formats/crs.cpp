@@ -6,19 +6,22 @@
 #include <utility>
 
 namespace rvlio {
-namespace {
-
-// PROJ logs errors to stderr by default; the library never prints.
-void Silent(void*, int, const char*) {}
-
+// Owners of PROJ's handles (named: GeodeticToCrs::Impl holds them).
+namespace proj_handles {
 struct ContextDeleter {
   void operator()(PJ_CONTEXT* ctx) const { proj_context_destroy(ctx); }
 };
 struct PjDeleter {
   void operator()(PJ* pj) const { proj_destroy(pj); }
 };
-using Context = std::unique_ptr<PJ_CONTEXT, ContextDeleter>;
-using Pj = std::unique_ptr<PJ, PjDeleter>;
+}  // namespace proj_handles
+using Context = std::unique_ptr<PJ_CONTEXT, proj_handles::ContextDeleter>;
+using Pj = std::unique_ptr<PJ, proj_handles::PjDeleter>;
+
+namespace {
+
+// PROJ logs errors to stderr by default; the library never prints.
+void Silent(void*, int, const char*) {}
 
 Context NewContext() {
   Context ctx(proj_context_create());

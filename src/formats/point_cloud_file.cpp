@@ -20,7 +20,9 @@ const PointCloudField* PointCloudFile::Field(const std::string& name) const {
   return nullptr;
 }
 
-namespace {
+// The record layout of a file: named (not in the unnamed namespace below)
+// because PointCloudStream::Impl holds one.
+namespace point_cloud_layout {
 
 enum class ScalarKind { kFloat, kInt, kUint };
 
@@ -41,6 +43,18 @@ struct FileLayout {
   bool big_endian = false;
   int64_t num_points = 0;
 };
+
+// Which fields become x, y, z and which are kept.
+struct FieldPlan {
+  int x = -1, y = -1, z = -1;
+  std::vector<int> kept;  // indices into layout.fields
+};
+
+}  // namespace point_cloud_layout
+
+namespace {
+
+using namespace point_cloud_layout;  // NOLINT: this file's own types
 
 struct Body {
   const char* data = nullptr;  // first byte after the header
@@ -356,11 +370,6 @@ double DecodeScalar(const char* p, ScalarKind kind, int size, bool big_endian) {
   return 0.0;
 }
 
-// Which fields become x, y, z and which are kept.
-struct FieldPlan {
-  int x = -1, y = -1, z = -1;
-  std::vector<int> kept;  // indices into layout.fields
-};
 
 Status PlanFields(const std::string& path, const FileLayout& layout, bool keep_fields,
                   FieldPlan* plan) {

@@ -2,7 +2,7 @@
 // JSON document on stdout, what each of them found (test/las/las_reader_test.cpp
 // compares it with what rvlio wrote; docs/outputs.md "Checked by other readers"):
 //
-//   loaders   @loaders.gl/las (LASLoader): the header's version, point format,
+//   loaders   @loaders.gl/las (LAZRsLoader, its LAS 1.4 reader): the header's version, point format,
 //             count, scale, offset and bounds; every point's x y z (fp64) and
 //             intensity.
 //   copc      the LAS 1.4 module of the copc package: the header (global
@@ -14,8 +14,16 @@
 //
 // usage: node read_las.mjs FILE.las...
 import { readFileSync } from 'node:fs';
-import { LASLoader } from '@loaders.gl/las';
+import { LAZRsLoader } from '@loaders.gl/las';
 import { Las } from 'copc';
+// The loader's WebAssembly part fetches its .wasm file by URL, which Node's
+// fetch does not do for file: URLs; given its bytes it loads, once (the
+// loader's own init then finds it loaded). Imported by path: the package
+// exports only its entry point.
+import initLazRs from './node_modules/@loaders.gl/las/dist/libs/laz-rs-wasm/laz_rs_wasm.js';
+
+await initLazRs({ module_or_path: readFileSync(new URL(
+    './node_modules/@loaders.gl/las/dist/libs/laz-rs-wasm/laz_rs_wasm_bg.wasm', import.meta.url)) });
 
 function bufferOf(path) {
   const b = readFileSync(path);
@@ -36,7 +44,7 @@ function num(v) {
 }
 
 async function readWithLoaders(bytes) {
-  const mesh = await LASLoader.parse(arrayBufferOf(bytes), { las: { fp64: true } });
+  const mesh = await LAZRsLoader.parse(arrayBufferOf(bytes), { las: { fp64: true, colorDepth: 'auto' } });
   const h = mesh.loaderData;
   return {
     version: h.versionAsString,
