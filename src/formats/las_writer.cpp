@@ -159,8 +159,13 @@ int LasScalarSize(LasScalar type) {
 }
 
 double UnixToAdjustedGpsTime(double unix_s) {
-  int leap = 0;
-  for (const auto& m : kLeapSecondMonths) leap += unix_s >= UnixTimeOf(m[0], m[1]) ? 1 : 0;
+  static const std::vector<double> kLeapUnix_s = [] {  // computed once, thread-safe
+    std::vector<double> t;
+    for (const auto& m : kLeapSecondMonths) t.push_back(UnixTimeOf(m[0], m[1]));
+    return t;
+  }();
+  const int leap = static_cast<int>(
+      std::upper_bound(kLeapUnix_s.begin(), kLeapUnix_s.end(), unix_s) - kLeapUnix_s.begin());
   return unix_s - kGpsMinusUnix_s + leap - kAdjustedGpsShift_s;
 }
 
