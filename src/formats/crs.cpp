@@ -66,7 +66,8 @@ StatusOr<Crs> ResolveCrs(const std::string& crs) {
                             Reason(ctx.get(), "PROJ cannot parse it") +
                             "; e.g. EPSG:25832, a PROJ string or WKT, or local)");
   if (!proj_is_crs(pj.get()))
-    return NotACrs(crs, "not a coordinate reference system (a transformation or operation)");
+    return NotACrs(crs, "not a coordinate reference system but an operation (a PROJ string "
+                        "names a CRS with +type=crs)");
   const PJ_TYPE horizontal = HorizontalType(ctx.get(), pj.get());
   if (IsGeographic(horizontal))
     return NotACrs(crs, "geographic (degrees); the map is in metres: give a projected CRS "

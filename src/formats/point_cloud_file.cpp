@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "rvlio/common/memory.h"
@@ -165,6 +166,8 @@ Status ParsePcdHeader(const std::string& path, const std::string& text, FileLayo
     else return PcdError(path, "field " + f.name + " has TYPE " + t + " SIZE " + sizes[i]);
     layout->fields.push_back(f);
   }
+  if (width >= 0 && height > 0 && width > std::numeric_limits<int64_t>::max() / height)
+    return PcdError(path, "WIDTH x HEIGHT overflows");
   if (points < 0) {
     if (width < 0) return PcdError(path, "neither POINTS nor WIDTH");
     points = width * height;

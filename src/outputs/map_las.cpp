@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include "rvlio/formats/crs.h"
 #include "rvlio/formats/point_cloud_file.h"
@@ -104,6 +105,19 @@ bool EndsWithLas(const std::string& path) {
   return lower == ".las";
 }
 
+// A PCD field name that LAS extra bytes cannot hold, or a name given twice.
+Status CheckFieldNames(const std::string& path, const std::vector<PointCloudStreamField>& fields) {
+  std::set<std::string> seen;
+  for (const PointCloudStreamField& f : fields) {
+    if (f.name.size() > 32)
+      return Status::InvalidInput(path + ": field '" + f.name.substr(0, 40) +
+                                  "...' has a longer name than LAS extra bytes hold (32 characters)");
+    if (!seen.insert(f.name).second)
+      return Status::InvalidInput(path + ": field " + f.name + " appears twice");
+  }
+  return Status::Ok();
+}
+
 Status CheckExportPaths(const std::string& pcd_path, const std::string& las_path) {
   if (!EndsWithLas(las_path))
     return Status::InvalidInput(las_path + ": the output must be a .las file (rvlio writes "
@@ -170,6 +184,7 @@ StatusOr<LasExportResult> ExportPointCloudToLas(const std::string& pcd_path,
   PointCloudStream stream;
   if (Status s = stream.Open(pcd_path); !s.ok()) return s;
   const std::vector<PointCloudStreamField>& fields = stream.fields();
+  if (Status s = CheckFieldNames(pcd_path, fields); !s.ok()) return s;
   const FieldRoles roles = AssignRoles(fields);
   LasExportResult result;
   LasWriterOptions w;

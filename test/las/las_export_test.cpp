@@ -198,6 +198,12 @@ TEST(LasExport, BadInputIsOneLineNamingTheFileAndLeavesNothing) {
   std::ofstream(dir.Path("word.pcd"), std::ios::binary)
       << "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 2\nDATA ascii\n1 2 3\n4 five 6\n";
   std::ofstream(dir.Path("a_file"), std::ios::binary) << "x";
+  std::ofstream(dir.Path("huge.pcd"), std::ios::binary)
+      << "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4294967296\nHEIGHT 4294967296\nDATA binary\n";
+  std::ofstream(dir.Path("long.pcd"), std::ios::binary)
+      << "FIELDS x y z " << std::string(33, 'f') << "\nSIZE 4 4 4 4\nTYPE F F F F\nPOINTS 1\nDATA ascii\n1 2 3 4\n";
+  std::ofstream(dir.Path("twice.pcd"), std::ios::binary)
+      << "FIELDS x y z w w\nSIZE 4 4 4 4 4\nTYPE F F F F F\nPOINTS 1\nDATA ascii\n1 2 3 4 5\n";
   const struct { std::string map, out, crs; StatusCode code; std::string says; } kBad[] = {
       {dir.Path("missing.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "missing.pcd: cannot open"},
       {dir.Path("truncated.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "truncated"},
@@ -207,6 +213,9 @@ TEST(LasExport, BadInputIsOneLineNamingTheFileAndLeavesNothing) {
       {dir.Path("nan.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "point 1 has a non-finite"},
       {dir.Path("word.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "'five' is not a number"},
       {dir.dir().string(), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "is a directory"},
+      {dir.Path("huge.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "WIDTH x HEIGHT overflows"},
+      {dir.Path("long.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "long.pcd: field 'fff"},
+      {dir.Path("twice.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "twice.pcd: field w appears twice"},
       {dir.Path("good.pcd"), dir.Path("o.las"), "EPSG:99999999", StatusCode::kInvalidInput, "survey.crs 'EPSG:99999999'"},
       {dir.Path("good.pcd"), dir.Path("o.laz"), "local", StatusCode::kInvalidInput, "must be a .las file"},
       {dir.Path("good.pcd"), dir.Path("a_file/o.las"), "local", StatusCode::kIoError, "cannot write"},
