@@ -55,7 +55,9 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # agreement with the exact factors is math, checked in Release). The LAS
 # readers' test runs Node.js on files our code wrote (the writer's bytes are
 # checked here by LasWriter.*); the LAS memory bounds measure a Release
-# build's peak, as the refine one does.
+# build's peak, as the refine one does; MapLasCli runs run, refine and merge
+# end to end for the one call each makes to the LAS writer, which runs here in
+# LasExport.* and LasWriter.*.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -103,7 +105,7 @@ ex=(
   BatchSignalsTest.InterruptedAblationKeepsFinishedCellsAndResumes
   Refine.SummarizedFactorsAgreeWithExactFactors
   'LasReaders\..*' LasWriter.MemoryStaysBoundedWhileMillionsOfPointsAreWritten
-  LasExport.AMapOfMillionsOfPointsIsExportedInBoundedMemory
+  LasExport.AMapOfMillionsOfPointsIsExportedInBoundedMemory MapLasCli.RunRefineAndMergeWriteMapLasWhenAsked
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}
