@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "interrupt.h"
 #include "rvlio/common/text.h"
+#include "rvlio/formats/atomic_file.h"
 #include "rvlio/outputs/map_las.h"
 
 namespace rvlio::cli {
@@ -39,9 +40,12 @@ int CmdExport(int argc, char** argv) {
       return Fail("export", "--intensity-range '" + text + "' is not a number of levels >= 1");
   }
   InterruptScope interrupts;
-  options.stop = [] { return Interrupted(); };
+  options.stop = [] { return Interrupted(); };  // the first signal: stop between chunks
   const std::string out = args.Get("out");
+  SetAbortRemovePath(AtomicTempPath(out));      // a second one: _exit without the temporary
+
   StatusOr<LasExportResult> r = ExportPointCloudToLas(args.Get("map"), out, options);
+  SetAbortRemovePath("");
   if (!r.ok()) return Fail("export", r.status());
   if (r->stopped) {
     std::fprintf(stderr, "rvlio export: stopped by %s; %s not written\n",

@@ -52,7 +52,7 @@ void PrintHelp() {
   }
   std::cout << "\nexit status: 0 success, 2 bad input or configuration, 3 divergence detected\n"
                "(run, refine; outputs written), 1 internal failure, 130 / 143 stopped by\n"
-               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate)\n";
+               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate, export)\n";
 }
 
 }  // namespace

@@ -50,6 +50,10 @@ void SyncDirectory(const std::string& dir) {
 
 }  // namespace
 
+std::string AtomicTempPath(const std::string& path) {
+  return path + ".tmp." + std::to_string(::getpid());
+}
+
 Status WriteFileAtomically(const std::string& path, const std::string& content) {
   AtomicFileWriter writer;
   Status s = writer.Open(path);
@@ -80,7 +84,7 @@ Status AtomicFileWriter::Open(const std::string& path) {
   error_ = Status::Ok();
   size_ = 0;
   path_ = path;
-  temp_path_ = path + ".tmp." + std::to_string(::getpid());
+  temp_path_ = AtomicTempPath(path);
   fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     const int err = errno;

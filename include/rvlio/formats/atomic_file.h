@@ -12,6 +12,10 @@
 
 namespace rvlio {
 
+// The temporary file of `path` while this process writes it (for a signal
+// handler that removes it on an abort).
+std::string AtomicTempPath(const std::string& path);
+
 // Writes `content` to `path` atomically.
 Status WriteFileAtomically(const std::string& path, const std::string& content);
 
