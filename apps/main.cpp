@@ -35,6 +35,8 @@ constexpr Subcommand kSubcommands[] = {
     {"demo", "simulate the default tunnel and show what rvlio does with it", rvlio::cli::CmdDemo},
     {"report", "one self-contained report.html for a compare, demo, ablate or run folder",
      rvlio::cli::CmdReport},
+    {"export", "convert a map PCD into LAS 1.4 (intensity, GPS time, extra bytes, CRS)",
+     rvlio::cli::CmdExport},
 };
 
 void PrintHelp() {
@@ -50,7 +52,7 @@ void PrintHelp() {
   }
   std::cout << "\nexit status: 0 success, 2 bad input or configuration, 3 divergence detected\n"
                "(run, refine; outputs written), 1 internal failure, 130 / 143 stopped by\n"
-               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate)\n";
+               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate, export)\n";
 }
 
 }  // namespace

@@ -53,6 +53,7 @@ set(rvlio_public_headers
   rvlio/odometry/odometry.h
   rvlio/odometry/options.h
   rvlio/odometry/reference.h
+  rvlio/outputs/output_options.h
   rvlio/outputs/run_outputs.h
   rvlio/refine/refine.h
   rvlio/refine/refine_jobs.h

@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libceres-dev libsuitesparse-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev
   libpcl-dev libzstd-dev liblz4-dev libdeflate-dev zlib1g-dev
-  libsqlite3-dev
+  libsqlite3-dev libproj-dev
   librosbag-storage-dev libsensor-msgs-dev libroscpp-core-dev
   pluginlib-dev libclass-loader-dev librcpputils-dev libament-index-cpp-dev
   python3-rosbag python3-matplotlib python3-yaml

@@ -52,7 +52,12 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # ParallelFor tests and test_association (the two-thread CLI comparison is a
 # minute of ASan); batch interruption in RunSignalsTest's compare case; the
 # refine summaries (on by default) in every other Refine case (their
-# agreement with the exact factors is math, checked in Release).
+# agreement with the exact factors is math, checked in Release). The LAS
+# readers' test runs Node.js on files our code wrote (the writer's bytes are
+# checked here by LasWriter.*); the LAS memory bounds measure a Release
+# build's peak, as the refine one does; MapLasCli runs run, refine and merge
+# end to end for the one call each makes to the LAS writer, which runs here in
+# LasExport.* and LasWriter.*.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -99,6 +104,8 @@ ex=(
   AssociationThreadsCliTest.TwoThreadsWriteTheSameOutputsAsOne
   BatchSignalsTest.InterruptedAblationKeepsFinishedCellsAndResumes
   Refine.SummarizedFactorsAgreeWithExactFactors
+  'LasReaders\..*' LasWriter.MemoryStaysBoundedWhileMillionsOfPointsAreWritten
+  LasExport.AMapOfMillionsOfPointsIsExportedInBoundedMemory MapLasCli.RunRefineAndMergeWriteMapLasWhenAsked
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

@@ -37,6 +37,7 @@ struct ChunkFolder {
   json manifest;  // chunk.json
   RefineJobTrajectory job;
   std::vector<std::string> warnings;  // its summary.json "warnings"
+  json config;                        // its summary.json "config" (the refinement's options)
 };
 
 // The whole file ("" when it cannot be read: the JSON parse then says so).
@@ -119,7 +120,24 @@ StatusOr<ChunkFolder> ReadChunkFolder(const std::string& dir) {
   if (summary.is_object() && summary.contains("warnings") && summary["warnings"].is_array())
     for (const json& w : summary["warnings"])
       if (w.is_string()) c.warnings.push_back(w.get<std::string>());
+  if (summary.is_object() && summary.contains("config")) c.config = summary["config"];
   return c;
+}
+
+// map.las as the chunks were refined: their output.las and survey.crs (the
+// chunks share their options, CheckChunks); absent keys keep the defaults.
+StatusOr<MapLasRequest> MergedLasRequest(const ChunkFolder& chunk) {
+  OutputOptions output;
+  SurveyOptions survey;
+  const json& c = chunk.config;
+  if (c.is_object() && c.contains("output") && c["output"].is_object())
+    output.las = c["output"].value("las", output.las);
+  if (c.is_object() && c.contains("survey") && c["survey"].is_object())
+    survey.crs = c["survey"].value("crs", survey.crs);
+  StatusOr<MapLasRequest> las = MapLasRequestOf(output, survey);
+  if (!las.ok())
+    return las.status().WithMessage(FilePath(chunk.dir, "summary.json") + ": " + las.status().message());
+  return las;
 }
 
 // The chunks of one refinement, in order 1..N: InvalidInput naming what differs or is missing.
@@ -200,12 +218,12 @@ json Summary(const std::vector<ChunkFolder>& chunks, const MergeResult& r) {
 }
 
 Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
-                    const MapDeviation* deviation) {
+                    const MapDeviation* deviation, const MapLasRequest& las) {
   OutputStage stage(out_dir);  // all outputs or none
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), r.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteMapOutputs(&stage, r.map_points, deviation); !s.ok()) return s;
+  if (Status s = WriteMapOutputs(&stage, r.map_points, deviation, las); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
     return stage.Explain(s);
@@ -267,6 +285,8 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
     chunks.push_back(std::move(*c));
   }
   if (Status s = CheckChunks(&chunks); !s.ok()) return s;
+  StatusOr<MapLasRequest> las = MergedLasRequest(chunks.front());
+  if (!las.ok()) return las.status();
   StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front());
   if (!reference.ok()) return reference.status();
   OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
@@ -300,7 +320,7 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
     r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   }
   if (args.out_dir.empty()) return r;
-  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr); !s.ok())
+  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr, *las); !s.ok())
     return s;
   out_folder.Keep();
   r.written = true;

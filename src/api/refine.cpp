@@ -244,7 +244,7 @@ nlohmann::json Summary(const RefineArgs& args, const RefineRunResult& r,
 }
 
 Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
-                    const MapDeviation* deviation) {
+                    const MapDeviation* deviation, const MapLasRequest& las) {
   OutputStage stage(out_dir);  // all outputs or none
   if (Status s = stage.Open(); !s.ok()) return s;
   if (!r.chunk.is_null())
@@ -252,7 +252,7 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
       return stage.Explain(s);
   if (Status s = WriteTum(stage.Path("trajectory.tum"), r.refine.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteMapOutputs(&stage, r.refine.map_points, deviation); !s.ok()) return s;
+  if (Status s = WriteMapOutputs(&stage, r.refine.map_points, deviation, las); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
     return stage.Explain(s);
@@ -309,6 +309,8 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
                                           &notes);
       !s.ok())
     return s;
+  StatusOr<MapLasRequest> las = MapLasRequestOf(args.options.output, args.options.survey);
+  if (!las.ok()) return las.status();  // an unknown survey.crs, before anything is read
   RefineInput input;
   if (!args.init.empty()) {
     input.init = args.init;
@@ -395,7 +397,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   }
   if (!write) return r;
-  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr); !s.ok())
+  if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr, *las); !s.ok())
     return s;
   out_folder.Keep();
   r.written = true;

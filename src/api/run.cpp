@@ -148,12 +148,13 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
 }
 
 Status WriteOutputs(const std::string& out_dir, const std::vector<Eigen::Vector3d>& p_map,
-                    const RunResult& result, const MapDeviation* deviation) {
+                    const RunResult& result, const MapDeviation* deviation,
+                    const MapLasRequest& las) {
   OutputStage stage(out_dir);
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), result.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteMapOutputs(&stage, p_map, deviation); !s.ok()) return s;
+  if (Status s = WriteMapOutputs(&stage, p_map, deviation, las); !s.ok()) return s;
   if (Status s = WriteScansCsv(stage.Path("scans.csv"), result.scans, result.rss_mb); !s.ok())
     return stage.Explain(s);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(result.summary) + "\n");
@@ -292,6 +293,8 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
                                           &notes);
       !s.ok())
     return s;
+  StatusOr<MapLasRequest> las = MapLasRequestOf(args.options.output, args.options.survey);
+  if (!las.ok()) return las.status();  // an unknown survey.crs, before anything is read
   Localization localization;
   std::shared_ptr<const ReferenceMap> reference;  // the full cloud, for the deviation
   if (!args.map.empty()) {
@@ -360,7 +363,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   }
   if (!write) return result;
   const Status written =
-      WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr);
+      WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr, *las);
   partial.Remove();  // the complete outputs (or the folder as it was) replace it
   if (!written.ok()) return written;  // out_folder removes a folder it created
   out_folder.Keep();

@@ -95,6 +95,11 @@ StatusOr<std::string> ResolveOutputFile(const std::string& path) {
   }
 }
 
+std::string AtomicTempPath(const std::string& path) {
+  StatusOr<std::string> target = ResolveOutputFile(path);
+  return (target.ok() ? *target : path) + ".tmp." + std::to_string(::getpid());
+}
+
 Status WriteFileAtomically(const std::string& path, const std::string& content) {
   AtomicFileWriter writer;
   Status s = writer.Open(path);
@@ -115,6 +120,7 @@ AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept
     target_ = std::move(other.target_);
     temp_path_ = std::move(other.temp_path_);
     buffer_ = std::move(other.buffer_);
+    size_ = std::exchange(other.size_, 0);
     error_ = std::move(other.error_);
   }
   return *this;
@@ -123,6 +129,7 @@ AtomicFileWriter& AtomicFileWriter::operator=(AtomicFileWriter&& other) noexcept
 Status AtomicFileWriter::Open(const std::string& path) {
   Discard();
   error_ = Status::Ok();
+  size_ = 0;
   path_ = path;
   StatusOr<std::string> target = ResolveOutputFile(path);
   if (!target.ok()) return target.status();
@@ -141,7 +148,23 @@ Status AtomicFileWriter::Append(std::string_view data) {
   if (!error_.ok()) return error_;
   RVLIO_CHECK_MSG(is_open(), "AtomicFileWriter::Append before Open");
   buffer_.append(data.data(), data.size());
+  size_ += data.size();
   if (buffer_.size() >= kFlushBytes) return Flush();
+  return Status::Ok();
+}
+
+Status AtomicFileWriter::WriteAt(uint64_t offset, std::string_view data) {
+  if (!error_.ok()) return error_;
+  RVLIO_CHECK_MSG(is_open(), "AtomicFileWriter::WriteAt before Open");
+  RVLIO_CHECK_MSG(offset + data.size() <= size_, "AtomicFileWriter::WriteAt past the end");
+  if (Status s = Flush(); !s.ok()) return s;
+  while (!data.empty()) {
+    const ssize_t n = ::pwrite(fd_, data.data(), data.size(), static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return FailAndDiscard("cannot write", n < 0 ? errno : EIO);
+    data.remove_prefix(static_cast<size_t>(n));
+    offset += static_cast<uint64_t>(n);
+  }
   return Status::Ok();
 }
 

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "rvlio/common/memory.h"
@@ -20,7 +21,9 @@ const PointCloudField* PointCloudFile::Field(const std::string& name) const {
   return nullptr;
 }
 
-namespace {
+// The record layout of a file: named (not in the unnamed namespace below)
+// because PointCloudStream::Impl holds one.
+namespace point_cloud_layout {
 
 enum class ScalarKind { kFloat, kInt, kUint };
 
@@ -41,6 +44,18 @@ struct FileLayout {
   bool big_endian = false;
   int64_t num_points = 0;
 };
+
+// Which fields become x, y, z and which are kept.
+struct FieldPlan {
+  int x = -1, y = -1, z = -1;
+  std::vector<int> kept;  // indices into layout.fields
+};
+
+}  // namespace point_cloud_layout
+
+namespace {
+
+using namespace point_cloud_layout;  // NOLINT: this file's own types
 
 struct Body {
   const char* data = nullptr;  // first byte after the header
@@ -151,6 +166,8 @@ Status ParsePcdHeader(const std::string& path, const std::string& text, FileLayo
     else return PcdError(path, "field " + f.name + " has TYPE " + t + " SIZE " + sizes[i]);
     layout->fields.push_back(f);
   }
+  if (width >= 0 && height > 0 && width > std::numeric_limits<int64_t>::max() / height)
+    return PcdError(path, "WIDTH x HEIGHT overflows");
   if (points < 0) {
     if (width < 0) return PcdError(path, "neither POINTS nor WIDTH");
     points = width * height;
@@ -356,11 +373,6 @@ double DecodeScalar(const char* p, ScalarKind kind, int size, bool big_endian) {
   return 0.0;
 }
 
-// Which fields become x, y, z and which are kept.
-struct FieldPlan {
-  int x = -1, y = -1, z = -1;
-  std::vector<int> kept;  // indices into layout.fields
-};
 
 Status PlanFields(const std::string& path, const FileLayout& layout, bool keep_fields,
                   FieldPlan* plan) {
@@ -573,6 +585,180 @@ StatusOr<PointCloudFile> ReadPointCloud(const std::string& path,
   if (!cloud.ok()) return cloud;
   if (Status s = CheckPoints(path, *cloud, options.allow_empty); !s.ok()) return s;
   return cloud;
+}
+
+// ------------------------------------------------------------ streaming PCD
+
+namespace {
+
+constexpr size_t kStreamBlockBytes = 1 << 20;       // bytes per read of the body
+constexpr size_t kMaxPcdHeaderBytes = 16u << 20;    // a header past this has no DATA line
+
+// True when `head` holds a complete DATA line (the header's last).
+bool HasDataLine(const std::string& head) {
+  for (size_t line = 0; line < head.size();) {
+    const size_t end = head.find('\n', line);
+    if (end == std::string::npos) return false;
+    if (head.compare(line, 4, "DATA") == 0) return true;
+    line = end + 1;
+  }
+  return false;
+}
+
+}  // namespace
+
+struct PointCloudStream::Impl {
+  std::string path;
+  std::ifstream in;
+  FileLayout layout;
+  FieldPlan plan;
+  std::string format;
+  std::vector<PointCloudStreamField> fields;
+  bool ascii = false;
+  int64_t read = 0;     // points returned so far
+  std::string buffer;   // body bytes read but not yet decoded, from pos on
+  size_t pos = 0;
+  bool eof = false;
+
+  // Reads the next block into buffer (keeping the bytes from pos on). False
+  // when the file has no more bytes.
+  bool Refill() {
+    if (eof) return false;
+    buffer.erase(0, pos);
+    pos = 0;
+    const size_t old = buffer.size();
+    buffer.resize(old + kStreamBlockBytes);
+    in.read(&buffer[old], static_cast<std::streamsize>(kStreamBlockBytes));
+    const size_t got = static_cast<size_t>(in.gcount());
+    buffer.resize(old + got);
+    if (got < kStreamBlockBytes) eof = true;
+    return got > 0;
+  }
+
+  Status Truncated(int64_t holds) const {
+    return Status::InvalidInput(path + ": truncated: the header declares " +
+                                std::to_string(layout.num_points) + " points, the data holds " +
+                                std::to_string(holds));
+  }
+
+  // The next whitespace-separated word of an ascii body; false at the end.
+  bool NextWord(std::string* word) {
+    word->clear();
+    for (;;) {
+      while (pos < buffer.size() && std::isspace(static_cast<unsigned char>(buffer[pos]))) ++pos;
+      if (pos < buffer.size()) break;
+      if (!Refill()) return false;
+    }
+    for (;;) {
+      const size_t start = pos;
+      while (pos < buffer.size() && !std::isspace(static_cast<unsigned char>(buffer[pos]))) ++pos;
+      word->append(buffer, start, pos - start);
+      if (pos < buffer.size() || !Refill()) return true;
+    }
+  }
+
+  Status ReadAsciiPoint(std::vector<double>* record) {
+    std::string word;
+    for (double& value : *record) {
+      if (!NextWord(&word)) return Truncated(read);
+      char* end = nullptr;
+      value = std::strtod(word.c_str(), &end);
+      if (end == word.c_str() || *end != '\0') {
+        if (pos >= buffer.size() && eof)
+          return Status::InvalidInput(path + ": truncated: the header declares " +
+                                      std::to_string(layout.num_points) +
+                                      " points, the data ends in point " + std::to_string(read));
+        return Status::InvalidInput(path + ": point " + std::to_string(read) + ": '" +
+                                    word.substr(0, 20) + "' is not a number");
+      }
+    }
+    return Status::Ok();
+  }
+
+  // One binary record at buffer[pos]; the caller made sure it is there.
+  void DecodeRecord(std::vector<double>* record) {
+    const char* p = buffer.data() + pos;
+    for (size_t f = 0; f < layout.fields.size(); ++f) {
+      const FieldLayout& fl = layout.fields[f];
+      (*record)[fl.first_scalar] = fl.count == 1 ? DecodeScalar(p + fl.offset, fl.kind, fl.size, false) : 0.0;
+    }
+    pos += layout.record_bytes;
+  }
+
+  Status NextPoint(std::vector<double>* record) {
+    if (ascii) return ReadAsciiPoint(record);
+    if (buffer.size() - pos < layout.record_bytes) {
+      while (buffer.size() - pos < layout.record_bytes)
+        if (!Refill()) return Truncated(read);
+    }
+    DecodeRecord(record);
+    return Status::Ok();
+  }
+};
+
+PointCloudStream::PointCloudStream() : impl_(std::make_unique<Impl>()) {}
+PointCloudStream::~PointCloudStream() = default;
+
+const std::vector<PointCloudStreamField>& PointCloudStream::fields() const { return impl_->fields; }
+int64_t PointCloudStream::size() const { return impl_->layout.num_points; }
+const std::string& PointCloudStream::format() const { return impl_->format; }
+
+Status PointCloudStream::Open(const std::string& path) {
+  impl_ = std::make_unique<Impl>();
+  Impl& m = *impl_;
+  m.path = path;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    return Status::InvalidInput(path + ": is a directory, not a point cloud file");
+  m.in.open(path, std::ios::binary);
+  if (!m.in) return Status::InvalidInput(path + ": cannot open (" + std::strerror(errno) + ")");
+  while (!HasDataLine(m.buffer) && m.buffer.size() < kMaxPcdHeaderBytes && m.Refill()) {
+  }
+  const std::string& head = m.buffer;
+  if (head.empty()) return Status::InvalidInput(path + ": empty file (0 bytes)");
+  if (head.rfind("ply", 0) == 0)
+    return Status::InvalidInput(path + ": a PLY file; streaming reads PCD only (DATA ascii or "
+                                       "binary, as rvlio writes map.pcd)");
+  if (!(head.rfind("#", 0) == 0 || head.rfind("VERSION", 0) == 0 || head.rfind("FIELDS", 0) == 0))
+    return Status::InvalidInput(path + ": not a PCD point cloud");
+  std::string kind;
+  size_t body_pos = 0;
+  if (Status s = ParsePcdHeader(path, head, &m.layout, &kind, &body_pos); !s.ok()) return s;
+  if (kind == "binary_compressed")
+    return Status::InvalidInput(path + ": DATA binary_compressed cannot be streamed (its fields "
+                                       "are stored one after another); convert it to binary "
+                                       "first, e.g. pcl_convert_pcd_ascii_binary IN OUT 1");
+  if (Status s = PlanFields(path, m.layout, true, &m.plan); !s.ok()) return s;
+  m.ascii = kind == "ascii";
+  m.format = "pcd " + kind;
+  m.pos = body_pos;
+  for (int f : m.plan.kept) {
+    const FieldLayout& fl = m.layout.fields[f];
+    m.fields.push_back({fl.name, fl.kind == ScalarKind::kFloat ? 'F' : fl.kind == ScalarKind::kInt ? 'I' : 'U', fl.size});
+  }
+  return Status::Ok();
+}
+
+StatusOr<size_t> PointCloudStream::Read(size_t max_points, PointCloudChunk* chunk) {
+  Impl& m = *impl_;
+  const size_t n = static_cast<size_t>(
+      std::min<int64_t>(static_cast<int64_t>(max_points), m.layout.num_points - m.read));
+  chunk->points.resize(n);
+  chunk->fields.resize(m.plan.kept.size());
+  for (std::vector<double>& f : chunk->fields) f.resize(n);
+  std::vector<double> record(m.layout.record_scalars);
+  const auto at = [&](int f) { return record[m.layout.fields[f].first_scalar]; };
+  for (size_t i = 0; i < n; ++i) {
+    if (Status s = m.NextPoint(&record); !s.ok()) return s;
+    const Eigen::Vector3d p(at(m.plan.x), at(m.plan.y), at(m.plan.z));
+    if (!p.allFinite())
+      return Status::InvalidInput(m.path + ": point " + std::to_string(m.read) +
+                                  " has a non-finite coordinate (NaN or inf)");
+    chunk->points[i] = p;
+    for (size_t k = 0; k < m.plan.kept.size(); ++k) chunk->fields[k][i] = at(m.plan.kept[k]);
+    ++m.read;
+  }
+  return n;
 }
 
 }  // namespace rvlio

@@ -4,6 +4,7 @@
 // `<target>` (the path, or the final target of a link: ResolveOutputFile), so a reader sees either the old file or the complete new one, never
 // a half-written file. On any failure the temporary file is removed and an
 // InvalidInput status names the path and the system error text.
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -25,6 +26,10 @@ StatusOr<std::string> ResolveOutputFile(const std::string& path);
 // "a FIFO", "a folder", ... : what the file at `path` is, "" when it does not
 // exist or is a regular file (lstat: a link is "a symbolic link").
 std::string SpecialFileKind(const std::string& path);
+
+// The temporary file of `path` (of its link's final target) while this
+// process writes it (for a signal handler that removes it on an abort).
+std::string AtomicTempPath(const std::string& path);
 
 // Writes `content` to `path` atomically.
 Status WriteFileAtomically(const std::string& path, const std::string& content);
@@ -50,6 +55,10 @@ class AtomicFileWriter {
 
   Status Open(const std::string& path);
   Status Append(std::string_view data);
+  // Replaces bytes already appended, from `offset` on (a header whose counts
+  // are known only at the end: formats/las_writer.h). offset + size must not
+  // pass the bytes appended so far.
+  Status WriteAt(uint64_t offset, std::string_view data);
   Status Commit();
   // Removes the temporary file; the target is untouched. Safe to call twice.
   void Discard();
@@ -68,6 +77,7 @@ class AtomicFileWriter {
   std::string target_;
   std::string temp_path_;
   std::string buffer_;  // pending bytes, flushed in large blocks
+  uint64_t size_ = 0;   // bytes appended (written and pending)
   Status error_;        // sticky failure after Append()
 };
 

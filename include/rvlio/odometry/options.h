@@ -15,6 +15,7 @@
 #include "rvlio/map/options.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/reference.h"
+#include "rvlio/outputs/output_options.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/window/options.h"
 
@@ -43,6 +44,8 @@ struct OdometryOptions {
   DivergenceOptions divergence;
   LocalizationOptions localization;  // used only with a reference map (`run --map`)
   ReaderOptions io;
+  OutputOptions output;  // optional output files (map.las)
+  SurveyOptions survey;  // the map frame's coordinate reference system
 
   template <class V>
   void Visit(V& v) {
@@ -59,6 +62,8 @@ struct OdometryOptions {
     v.Section("divergence", divergence);
     v.Section("localization", localization);
     v.Section("io", io);
+    v.Section("output", output);
+    v.Section("survey", survey);
   }
 
   // Ranges and choices of every key, then the cross-field rules of each module.
@@ -67,7 +72,8 @@ struct OdometryOptions {
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), degeneracy.Validate(), ieskf.Validate(), smoother.Validate(),
-                     divergence.Validate(), localization.Validate(), io.Validate()})
+                     divergence.Validate(), localization.Validate(), io.Validate(),
+                     output.Validate(), survey.Validate()})
       if (!m.ok()) return m;
     if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
       return Status::InvalidInput(

@@ -10,6 +10,7 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/outputs/map_las.h"
 #include "rvlio/outputs/output_stage.h"
 #include "rvlio/map/reference_map.h"
 #include "rvlio/odometry/deviation.h"
@@ -33,9 +34,10 @@ MapDeviation ComputeMapDeviation(const std::vector<Eigen::Vector3d>& p_map,
 nlohmann::json DeviationSummaryJson(const MapDeviation& d);
 
 // map.pcd of p_map into the stage, with the deviation_m field and
-// deviation.csv beside it when `deviation` (of p_map) is not null. The error
-// is the stage's explanation (nothing of the stage is committed).
+// deviation.csv beside it when `deviation` (of p_map) is not null, and map.las
+// of the same points and fields when las.enabled (output.las). The error is
+// the stage's explanation (nothing of the stage is committed).
 Status WriteMapOutputs(OutputStage* stage, const std::vector<Eigen::Vector3d>& p_map,
-                       const MapDeviation* deviation);
+                       const MapDeviation* deviation, const MapLasRequest& las = {});
 
 }  // namespace rvlio
