@@ -6,6 +6,7 @@
 #include <map>
 
 #include "rvlio/common/text.h"
+#include "rvlio/math/pose_interpolation.h"
 
 namespace rvlio {
 namespace {
@@ -131,9 +132,7 @@ StatusOr<RefineJobSpan> MakeRefineJobSpan(TimeNs t0_ns, TimeNs t1_ns, int chunk,
 }
 
 StampedPose BlendPoses(const StampedPose& a, const StampedPose& b, double w) {
-  StampedPose out = a;
-  out.p_world_imu = (1.0 - w) * a.p_world_imu + w * b.p_world_imu;
-  out.q_world_imu = a.q_world_imu.normalized().slerp(w, b.q_world_imu.normalized());
+  StampedPose out = InterpolateBetween(a, b, w);
   out.q_world_imu.normalize();
   return out;
 }

@@ -19,7 +19,7 @@
 #include "cli_util.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/math/pose_interpolation.h"
 
 namespace rvlio {
 namespace {
