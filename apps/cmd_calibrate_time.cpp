@@ -26,7 +26,7 @@ struct Recording {
   std::vector<TimeNs> scan_start_ns, scan_end_ns, imu_ns;
 };
 
-Status Read(const std::string& bag, const OdometryOptions& o, Recording* rec) {
+Status Read(const std::string& bag, const Configuration& o, Recording* rec) {
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(bag, o.lidar, o.imu, ReadWindow(), o.io);
   if (!reader.ok()) return reader.status();
@@ -67,7 +67,7 @@ void PrintStamps(const StampReport& s, const std::string& header_stamp) {
       1e3 * s.imu_jitter_s, s.imu_gaps, 1e3 * s.imu_max_gap_s);
 }
 
-void PrintOffset(const ClockCheckResult& r, const OdometryOptions& o, const ClockCheckOptions& c) {
+void PrintOffset(const ClockCheckResult& r, const Configuration& o, const ClockCheckOptions& c) {
   std::printf(
       "clock offset (scan-to-scan rotation rate vs gyroscope, %d intervals, lag searched +-%.0f "
       "ms):\n"
@@ -106,7 +106,7 @@ int CmdCalibrateTime(int argc, char** argv) {
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   std::vector<std::string> warnings;
-  StatusOr<OdometryOptions> o = LoadConfig(args.GetAll("config"), args.GetAll("set"), &warnings);
+  StatusOr<Configuration> o = LoadConfig(args.GetAll("config"), args.GetAll("set"), &warnings);
   if (!o.ok()) return Fail(kCalibrateTime, o.status().message());
   for (const auto& w : warnings) std::fprintf(stderr, "rvlio %s: warning: %s\n", kCalibrateTime, w.c_str());
   Recording rec;

@@ -10,7 +10,7 @@
 #include "rvlio/common/text.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/point_cloud_file.h"
-#include "rvlio/odometry/scan_columns.h"
+#include "rvlio/outputs/scan_columns.h"
 
 namespace rvlio {
 namespace {

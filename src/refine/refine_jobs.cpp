@@ -104,14 +104,14 @@ StatusOr<RefineJobSpan> MakeRefineJobSpan(TimeNs t0_ns, TimeNs t1_ns, int chunk,
   if (t1_ns <= t0_ns)
     return Status::InvalidInput("the initial trajectory spans no time: it cannot be cut into chunks");
   if (!(overlap_s >= 0.0))
-    return Status::InvalidInput("smoother.refine_job_overlap_s must be >= 0");
+    return Status::InvalidInput("refine.job_overlap_s must be >= 0");
   const double length_s = NsToSeconds(t1_ns - t0_ns);
   const double core_s = length_s / count;
   if (count > 1 && core_s < overlap_s)
     return Status::InvalidInput("--of " + std::to_string(count) + ": chunks of " +
                                 FormatFixed(core_s, 3) + " s (" + FormatFixed(length_s, 3) +
                                 " s of initial trajectory) are shorter than their overlap "
-                                "smoother.refine_job_overlap_s = " +
+                                "refine.job_overlap_s = " +
                                 FormatFixed(overlap_s, 3) +
                                 " s; use fewer chunks or a "
                                 "shorter overlap");
@@ -151,7 +151,7 @@ StatusOr<RefineJobMerge> MergeRefineJobs(const std::vector<RefineJobTrajectory>&
       return Status::InvalidInput(
           "chunks " + std::to_string(k) + " and " + std::to_string(k + 1) + " share " +
           std::to_string(shared.merged.size()) + " poses (need " +
-          std::to_string(kRefineJobMinSharedPoses) + "): a longer smoother.refine_job_overlap_s");
+          std::to_string(kRefineJobMinSharedPoses) + "): a longer refine.job_overlap_s");
     RefineJobAlignment a;
     a.chunk = static_cast<int>(k) + 1;
     a.T_merged_chunk = AlignShared(shared);
