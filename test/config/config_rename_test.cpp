@@ -43,7 +43,8 @@ TEST(ConfigRename, OldSmootherHuberNamesSetTheScopedFieldsWithOneWarningEach) {
   // The resolved configuration speaks only of the new names.
   const std::string dump = DumpYaml(*r);
   EXPECT_NE(dump.find("refine:\n  huber_delta: 0.2"), std::string::npos) << dump;
-  EXPECT_EQ(dump.find("refine_"), std::string::npos);
+  EXPECT_EQ(dump.find("refine_huber_delta"), std::string::npos);
+  EXPECT_EQ(dump.find(" huber_delta: 0.1"), std::string::npos);
   EXPECT_EQ(dump.find("online_huber_delta"), std::string::npos);
 }
 
