@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <utility>
 
 #include "rvlio/api.h"
 #include "rvlio/formats/point_cloud_file.h"
@@ -150,7 +151,7 @@ StatusOr<MapEvalResult> EvaluateMapFiles(const std::string& map_path, const std:
   if (!map.ok()) return map.status();
   StatusOr<PointCloudFile> ref = ReadPointCloud(ref_path, xyz_only);
   if (!ref.ok()) return ref.status();
-  StatusOr<MapEvalResult> r = EvaluateMap(map->points, ref->points, options);
+  StatusOr<MapEvalResult> r = EvaluateMap(std::move(map->points), std::move(ref->points), options);
   if (!r.ok()) return Status::InvalidInput(map_path + " vs " + ref_path + ": " + r.status().message());
   return r;
 }

@@ -154,13 +154,16 @@ Status CheckChunks(std::vector<ChunkFolder>* chunks) {
   return Status::Ok();
 }
 
-// Each chunk's map carried into the merged frame, re-voxelized at the chunks' resolution.
+// Each chunk's map carried into the merged frame, re-voxelized at the
+// chunks' resolution; in the local frame of `origin`, as the trajectories.
 StatusOr<std::vector<Eigen::Vector3d>> MergeMaps(const std::vector<ChunkFolder>& chunks,
-                                                 const RefineJobMerge& merge) {
+                                                 const RefineJobMerge& merge,
+                                                 const LocalOrigin& origin) {
   OutputMap output(chunks.front().manifest["map_output_resolution"].get<double>());
   for (size_t k = 0; k < chunks.size(); ++k) {
     StatusOr<std::vector<Eigen::Vector3d>> points = ReadMapPcd(FilePath(chunks[k].dir, "map.pcd"));
     if (!points.ok()) return points.status();
+    origin.ToLocal(&*points);
     const Pose3& T = merge.alignments[k].T_merged_chunk;
     for (Eigen::Vector3d& p : *points) p = T * p;
     output.Insert(*points);
@@ -216,7 +219,8 @@ Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
 // refined with (chunk.json's map_hash: the file's content), and the chunks'
 // deviation options. Null without --map.
 struct MergeReference {
-  std::shared_ptr<const ReferenceMap> surface;
+  std::shared_ptr<const ReferenceMap> surface;  // in its local frame
+  LocalOrigin origin;
   DeviationOptions options;
 };
 
@@ -239,7 +243,7 @@ StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkF
                                manifest + " deviation");
       !s.ok())
     return s;
-  StatusOr<std::shared_ptr<const ReferenceMap>> surface = LoadReferenceSurface(map);
+  StatusOr<std::shared_ptr<const ReferenceMap>> surface = LoadReferenceSurface(map, &ref.origin);
   if (!surface.ok()) return surface.status();
   ref.surface = std::move(*surface);
   return ref;
@@ -271,13 +275,22 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   if (!reference.ok()) return reference.status();
   if (!args.out_dir.empty())
     if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
+  // The chunks are merged in a local frame: the reference's (the frame
+  // refine --map used), else one chosen from chunk 1's trajectory; the
+  // outputs go out in the chunks' frame.
+  const LocalOrigin origin = reference->surface != nullptr
+                                 ? reference->origin
+                                 : ChooseLocalOrigin(chunks.front().job.trajectory);
   std::vector<RefineJobTrajectory> jobs;
-  for (const ChunkFolder& c : chunks) jobs.push_back(c.job);
+  for (const ChunkFolder& c : chunks) {
+    jobs.push_back(c.job);
+    origin.ToLocal(&jobs.back().trajectory);
+  }
   StatusOr<RefineJobMerge> merge = MergeRefineJobs(jobs);
   if (!merge.ok()) return merge.status();
   MergeResult r;
   r.trajectory = merge->trajectory;
-  StatusOr<std::vector<Eigen::Vector3d>> map = MergeMaps(chunks, *merge);
+  StatusOr<std::vector<Eigen::Vector3d>> map = MergeMaps(chunks, *merge, origin);
   if (!map.ok()) return map.status();
   r.map_points = std::move(*map);
   for (const ChunkFolder& c : chunks)
@@ -290,11 +303,15 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
                          "; merge --map " + chunk_map + " writes the deviation from it");
   for (size_t k = 0; k < chunks.size(); ++k)
     r.chunks.push_back(Merged(chunks[k], merge->alignments[k]));
-  r.summary = Summary(chunks, r);
-  std::optional<MapDeviation> deviation;
-  if (reference->surface != nullptr) {
+  std::optional<MapDeviation> deviation;  // in the local frame, as the reference
+  if (reference->surface != nullptr)
     deviation = ComputeMapDeviation(r.map_points, *reference->surface, r.trajectory,
                                     reference->options);
+  origin.ToUser(&r.trajectory);
+  origin.ToUser(&r.map_points);
+  r.summary = Summary(chunks, r);
+  r.summary["local_origin"] = LocalOriginJson(origin);
+  if (deviation) {
     r.summary["map"] = args.map;
     r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   }

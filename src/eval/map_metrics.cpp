@@ -9,6 +9,7 @@
 
 #include "rvlio/common/parallel.h"
 #include "rvlio/map/voxel_order.h"
+#include "rvlio/math/local_origin.h"
 
 namespace rvlio {
 
@@ -151,11 +152,12 @@ ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points) {
   return axis;
 }
 
-StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
-                                    const std::vector<Eigen::Vector3d>& ref_points,
-                                    const MapEvalOptions& options) {
-  if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
-  if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+namespace {
+
+// EvaluateMap of clouds in the reference's local frame (checked).
+StatusOr<MapEvalResult> EvaluateLocal(const std::vector<Eigen::Vector3d>& map_points,
+                                      const std::vector<Eigen::Vector3d>& ref_points,
+                                      const MapEvalOptions& options) {
   const double D = options.max_distance;
   MapEvalResult r;
   r.map_points = map_points.size();
@@ -169,6 +171,8 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
   MapPointDistances d;
   {
     const ReferenceMap ref(ref_points, ref_order, options.search);
+    if (Status s = CheckReach(ref.voxels(), ref_points); !s.ok())
+      return Status::InvalidInput("the reference: " + s.message());
     d = MapToReference(map_points, map_order, ref, options);
   }  // the reference's search structure is freed before the map's is built
   std::vector<double> plane, nearest;
@@ -208,6 +212,33 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
   r.axis_direction = axis.direction;
   r.profile = Profile(map_points, ref_points, d, ref_nearest, axis, options);
   return r;
+}
+
+}  // namespace
+
+StatusOr<MapEvalResult> EvaluateMap(std::vector<Eigen::Vector3d>&& map_points,
+                                    std::vector<Eigen::Vector3d>&& ref_points,
+                                    const MapEvalOptions& options) {
+  if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
+  if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+  const LocalOrigin origin = ChooseLocalOrigin(ref_points);
+  origin.ToLocal(&map_points);
+  origin.ToLocal(&ref_points);
+  StatusOr<MapEvalResult> r = EvaluateLocal(map_points, ref_points, options);
+  if (r.ok()) r->axis_origin = origin.ToUser(r->axis_origin);
+  return r;
+}
+
+StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
+                                    const std::vector<Eigen::Vector3d>& ref_points,
+                                    const MapEvalOptions& options) {
+  if (ChooseLocalOrigin(ref_points).IsZero()) {  // no copies needed
+    if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
+    if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+    return EvaluateLocal(map_points, ref_points, options);
+  }
+  return EvaluateMap(std::vector<Eigen::Vector3d>(map_points),
+                     std::vector<Eigen::Vector3d>(ref_points), options);
 }
 
 }  // namespace rvlio

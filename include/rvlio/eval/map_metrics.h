@@ -95,12 +95,21 @@ struct ChainageAxis {
 };
 ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points);
 
-// Evaluates map_points against ref_points (same frame, m). InvalidInput
-// (message without file names; the caller adds them) for an empty cloud, a
-// non-finite point, or clouds that do not overlap (no MAP point within D of
-// REF).
+// Evaluates map_points against ref_points (same frame, m). Both are moved
+// into the reference's local frame first (ChooseLocalOrigin(ref_points),
+// math/local_origin.h), so clouds in a national grid (UTM) are searched as
+// precisely as clouds near zero; axis_origin is given back in their frame.
+// InvalidInput (message without file names; the caller adds them) for an
+// empty cloud, a non-finite point, a reference that spans more than its
+// search structure reaches (CheckReach: ~210 km at 0.1 m voxels), or clouds
+// that do not overlap (no MAP point within D of REF).
 StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
                                     const std::vector<Eigen::Vector3d>& ref_points,
+                                    const MapEvalOptions& options);
+// The same, moving the clouds into the local frame in place (no copies: for
+// clouds read only for this).
+StatusOr<MapEvalResult> EvaluateMap(std::vector<Eigen::Vector3d>&& map_points,
+                                    std::vector<Eigen::Vector3d>&& ref_points,
                                     const MapEvalOptions& options);
 
 }  // namespace rvlio

@@ -36,6 +36,7 @@
 #include "rvlio/map/reference_map.h"
 #include "rvlio/odometry/deviation.h"
 #include "rvlio/map/voxel_map.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/math/pose.h"
 
 namespace rvlio {
@@ -107,10 +108,14 @@ struct LocalizationOptions {
 // What the odometry localizes in: the reference map (filled once, never
 // changed) and the IMU pose in the reference frame at the first scan: the
 // one pose of `initial_poses`, or the poses interpolated at the first scan's
-// time (sorted by time).
+// time (sorted by time). Both are in the reference's local frame (`origin`:
+// the reference frame translated to near the map, math/local_origin.h), and
+// so is everything the odometry estimates; the odometry never reads
+// `origin`: whoever writes its results adds it back (api/run.cpp).
 struct Localization {
   std::shared_ptr<const VoxelMap> reference;
   Trajectory initial_poses;
+  LocalOrigin origin;
 };
 
 // Builds the reference's search structure from its points (reference frame, m).

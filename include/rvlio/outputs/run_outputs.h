@@ -13,7 +13,17 @@
 
 namespace rvlio {
 
-// Binary PCD (x y z float32; header made by PCL), written atomically.
+// map.pcd stores x y z as float32 while every coordinate is below this in
+// magnitude (float32 rounds to within 0.25 mm there), else as float64
+// (PCD SIZE 8 TYPE F): a map in a national grid (UTM: eastings of 5e5 m,
+// northings of 5e6 m, where a float32 keeps only decimetres) keeps its
+// millimetres.
+constexpr double kFloat32MapReach_m = 8192.0;
+// True when a coordinate of p_world reaches kFloat32MapReach_m.
+bool MapNeedsFloat64(const std::vector<Eigen::Vector3d>& p_world);
+
+// Binary PCD (x y z float32, or float64 when MapNeedsFloat64; header made by
+// PCL), written atomically.
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
 // The same with a fourth float32 field deviation_m (one per point; NaN
 // allowed) when deviation_m is not null: what PCL viewers and CloudCompare
