@@ -576,11 +576,10 @@ Status CheckReach(const VoxelMap& map, const std::vector<Eigen::Vector3d>& p_ins
   char text[400];
   std::snprintf(text, sizeof(text),
                 "%zu of %zu points lie more than %.1f km from the local origin along an axis, "
-                "beyond the reach of a voxel map of %g m voxels: the cloud spans %.1f x %.1f x "
-                "%.1f km (x, y, z), more than %.0f km (crop it to the area of interest, or remove "
-                "stray points)",
+                "beyond the reach of a voxel map of %g m voxels (the cloud spans %.1f x %.1f x "
+                "%.1f km in x, y, z): crop it to the area of interest, or remove stray points",
                 map.NumOutOfReach(), p_inserted.size(), reach_km, map.options().voxel_size,
-                span_km.x(), span_km.y(), span_km.z(), 2.0 * reach_km);
+                span_km.x(), span_km.y(), span_km.z());
   return Status::InvalidInput(text);
 }
 

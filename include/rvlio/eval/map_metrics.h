@@ -100,9 +100,10 @@ ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points);
 // math/local_origin.h), so clouds in a national grid (UTM) are searched as
 // precisely as clouds near zero; axis_origin is given back in their frame.
 // InvalidInput (message without file names; the caller adds them) for an
-// empty cloud, a non-finite point, a reference that spans more than its
-// search structure reaches (CheckReach: ~210 km at 0.1 m voxels), or clouds
-// that do not overlap (no MAP point within D of REF).
+// empty cloud, a non-finite point, a reference point beyond its search
+// structure's reach from the local origin (CheckReach: 104.8 km along an axis
+// at 0.1 m voxels), or clouds that do not overlap (no MAP point within D of
+// REF).
 StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
                                     const std::vector<Eigen::Vector3d>& ref_points,
                                     const MapEvalOptions& options);

@@ -21,8 +21,9 @@ namespace rvlio {
 // in a national grid (UTM) is searched as precisely as one near zero.
 // InvalidInput, one line starting with "--map PATH", when the file is
 // missing, unreadable, truncated, empty or holds a non-finite point, and when
-// the map spans more than its search structures reach (CheckReach: ~210 km
-// for the deviation's 0.1 m voxels). The file is only read.
+// a point lies beyond its search structures' reach from the local origin
+// (CheckReach: 104.8 km along an axis for the deviation's 0.1 m voxels: a
+// map larger than ~200 km, or a stray point far away). The file is only read.
 // surface (when not null) receives the full cloud for the deviation
 // (QueryReferenceSurface), from the same read, in the same local frame.
 StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(

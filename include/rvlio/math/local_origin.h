@@ -20,10 +20,10 @@
 
 namespace rvlio {
 
-// The local origin is the centre of the data's bounding box rounded to a
-// multiple of this, per axis: a readable offset, and data within half of it
-// of the user frame's origin (the simulator's, a run without a map) keep the
-// user frame unchanged (zero offset), so their results do not change.
+// The local origin is the data's median rounded to a multiple of this, per
+// axis: a readable offset, and data within half of it of the user frame's
+// origin (the simulator's, a run without a map) keep the user frame (zero
+// offset), so their results do not change.
 constexpr double kLocalOriginGrid_m = 1000.0;
 
 struct LocalOrigin {
@@ -40,10 +40,12 @@ struct LocalOrigin {
   void ToUser(Trajectory* trajectory) const;
 };
 
-// The multiple of kLocalOriginGrid_m nearest to the centre of the
-// axis-aligned bounding box of the finite points, per axis (zero when there
-// are none). The centre rather than the mean: the local coordinates are then
-// at most half the data's extent (plus half the grid) in size.
+// The multiple of kLocalOriginGrid_m nearest to the median of the finite
+// points, per axis (of an even subsample of at most 65536 of them; zero when
+// none is finite). The median rather than the centre of the bounding box: a
+// stray point (a survey's (0, 0, 0), a blunder 200 km away) does not move the
+// origin away from where the data are, and the bulk of the data gets the
+// finest float32 resolution.
 LocalOrigin ChooseLocalOrigin(const std::vector<Eigen::Vector3d>& p_user);
 // The same over the positions of a trajectory.
 LocalOrigin ChooseLocalOrigin(const Trajectory& trajectory);
