@@ -52,7 +52,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # ParallelFor tests and test_association (the two-thread CLI comparison is a
 # minute of ASan); batch interruption in RunSignalsTest's compare case; the
 # refine summaries (on by default) in every other Refine case (their
-# agreement with the exact factors is math, checked in Release).
+# agreement with the exact factors is math, checked in Release). The
+# survey-coordinates suite (SurveyCoordinates) runs a flight twice, a refine
+# and eval --map of a 590 k point survey; the local frame it checks runs here
+# in LocalOrigin, VoxelMap, ReferenceMap, MapMetrics and ReferenceMapFileTest.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -96,6 +99,7 @@ ex=(
   'TimeOffsetCliTest\..*'
   'DegeneracyCliTest\..*'
   'SurveyFlights\..*' SurveyFeatureless.StartTwentyMetresOffAlongTheAxisIsRefused
+  'SurveyCoordinates\..*'
   AssociationThreadsCliTest.TwoThreadsWriteTheSameOutputsAsOne
   BatchSignalsTest.InterruptedAblationKeepsFinishedCellsAndResumes
   Refine.SummarizedFactorsAgreeWithExactFactors
