@@ -22,22 +22,15 @@
 
 #include <gtest/gtest.h>
 
+#include "test_dir.h"
+
 namespace rvlio {
 namespace {
 
 namespace fs = std::filesystem;
 
-class PointCloudFileTest : public ::testing::Test {
+class PointCloudFileTest : public MapioTestDir {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rvlio_pcf_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
   std::string Write(const std::string& name, const std::string& bytes) const {
     std::ofstream(Path(name), std::ios::binary) << bytes;
     return Path(name);
@@ -69,7 +62,6 @@ class PointCloudFileTest : public ::testing::Test {
       }
     }
   }
-  fs::path dir_;
 };
 
 TEST_F(PointCloudFileTest, ReadsPclPcdInEveryEncoding) {

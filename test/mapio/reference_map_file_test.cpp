@@ -4,7 +4,6 @@
 #include "rvlio/formats/reference_map_file.h"
 
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
@@ -13,25 +12,15 @@
 
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/outputs/run_outputs.h"
+#include "test_dir.h"
 
 namespace rvlio {
 namespace {
 
-namespace fs = std::filesystem;
-
 const Eigen::Vector3d kUtm(500000.0, 5400000.0, 0.0);
 
-class ReferenceMapFileTest : public ::testing::Test {
+class ReferenceMapFileTest : public MapioTestDir {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rvlio_rmf_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
   // A floor and a wall (10 cm grid) around kUtm + (5, 0, 0), written as map.pcd (float64 x y z).
   std::string WriteMap(const std::string& name, std::vector<Eigen::Vector3d> extra = {}) const {
     std::vector<Eigen::Vector3d> p;
@@ -44,7 +33,6 @@ class ReferenceMapFileTest : public ::testing::Test {
     EXPECT_TRUE(WriteMapPcd(Path(name), p).ok());
     return Path(name);
   }
-  fs::path dir_;
 };
 
 TEST_F(ReferenceMapFileTest, MapAndInitialPoseEnterTheMapsLocalFrame) {
