@@ -224,7 +224,8 @@ struct MergeReference {
   DeviationOptions options;
 };
 
-StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkFolder& first) {
+StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkFolder& first,
+                                            std::vector<std::string>* warnings) {
   MergeReference ref;
   if (map.empty()) return ref;
   const std::string manifest = FilePath(first.dir, "chunk.json");
@@ -243,7 +244,8 @@ StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkF
                                manifest + " deviation");
       !s.ok())
     return s;
-  StatusOr<std::shared_ptr<const ReferenceMap>> surface = LoadReferenceSurface(map, &ref.origin);
+  StatusOr<std::shared_ptr<const ReferenceMap>> surface =
+      LoadReferenceSurface(map, &ref.origin, warnings);
   if (!surface.ok()) return surface.status();
   ref.surface = std::move(*surface);
   return ref;
@@ -271,7 +273,8 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
     chunks.push_back(std::move(*c));
   }
   if (Status s = CheckChunks(&chunks); !s.ok()) return s;
-  StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front());
+  std::vector<std::string> map_warnings;
+  StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front(), &map_warnings);
   if (!reference.ok()) return reference.status();
   if (!args.out_dir.empty())
     if (Status s = PrepareOutputDir(args.out_dir); !s.ok()) return s;
@@ -293,10 +296,10 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   StatusOr<std::vector<Eigen::Vector3d>> map = MergeMaps(chunks, *merge, origin);
   if (!map.ok()) return map.status();
   r.map_points = std::move(*map);
-  for (const ChunkFolder& c : chunks)
-    for (const std::string& w : c.warnings)
-      if (std::find(r.warnings.begin(), r.warnings.end(), w) == r.warnings.end())
-        r.warnings.push_back(w);
+  for (const ChunkFolder& c : chunks) map_warnings.insert(map_warnings.end(), c.warnings.begin(), c.warnings.end());
+  for (const std::string& w : map_warnings)  // each once
+    if (std::find(r.warnings.begin(), r.warnings.end(), w) == r.warnings.end())
+      r.warnings.push_back(w);
   const std::string chunk_map = chunks.front().manifest.value("map", std::string());
   if (args.map.empty() && !chunks.front().manifest.value("map_hash", std::string()).empty())
     r.warnings.push_back("the chunks were refined with --map " + chunk_map +

@@ -335,7 +335,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   LocalOrigin origin = ChooseLocalOrigin(input.init);
   if (!args.map.empty()) {  // read before anything is written
     StatusOr<std::shared_ptr<const VoxelMap>> loaded =
-        LoadReferenceMap(args.map, args.options.localization, &surface, &origin);
+        LoadReferenceMap(args.map, args.options.localization, &surface, &origin, &notes);
     if (!loaded.ok()) return loaded.status();
     reference = std::move(*loaded);
   }

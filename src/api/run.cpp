@@ -300,11 +300,13 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
     return s;
   Localization localization;
   std::shared_ptr<const ReferenceMap> reference;  // the full cloud, for the deviation
+  std::vector<std::string> map_warnings;  // e.g. a float32 map far from zero
   if (!args.map.empty()) {
-    StatusOr<Localization> loaded = LoadLocalization(args.map, args.initial_pose,
-                                                     args.initial_pose_tum, args.options, &reference);
+    StatusOr<Localization> loaded = LoadLocalization(
+        args.map, args.initial_pose, args.initial_pose_tum, args.options, &reference, &map_warnings);
     if (!loaded.ok()) return loaded.status();
     localization = std::move(*loaded);
+    notes.insert(notes.end(), map_warnings.begin(), map_warnings.end());
   } else if (!args.initial_pose.empty() || !args.initial_pose_tum.empty()) {
     return Status::InvalidInput("--initial-pose and --initial-pose-tum need --map");
   }
@@ -341,7 +343,9 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
       partial.Remove();
       if (!out_dir_existed) std::filesystem::remove(args.out_dir, ec);  // only if empty
     }
-    return Status::InvalidInput("--map " + args.map + ": " + (*odo)->status().message());
+    std::string text = "--map " + args.map + ": " + (*odo)->status().message();
+    for (const std::string& w : map_warnings) text += "; " + w;  // maybe why the map did not fit
+    return Status::InvalidInput(text);
   }
 
   const SensorReaderStats& reader_stats = (*reader)->stats();

@@ -1,11 +1,13 @@
 // Reading the inputs of `run --map` and `refine --map` (formats/reference_map_file.h).
 #include "rvlio/formats/reference_map_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -40,14 +42,33 @@ double NearestDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::
   return std::sqrt(best2);
 }
 
+// The warning for a map stored as float32 where float32 steps by a
+// millimetre or more (empty otherwise): its points are no finer than that,
+// whatever the local frame does.
+std::string PrecisionWarning(const std::string& path, const PointCloudFile& cloud) {
+  if (!cloud.xyz_single_precision) return "";
+  double largest = 0.0;
+  for (const Eigen::Vector3d& p : cloud.points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  if (largest < kFloat32MillimetreReach_m) return "";
+  char text[320];
+  std::snprintf(text, sizeof(text),
+                "--map %s: x y z are float32 and reach %.0f m, where float32 steps by %.3g m: "
+                "the map is no finer than that (store it with float64 x y z, or in a local frame)",
+                path.c_str(), largest, Float32Step(largest));
+  return text;
+}
+
 // The points of --map in their local frame (*origin, chosen from them): the
 // file's coordinates, read in double precision, minus the origin.
 StatusOr<std::vector<Eigen::Vector3d>> ReadReferencePoints(const std::string& path,
-                                                           LocalOrigin* origin) {
+                                                           LocalOrigin* origin,
+                                                           std::vector<std::string>* warnings) {
   PointCloudReadOptions read;
   read.keep_fields = false;
   StatusOr<PointCloudFile> cloud = ReadPointCloud(path, read);
   if (!cloud.ok()) return Status::InvalidInput("--map " + cloud.status().message());
+  if (std::string w = PrecisionWarning(path, *cloud); !w.empty() && warnings != nullptr)
+    warnings->push_back(w);
   *origin = ChooseLocalOrigin(cloud->points);
   origin->ToLocal(&cloud->points);
   return std::move(cloud->points);
@@ -88,15 +109,16 @@ StatusOr<std::shared_ptr<const VoxelMap>> BuildReferenceStructures(
 
 StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(
     const std::string& path, const LocalizationOptions& options,
-    std::shared_ptr<const ReferenceMap>* surface, LocalOrigin* origin) {
-  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path, origin);
+    std::shared_ptr<const ReferenceMap>* surface, LocalOrigin* origin,
+    std::vector<std::string>* warnings) {
+  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path, origin, warnings);
   if (!p_ref.ok()) return p_ref.status();
   return BuildReferenceStructures(path, *p_ref, options, surface);
 }
 
-StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(const std::string& path,
-                                                                   LocalOrigin* origin) {
-  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path, origin);
+StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(
+    const std::string& path, LocalOrigin* origin, std::vector<std::string>* warnings) {
+  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path, origin, warnings);
   if (!p_ref.ok()) return p_ref.status();
   auto surface = std::make_shared<const ReferenceMap>(*p_ref);
   if (Status s = CheckReferenceReach(path, surface->voxels(), *p_ref); !s.ok()) return s;
@@ -132,11 +154,13 @@ StatusOr<Localization> LoadLocalization(const std::string& map_path,
                                         const std::string& initial_pose,
                                         const std::string& initial_pose_tum,
                                         const OdometryOptions& options,
-                                        std::shared_ptr<const ReferenceMap>* surface) {
+                                        std::shared_ptr<const ReferenceMap>* surface,
+                                        std::vector<std::string>* warnings) {
   StatusOr<Trajectory> poses = InitialPoses(initial_pose, initial_pose_tum);
   if (!poses.ok()) return poses.status();
   Localization loc;
-  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(map_path, &loc.origin);
+  StatusOr<std::vector<Eigen::Vector3d>> p_ref =
+      ReadReferencePoints(map_path, &loc.origin, warnings);
   if (!p_ref.ok()) return p_ref.status();
   loc.origin.ToLocal(&*poses);  // the initial poses are given in the map's frame
   if (!poses->empty()) {

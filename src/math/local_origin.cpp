@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 namespace rvlio {
 namespace {
@@ -51,6 +52,11 @@ void LocalOrigin::ToLocal(Trajectory* trajectory) const {
 
 void LocalOrigin::ToUser(Trajectory* trajectory) const {
   for (StampedPose& pose : *trajectory) pose.p_world_imu += t_user_local;
+}
+
+double Float32Step(double v) {
+  const float f = static_cast<float>(std::abs(v));
+  return static_cast<double>(std::nextafter(f, std::numeric_limits<float>::infinity()) - f);
 }
 
 LocalOrigin ChooseLocalOrigin(const std::vector<Eigen::Vector3d>& p_user) {

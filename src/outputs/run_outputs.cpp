@@ -10,6 +10,7 @@
 #include "rvlio/common/text.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/odometry/scan_columns.h"
 
 namespace rvlio {
@@ -53,7 +54,7 @@ void AppendPcdRecord(const Eigen::Vector3d& p, int xyz_bytes, const double* devi
 
 bool MapNeedsFloat64(const std::vector<Eigen::Vector3d>& p_world) {
   for (const Eigen::Vector3d& p : p_world)
-    if (p.cwiseAbs().maxCoeff() >= kFloat32MapReach_m) return true;
+    if (p.cwiseAbs().maxCoeff() >= kFloat32MillimetreReach_m) return true;
   return false;
 }
 

@@ -146,7 +146,7 @@ TEST_F(PointCloudFileTest, MapPcdIsWhatPclWritesAndReads) {
 // A map in a national grid (UTM: easting 5e5 m, northing 5.4e6 m, where a
 // float32 keeps only decimetres) is written with x y z as float64: the header
 // and the bytes are PCL's for such a cloud, PCL reads the doubles back, and so
-// does our reader, exactly. Below kFloat32MapReach_m the map stays float32.
+// does our reader, exactly. Below kFloat32MillimetreReach_m the map stays float32.
 TEST_F(PointCloudFileTest, FarMapPcdIsFloat64AndWhatPclWrites) {
   const std::vector<Eigen::Vector3d> points = {{500000.0011, 5400000.0022, 312.0033},
                                                {500012.25, 5399990.5, 300.0},

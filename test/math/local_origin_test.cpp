@@ -76,5 +76,12 @@ TEST(LocalOrigin, RoundTripKeepsTheCoordinates) {
   EXPECT_NEAR((t[0].p_world_imu - kUtm - Eigen::Vector3d(0.001, 0.002, 0.003)).norm(), 0.0, 1e-9);
 }
 
+TEST(LocalOrigin, Float32StepsAtSurveyCoordinates) {
+  EXPECT_EQ(Float32Step(5400000.0), 0.5);     // a UTM northing
+  EXPECT_EQ(Float32Step(-500000.0), 0.03125);  // a UTM easting
+  EXPECT_LT(Float32Step(kFloat32MillimetreReach_m - 1.0), 1e-3);
+  EXPECT_GE(Float32Step(kFloat32MillimetreReach_m), 0.9e-3);
+}
+
 }  // namespace
 }  // namespace rvlio

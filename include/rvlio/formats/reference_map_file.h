@@ -4,6 +4,7 @@
 // initial pose.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
@@ -26,14 +27,18 @@ namespace rvlio {
 // map larger than ~200 km, or a stray point far away). The file is only read.
 // surface (when not null) receives the full cloud for the deviation
 // (QueryReferenceSurface), from the same read, in the same local frame.
+// warnings (when not null) receives one line, naming the file, for a map
+// whose x y z are float32 where float32 steps by a millimetre or more
+// (from 8192 m on: a UTM map stored as float32 holds only decimetres).
 StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(
     const std::string& path, const LocalizationOptions& options,
-    std::shared_ptr<const ReferenceMap>* surface, LocalOrigin* origin);
+    std::shared_ptr<const ReferenceMap>* surface, LocalOrigin* origin,
+    std::vector<std::string>* warnings);
 
 // The full cloud alone, for the deviation (merge --map), in its local frame
-// (*origin); errors as above.
-StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(const std::string& path,
-                                                                   LocalOrigin* origin);
+// (*origin); errors and warnings as above.
+StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(
+    const std::string& path, LocalOrigin* origin, std::vector<std::string>* warnings);
 
 // "x,y,z,roll_deg,pitch_deg,yaw_deg" (metres, degrees; R = Rz(yaw) Ry(pitch)
 // Rx(roll)) as a one-pose trajectory at t = 0. InvalidInput naming
@@ -48,11 +53,13 @@ StatusOr<Trajectory> ParseInitialPose(const std::string& text);
 // in the map's local frame (Localization::origin). Checks that the
 // reference has points within localization.max_start_distance of the
 // initial position (else the map is in another frame or unit). *surface
-// receives the full cloud for the deviation (QueryReferenceSurface).
+// receives the full cloud for the deviation (QueryReferenceSurface);
+// warnings as LoadReferenceMap's.
 StatusOr<Localization> LoadLocalization(const std::string& map_path,
                                         const std::string& initial_pose,
                                         const std::string& initial_pose_tum,
                                         const OdometryOptions& options,
-                                        std::shared_ptr<const ReferenceMap>* surface);
+                                        std::shared_ptr<const ReferenceMap>* surface,
+                                        std::vector<std::string>* warnings);
 
 }  // namespace rvlio

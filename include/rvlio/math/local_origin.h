@@ -26,6 +26,14 @@ namespace rvlio {
 // offset), so their results do not change.
 constexpr double kLocalOriginGrid_m = 1000.0;
 
+// Below this magnitude a float32 coordinate is within 0.25 mm of the value
+// (its steps are 0.5 mm or finer); from it on, a coordinate needs float64 to
+// keep millimetres (map.pcd is written so: outputs/run_outputs.h).
+constexpr double kFloat32MillimetreReach_m = 8192.0;
+// The spacing of float32 values at magnitude |v| (m): 0.5 at a northing of
+// 5.4e6 m, 0.03125 at an easting of 5e5 m.
+double Float32Step(double v);
+
 struct LocalOrigin {
   // The local frame's origin in the user frame, m: p_user = p_local + t_user_local.
   Eigen::Vector3d t_user_local = Eigen::Vector3d::Zero();

@@ -110,8 +110,9 @@ struct LocalizationOptions {
 // one pose of `initial_poses`, or the poses interpolated at the first scan's
 // time (sorted by time). Both are in the reference's local frame (`origin`:
 // the reference frame translated to near the map, math/local_origin.h), and
-// so is everything the odometry estimates; the odometry never reads
-// `origin`: whoever writes its results adds it back (api/run.cpp).
+// so is everything the odometry estimates; the odometry reads `origin` only
+// to print positions in the map's frame in its messages: whoever writes its
+// results adds it back (api/run.cpp).
 struct Localization {
   std::shared_ptr<const VoxelMap> reference;
   Trajectory initial_poses;

@@ -13,13 +13,12 @@
 
 namespace rvlio {
 
-// map.pcd stores x y z as float32 while every coordinate is below this in
-// magnitude (float32 rounds to within 0.25 mm there), else as float64
-// (PCD SIZE 8 TYPE F): a map in a national grid (UTM: eastings of 5e5 m,
-// northings of 5e6 m, where a float32 keeps only decimetres) keeps its
-// millimetres.
-constexpr double kFloat32MapReach_m = 8192.0;
-// True when a coordinate of p_world reaches kFloat32MapReach_m.
+// map.pcd stores x y z as float32 while every coordinate is below
+// kFloat32MillimetreReach_m (8192 m, math/local_origin.h) in magnitude, else
+// as float64 (PCD SIZE 8 TYPE F): a map in a national grid (UTM: eastings of
+// 5e5 m, northings of 5e6 m, where a float32 keeps only decimetres) keeps
+// its millimetres.
+// True when a coordinate of p_world reaches kFloat32MillimetreReach_m.
 bool MapNeedsFloat64(const std::vector<Eigen::Vector3d>& p_world);
 
 // Binary PCD (x y z float32, or float64 when MapNeedsFloat64; header made by
