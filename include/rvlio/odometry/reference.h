@@ -119,7 +119,9 @@ struct Localization {
   LocalOrigin origin;
 };
 
-// Builds the reference's search structure from its points (reference frame, m).
+// Builds the reference's search structure from its points (reference frame,
+// m; a cloud far from zero, e.g. in UTM, first into its local frame:
+// ChooseLocalOrigin, math/local_origin.h, as LoadLocalization does).
 std::shared_ptr<const VoxelMap> MakeReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
                                                  const LocalizationOptions& options);
 
