@@ -67,18 +67,49 @@ void PrintStamps(const StampReport& s, const std::string& header_stamp) {
       1e3 * s.imu_jitter_s, s.imu_gaps, 1e3 * s.imu_max_gap_s);
 }
 
+// Why the recording cannot judge the offset, or "" when it can.
+std::string CannotJudge(const ClockCheckResult& r, const ClockCheckOptions& c) {
+  char text[320];
+  switch (r.verdict) {
+    case ClockVerdict::kJudged: return "";
+    case ClockVerdict::kNoData:
+      return "too little data: " + std::to_string(r.intervals) +
+             " scan pairs registered inside the gyro's span (3 needed)";
+    case ClockVerdict::kNotEnoughRotation:
+      std::snprintf(text, sizeof(text), "not enough rotation: gyro rate spread %.3f rad/s (needed: %.3f)",
+                    r.rate_spread_rad_s, c.min_rate_spread);
+      return text;
+    case ClockVerdict::kTooShort:
+      std::snprintf(text, sizeof(text),
+                    "the recording is too short to judge: %.1f s of rotation (needed: %.1f s)",
+                    r.moving_s, c.min_moving_s);
+      return text;
+    case ClockVerdict::kTooUncertain:
+      std::snprintf(text, sizeof(text),
+                    "the recording cannot judge the offset: 1-sigma %.2f ms (needed: %.1f ms) over "
+                    "%.1f s of rotation",
+                    1e3 * r.std_s, 1e3 * c.max_std_s, r.moving_s);
+      return text;
+  }
+  return "";
+}
+
 void PrintOffset(const ClockCheckResult& r, const OdometryOptions& o, const ClockCheckOptions& c) {
   std::printf(
-      "clock offset (scan-to-scan rotation rate vs gyroscope, %d intervals, lag searched +-%.0f "
-      "ms):\n"
-      "  rotation excitation: gyro rate spread %.3f rad/s RMS (needed: %.3f)\n",
-      r.intervals, 1e3 * c.max_lag_s, r.rate_spread_rad_s, c.min_rate_spread);
+      "clock offset (scan-to-scan rotation vs gyroscope, %d intervals, lag searched +-%.0f ms):\n"
+      "  rotation excitation: gyro rate spread %.3f rad/s RMS (needed: %.3f), %.1f s rotating "
+      "(needed: %.1f)\n",
+      r.intervals, 1e3 * c.max_lag_s, r.rate_spread_rad_s, c.min_rate_spread, r.moving_s,
+      c.min_moving_s);
   const double offset_s = o.lidar.time_offset + r.lag_s;
-  if (!r.enough_rotation) {
-    std::printf(
-        "  not enough rotation: the best lag %.1f ms has a 1-sigma of %.1f ms (needed: %.1f ms); "
-        "record a few seconds of turning about all axes (or keep lidar.time_offset %.4f s)\n",
-        1e3 * r.lag_s, 1e3 * r.std_s, 1e3 * c.max_std_s, o.lidar.time_offset);
+  if (const std::string why = CannotJudge(r, c); !why.empty()) {
+    if (r.verdict == ClockVerdict::kNoData)
+      std::printf("  %s; no offset recommended\n", why.c_str());
+    else
+      std::printf(
+          "  %s; no offset recommended (the best lag, %.1f ms +- %.1f ms, is not to be trusted); "
+          "record a few seconds of turning about all axes (or keep lidar.time_offset %.4f s)\n",
+          why.c_str(), 1e3 * r.lag_s, 1e3 * r.std_s, o.lidar.time_offset);
     return;
   }
   std::printf(
