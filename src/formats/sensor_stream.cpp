@@ -44,9 +44,15 @@ class WindowedReader final : public SensorBagReader {
       have_first_ = true;
       const TimeNs rel = t - first_ns_;
       if (end_ns_ >= 0 && rel > end_ns_) {
-        ended_ = true;  // the recording is in time order: nothing later is in the window
+        // The recording is in time order: after two messages in a row past the
+        // window, nothing later is in it. One alone may carry a stamp jumped
+        // ahead (a bit flip in a header stamp, lidar/scan_order.h): it is
+        // left out, not the rest of the window.
+        if (++past_end_ < 2) continue;
+        ended_ = true;
         return SensorMessage::kEnd;
       }
+      past_end_ = 0;
       // Only a --start selects: without one, scans that lidar.time_offset moved
       // before the recording's first stamp are delivered (and counted where
       // they are dropped), not skipped here unseen.
@@ -72,6 +78,7 @@ class WindowedReader final : public SensorBagReader {
   TimeNs first_ns_;
   bool have_first_;
   bool ended_ = false;
+  int past_end_ = 0;  // messages in a row past the window's end
   int64_t scans_delivered_ = 0, imu_delivered_ = 0;
   mutable SensorReaderStats stats_;
 };
