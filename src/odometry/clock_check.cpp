@@ -291,7 +291,7 @@ double BestLag(const std::vector<Interval>& intervals, const GyroIntegral& gyro,
     if (c < best_cost) best_cost = c, best = lag;
   }
   const double phi = (std::sqrt(5.0) - 1.0) / 2.0;
-  double lo = best - kCoarseStepS, hi = best + kCoarseStepS;
+  double lo = std::max(best - kCoarseStepS, -max_lag_s), hi = std::min(best + kCoarseStepS, max_lag_s);
   while (hi - lo > kRefineToleranceS) {
     const double m1 = hi - phi * (hi - lo), m2 = lo + phi * (hi - lo);
     if (FitLag(intervals, gyro, m1).cost < FitLag(intervals, gyro, m2).cost) hi = m2;
