@@ -104,8 +104,8 @@ void PrintStamps(const StampReport& s, const Recording& rec, const std::string& 
       1e3 * s.scan_duration_s, header_stamp.c_str());
   if (rec.scans_out_of_order > 0 || rec.scans_stamp_ahead > 0)
     std::printf(
-        "         %d more skipped: %d stamped out of order (repeating or going back), %d stamped "
-        "ahead of the scans after them and of the IMU\n",
+        "         %d more skipped (the gaps they leave count as dropped): %d stamped out of "
+        "order (repeating or going back), %d stamped ahead of the scans after them and of the IMU\n",
         rec.scans_out_of_order + rec.scans_stamp_ahead, rec.scans_out_of_order,
         rec.scans_stamp_ahead);
   std::printf(

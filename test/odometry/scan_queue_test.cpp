@@ -13,6 +13,7 @@
 #include "rvlio/odometry/scan_frontend.h"
 
 namespace rvlio {
+namespace scan_queue_test {
 namespace {
 
 constexpr TimeNs kMs = 1000000;
@@ -157,4 +158,5 @@ TEST(ScanQueueStamps, ScanAgreeingWithTheImuIsKept) {
 }
 
 }  // namespace
+}  // namespace scan_queue_test
 }  // namespace rvlio

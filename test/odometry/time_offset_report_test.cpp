@@ -8,6 +8,7 @@
 #include "rvlio/odometry/odometry.h"
 
 namespace rvlio {
+namespace time_offset_report_test {
 namespace {
 
 bool Contains(const std::string& text, const std::string& part) {
@@ -81,4 +82,5 @@ TEST(TimeOffsetNote, BoundWarningAgreesWithTheReport) {
 }
 
 }  // namespace
+}  // namespace time_offset_report_test
 }  // namespace rvlio
