@@ -35,24 +35,20 @@ class WindowedReader final : public SensorBagReader {
   StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override {
     if (ended_) return SensorMessage::kEnd;
     for (;;) {
-      StatusOr<SensorMessage> m = inner_->Next(imu, scan);
+      const bool read_ahead = !ahead_.empty();
+      StatusOr<SensorMessage> m = read_ahead ? TakeAhead(imu, scan) : ReadShifted(imu, scan);
       if (!m.ok() || *m == SensorMessage::kEnd) return m;
       const bool is_imu = *m == SensorMessage::kImu;
-      if (!is_imu && offset_ns_ != 0) ShiftScanTime(offset_ns_, scan);
-      const TimeNs t = is_imu ? imu->t_ns : scan->t_end_ns;
-      if (!have_first_) first_ns_ = t;
-      have_first_ = true;
-      const TimeNs rel = t - first_ns_;
+      const TimeNs rel = Relative(is_imu ? imu->t_ns : scan->t_end_ns);
       if (end_ns_ >= 0 && rel > end_ns_) {
-        // The recording is in time order: after two messages in a row past the
-        // window, nothing later is in it. One alone may carry a stamp jumped
-        // ahead (a bit flip in a header stamp, lidar/scan_order.h): it is
-        // left out, not the rest of the window.
-        if (++past_end_ < 2) continue;
+        // The recording is in time order: nothing later is in the window,
+        // unless this is a scan whose stamp jumped ahead (a bit flip in a
+        // header stamp, lidar/scan_order.h): then the next scan is inside
+        // the window, and only this one is left out.
+        if (!is_imu && !read_ahead && NextScanInWindow()) continue;
         ended_ = true;
         return SensorMessage::kEnd;
       }
-      past_end_ = 0;
       // Only a --start selects: without one, scans that lidar.time_offset moved
       // before the recording's first stamp are delivered (and counted where
       // they are dropped), not skipped here unseen.
@@ -73,12 +69,53 @@ class WindowedReader final : public SensorBagReader {
   bool truncated() const override { return inner_->truncated(); }
 
  private:
+  struct Message {
+    SensorMessage kind = SensorMessage::kEnd;  // kImu or kScan
+    ImuSample imu;
+    Scan scan;
+  };
+
+  // The inner reader's next message, its scan moved onto the IMU clock.
+  StatusOr<SensorMessage> ReadShifted(ImuSample* imu, Scan* scan) {
+    StatusOr<SensorMessage> m = inner_->Next(imu, scan);
+    if (m.ok() && *m == SensorMessage::kScan && offset_ns_ != 0) ShiftScanTime(offset_ns_, scan);
+    return m;
+  }
+  StatusOr<SensorMessage> TakeAhead(ImuSample* imu, Scan* scan) {
+    Message& m = ahead_.front();
+    const SensorMessage kind = m.kind;
+    if (kind == SensorMessage::kImu) *imu = m.imu;
+    else *scan = std::move(m.scan);
+    ahead_.pop_front();
+    return kind;
+  }
+  // The stamp relative to the recording's first delivered stamp.
+  TimeNs Relative(TimeNs t_ns) {
+    if (!have_first_) first_ns_ = t_ns;
+    have_first_ = true;
+    return t_ns - first_ns_;
+  }
+  // Reads up to the next scan (kept in ahead_ with the IMU samples before
+  // it): whether it ends inside the window. At the end of input or an error
+  // the window ends where it was, as without the look.
+  bool NextScanInWindow() {
+    for (;;) {
+      Message m;
+      StatusOr<SensorMessage> kind = ReadShifted(&m.imu, &m.scan);
+      if (!kind.ok() || *kind == SensorMessage::kEnd) return false;
+      m.kind = *kind;
+      const TimeNs t_ns = m.kind == SensorMessage::kImu ? m.imu.t_ns : m.scan.t_end_ns;
+      ahead_.push_back(std::move(m));
+      if (ahead_.back().kind == SensorMessage::kScan) return t_ns - first_ns_ <= end_ns_;
+    }
+  }
+
   std::unique_ptr<SensorBagReader> inner_;
   TimeNs offset_ns_, start_ns_, end_ns_, lead_in_ns_;
   TimeNs first_ns_;
   bool have_first_;
   bool ended_ = false;
-  int past_end_ = 0;  // messages in a row past the window's end
+  std::deque<Message> ahead_;  // read past a scan stamped past the window's end
   int64_t scans_delivered_ = 0, imu_delivered_ = 0;
   mutable SensorReaderStats stats_;
 };
