@@ -10,6 +10,9 @@
 //   - a drifting clock offset: both backends follow the drift;
 //   - a 100 ms clock error without estimation stops the run (exit 3) with a
 //     message naming the clocks and the check command.
+// Short flights (TimeOffsetShortFlights, 8 s and 2 s): calibrate-time within
+// 2 sigma where it was biased, "too short to judge" on 2 s, and an estimate
+// beyond its bound that keeps the stamps increasing.
 // The full matrix (-100/-30/+30/+100 ms, tunnel and hall, both backends) is
 // TimeOffsetMatrix (Release stage only: excluded from the sanitizer stage).
 #include <algorithm>
@@ -108,6 +111,21 @@ class TimeOffsetCliTest : public ::testing::Test {
     const std::string csv = ReadFile(est + "/scans.csv");
     EXPECT_NE(csv.substr(0, csv.find('\n')).find(",time_offset_s,time_offset_std_s"),
               std::string::npos);
+  }
+  static inline std::string dir_;
+};
+
+// Short flights (8 s and less) of their own, without the suite's 20 s ones.
+class TimeOffsetShortFlights : public ::testing::Test {
+ protected:
+  static constexpr double kOffsetS = 0.03;
+  static void SetUpTestSuite() {
+    dir_ = testing_cli::MakeTempDir("rvlio_toff_short");
+    ASSERT_FALSE(dir_.empty());
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+  static nlohmann::json TimeOffset(const std::string& out) {
+    return nlohmann::json::parse(ReadFile(out + "/summary.json"))["time_offset"];
   }
   static inline std::string dir_;
 };
@@ -294,7 +312,7 @@ double PrintedStd(const std::string& out) {
 // Its error is now within 2 sigma and 1.5 ms (so with the right offset
 // configured it would not call the clocks unsynchronized: that needs a lag
 // over 2 ms and 3 sigma).
-TEST_F(TimeOffsetCliTest, CalibrateTimeOnAShortSwayingFlightIsUnbiased) {
+TEST_F(TimeOffsetShortFlights, CalibrateTimeOnAShortSwayingFlightIsUnbiased) {
   const std::string out = dir_ + "/short8";
   const ToolRun sim = CachedSimulate(SimArgs("tunnel", 8, kOffsetS), out, dir_);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
@@ -308,7 +326,7 @@ TEST_F(TimeOffsetCliTest, CalibrateTimeOnAShortSwayingFlightIsUnbiased) {
 
 // Item: a recording too short to judge (2 s of swaying flight) gets no
 // recommended offset, and the line says why.
-TEST_F(TimeOffsetCliTest, CalibrateTimeSaysWhenARecordingIsTooShort) {
+TEST_F(TimeOffsetShortFlights, CalibrateTimeSaysWhenARecordingIsTooShort) {
   const std::string out = dir_ + "/short2";
   const ToolRun sim = CachedSimulate(
       SimArgs("tunnel", 2, kOffsetS) + " --set trajectory.static_duration=0", out, dir_);
@@ -326,7 +344,7 @@ TEST_F(TimeOffsetCliTest, CalibrateTimeSaysWhenARecordingIsTooShort) {
 // one before it was estimated behind it: trajectory.tum's stamps went back
 // (and eval refused it). Such a scan is skipped now (scans_out_of_order);
 // summary.json's at_bound and estimate_s and the warning say the same.
-TEST_F(TimeOffsetCliTest, EstimateBeyondTheBoundKeepsStampsIncreasing) {
+TEST_F(TimeOffsetShortFlights, EstimateBeyondTheBoundKeepsStampsIncreasing) {
   const std::string sim_out = dir_ + "/off1000";
   const ToolRun sim = CachedSimulate(SimArgs("tunnel", 8, 1.0), sim_out, dir_);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
