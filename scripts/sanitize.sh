@@ -46,7 +46,11 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # suite simulates and runs a 20 s flight in every test process (several
 # minutes each under ASan); its math runs here in TimeOffsetResidual and the
 # IESKF and smoother unit tests, and a scan moved by the offset in
-# QuietFailureTest. Two of the three survey bad-input cases run a whole
+# QuietFailureTest; its short flights (TimeOffsetShortFlights: calibrate-time
+# and an estimation run on 8 s flights, 2-7 s each in Release) likewise: the
+# clock check's lag search runs here in ClockCheck.*, the scan queue's stamp
+# checks in ScanQueueStamps.* and the report's note and warning in
+# TimeOffsetNote.*. Two of the three survey bad-input cases run a whole
 # IESKF flight first; SurveyBadInput.MalformedOrMissingInitialPose stays.
 # The worker threads of the association run here in test_common's
 # ParallelFor tests and test_association (the two-thread CLI comparison is a
@@ -101,7 +105,7 @@ ex=(
   'ReportBrowserTest\..*'
   'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
   SurveyBadInput.MissingEmptyTruncatedOrNonFiniteMap SurveyBadInput.MapInMillimetresOrFarFromTheStart
-  'TimeOffsetCliTest\..*'
+  'TimeOffsetCliTest\..*' 'TimeOffsetShortFlights\..*'
   'DegeneracyCliTest\..*'
   'SurveyFlights\..*' SurveyFeatureless.StartTwentyMetresOffAlongTheAxisIsRefused
   'SurveyCoordinates\..*'

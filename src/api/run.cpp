@@ -40,6 +40,7 @@ nlohmann::json StatsJson(const OdometryStats& o, const SensorReaderStats& r) {
           {"imu_factors_skipped", o.imu_factors_skipped},
           {"marginalization_failures", o.marginalization_failures},
           {"scans_out_of_order", o.scans_out_of_order},
+          {"scans_stamp_ahead", o.scans_stamp_ahead},
           {"scans_after_imu", o.scans_after_imu},
           {"imu_non_finite", o.imu_non_finite},
           {"time_split_ms",
@@ -190,7 +191,8 @@ std::string NoScanMessage(const std::string& bag, const OdometryOptions& o,
                      " before the first IMU sample, " + std::to_string(odo.scans_too_few_points) +
                      " with too few points, " + std::to_string(odo.scans_before_imu) +
                      " during the IMU initialization, " + std::to_string(odo.scans_out_of_order) +
-                     " out of order, " + std::to_string(odo.scans_after_imu) +
+                     " out of order, " + std::to_string(odo.scans_stamp_ahead) +
+                     " stamped ahead, " + std::to_string(odo.scans_after_imu) +
                      " after the last IMU sample";
   const int64_t imu_dropped = r.imu_invalid + r.imu_duplicates + r.imu_non_monotonic;
   if (!odo.initialized || imu_dropped > 0)
