@@ -3,6 +3,7 @@
 // stamps alone tell (scan period, jitter, drops, header stamp, IMU rate).
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "rvlio/config/config.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/formats/sensor_stream.h"
+#include "rvlio/lidar/scan_order.h"
 #include "rvlio/odometry/clock_check.h"
 
 namespace rvlio::cli {
@@ -23,29 +25,66 @@ constexpr double kSynchronizedS = 0.002;
 struct Recording {
   std::vector<ImuSample> imu;
   std::vector<LidarRateSample> rates;
-  std::vector<TimeNs> scan_start_ns, scan_end_ns, imu_ns;
+  std::vector<TimeNs> scan_start_ns, scan_end_ns, imu_ns;  // of the scans taken
+  int scans_out_of_order = 0, scans_stamp_ahead = 0;       // skipped (lidar/scan_order.h)
+};
+
+// The scans in stamp order, as the odometry takes them (lidar/scan_order.h):
+// each goes to the tracker one scan late, when the next one shows whether
+// its stamp jumped ahead.
+class ScreenedScans {
+ public:
+  ScreenedScans(const OdometryOptions& o, Recording* rec) : tracker_(o), rec_(rec) {}
+  void Add(Scan&& scan) {
+    const TimeNs imu_end_ns = rec_->imu.empty() ? ScanStampScreen::kNoImu : rec_->imu.back().t_ns;
+    switch (screen_.Judge({scan.t_start_ns, scan.t_end_ns}, imu_end_ns)) {
+      case StampVerdict::kOutOfOrder: ++rec_->scans_out_of_order; return;
+      case StampVerdict::kNewestWereAhead:
+        rec_->scans_stamp_ahead += static_cast<int>(screen_.dropped().size());
+        has_held_ = false;  // the newest; older ones stamped ahead were tracked already
+        break;
+      case StampVerdict::kInOrder: break;
+    }
+    Flush();
+    held_ = std::move(scan);
+    has_held_ = true;
+  }
+  void Flush() {
+    if (!has_held_) return;
+    rec_->scan_start_ns.push_back(held_.t_start_ns);
+    rec_->scan_end_ns.push_back(held_.t_end_ns);
+    if (std::optional<LidarRateSample> r = tracker_.Add(held_)) rec_->rates.push_back(*r);
+    has_held_ = false;
+  }
+
+ private:
+  ScanRotationTracker tracker_;
+  ScanStampScreen screen_;
+  Scan held_;
+  bool has_held_ = false;
+  Recording* rec_;
 };
 
 Status Read(const std::string& bag, const Configuration& o, Recording* rec) {
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(bag, o.lidar, o.imu, ReadWindow(), o.io);
   if (!reader.ok()) return reader.status();
-  ScanRotationTracker tracker(o);
+  ScreenedScans scans(o, rec);
   ImuSample imu;
   Scan scan;
   for (;;) {
     StatusOr<SensorMessage> m = (*reader)->Next(&imu, &scan);
     if (!m.ok()) return m.status();
-    if (*m == SensorMessage::kEnd) return Status::Ok();
+    if (*m == SensorMessage::kEnd) break;
     if (*m == SensorMessage::kImu) {
       rec->imu.push_back(imu);
       rec->imu_ns.push_back(imu.t_ns);
       continue;
     }
-    rec->scan_start_ns.push_back(scan.t_start_ns);
-    rec->scan_end_ns.push_back(scan.t_end_ns);
-    if (std::optional<LidarRateSample> r = tracker.Add(scan)) rec->rates.push_back(*r);
+    scans.Add(std::move(scan));
   }
+  scans.Flush();
+  return Status::Ok();
 }
 
 std::string HeaderStampLine(const std::string& bag, const std::string& topic) {
@@ -56,29 +95,67 @@ std::string HeaderStampLine(const std::string& bag, const std::string& topic) {
   return "not applicable (no PointCloud2 header time layout)";
 }
 
-void PrintStamps(const StampReport& s, const std::string& header_stamp) {
+void PrintStamps(const StampReport& s, const Recording& rec, const std::string& header_stamp) {
   std::printf(
       "stamps (no estimation):\n"
       "  lidar: %d scans, period %.2f ms (median), jitter %.3f ms RMS, %d dropped; sweep %.2f ms; "
-      "header stamp %s\n"
-      "  imu:   %d samples, %.1f Hz, jitter %.3f ms RMS, %d gaps over 2 periods (longest %.2f ms)\n",
+      "header stamp %s\n",
       s.scans, 1e3 * s.scan_period_s, 1e3 * s.scan_jitter_s, s.dropped_scans,
-      1e3 * s.scan_duration_s, header_stamp.c_str(), s.imu_samples, s.imu_rate_hz,
-      1e3 * s.imu_jitter_s, s.imu_gaps, 1e3 * s.imu_max_gap_s);
+      1e3 * s.scan_duration_s, header_stamp.c_str());
+  if (rec.scans_out_of_order > 0 || rec.scans_stamp_ahead > 0)
+    std::printf(
+        "         %d more skipped (the gaps they leave count as dropped): %d stamped out of "
+        "order (repeating or going back), %d stamped ahead of the scans after them and of the IMU\n",
+        rec.scans_out_of_order + rec.scans_stamp_ahead, rec.scans_out_of_order,
+        rec.scans_stamp_ahead);
+  std::printf(
+      "  imu:   %d samples, %.1f Hz, jitter %.3f ms RMS, %d gaps over 2 periods (longest %.2f ms)\n",
+      s.imu_samples, s.imu_rate_hz, 1e3 * s.imu_jitter_s, s.imu_gaps, 1e3 * s.imu_max_gap_s);
+}
+
+// Why the recording cannot judge the offset, or "" when it can.
+std::string CannotJudge(const ClockCheckResult& r, const ClockCheckOptions& c) {
+  char text[320];
+  switch (r.verdict) {
+    case ClockVerdict::kJudged: return "";
+    case ClockVerdict::kNoData:
+      return "too little data: " + std::to_string(r.intervals) +
+             " scan pairs registered inside the gyro's span (3 needed)";
+    case ClockVerdict::kNotEnoughRotation:
+      std::snprintf(text, sizeof(text), "not enough rotation: gyro rate spread %.3f rad/s (needed: %.3f)",
+                    r.rate_spread_rad_s, c.min_rate_spread);
+      return text;
+    case ClockVerdict::kTooShort:
+      std::snprintf(text, sizeof(text),
+                    "the recording is too short to judge: %.1f s of rotation (needed: %.1f s)",
+                    r.moving_s, c.min_moving_s);
+      return text;
+    case ClockVerdict::kTooUncertain:
+      std::snprintf(text, sizeof(text),
+                    "the recording cannot judge the offset: 1-sigma %.2f ms (needed: %.1f ms) over "
+                    "%.1f s of rotation",
+                    1e3 * r.std_s, 1e3 * c.max_std_s, r.moving_s);
+      return text;
+  }
+  return "";
 }
 
 void PrintOffset(const ClockCheckResult& r, const Configuration& o, const ClockCheckOptions& c) {
   std::printf(
-      "clock offset (scan-to-scan rotation rate vs gyroscope, %d intervals, lag searched +-%.0f "
-      "ms):\n"
-      "  rotation excitation: gyro rate spread %.3f rad/s RMS (needed: %.3f)\n",
-      r.intervals, 1e3 * c.max_lag_s, r.rate_spread_rad_s, c.min_rate_spread);
+      "clock offset (scan-to-scan rotation vs gyroscope, %d intervals, lag searched +-%.0f ms):\n"
+      "  rotation excitation: gyro rate spread %.3f rad/s RMS (needed: %.3f), %.1f s rotating "
+      "(needed: %.1f)\n",
+      r.intervals, 1e3 * c.max_lag_s, r.rate_spread_rad_s, c.min_rate_spread, r.moving_s,
+      c.min_moving_s);
   const double offset_s = o.lidar.time_offset + r.lag_s;
-  if (!r.enough_rotation) {
-    std::printf(
-        "  not enough rotation: the best lag %.1f ms has a 1-sigma of %.1f ms (needed: %.1f ms); "
-        "record a few seconds of turning about all axes (or keep lidar.time_offset %.4f s)\n",
-        1e3 * r.lag_s, 1e3 * r.std_s, 1e3 * c.max_std_s, o.lidar.time_offset);
+  if (const std::string why = CannotJudge(r, c); !why.empty()) {
+    if (r.verdict == ClockVerdict::kNoData)
+      std::printf("  %s; no offset recommended\n", why.c_str());
+    else
+      std::printf(
+          "  %s; no offset recommended (the best lag, %.1f ms +- %.1f ms, is not to be trusted); "
+          "record a few seconds of turning about all axes (or keep lidar.time_offset %.4f s)\n",
+          why.c_str(), 1e3 * r.lag_s, 1e3 * r.std_s, o.lidar.time_offset);
     return;
   }
   std::printf(
@@ -116,7 +193,7 @@ int CmdCalibrateTime(int argc, char** argv) {
     return Fail(kCalibrateTime, args.Get("bag") + ": no scans on lidar.topic '" + o->lidar.topic +
                            "' or no IMU samples on imu.topic '" + o->imu.topic + "'");
   std::printf("rvlio %s: %s\n", kCalibrateTime, args.Get("bag").c_str());
-  PrintStamps(AnalyzeStamps(rec.scan_start_ns, rec.scan_end_ns, rec.imu_ns),
+  PrintStamps(AnalyzeStamps(rec.scan_start_ns, rec.scan_end_ns, rec.imu_ns), rec,
               HeaderStampLine(args.Get("bag"), o->lidar.topic));
   ClockCheckOptions c;
   c.max_lag_s = o->lidar.time_offset_max;

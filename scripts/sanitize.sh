@@ -46,7 +46,11 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # suite simulates and runs a 20 s flight in every test process (several
 # minutes each under ASan); its math runs here in TimeOffsetResidual and the
 # IESKF and smoother unit tests, and a scan moved by the offset in
-# QuietFailureTest. Two of the three survey bad-input cases run a whole
+# QuietFailureTest; its short flights (TimeOffsetShortFlights: calibrate-time
+# and an estimation run on 8 s flights, 2-7 s each in Release) likewise: the
+# clock check's lag search runs here in ClockCheck.*, the scan queue's stamp
+# checks in ScanQueueStamps.* and the report's note and warning in
+# TimeOffsetNote.*. Two of the three survey bad-input cases run a whole
 # IESKF flight first; SurveyBadInput.MalformedOrMissingInitialPose stays.
 # The worker threads of the association run here in test_common's
 # ParallelFor tests and test_association (the two-thread CLI comparison is a
@@ -57,7 +61,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # checked here by LasWriter.*); the LAS memory bounds measure a Release
 # build's peak, as the refine one does; MapLasCli runs run, refine and merge
 # end to end for the one call each makes to the LAS writer, which runs here in
-# LasExport.* and LasWriter.*.
+# LasExport.* and LasWriter.*. The
+# survey-coordinates suite (SurveyCoordinates) runs a flight twice, a refine
+# and eval --map of a 590 k point survey; the local frame it checks runs here
+# in LocalOrigin, VoxelMap, ReferenceMap, MapMetrics and ReferenceMapFileTest.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -98,9 +105,10 @@ ex=(
   'ReportBrowserTest\..*'
   'Backends/SurveyStart\..*' SurveyCli.InitialPoseFromATumFileAndRefineHeldToTheMap
   SurveyBadInput.MissingEmptyTruncatedOrNonFiniteMap SurveyBadInput.MapInMillimetresOrFarFromTheStart
-  'TimeOffsetCliTest\..*'
+  'TimeOffsetCliTest\..*' 'TimeOffsetShortFlights\..*'
   'DegeneracyCliTest\..*'
   'SurveyFlights\..*' SurveyFeatureless.StartTwentyMetresOffAlongTheAxisIsRefused
+  'SurveyCoordinates\..*'
   AssociationThreadsCliTest.TwoThreadsWriteTheSameOutputsAsOne
   BatchSignalsTest.InterruptedAblationKeepsFinishedCellsAndResumes
   Refine.SummarizedFactorsAgreeWithExactFactors

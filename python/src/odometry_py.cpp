@@ -209,6 +209,7 @@ py::dict StatsDict(const OdometryStats& s) {
   d["initialized"] = s.initialized;
   d["started_moving"] = s.started_moving;
   d["scans_out_of_order"] = s.scans_out_of_order;
+  d["scans_stamp_ahead"] = s.scans_stamp_ahead;
   d["imu_non_finite"] = s.imu_non_finite;
   return d;
 }

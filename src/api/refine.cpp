@@ -331,12 +331,17 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   const Trajectory init_span = {input.init.front(), input.init.back()};
   std::shared_ptr<const VoxelMap> reference;
   std::shared_ptr<const ReferenceMap> surface;  // the full cloud, for the deviation
+  // The refinement runs in a local frame: the map's (the frame run --map
+  // used), else one chosen from the initial trajectory; the outputs go out in
+  // the frame of --init and --map.
+  LocalOrigin origin = ChooseLocalOrigin(input.init);
   if (!args.map.empty()) {  // read before anything is written
     StatusOr<std::shared_ptr<const VoxelMap>> loaded =
-        LoadReferenceMap(args.map, args.options.localization, &surface);
+        LoadReferenceMap(args.map, args.options.localization, &surface, &origin, &notes);
     if (!loaded.ok()) return loaded.status();
     reference = std::move(*loaded);
   }
+  origin.ToLocal(&input.init);
   uint64_t map_hash = 0;  // what a checkpoint and chunk.json know the map by
   if (!args.map.empty() && (job || !args.checkpoint_dir.empty())) {
     StatusOr<uint64_t> hash = FileContentHash(args.map);
@@ -385,17 +390,19 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (!r.stopped) r.stop_reason.clear();
   r.divergence = CheckRefineResult(r.refine, args.options.divergence,
                                    args.options.constraints.lidar_noise, args.options.imu.gravity);
+  std::optional<MapDeviation> deviation;  // in the local frame, as the reference
+  if (surface != nullptr && !r.refine.trajectory.empty())
+    deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
+                                    args.options.localization.deviation);
+  origin.ToUser(&r.refine.trajectory);
+  origin.ToUser(&r.refine.map_points);
   times.wall_s = SecondsSince(t0);
   r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
+  r.summary["local_origin"] = LocalOriginJson(origin);
   r.summary["truncated"] = (*reader)->truncated();
   r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
   if (job) r.summary["chunk"] = r.chunk;
-  std::optional<MapDeviation> deviation;
-  if (surface != nullptr && !r.refine.trajectory.empty()) {
-    deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
-                                    args.options.localization.deviation);
-    r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
-  }
+  if (deviation) r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   if (!write) return r;
   if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr, *las); !s.ok())
     return s;

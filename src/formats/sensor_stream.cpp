@@ -17,6 +17,23 @@
 namespace rvlio {
 namespace {
 
+// A message read ahead and held to be delivered in order.
+struct HeldMessage {
+  SensorMessage kind = SensorMessage::kEnd;  // kImu or kScan
+  ImuSample imu;
+  Scan scan;
+};
+
+// Delivers the oldest held message (there is one).
+SensorMessage PopHeld(std::deque<HeldMessage>* held, ImuSample* imu, Scan* scan) {
+  HeldMessage& h = held->front();
+  const SensorMessage kind = h.kind;
+  if (kind == SensorMessage::kImu) *imu = h.imu;
+  else *scan = std::move(h.scan);
+  held->pop_front();
+  return kind;
+}
+
 // Moves scans onto the IMU clock and keeps the messages inside the window.
 class WindowedReader final : public SensorBagReader {
  public:
@@ -35,16 +52,19 @@ class WindowedReader final : public SensorBagReader {
   StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override {
     if (ended_) return SensorMessage::kEnd;
     for (;;) {
-      StatusOr<SensorMessage> m = inner_->Next(imu, scan);
+      const bool read_ahead = !ahead_.empty();
+      StatusOr<SensorMessage> m =
+          read_ahead ? StatusOr<SensorMessage>(PopHeld(&ahead_, imu, scan)) : ReadShifted(imu, scan);
       if (!m.ok() || *m == SensorMessage::kEnd) return m;
       const bool is_imu = *m == SensorMessage::kImu;
-      if (!is_imu && offset_ns_ != 0) ShiftScanTime(offset_ns_, scan);
-      const TimeNs t = is_imu ? imu->t_ns : scan->t_end_ns;
-      if (!have_first_) first_ns_ = t;
-      have_first_ = true;
-      const TimeNs rel = t - first_ns_;
+      const TimeNs rel = Relative(is_imu ? imu->t_ns : scan->t_end_ns);
       if (end_ns_ >= 0 && rel > end_ns_) {
-        ended_ = true;  // the recording is in time order: nothing later is in the window
+        // The recording is in time order: nothing later is in the window,
+        // unless this is a scan whose stamp jumped ahead (a bit flip in a
+        // header stamp, lidar/scan_order.h): then the next scan is inside
+        // the window, and only this one is left out.
+        if (!is_imu && !read_ahead && NextScanInWindow()) continue;
+        ended_ = true;
         return SensorMessage::kEnd;
       }
       // Only a --start selects: without one, scans that lidar.time_offset moved
@@ -67,11 +87,39 @@ class WindowedReader final : public SensorBagReader {
   bool truncated() const override { return inner_->truncated(); }
 
  private:
+  // The inner reader's next message, its scan moved onto the IMU clock.
+  StatusOr<SensorMessage> ReadShifted(ImuSample* imu, Scan* scan) {
+    StatusOr<SensorMessage> m = inner_->Next(imu, scan);
+    if (m.ok() && *m == SensorMessage::kScan && offset_ns_ != 0) ShiftScanTime(offset_ns_, scan);
+    return m;
+  }
+  // The stamp relative to the recording's first delivered stamp.
+  TimeNs Relative(TimeNs t_ns) {
+    if (!have_first_) first_ns_ = t_ns;
+    have_first_ = true;
+    return t_ns - first_ns_;
+  }
+  // Reads up to the next scan (kept in ahead_ with the IMU samples before
+  // it): whether it ends inside the window. At the end of input or an error
+  // the window ends where it was, as without the look.
+  bool NextScanInWindow() {
+    for (;;) {
+      HeldMessage m;
+      StatusOr<SensorMessage> kind = ReadShifted(&m.imu, &m.scan);
+      if (!kind.ok() || *kind == SensorMessage::kEnd) return false;
+      m.kind = *kind;
+      const TimeNs t_ns = m.kind == SensorMessage::kImu ? m.imu.t_ns : m.scan.t_end_ns;
+      ahead_.push_back(std::move(m));
+      if (ahead_.back().kind == SensorMessage::kScan) return t_ns - first_ns_ <= end_ns_;
+    }
+  }
+
   std::unique_ptr<SensorBagReader> inner_;
   TimeNs offset_ns_, start_ns_, end_ns_, lead_in_ns_;
   TimeNs first_ns_;
   bool have_first_;
   bool ended_ = false;
+  std::deque<HeldMessage> ahead_;  // read past a scan stamped past the window's end
   int64_t scans_delivered_ = 0, imu_delivered_ = 0;
   mutable SensorReaderStats stats_;
 };
@@ -120,12 +168,12 @@ class SkipAheadReader final : public SensorBagReader {
     bool imu_checked = false, scan_checked = false;
     size_t held_bytes = 0;
     while (!(imu_checked && scan_checked)) {
-      Held held;
+      HeldMessage held;
       StatusOr<SensorMessage> kind = inner_->Next(&held.imu, &held.scan);
       if (!kind.ok() || *kind == SensorMessage::kEnd || held_bytes > kSkipCheckBytes)
         return ReadFromStart();  // a read from the start meets the same error in its place
       held.kind = *kind;
-      held_bytes += sizeof(Held) + held.scan.points.size() * sizeof(LidarPoint);
+      held_bytes += sizeof(HeldMessage) + held.scan.points.size() * sizeof(LidarPoint);
       const bool is_imu = *kind == SensorMessage::kImu;
       bool& checked = is_imu ? imu_checked : scan_checked;
       if (!checked) {
@@ -140,12 +188,7 @@ class SkipAheadReader final : public SensorBagReader {
 
   StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override {
     if (held_.empty()) return inner_->Next(imu, scan);
-    Held& h = held_.front();
-    const SensorMessage kind = h.kind;
-    if (kind == SensorMessage::kImu) *imu = h.imu;
-    else *scan = std::move(h.scan);
-    held_.pop_front();
-    return kind;
+    return PopHeld(&held_, imu, scan);
   }
 
   const SensorReaderStats& stats() const override { return inner_->stats(); }
@@ -154,12 +197,6 @@ class SkipAheadReader final : public SensorBagReader {
   bool truncated() const override { return inner_->truncated(); }
 
  private:
-  struct Held {
-    SensorMessage kind = SensorMessage::kEnd;  // kImu or kScan
-    ImuSample imu;
-    Scan scan;
-  };
-
   Status ReadFromStart() {
     held_.clear();
     StatusOr<std::unique_ptr<SensorBagReader>> full = SensorBagReader::Open(path_, lidar_, imu_);
@@ -174,7 +211,7 @@ class SkipAheadReader final : public SensorBagReader {
   TimeNs offset_ns_;
   SkipThresholds thresholds_;
   std::unique_ptr<SensorBagReader> inner_;
-  std::deque<Held> held_;  // read while checking the start, not yet returned
+  std::deque<HeldMessage> held_;  // read while checking the start, not yet returned
 };
 
 // Runs the wrapped reader on a thread of its own; the consumer sees each

@@ -257,7 +257,6 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
   P_x_td_.setZero();
   P_td_td_ = lidar_.estimate_time_offset ? lidar_.time_offset_init_std * lidar_.time_offset_init_std
                                          : 0.0;
-  td_at_bound_ = false;
   td_observed_ = false;
   ClearPoseHistory();
 }
@@ -549,9 +548,7 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
 // time_offset_at_bound()); the state's pose is left as the update made it.
 void Ieskf::HoldTimeOffsetInBound() {
   const double bound_s = lidar_.time_offset_max;
-  if (std::abs(td_s_) <= bound_s) return;
-  td_s_ = std::copysign(bound_s, td_s_);
-  td_at_bound_ = true;
+  if (std::abs(td_s_) > bound_s) td_s_ = std::copysign(bound_s, td_s_);
 }
 
 // A held extrinsic axis carries the tiny kFixedExtrinsicStd in P (a loose

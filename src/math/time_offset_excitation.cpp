@@ -29,6 +29,7 @@ void TimeOffsetExcitation::CountScan(TimeNs t_ns, const Eigen::Vector3d& gyro_im
   max_velocity_spread_ = std::max(max_velocity_spread_, velocity);
   const bool excited_now = rate >= kMinRateSpread || velocity >= kMinVelocitySpread;
   if (excited_now && last_t_ns_ >= 0) excited_s_ += NsToSeconds(t_ns - last_t_ns_);
+  if (first_t_ns_ < 0) first_t_ns_ = t_ns;
   last_t_ns_ = t_ns;
 }
 

@@ -179,7 +179,7 @@ void IeskfPipeline::TryInitialize(const ImuSample& imu) {
 
 std::vector<std::string> IeskfPipeline::warnings() const {
   std::vector<std::string> w = warnings_;
-  for (std::string& q : QueueWarnings(stats_)) w.push_back(std::move(q));
+  for (std::string& q : StatsWarnings(stats_)) w.push_back(std::move(q));
   return w;
 }
 
@@ -216,14 +216,16 @@ void IeskfPipeline::SetTimeOffset(double td_s, double std_s) {
 // The scan is moved onto the IMU clock by the current estimate (prediction
 // and deskew at the moved times); the update then refines the estimate
 // (Ieskf::Update, ScanTimeMotion). The result's stamp and pose are the
-// filter's: the IMU at the moved scan end.
+// filter's: the IMU at the moved scan end. A scan the estimate's change since
+// it was queued moved to end at or before the filter's time is skipped
+// (ScanQueue::PopFrontShifted), so the stamps always increase.
 void IeskfPipeline::ProcessFrontScan(std::vector<ScanResult>* out) {
-  Scan scan = scans_.PopFront();
   const double start_ms = WorkCpuMs();  // association helpers included
-  if (options_.lidar.estimate_time_offset) {
-    applied_shift_ns_ = ScanTimeShiftNs();
-    ShiftScanTime(applied_shift_ns_, &scan);
-  }
+  const TimeNs shift_ns = ScanTimeShiftNs();
+  std::optional<Scan> shifted = scans_.PopFrontShifted(shift_ns, filter_.time_ns(), &stats_);
+  if (!shifted) return;
+  applied_shift_ns_ = shift_ns;
+  Scan& scan = *shifted;
   const Eigen::Vector3d mean_acc_imu = Predict(scan.t_end_ns);
   preprocessor_.Downsample(scan, &downsampled_);
   if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {
@@ -346,19 +348,16 @@ TimeNs IeskfPipeline::ScanTimeShiftNs() const {
 
 void IeskfPipeline::ReportTimeOffset(ScanResult* r) {
   if (!options_.lidar.estimate_time_offset) return;
-  const bool was_at_bound = stats_.time_offset.at_bound;
   if (!filter_.pose_history().empty())
     time_offset_excitation_.CountScan(filter_.time_ns(), filter_.pose_history().back().gyro_imu,
                                       filter_.state().v_world_imu);
   r->time_offset_s = filter_.time_offset_s();
   r->time_offset_std_s = filter_.time_offset_std_s();
-  stats_.time_offset =
-      MakeTimeOffsetReport(time_offset_excitation_, options_.lidar, filter_.time_offset_s(),
-                           filter_.time_offset_std_s(), filter_.time_offset_at_bound());
+  UpdateTimeOffsetReport(time_offset_excitation_, options_.lidar, filter_.time_offset_s(),
+                         filter_.time_offset_std_s(), filter_.time_offset_at_bound(),
+                         filter_.time_ns(), &stats_.time_offset);
   stats_.time_offset.map_hold_scans = map_hold_scans_;
   stats_.time_offset.replayed_scans = replayed_scans_;
-  if (stats_.time_offset.at_bound && !was_at_bound)
-    warnings_.push_back(TimeOffsetAtBoundWarning(options_.lidar, filter_.time_ns()));
 }
 
 // The map hold (lidar.time_offset_map_hold, docs/time_offset.md "Map hold"):

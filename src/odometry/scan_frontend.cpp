@@ -84,13 +84,6 @@ void WorkingMap::Rebuild(const Pose3& T_imu_lidar) {
   ++rebuilds_;
 }
 
-std::string TimeOffsetAtBoundWarning(const LidarOptions& lidar, TimeNs t_ns) {
-  return "the estimated LiDAR-IMU time offset reached lidar.time_offset_max (" +
-         std::to_string(lidar.time_offset_max) + " s) at t=" + std::to_string(NsToSeconds(t_ns)) +
-         " s and is held there: the clocks differ by more, or the estimate is lost; check the "
-         "recording with `rvlio calibrate-time` and set lidar.time_offset";
-}
-
 ReferenceLocalizer::ReferenceLocalizer(Localization localization,
                                        const LocalizationOptions& options,
                                        const ConstraintOptions& constraints)
@@ -158,10 +151,13 @@ StatusOr<ReferenceAlignment> ReferenceLocalizer::SearchStart(
     return Status::InvalidInput(
         "no place in the reference map matches the first scan (global search); check that the "
         "map is in metres and covers the start, or give --initial-pose");
+  // Positions in the message are in the map's frame, as the user gave it.
+  const LocalOrigin& origin = localization_.origin;
   if (const ReferenceAlignment* rival = RivalOf(candidates, options_.search_ambiguity))
     return Status::InvalidInput(
         "the first scan matches the reference map equally well at " +
-        Vec(candidates.front().T_ref_imu.t, 2) + " and at " + Vec(rival->T_ref_imu.t, 2) +
+        Vec(origin.ToUser(candidates.front().T_ref_imu.t), 2) + " and at " +
+        Vec(origin.ToUser(rival->T_ref_imu.t), 2) +
         " (global search): give --initial-pose");
   return candidates.front();
 }
@@ -221,37 +217,75 @@ bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, TimeNs
 
 void ScanQueue::Add(Scan scan, bool initialized, TimeNs state_time_ns, OdometryStats* stats) {
   ++stats->scans_received;
-  if (initialized && scan.t_end_ns <= last_end_ns_) {
+  const StampVerdict verdict = screen_.Judge({scan.t_start_ns, scan.t_end_ns}, imu_end_ns_);
+  if (verdict == StampVerdict::kOutOfOrder) {
     ++stats->scans_out_of_order;  // estimating it would step the trajectory back in time
     return;
   }
+  if (verdict == StampVerdict::kNewestWereAhead) {
+    const std::vector<ScanSpan>& dropped = screen_.dropped();
+    for (auto s = dropped.rbegin(); s != dropped.rend(); ++s) DropAhead(s->end_ns, stats);  // newest first
+  }
   if (!initialized || scan.t_start_ns < state_time_ns) {
     ++stats->scans_before_imu;  // no IMU state covers this scan
+    before_imu_ends_ns_.push_back(scan.t_end_ns);
+    if (before_imu_ends_ns_.size() > ScanStampScreen::kRecent) before_imu_ends_ns_.pop_front();
     return;
   }
-  last_end_ns_ = scan.t_end_ns;
   scans_.push_back(std::move(scan));
 }
 
+// A scan stamped ahead is still queued (at the back: it waits for the IMU to
+// reach its end), or was counted before the IMU; one already estimated
+// stays (the scans behind its stamp then fall before the state and are
+// skipped as such).
+void ScanQueue::DropAhead(TimeNs end_ns, OdometryStats* stats) {
+  const auto before = std::find(before_imu_ends_ns_.begin(), before_imu_ends_ns_.end(), end_ns);
+  if (!scans_.empty() && scans_.back().t_end_ns == end_ns) {
+    scans_.pop_back();
+  } else if (before != before_imu_ends_ns_.end()) {
+    before_imu_ends_ns_.erase(before);
+    --stats->scans_before_imu;
+  } else {
+    return;
+  }
+  ++stats->scans_stamp_ahead;
+}
+
+std::optional<Scan> ScanQueue::PopFrontShifted(TimeNs shift_ns, TimeNs state_time_ns,
+                                               OdometryStats* stats) {
+  Scan scan = PopFront();
+  if (shift_ns != 0) ShiftScanTime(shift_ns, &scan);
+  if (scan.t_end_ns > state_time_ns) return scan;
+  ++stats->scans_out_of_order;
+  return std::nullopt;
+}
+
 void ScanQueue::DropPastImu(TimeNs max_gap_ns, OdometryStats* stats) {
-  if (imu_end_ns_ == std::numeric_limits<TimeNs>::min()) return;  // no IMU: nothing was queued
+  if (imu_end_ns_ == ScanStampScreen::kNoImu) return;  // no IMU: nothing was queued
   while (!scans_.empty() && scans_.back().t_end_ns - imu_end_ns_ > max_gap_ns) {
     scans_.pop_back();
     ++stats->scans_after_imu;
   }
 }
 
-std::vector<std::string> QueueWarnings(const OdometryStats& stats) {
+std::vector<std::string> StatsWarnings(const OdometryStats& stats) {
   std::vector<std::string> w;
   if (stats.scans_out_of_order > 0)
     w.push_back(std::to_string(stats.scans_out_of_order) +
                 " scans were skipped: their stamps repeat or go back behind a scan already taken "
                 "(stats.scans_out_of_order)");
+  if (stats.scans_stamp_ahead > 0)
+    w.push_back(std::to_string(stats.scans_stamp_ahead) +
+                " scans were skipped: their stamps jumped ahead, at least a scan period past the "
+                "scan after them and past the IMU, which the scans after them follow "
+                "(stats.scans_stamp_ahead)");
   if (stats.scans_after_imu > 0)
     w.push_back(std::to_string(stats.scans_after_imu) +
                 " scans at the end were skipped: they end more than imu.max_gap after the last "
                 "IMU sample (the IMU stopped before the LiDAR, or lidar.time_offset is wrong; "
                 "stats.scans_after_imu)");
+  for (std::string& t : TimeOffsetWarnings(stats.time_offset)) w.push_back(std::move(t));
   return w;
 }
 

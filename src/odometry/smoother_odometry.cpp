@@ -108,18 +108,15 @@ void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
 
 // Predict -> Downsample -> Deskew -> Add + Optimize -> Insert -> Marginalize.
 // With lidar.estimate_time_offset the scan is first moved onto the IMU clock
-// by the current estimate (the window then refines it).
+// by the current estimate (the window then refines it); one the estimate's
+// change moved to end at or before the newest state is skipped.
 void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
-  Scan scan = scans_.PopFront();
   const double start_ms = WorkCpuMs();  // association helpers included
-  if (options_.lidar.estimate_time_offset) {
-    applied_shift_ns_ = ScanTimeShiftNs();
-    ShiftScanTime(applied_shift_ns_, &scan);
-  }
-  if (scan.t_end_ns < newest_.t_ns) {
-    ++stats_.scans_out_of_order;
-    return;
-  }
+  const TimeNs shift_ns = ScanTimeShiftNs();
+  std::optional<Scan> shifted = scans_.PopFrontShifted(shift_ns, newest_.t_ns, &stats_);
+  if (!shifted) return;
+  applied_shift_ns_ = shift_ns;
+  Scan& scan = *shifted;
   const Eigen::Vector3d& g = window_options_.g_world;
   const std::vector<ImuSample> samples = ImuCovering(newest_.t_ns, scan.t_end_ns);
   const ImuPoseHistory history =
@@ -312,16 +309,13 @@ TimeNs SmootherOdometry::ScanTimeShiftNs() const {
 
 void SmootherOdometry::ReportTimeOffset(ScanResult* r, const ImuPoseHistory& history) {
   if (!options_.lidar.estimate_time_offset || !window_) return;
-  const bool was_at_bound = stats_.time_offset.at_bound;
   time_offset_excitation_.CountScan(newest_.t_ns, MotionAtEnd(history).gyro_imu,
                                     newest_.v_world_imu);
   r->time_offset_s = window_->time_offset_s();
   r->time_offset_std_s = window_->time_offset_std_s();
-  stats_.time_offset =
-      MakeTimeOffsetReport(time_offset_excitation_, options_.lidar, window_->time_offset_s(),
-                           window_->time_offset_std_s(), window_->time_offset_at_bound());
-  if (stats_.time_offset.at_bound && !was_at_bound)
-    warnings_.push_back(TimeOffsetAtBoundWarning(options_.lidar, newest_.t_ns));
+  UpdateTimeOffsetReport(time_offset_excitation_, options_.lidar, window_->time_offset_s(),
+                         window_->time_offset_std_s(), window_->time_offset_at_bound(),
+                         newest_.t_ns, &stats_.time_offset);
 }
 
 void SmootherOdometry::SetNewestFromWindow() {
@@ -336,7 +330,7 @@ void SmootherOdometry::SetNewestFromWindow() {
 
 std::vector<std::string> SmootherOdometry::warnings() const {
   std::vector<std::string> w = warnings_;
-  for (std::string& q : QueueWarnings(stats_)) w.push_back(std::move(q));
+  for (std::string& q : StatsWarnings(stats_)) w.push_back(std::move(q));
   const auto count = [&w](int64_t n, const std::string& what) {
     if (n > 0) w.push_back(std::to_string(n) + " " + what);
   };

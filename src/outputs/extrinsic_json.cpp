@@ -46,18 +46,18 @@ nlohmann::json TimeOffsetJson(const TimeOffsetReport& r) {
           {"prior_s", r.prior_s},
           {"at_bound", r.at_bound},
           {"bound_s", r.bound_s},
+          {"bound_scans", r.bound_scans},
+          {"first_bound_time_s",
+           r.bound_scans > 0 ? nlohmann::json(NsToSeconds(r.first_bound_t_ns)) : nlohmann::json()},
           {"excited", r.excited},
           {"excited_s", r.excited_s},
+          {"scans_s", r.scans_s},
           {"max_rotation_rate_spread_rad_s", r.max_rate_spread_rad_s},
           {"max_velocity_spread_m_s", r.max_velocity_spread_m_s},
           {"trustworthy", r.trustworthy},
           {"map_hold_scans", r.map_hold_scans},
           {"replayed_scans", r.replayed_scans},
-          {"note", r.trustworthy ? "put estimate_s in lidar.time_offset"
-                   : r.excited   ? "not trustworthy: the estimate is not settled (1-sigma above "
-                                   "lidar.time_offset_excited_std, or at the bound)"
-                                 : "not trustworthy: the motion never excited the time offset "
-                                   "(hover or constant velocity); keep lidar.time_offset"}};
+          {"note", TimeOffsetNote(r)}};
 }
 
 }  // namespace rvlio

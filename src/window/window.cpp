@@ -202,7 +202,6 @@ void SlidingWindow::HoldTimeOffsetInBound() {
   if (!estimate_time_offset() || std::abs(time_offset_[0]) <= options_.lidar.time_offset_max)
     return;
   time_offset_[0] = std::copysign(options_.lidar.time_offset_max, time_offset_[0]);
-  time_offset_at_bound_ = true;
 }
 
 Pose3 SlidingWindow::T_imu_lidar() const {

@@ -128,6 +128,24 @@ TEST(IeskfTimeOffset, ObservableAtJudgesTheNextScanWithoutMovingTheFilter) {
   EXPECT_NEAR(rest.time_offset_std_s(), 0.0007, 1e-12);
 }
 
+// Item: time_offset_at_bound() is whether the estimate is held at the bound
+// now (it was a flag set once and never cleared, so summary.json said
+// at_bound while the estimate had come back to -0.0425 s).
+TEST(IeskfTimeOffset, AtBoundIsTheCurrentEstimates) {
+  LidarOptions lidar;
+  lidar.estimate_time_offset = true;
+  lidar.time_offset_max = 0.2;
+  RvOptions rv;
+  rv.enabled = false;
+  Ieskf f(IeskfOptions(), ImuOptions(), ConstraintOptions(), rv, lidar);
+  f.Initialize(FilterState(), 0, ImuSample());
+  EXPECT_FALSE(f.time_offset_at_bound());
+  f.SetTimeOffset(-0.2, 0.001);
+  EXPECT_TRUE(f.time_offset_at_bound());
+  f.SetTimeOffset(-0.0425, 0.001);
+  EXPECT_FALSE(f.time_offset_at_bound());
+}
+
 TEST(IeskfPropagation, PoseHistoryCoversTheIntervalInOrder) {
   const Motion m;
   Ieskf f = MakeFilter();

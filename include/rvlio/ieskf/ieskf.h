@@ -4,6 +4,7 @@
 // covariance, and the iterated point-to-plane update of paper Eq. (1) with
 // re-association and the RV modules inside every iteration (Alg. 3).
 #include <array>
+#include <cmath>
 #include <deque>
 #include <functional>
 #include <limits>
@@ -105,8 +106,11 @@ class Ieskf {
   double time_offset_s() const { return td_s_; }
   // Its 1-sigma (0 when not estimated).
   double time_offset_std_s() const;
-  // True once an update pushed the estimate to +-lidar.time_offset_max (held there).
-  bool time_offset_at_bound() const { return td_at_bound_; }
+  // True while the estimate is held at +-lidar.time_offset_max (an update
+  // pushed it there or past it).
+  bool time_offset_at_bound() const {
+    return lidar_.estimate_time_offset && std::abs(td_s_) >= lidar_.time_offset_max;
+  }
   // True when the last update estimated the offset: the motion showed it
   // (not at rest; estimate_time_offset only).
   bool time_offset_observed() const { return td_observed_; }
@@ -153,7 +157,6 @@ class Ieskf {
   ScanTimeMotion scan_motion_;
   Vector24d P_x_td_ = Vector24d::Zero();
   double P_td_td_ = 0.0;
-  bool td_at_bound_ = false;
   bool td_observed_ = false;  // the last update estimated the offset (not at rest)
 };
 

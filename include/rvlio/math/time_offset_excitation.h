@@ -34,6 +34,10 @@ class TimeOffsetExcitation {
 
   bool excited() const { return excited_s_ >= kMinExcitedSeconds; }
   double excited_seconds() const { return excited_s_; }
+  // Seconds from the first scan counted to the last.
+  double counted_seconds() const {
+    return first_t_ns_ >= 0 ? NsToSeconds(last_t_ns_ - first_t_ns_) : 0.0;
+  }
   double max_rate_spread() const { return max_rate_spread_; }          // rad/s
   double max_velocity_spread() const { return max_velocity_spread_; }  // m/s
 
@@ -43,7 +47,7 @@ class TimeOffsetExcitation {
     Eigen::Vector3d gyro_imu, v_world;
   };
   std::deque<Sample> window_;
-  TimeNs last_t_ns_ = -1;
+  TimeNs first_t_ns_ = -1, last_t_ns_ = -1;
   double excited_s_ = 0.0;
   double max_rate_spread_ = 0.0, max_velocity_spread_ = 0.0;
 };

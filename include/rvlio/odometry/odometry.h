@@ -81,28 +81,40 @@ ExtrinsicReport MakeExtrinsicReport(const ExtrinsicExcitation& excitation,
                                     const Pose3& T_imu_lidar_prior, const Pose3& T_imu_lidar);
 
 // Online time-offset estimation (lidar.estimate_time_offset), reported in
-// summary.json ("time_offset"; math/time_offset_excitation.h).
+// summary.json ("time_offset"; math/time_offset_excitation.h). The note and
+// the warning of the run are made from it (TimeOffsetNote,
+// TimeOffsetWarnings): one source for what summary.json and stderr say.
 struct TimeOffsetReport {
   bool enabled = false;
   double prior_s = 0.0;     // lidar.time_offset
   double estimate_s = 0.0;  // final estimate
   double std_s = 0.0;       // its 1-sigma
-  bool at_bound = false;    // the estimate reached lidar.time_offset_max (held there)
+  bool at_bound = false;    // the final estimate is held at +-lidar.time_offset_max
   double bound_s = 0.0;     // lidar.time_offset_max
+  int64_t bound_scans = 0;  // scans whose estimate was held at the bound
+  TimeNs first_bound_t_ns = 0;  // the first of them (bound_scans > 0)
   bool excited = false;     // the motion excited it (TimeOffsetExcitation::excited)
   double excited_s = 0.0;   // seconds of excited scans
+  double scans_s = 0.0;     // seconds from the first to the last scan counted
   double max_rate_spread_rad_s = 0.0;
   double max_velocity_spread_m_s = 0.0;
-  bool trustworthy = false;  // excited, 1-sigma under time_offset_excited_std, not at the bound
+  double trust_std_s = 0.0;  // lidar.time_offset_excited_std
+  // excited, 1-sigma under time_offset_excited_std, never at the bound
+  bool trustworthy = false;
   int64_t map_hold_scans = 0;  // IESKF: lidar.time_offset_map_hold (0 for the smoother)
   int64_t replayed_scans = 0;  // IESKF: lidar.time_offset_replay (0 for the smoother)
 };
 
-// The report of a backend's time-offset estimate (estimate_s, std_s) and
-// excitation monitor under the lidar options.
-TimeOffsetReport MakeTimeOffsetReport(const TimeOffsetExcitation& excitation,
-                                      const LidarOptions& lidar, double estimate_s, double std_s,
-                                      bool at_bound);
+// Brings the report of a backend's time-offset estimate up to the scan
+// processed at t_ns: its estimate (estimate_s, std_s, at_bound: held at the
+// bound) and excitation monitor, under the lidar options.
+void UpdateTimeOffsetReport(const TimeOffsetExcitation& excitation, const LidarOptions& lidar,
+                            double estimate_s, double std_s, bool at_bound, TimeNs t_ns,
+                            TimeOffsetReport* r);
+// What to do with the estimate, from what was measured (summary.json note).
+std::string TimeOffsetNote(const TimeOffsetReport& r);
+// The run's warning when the estimate reached the bound (else none).
+std::vector<std::string> TimeOffsetWarnings(const TimeOffsetReport& r);
 
 // Counts of what was skipped or repaired, reported in summary.json.
 struct OdometryStats {
@@ -118,8 +130,9 @@ struct OdometryStats {
   // Sliding-window smoother (backend: smoother); zero for the IESKF.
   int64_t imu_factors_skipped = 0;       // window states added without an IMU factor (IMU gap)
   int64_t marginalization_failures = 0;  // replaced by a prior at the next state's estimate
-  int64_t scans_out_of_order = 0;        // stamp repeating or going back (or, window: ending
-                                         // before the newest window state): skipped
+  int64_t scans_out_of_order = 0;        // stamp repeating or going back, or moved behind the
+                                         // estimator's time by a changed time-offset estimate: skipped
+  int64_t scans_stamp_ahead = 0;         // stamp jumped ahead of the scans after it and the IMU: skipped
   int64_t scans_after_imu = 0;           // ending more than imu.max_gap after the last IMU sample
   int64_t imu_non_finite = 0;            // non-finite IMU samples dropped
   double association_ms = 0.0;           // CPU ms in association, RV and robust weights (total)

@@ -19,6 +19,7 @@
 #include "rvlio/lidar/deskew.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/lidar/preprocess.h"
+#include "rvlio/lidar/scan_order.h"
 #include "rvlio/map/options.h"
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
@@ -100,9 +101,6 @@ class WorkingMap {
   std::vector<Eigen::Vector3d> p_world_;
 };
 
-// The warning for an estimated time offset that reached lidar.time_offset_max
-// (at the estimator's time t_ns).
-std::string TimeOffsetAtBoundWarning(const LidarOptions& lidar, TimeNs t_ns);
 // The reference-map side of both backends (odometry/reference.h): the start
 // alignment and, per scan, the choice between the reference and the working
 // map. Disabled (and never consulted) without a reference.
@@ -153,18 +151,23 @@ class ReferenceLocalizer {
 bool AcceptImu(const ImuSample& imu, const std::deque<ImuSample>& buffer, TimeNs max_gap_ns,
                OdometryStats* stats);
 
-// Warnings for the scans the queue skipped (out of order, after the IMU's end).
-std::vector<std::string> QueueWarnings(const OdometryStats& stats);
+// The warnings the counts call for: scans the queue skipped (out of order,
+// stamped ahead, after the IMU's end) and a time-offset estimate that reached
+// its bound (TimeOffsetWarnings).
+std::vector<std::string> StatsWarnings(const OdometryStats& stats);
 
 // Scans waiting for the IMU data that covers them: both backends hand a scan
 // to the estimator only once an IMU sample at or after its end has arrived.
 class ScanQueue {
  public:
-  // Queues a scan unless no IMU state covers it yet (not initialized, or it
-  // starts before the estimator's current time: scans_before_imu) or it does
-  // not end after the previous scan taken (a stamp repeated or going back:
-  // scans_out_of_order), so the estimates come out in increasing time;
-  // counts either way.
+  // Judges the scan's stamps (lidar/scan_order.h) against the scans received
+  // before it and the IMU received so far: out of order (a stamp repeated or
+  // going back behind the newest scan taken: skipped, scans_out_of_order), or
+  // taken, dropping the newest scans taken before it when their stamps
+  // jumped ahead (scans_stamp_ahead). A scan taken is queued unless no IMU
+  // state covers it yet (not initialized, or it starts before the
+  // estimator's current time: scans_before_imu). So the estimates come out
+  // in increasing time.
   void Add(Scan scan, bool initialized, TimeNs state_time_ns, OdometryStats* stats);
   // The newest IMU sample received (accepted or used for initialization).
   void NoteImu(TimeNs t_ns) { imu_end_ns_ = std::max(imu_end_ns_, t_ns); }
@@ -182,14 +185,24 @@ class ScanQueue {
   size_t size() const { return scans_.size(); }
   const Scan& front() const { return scans_.front(); }
   Scan PopFront();
+  // The oldest scan moved by shift_ns (the estimated time offset) onto the
+  // IMU clock; nothing (counted in scans_out_of_order) when it then ends at
+  // or before state_time_ns (the estimator's time): a change of the estimate
+  // since it was queued moved it behind a scan already estimated, and
+  // estimating it would step the trajectory back in time.
+  std::optional<Scan> PopFrontShifted(TimeNs shift_ns, TimeNs state_time_ns, OdometryStats* stats);
   // Drops (and counts in scans_before_imu) the queued scans that start before
   // state_time_ns, as Add would have (after the estimated shift changed).
   void DropStartingBefore(TimeNs state_time_ns, OdometryStats* stats);
 
  private:
+  // Drops the scan ending at end_ns that the screen found stamped ahead.
+  void DropAhead(TimeNs end_ns, OdometryStats* stats);
+
   std::deque<Scan> scans_;
-  TimeNs last_end_ns_ = std::numeric_limits<TimeNs>::min();  // of the newest scan taken
-  TimeNs imu_end_ns_ = std::numeric_limits<TimeNs>::min();
+  ScanStampScreen screen_;
+  std::deque<TimeNs> before_imu_ends_ns_;  // the recent scans counted in scans_before_imu
+  TimeNs imu_end_ns_ = ScanStampScreen::kNoImu;  // the lowest TimeNs
 };
 
 }  // namespace rvlio

@@ -68,6 +68,7 @@
 //
 // The window owns no map: association is a callback, so the window can be
 // driven by the odometry's voxel map or by an exact synthetic world.
+#include <cmath>
 #include <deque>
 #include <functional>
 #include <memory>
@@ -233,9 +234,12 @@ class SlidingWindow {
   Pose3 T_imu_lidar() const;
   const ExtrinsicExcitation& extrinsic_excitation() const { return excitation_; }
   // The time offset in use (s): the estimate (lidar.estimate_time_offset) or
-  // lidar.time_offset; whether an estimate reached lidar.time_offset_max.
+  // lidar.time_offset; whether the estimate is held at +-lidar.time_offset_max
+  // (a solve pushed it there or past it).
   double time_offset_s() const { return time_offset_[0]; }
-  bool time_offset_at_bound() const { return time_offset_at_bound_; }
+  bool time_offset_at_bound() const {
+    return estimate_time_offset() && std::abs(time_offset_[0]) >= options_.lidar.time_offset_max;
+  }
   // The marginal 1-sigma of the offset under the marginalization prior (s;
   // the prior's std before the first marginalization, 0 when not estimated).
   double time_offset_std_s() const { return time_offset_std_s_; }
@@ -290,7 +294,6 @@ class SlidingWindow {
   ExtrinsicExcitation excitation_;
   double time_offset_[1] = {0.0};                      // s
   std::unique_ptr<ceres::CostFunction> time_offset_prior_;  // until the first marginalization
-  bool time_offset_at_bound_ = false;
   double time_offset_std_s_ = 0.0;
   RvWorkspace rv_workspace_;
   WindowStats stats_;
