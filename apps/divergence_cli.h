@@ -15,7 +15,8 @@ namespace rvlio::cli {
 // "Ran to the end but diverged": every output is written for inspection.
 constexpr int kExitDiverged = 3;
 
-// Prints "rvlio CMD: warning: divergence at bag time T s: WHAT" for every
+// Prints "rvlio CMD: warning: divergence at bag time T s: WHAT" (or
+// "inconsistency at" for an episode a clock offset explains) for every
 // episode start after the first *printed ones; updates *printed.
 void WarnDivergence(const std::string& command, const DivergenceReport& report, size_t* printed);
 

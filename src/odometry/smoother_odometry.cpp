@@ -53,7 +53,8 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options, Localization 
       preprocessor_(options.lidar),
       initializer_(options.imu.init_duration),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
-      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity),
+      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity,
+               options.lidar.time_offset_max),
       localizer_(std::move(localization), options.localization, options.constraints) {}
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
