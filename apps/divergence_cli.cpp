@@ -44,15 +44,29 @@ static int64_t LostEpisodes(const DivergenceReport& r) {
   return n;
 }
 
+// With a reference map, a divergence that began while the gyro showed no
+// rotation: the start or the map.
+static std::string StartHint(const DivergenceReport& r, bool reference_map) {
+  for (const DivergenceEvent& e : r.events) {
+    if (!e.lost) continue;
+    if (!reference_map || !e.still) return "";
+    return "; it began while the gyro showed no rotation, where neither a wrong extrinsic "
+           "rotation nor unsynchronized clocks show, "
+           "with the scans localized in the reference map: the start pose (--initial-pose) or the "
+           "map (--map) is wrong";
+  }
+  return "";
+}
+
 int FinishDiverged(const std::string& command, const DivergenceReport& r,
-                   const std::string& out_dir, bool allow) {
+                   const std::string& out_dir, bool allow, bool reference_map) {
   char when[64];
   std::snprintf(when, sizeof(when), "%.3f", NsToSeconds(r.first_t_ns));
   const std::string what = "the estimate diverged from bag time " + std::string(when) + " s (" +
                            std::to_string(LostEpisodes(r)) + " episode(s), " +
                            std::to_string(r.scans_flagged) +
                            " scans flagged; see divergence in summary.json); outputs written to " +
-                           out_dir + " for inspection" + ClockHint(r);
+                           out_dir + " for inspection" + StartHint(r, reference_map) + ClockHint(r);
   if (allow) {
     std::fprintf(stderr, "rvlio %s: warning: %s\n", command.c_str(), what.c_str());
     return 0;

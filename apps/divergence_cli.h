@@ -21,8 +21,9 @@ constexpr int kExitDiverged = 3;
 void WarnDivergence(const std::string& command, const DivergenceReport& report, size_t* printed);
 
 // The closing line of a diverged run; returns kExitDiverged, or 0 when
-// allowed (the line is then a warning).
+// allowed (the line is then a warning). reference_map: the run localized in
+// one (`run --map`); a divergence from rest then names the start and the map.
 int FinishDiverged(const std::string& command, const DivergenceReport& report,
-                   const std::string& out_dir, bool allow);
+                   const std::string& out_dir, bool allow, bool reference_map = false);
 
 }  // namespace rvlio::cli

@@ -86,12 +86,18 @@ std::string DivergenceEvent::Describe() const {
                     "the scans turn %.2f deg per scan against the gyro (window mean) > "
                     "divergence.max_lidar_rotation_deg %g%s",
                     value, threshold,
-                    lost ? ", and no LiDAR-IMU clock offset explains it: check the extrinsic "
-                           "rotation"
-                         : "");
+                    !lost     ? ""
+                    : still ? ", while the gyro showed no rotation (where neither the "
+                              "extrinsic rotation nor the clocks show): the scans disagree "
+                              "with the map"
+                              : ", and no LiDAR-IMU clock offset explains it: check the "
+                                "extrinsic rotation");
       break;
   }
-  return lost ? std::string(text) : text + ClockExplanation(*this);
+  if (!lost) return text + ClockExplanation(*this);
+  return still && kind != DivergenceKind::kRotation
+             ? text + std::string(", while the gyro showed no rotation")
+             : text;
 }
 
 ClockFit FitClockOffset(const std::deque<RotationSample>& samples) {
@@ -139,7 +145,8 @@ bool DivergenceMonitor::Full(const Window& w) const {
 DivergenceEvent DivergenceMonitor::Judge(DivergenceKind k, TimeNs t_ns, double value,
                                          double threshold) const {
   DivergenceEvent e{k, t_ns, value, threshold};
-  if (k != DivergenceKind::kNis && k != DivergenceKind::kRotation) return e;
+  e.still = still_.Mean() >= DivergenceReport::kStillShare;
+  if (e.still || (k != DivergenceKind::kNis && k != DivergenceKind::kRotation)) return e;
   const ClockFit fit = FitClockOffset(rotations_);
   if (2 * fit.scans < options_.window_scans || !(fit.explained >= options_.min_clock_explained) ||
       !(std::abs(fit.offset_s) <= max_clock_offset_s_))
@@ -213,6 +220,7 @@ uint8_t DivergenceMonitor::Check(const HealthSample& s) {
   CountMotionResidual(s, report_.detected);
   PushRotation(s);
   const double speed = s.v_world_imu.norm();
+  Push(&still_, s.mean_gyro_imu.norm() < DivergenceReport::kStillRate ? 1.0 : 0.0);
   if (!std::isfinite(speed) || speed > options_.max_speed)
     Trip(DivergenceKind::kSpeed, s.t_ns, speed, options_.max_speed, &mask);
   if (have_previous_ && s.t_ns > previous_.t_ns) {

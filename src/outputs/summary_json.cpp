@@ -72,7 +72,8 @@ nlohmann::json DivergenceJson(const DivergenceReport& r) {
     nlohmann::json one = {{"kind", DivergenceKindName(e.kind)},
                           {"time_s", NsToSeconds(e.t_ns)},
                           {"value", e.value},
-                          {"threshold", e.threshold}};
+                          {"threshold", e.threshold},
+                          {"still", e.still}};
     if (e.lost) {
       episodes.push_back(one);
       continue;

@@ -124,6 +124,11 @@ struct DivergenceEvent {
   double value = 0.0;
   double threshold = 0.0;
   bool lost = true;
+  // The gyro showed no rotation (mean rate below DivergenceReport::kStillRate
+  // on kStillShare of the window up to the event): neither a wrong extrinsic
+  // rotation nor a clock offset shows there; with a reference map, the start
+  // or the map is what the scans disagree with.
+  bool still = false;
   // Inconsistency (lost false): the clock offset the window's rotations
   // suggest (s, to add to lidar.time_offset) and the share they explain.
   double clock_offset_s = std::numeric_limits<double>::quiet_NaN();
@@ -175,6 +180,11 @@ struct DivergenceReport {
   double residual_moving_m = std::numeric_limits<double>::quiet_NaN();
   bool clock_suspect = false;
   static constexpr double kRestSpeed = 0.05;          // m/s
+  static constexpr double kStillRate = 0.01;          // rad/s, DivergenceEvent::still
+  // The share of the window's scans below kStillRate for "still": an
+  // upside-down mount trips one second into a slow start with 70 % of its
+  // window below the rate (6 s tunnel, seed 2), a wrong start at rest 100 %.
+  static constexpr double kStillShare = 0.9;
   static constexpr double kMovingSpeed = 0.3;         // m/s
   static constexpr double kClockSuspectRatio = 2.5;
   static constexpr int kClockSuspectMinScans = 5;
@@ -235,6 +245,7 @@ class DivergenceMonitor {
   std::array<bool, kNumDivergenceKinds> active_{};
   std::array<bool, kNumDivergenceKinds> active_lost_{};  // the active episode is divergence
   bool residual_clock_suspect_ = false;  // CountMotionResidual's finding
+  Window still_;  // 1 for a scan whose gyro rate is below kStillRate, else 0
   std::array<int, kNumDivergenceKinds> clear_scans_{};
 };
 
