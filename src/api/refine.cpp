@@ -23,7 +23,11 @@
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/outputs/summary_json.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/lidar/deskew.h"
 #include "rvlio/lidar/preprocess.h"
+#include "rvlio/math/so3.h"
+#include "rvlio/odometry/reference.h"
+#include "rvlio/refine/refine_states.h"
 #include "rvlio/refine/refine_jobs.h"
 
 namespace rvlio {
@@ -121,6 +125,12 @@ std::string SecondsText(TimeNs t_ns) {
 // imu.init_duration (the odometry's static initialization has no poses) and
 // at its end, before refine says it covers only part of the recording.
 constexpr double kCoverageSlackS = 0.5;
+
+// refine --map: how far the initial trajectory may lie from where the scans
+// fit the map (CheckMapFits); refine is held to the map from the initial
+// poses, so they must be in its frame already (a run --map gives centimetres).
+constexpr double kInitInMapM = 0.5;
+constexpr double kInitInMapDeg = 5.0;
 
 bool CoversRecording(const ScansSeen& seen, const Trajectory& init, double init_duration_s) {
   if (seen.outside_init == 0) return true;
@@ -259,6 +269,64 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
   return stage.Commit();
 }
 
+// The IMU poses over [t0_ns, t1_ns] from the initial trajectory: its poses
+// from the last before t0 to the first after t1, each moving at the constant
+// velocity and rate that takes it to the next (enough to deskew one scan).
+std::vector<ImuPoseSample> PoseSamplesFrom(const Trajectory& init, TimeNs t0_ns, TimeNs t1_ns) {
+  size_t first = 0, last = init.size() - 1;
+  while (first + 1 < init.size() && init[first + 1].t_ns <= t0_ns) ++first;
+  while (last > first + 1 && init[last - 1].t_ns >= t1_ns) --last;
+  std::vector<ImuPoseSample> samples;
+  for (size_t i = first; i <= last; ++i) {
+    ImuPoseSample s;
+    s.t_ns = init[i].t_ns;
+    s.R_world_imu = init[i].q_world_imu.toRotationMatrix();
+    s.p_world_imu = init[i].p_world_imu;
+    if (i < last) {
+      const double dt_s = NsToSeconds(init[i + 1].t_ns - init[i].t_ns);
+      s.v_world_imu = (init[i + 1].p_world_imu - init[i].p_world_imu) / dt_s;
+      s.gyro_imu = so3::Log(s.R_world_imu.transpose() * init[i + 1].q_world_imu.toRotationMatrix()) / dt_s;
+    }
+    samples.push_back(s);
+  }
+  return samples;
+}
+
+// refine --map: the map must fit the recording where the initial trajectory
+// puts it, judged as `run --map` judges its start (FindStartInReference):
+// the first scan inside the initial trajectory, deskewed along it, from the
+// trajectory's pose there, which must then also be where the scan fits (the
+// trajectory in the map's frame). Ok without such a scan (refine says why).
+Status CheckMapFits(const RefineArgs& args, const RefineInput& input, const VoxelMap& reference) {
+  const Trajectory& init = input.init;
+  const auto covered = std::find_if(input.scans.begin(), input.scans.end(), [&](const Scan& s) {
+    return s.t_start_ns >= init.front().t_ns && s.t_end_ns <= init.back().t_ns &&
+           static_cast<int>(s.points.size()) >= kMinScanPoints;
+  });
+  if (covered == input.scans.end()) return Status::Ok();
+  Pose3 T_ref_imu;
+  if (!InterpolatePose(init, covered->t_end_ns, &T_ref_imu)) return Status::Ok();
+  const Pose3 T_imu_lidar = ImuTLidar(args.options.extrinsics);
+  std::vector<Eigen::Vector3d> p_lidar_end;
+  DeskewToScanEnd(PoseSamplesFrom(init, covered->t_start_ns, covered->t_end_ns), T_imu_lidar,
+                  covered->points, covered->t_end_ns, &p_lidar_end);
+  const std::string start = "the --init pose at " + SecondsText(covered->t_end_ns) + " s";
+  StatusOr<ReferenceAlignment> a =
+      FindStartInReference(p_lidar_end, T_imu_lidar, reference, &T_ref_imu, T_ref_imu.R,
+                           args.options.constraints, args.options.localization, start);
+  if (!a.ok()) return Status::InvalidInput("--map " + args.map + ": " + a.status().message());
+  const double moved_m = TranslationDifference(a->T_ref_imu, T_ref_imu);
+  const double turned_deg = RotationDifferenceDeg(a->T_ref_imu, T_ref_imu);
+  if (moved_m > kInitInMapM || turned_deg > kInitInMapDeg) {
+    char text[256];
+    std::snprintf(text, sizeof(text), ": the scan at %s s fits it %.2f m and %.1f deg away from "
+                  "the --init pose there: --init is not in the map's frame",
+                  SecondsText(covered->t_end_ns).c_str(), moved_m, turned_deg);
+    return Status::InvalidInput("--map " + args.map + text);
+  }
+  return Status::Ok();
+}
+
 // The refinement with its hooks: rounds, checkpoints, the stop flag.
 // *checkpoint_s: wall time of the fingerprint and the checkpoint writes.
 // map_hash: FileContentHash of --map (0 without one).
@@ -364,6 +432,8 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   }
   if (job && static_cast<int64_t>(input.scans.size()) < kRefineJobMinScans)
     return Status::InvalidInput(ShortChunk(*job, input.scans.size()));
+  if (reference != nullptr)
+    if (Status s = CheckMapFits(args, input, *reference); !s.ok()) return s;
   Times times;
   times.read_s = SecondsSince(t0);
   StatusOr<RefineResult> refined =
