@@ -134,28 +134,6 @@ TEST(AlignToReference, FarFromTheReferenceThereIsNoOverlap) {
   EXPECT_LT(a.overlap, 0.05);
 }
 
-// The start judged against the candidates around it (FindStartInReference):
-// the true pose passes with its fit; half a turn there fits the scan worse
-// than the truth within the check radius: the pose given is wrong.
-TEST(FindStartInReference, TrueStartPassesAHalfTurnIsRefused) {
-  const Scene s = MakeScene(true);
-  const LocalizationOptions options;
-  StatusOr<ReferenceAlignment> a =
-      FindStartInReference(s.p_lidar, s.T_imu_lidar, *s.reference, &s.T_ref_imu_true,
-                           s.T_ref_imu_true.R, ConstraintOptions(), options, "--initial-pose");
-  ASSERT_TRUE(a.ok()) << a.status().message();
-  EXPECT_LT((a->T_ref_imu.t - s.T_ref_imu_true.t).norm(), 0.01);
-  EXPECT_GT(a->Consistency(), options.min_start_fit);
-  const Pose3 turned(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                         s.T_ref_imu_true.R,
-                     s.T_ref_imu_true.t);
-  a = FindStartInReference(s.p_lidar, s.T_imu_lidar, *s.reference, &turned, turned.R,
-                           ConstraintOptions(), options, "--initial-pose");
-  ASSERT_FALSE(a.ok());
-  EXPECT_NE(a.status().message().find("--initial-pose"), std::string::npos)
-      << a.status().message();
-}
-
 TEST(LocalizationOptions, RejectsRadiiTheWrongWayRound) {
   LocalizationOptions o;
   o.align_radius_min = 3.0;
