@@ -63,6 +63,9 @@ struct ScansSeen {
   TimeNs first_end_ns = 0, last_end_ns = 0;
   int64_t outside_init = 0;  // end stamp outside the initial trajectory's span
   int64_t chunk_first = -1, chunk_last = -1;  // recording index (0-based) of a chunk's kept scans
+  // The recording's first scan inside the initial trajectory (downsampled),
+  // kept by a chunk job too: what refine --map checks the map on.
+  std::optional<Scan> first_in_init;
 };
 
 // A chunk job keeps the IMU samples around its scans and, as the whole
@@ -104,6 +107,13 @@ Status ReadBag(const RefineArgs& args, const RefineJobSpan* job, SensorBagReader
       continue;
     }
     CountScan(scan, input->init, seen);
+    const bool in_init = scan.t_start_ns >= input->init.front().t_ns &&
+                         scan.t_end_ns <= input->init.back().t_ns;
+    if (!seen->first_in_init && in_init) {
+      Scan small;
+      preprocessor.Downsample(scan, &small);
+      if (static_cast<int>(small.points.size()) >= kMinScanPoints) seen->first_in_init = small;
+    }
     if (job != nullptr && !job->Contains(scan.t_end_ns)) continue;
     if (seen->chunk_first < 0) seen->chunk_first = seen->scans - 1;
     seen->chunk_last = seen->scans - 1;
@@ -294,16 +304,14 @@ std::vector<ImuPoseSample> PoseSamplesFrom(const Trajectory& init, TimeNs t0_ns,
 
 // refine --map: the map must fit the recording where the initial trajectory
 // puts it, judged as `run --map` judges its start (FindStartInReference):
-// the first scan inside the initial trajectory, deskewed along it, from the
+// the recording's first scan inside the initial trajectory (the same scan for
+// every chunk job and the whole refine), deskewed along it, from the
 // trajectory's pose there, which must then also be where the scan fits (the
 // trajectory in the map's frame). Ok without such a scan (refine says why).
-Status CheckMapFits(const RefineArgs& args, const RefineInput& input, const VoxelMap& reference) {
-  const Trajectory& init = input.init;
-  const auto covered = std::find_if(input.scans.begin(), input.scans.end(), [&](const Scan& s) {
-    return s.t_start_ns >= init.front().t_ns && s.t_end_ns <= init.back().t_ns &&
-           static_cast<int>(s.points.size()) >= kMinScanPoints;
-  });
-  if (covered == input.scans.end()) return Status::Ok();
+Status CheckMapFits(const RefineArgs& args, const Trajectory& init, const ScansSeen& seen,
+                    const VoxelMap& reference) {
+  if (!seen.first_in_init) return Status::Ok();
+  const Scan* covered = &*seen.first_in_init;
   Pose3 T_ref_imu;
   if (!InterpolatePose(init, covered->t_end_ns, &T_ref_imu)) return Status::Ok();
   const Pose3 T_imu_lidar = ImuTLidar(args.options.extrinsics);
@@ -433,7 +441,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (job && static_cast<int64_t>(input.scans.size()) < kRefineJobMinScans)
     return Status::InvalidInput(ShortChunk(*job, input.scans.size()));
   if (reference != nullptr)
-    if (Status s = CheckMapFits(args, input, *reference); !s.ok()) return s;
+    if (Status s = CheckMapFits(args, input.init, seen, *reference); !s.ok()) return s;
   Times times;
   times.read_s = SecondsSince(t0);
   StatusOr<RefineResult> refined =
