@@ -78,7 +78,8 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
     std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());
   if (result->stopped) return ReportInterrupt(req, *result);
   if (result->divergence.detected)
-    return FinishDiverged("run", result->divergence, req.out_dir, req.allow_divergence);
+    return FinishDiverged("run", result->divergence, req.out_dir, req.allow_divergence,
+                          !req.map.empty());
   return 0;
 }
 

@@ -23,7 +23,11 @@
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/outputs/summary_json.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/lidar/deskew.h"
 #include "rvlio/lidar/preprocess.h"
+#include "rvlio/math/so3.h"
+#include "rvlio/odometry/reference.h"
+#include "rvlio/refine/refine_states.h"
 #include "rvlio/refine/refine_jobs.h"
 
 namespace rvlio {
@@ -59,6 +63,9 @@ struct ScansSeen {
   TimeNs first_end_ns = 0, last_end_ns = 0;
   int64_t outside_init = 0;  // end stamp outside the initial trajectory's span
   int64_t chunk_first = -1, chunk_last = -1;  // recording index (0-based) of a chunk's kept scans
+  // The recording's first scan inside the initial trajectory (downsampled),
+  // kept by a chunk job too: what refine --map checks the map on.
+  std::optional<Scan> first_in_init;
 };
 
 // A chunk job keeps the IMU samples around its scans and, as the whole
@@ -100,6 +107,13 @@ Status ReadBag(const RefineArgs& args, const RefineJobSpan* job, SensorBagReader
       continue;
     }
     CountScan(scan, input->init, seen);
+    const bool in_init = scan.t_start_ns >= input->init.front().t_ns &&
+                         scan.t_end_ns <= input->init.back().t_ns;
+    if (!seen->first_in_init && in_init) {
+      Scan small;
+      preprocessor.Downsample(scan, &small);
+      if (static_cast<int>(small.points.size()) >= kMinScanPoints) seen->first_in_init = small;
+    }
     if (job != nullptr && !job->Contains(scan.t_end_ns)) continue;
     if (seen->chunk_first < 0) seen->chunk_first = seen->scans - 1;
     seen->chunk_last = seen->scans - 1;
@@ -121,6 +135,12 @@ std::string SecondsText(TimeNs t_ns) {
 // imu.init_duration (the odometry's static initialization has no poses) and
 // at its end, before refine says it covers only part of the recording.
 constexpr double kCoverageSlackS = 0.5;
+
+// refine --map: how far the initial trajectory may lie from where the scans
+// fit the map (CheckMapFits); refine is held to the map from the initial
+// poses, so they must be in its frame already (a run --map gives centimetres).
+constexpr double kInitInMapM = 0.5;
+constexpr double kInitInMapDeg = 5.0;
 
 bool CoversRecording(const ScansSeen& seen, const Trajectory& init, double init_duration_s) {
   if (seen.outside_init == 0) return true;
@@ -259,6 +279,62 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
   return stage.Commit();
 }
 
+// The IMU poses over [t0_ns, t1_ns] from the initial trajectory: its poses
+// from the last before t0 to the first after t1, each moving at the constant
+// velocity and rate that takes it to the next (enough to deskew one scan).
+std::vector<ImuPoseSample> PoseSamplesFrom(const Trajectory& init, TimeNs t0_ns, TimeNs t1_ns) {
+  size_t first = 0, last = init.size() - 1;
+  while (first + 1 < init.size() && init[first + 1].t_ns <= t0_ns) ++first;
+  while (last > first + 1 && init[last - 1].t_ns >= t1_ns) --last;
+  std::vector<ImuPoseSample> samples;
+  for (size_t i = first; i <= last; ++i) {
+    ImuPoseSample s;
+    s.t_ns = init[i].t_ns;
+    s.R_world_imu = init[i].q_world_imu.toRotationMatrix();
+    s.p_world_imu = init[i].p_world_imu;
+    if (i < last) {
+      const double dt_s = NsToSeconds(init[i + 1].t_ns - init[i].t_ns);
+      s.v_world_imu = (init[i + 1].p_world_imu - init[i].p_world_imu) / dt_s;
+      s.gyro_imu = so3::Log(s.R_world_imu.transpose() * init[i + 1].q_world_imu.toRotationMatrix()) / dt_s;
+    }
+    samples.push_back(s);
+  }
+  return samples;
+}
+
+// refine --map: the map must fit the recording where the initial trajectory
+// puts it, judged as `run --map` judges its start (FindStartInReference):
+// the recording's first scan inside the initial trajectory (the same scan for
+// every chunk job and the whole refine), deskewed along it, from the
+// trajectory's pose there, which must then also be where the scan fits (the
+// trajectory in the map's frame). Ok without such a scan (refine says why).
+Status CheckMapFits(const RefineArgs& args, const Trajectory& init, const ScansSeen& seen,
+                    const VoxelMap& reference, const LocalOrigin& origin) {
+  if (!seen.first_in_init) return Status::Ok();
+  const Scan* covered = &*seen.first_in_init;
+  Pose3 T_ref_imu;
+  if (!InterpolatePose(init, covered->t_end_ns, &T_ref_imu)) return Status::Ok();
+  const Pose3 T_imu_lidar = ImuTLidar(args.options.extrinsics);
+  std::vector<Eigen::Vector3d> p_lidar_end;
+  DeskewToScanEnd(PoseSamplesFrom(init, covered->t_start_ns, covered->t_end_ns), T_imu_lidar,
+                  covered->points, covered->t_end_ns, &p_lidar_end);
+  const std::string start = "the --init pose at " + SecondsText(covered->t_end_ns) + " s";
+  StatusOr<ReferenceAlignment> a =
+      FindStartInReference(p_lidar_end, T_imu_lidar, reference, &T_ref_imu, T_ref_imu.R,
+                           args.options.constraints, args.options.localization, start, origin);
+  if (!a.ok()) return Status::InvalidInput("--map " + args.map + ": " + a.status().message());
+  const double moved_m = TranslationDifference(a->T_ref_imu, T_ref_imu);
+  const double turned_deg = RotationDifferenceDeg(a->T_ref_imu, T_ref_imu);
+  if (moved_m > kInitInMapM || turned_deg > kInitInMapDeg) {
+    char text[256];
+    std::snprintf(text, sizeof(text), ": the scan at %s s fits it %.2f m and %.1f deg away from "
+                  "the --init pose there: --init is not in the map's frame",
+                  SecondsText(covered->t_end_ns).c_str(), moved_m, turned_deg);
+    return Status::InvalidInput("--map " + args.map + text);
+  }
+  return Status::Ok();
+}
+
 // The refinement with its hooks: rounds, checkpoints, the stop flag.
 // *checkpoint_s: wall time of the fingerprint and the checkpoint writes.
 // map_hash: FileContentHash of --map (0 without one).
@@ -371,6 +447,8 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   }
   if (job && static_cast<int64_t>(input.scans.size()) < kRefineJobMinScans)
     return Status::InvalidInput(ShortChunk(*job, input.scans.size()));
+  if (reference != nullptr)
+    if (Status s = CheckMapFits(args, input.init, seen, *reference, origin); !s.ok()) return s;
   Times times;
   times.read_s = SecondsSince(t0);
   StatusOr<RefineResult> refined =

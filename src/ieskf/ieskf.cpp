@@ -143,16 +143,16 @@ Matrix24d ExcitationCovariance(const Matrix24d& P0, const Vector6d& extrinsic_st
 }
 
 // The rotation step of the point-to-plane normal equations alone (columns
-// [dtheta, dp, ...]: the first three), position held; NaN when the rotation
-// is not observable from them.
+// [dtheta, dp, ...]: the first three), position held (rad, IMU frame); NaN
+// when the rotation is not observable from them.
 template <class MatrixC, class VectorC>
-double LidarOnlyRotationDeg(const MatrixC& HtRinvH, const VectorC& HtRinvz) {
+Eigen::Vector3d LidarOnlyRotation(const MatrixC& HtRinvH, const VectorC& HtRinvz) {
+  const Eigen::Vector3d unknown = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   const Eigen::Matrix3d H_rr = HtRinvH.template topLeftCorner<3, 3>();
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(H_rr);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0))
-    return std::numeric_limits<double>::quiet_NaN();
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return unknown;
   const Eigen::Vector3d dtheta = -ldlt.solve(HtRinvz.template head<3>());
-  return dtheta.allFinite() ? dtheta.norm() * 180.0 / M_PI : std::numeric_limits<double>::quiet_NaN();
+  return dtheta.allFinite() ? dtheta : unknown;
 }
 
 // The motion a scan's time offset is observed through (its Jacobian column
@@ -511,7 +511,7 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
     // At x = x0 (e = 0): z^T (H P0 H^T + R)^-1 z = z^T R^-1 z - b^T A^-1 b = z^T R^-1 z + b^T dx.
     if (it == 0) {
       result.nis_per_dof = (zRinvz + b.dot(dx)) / result.num_constraints;
-      result.lidar_rotation_deg = LidarOnlyRotationDeg(HtRinvH, HtRinvz);
+      result.lidar_rotation_imu = LidarOnlyRotation(HtRinvH, HtRinvz);
     }
     // The degeneracy method acts on the increment; the covariance S stays
     // the plain posterior (docs/degeneracy.md).

@@ -33,6 +33,22 @@ std::string DivergenceKindNames(uint8_t mask) {
   return names;
 }
 
+namespace {
+
+// What an inconsistency explained by a clock offset adds to its description.
+std::string ClockExplanation(const DivergenceEvent& e) {
+  char text[384];
+  std::snprintf(text, sizeof(text),
+                "; a LiDAR-IMU clock offset of %+.1f ms explains %.0f %% of the scans' rotation "
+                "against the gyro (the estimate follows the scans, late; not divergence): add "
+                "%.4f s to lidar.time_offset, or run with --set lidar.estimate_time_offset=true "
+                "(`rvlio calibrate-time` checks it)",
+                1e3 * e.clock_offset_s, 100.0 * e.clock_explained, e.clock_offset_s);
+  return text;
+}
+
+}  // namespace
+
 std::string DivergenceEvent::Describe() const {
   char text[256];
   switch (kind) {
@@ -68,12 +84,36 @@ std::string DivergenceEvent::Describe() const {
     case DivergenceKind::kRotation:
       std::snprintf(text, sizeof(text),
                     "the scans turn %.2f deg per scan against the gyro (window mean) > "
-                    "divergence.max_lidar_rotation_deg %g: check the extrinsic rotation, or "
-                    "the LiDAR-IMU time offset (rvlio calibrate-time)",
-                    value, threshold);
+                    "divergence.max_lidar_rotation_deg %g%s",
+                    value, threshold,
+                    !lost     ? ""
+                    : still ? ", while the gyro showed no rotation (where neither the "
+                              "extrinsic rotation nor the clocks show): the scans disagree "
+                              "with the map"
+                              : ", and no LiDAR-IMU clock offset explains it: check the "
+                                "extrinsic rotation");
       break;
   }
-  return text;
+  if (!lost) return text + ClockExplanation(*this);
+  return still && kind != DivergenceKind::kRotation
+             ? text + std::string(", while the gyro showed no rotation")
+             : text;
+}
+
+ClockFit FitClockOffset(const std::deque<RotationSample>& samples) {
+  ClockFit f;
+  f.scans = static_cast<int>(samples.size());
+  double rr = 0.0, rw = 0.0, ww = 0.0;
+  for (const RotationSample& s : samples) {
+    rr += s.lidar_rotation_imu.squaredNorm();
+    rw += s.lidar_rotation_imu.dot(s.rate_change_imu);
+    ww += s.rate_change_imu.squaredNorm();
+  }
+  if (!(ww > 0.0) || !(rr > 0.0)) return f;
+  f.offset_s = rw / ww;
+  // sum |r - tau w|^2 = rr - 2 tau rw + tau^2 ww = rr - rw^2 / ww at the optimum.
+  f.explained = rw * rw / (ww * rr);
+  return f;
 }
 
 double DivergenceMonitor::Window::Mean() const {
@@ -87,8 +127,11 @@ double DivergenceMonitor::Window::Median() const {
 }
 
 DivergenceMonitor::DivergenceMonitor(const DivergenceOptions& options, double lidar_noise_m,
-                                     double gravity_mps2)
-    : options_(options), lidar_noise_m_(lidar_noise_m), gravity_mps2_(gravity_mps2) {}
+                                     double gravity_mps2, double max_clock_offset_s)
+    : options_(options),
+      lidar_noise_m_(lidar_noise_m),
+      gravity_mps2_(gravity_mps2),
+      max_clock_offset_s_(max_clock_offset_s) {}
 
 void DivergenceMonitor::Push(Window* w, double value) const {
   w->values.push_back(value);
@@ -99,17 +142,48 @@ bool DivergenceMonitor::Full(const Window& w) const {
   return static_cast<int>(w.values.size()) >= options_.window_scans;
 }
 
+DivergenceEvent DivergenceMonitor::Judge(DivergenceKind k, TimeNs t_ns, double value,
+                                         double threshold) const {
+  DivergenceEvent e{k, t_ns, value, threshold};
+  e.still = still_.Mean() >= DivergenceReport::kStillShare;
+  if (e.still || (k != DivergenceKind::kNis && k != DivergenceKind::kRotation)) return e;
+  const ClockFit fit = FitClockOffset(rotations_);
+  if (2 * fit.scans < options_.window_scans || !(fit.explained >= options_.min_clock_explained) ||
+      !(std::abs(fit.offset_s) <= max_clock_offset_s_))
+    return e;
+  e.lost = false;
+  e.clock_offset_s = fit.offset_s;
+  e.clock_explained = fit.explained;
+  return e;
+}
+
 void DivergenceMonitor::Trip(DivergenceKind k, TimeNs t_ns, double value, double threshold,
                              uint8_t* mask) {
   const int i = static_cast<int>(k);
-  *mask |= static_cast<uint8_t>(1u << i);
   clear_scans_[i] = 0;
-  if (active_[i]) return;  // the episode goes on: reported at its start only
-  active_[i] = true;
-  ++report_.episodes[i];
-  report_.events.push_back({k, t_ns, value, threshold});
-  if (!report_.detected) report_.first_t_ns = t_ns;
-  report_.detected = true;
+  if (!active_[i]) {  // a new episode, judged at its start; reported once
+    active_[i] = true;
+    const DivergenceEvent e = Judge(k, t_ns, value, threshold);
+    active_lost_[i] = e.lost;
+    report_.events.push_back(e);
+    if (e.lost) {
+      ++report_.episodes[i];
+      if (!report_.detected) report_.first_t_ns = t_ns;
+      report_.detected = true;
+    } else {
+      ++report_.inconsistencies;
+      report_.clock_offset_s = e.clock_offset_s;
+      report_.clock_suspect = true;
+    }
+  }
+  *mask |= static_cast<uint8_t>(1u << i);
+}
+
+// The clock fit's window: scans with a LiDAR-only rotation and a previous scan.
+void DivergenceMonitor::PushRotation(const HealthSample& s) {
+  if (!have_previous_ || !s.health.lidar_rotation_imu.allFinite()) return;
+  rotations_.push_back({s.health.lidar_rotation_imu, s.mean_gyro_imu - previous_.mean_gyro_imu});
+  while (static_cast<int>(rotations_.size()) > options_.window_scans) rotations_.pop_front();
 }
 
 // A kind's episode ends after a window of scans without it.
@@ -133,17 +207,20 @@ void DivergenceMonitor::CountMotionResidual(const HealthSample& s, bool detected
   }
   if (rest_scans_ > 0) report_.residual_at_rest_m = rest_sum_m_ / rest_scans_;
   if (moving_scans_ > 0) report_.residual_moving_m = moving_sum_m_ / moving_scans_;
-  report_.clock_suspect = rest_scans_ >= DivergenceReport::kClockSuspectMinScans &&
-                          moving_scans_ >= DivergenceReport::kClockSuspectMinScans &&
-                          report_.residual_moving_m >
-                              DivergenceReport::kClockSuspectRatio * report_.residual_at_rest_m;
+  residual_clock_suspect_ = rest_scans_ >= DivergenceReport::kClockSuspectMinScans &&
+                            moving_scans_ >= DivergenceReport::kClockSuspectMinScans &&
+                            report_.residual_moving_m >
+                                DivergenceReport::kClockSuspectRatio * report_.residual_at_rest_m;
+  report_.clock_suspect = residual_clock_suspect_ || report_.inconsistencies > 0;
 }
 
 uint8_t DivergenceMonitor::Check(const HealthSample& s) {
   uint8_t mask = 0;
   if (!options_.enabled) return mask;
   CountMotionResidual(s, report_.detected);
+  PushRotation(s);
   const double speed = s.v_world_imu.norm();
+  Push(&still_, s.mean_gyro_imu.norm() < DivergenceReport::kStillRate ? 1.0 : 0.0);
   if (!std::isfinite(speed) || speed > options_.max_speed)
     Trip(DivergenceKind::kSpeed, s.t_ns, speed, options_.max_speed, &mask);
   if (have_previous_ && s.t_ns > previous_.t_ns) {
@@ -180,13 +257,15 @@ uint8_t DivergenceMonitor::Check(const HealthSample& s) {
         std::abs(mean / gravity_mps2_ - 1.0) > options_.max_gravity_error)
       Trip(DivergenceKind::kGravity, s.t_ns, mean, gravity_mps2_, &mask);
   }
-  if (std::isfinite(s.health.lidar_rotation_deg)) {
-    Push(&lidar_rotation_, s.health.lidar_rotation_deg);
+  if (s.health.lidar_rotation_imu.allFinite()) {
+    Push(&lidar_rotation_, s.health.lidar_rotation_imu.norm() * 180.0 / M_PI);
     const double mean = lidar_rotation_.Mean();
     if (Full(lidar_rotation_) && mean > options_.max_lidar_rotation_deg)
       Trip(DivergenceKind::kRotation, s.t_ns, mean, options_.max_lidar_rotation_deg, &mask);
   }
   EndEpisodes(mask);
+  for (int i = 0; i < kNumDivergenceKinds; ++i)  // the kinds tripped as divergence
+    if (!active_lost_[i]) mask &= static_cast<uint8_t>(~(1u << i));
   if (mask != 0) ++report_.scans_flagged;
   previous_ = s;
   have_previous_ = true;

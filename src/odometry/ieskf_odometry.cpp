@@ -147,7 +147,8 @@ IeskfPipeline::IeskfPipeline(const OdometryOptions& options, Localization locali
       output_map_(options.map.output_resolution),
       preprocessor_(options.lidar),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
-      monitor_(MonitorOptions(options), options.constraints.lidar_noise, options.imu.gravity),
+      monitor_(MonitorOptions(options), options.constraints.lidar_noise, options.imu.gravity,
+               options.lidar.time_offset_max),
       initializer_(options.imu.init_duration),
       localizer_(std::move(localization), options.localization, options.constraints) {}
 
@@ -226,7 +227,7 @@ void IeskfPipeline::ProcessFrontScan(std::vector<ScanResult>* out) {
   if (!shifted) return;
   applied_shift_ns_ = shift_ns;
   Scan& scan = *shifted;
-  const Eigen::Vector3d mean_acc_imu = Predict(scan.t_end_ns);
+  const ImuSample mean_imu = Predict(scan.t_end_ns);
   preprocessor_.Downsample(scan, &downsampled_);
   if (static_cast<int>(downsampled_.points.size()) < kMinScanPoints) {
     ++stats_.scans_too_few_points;
@@ -239,7 +240,8 @@ void IeskfPipeline::ProcessFrontScan(std::vector<ScanResult>* out) {
   ScanResult r;
   r.degeneracy.method = options_.degeneracy.method;
   r.raw_points = static_cast<int>(scan.points.size());
-  r.mean_acc_imu = mean_acc_imu;
+  r.mean_acc_imu = mean_imu.acc_imu;
+  r.mean_gyro_imu = mean_imu.gyro_imu;
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
   r.status = map_.Empty() && !localizer_.enabled() ? ScanStatus::kMapInit : Correct(&r);
   InsertIntoMap(scan.t_end_ns, ProvisionalInMap(scan.t_end_ns));
@@ -257,17 +259,23 @@ void IeskfPipeline::ProcessFrontScan(std::vector<ScanResult>* out) {
 
 // Propagates with every buffered IMU sample up to the scan end, then to the
 // scan end itself.
-Eigen::Vector3d IeskfPipeline::Predict(TimeNs t_end_ns) {
-  Eigen::Vector3d acc_sum = Eigen::Vector3d::Zero();
+ImuSample IeskfPipeline::Predict(TimeNs t_end_ns) {
+  ImuSample mean;
+  mean.t_ns = t_end_ns;
   int n = 0;
   while (!imu_buffer_.empty() && imu_buffer_.front().t_ns <= t_end_ns) {
     filter_.Propagate(imu_buffer_.front());
-    acc_sum += imu_buffer_.front().acc_imu;
+    mean.acc_imu += imu_buffer_.front().acc_imu;
+    mean.gyro_imu += imu_buffer_.front().gyro_imu;
     ++n;
     imu_buffer_.pop_front();
   }
   filter_.PropagateTo(t_end_ns);
-  return n > 0 ? Eigen::Vector3d(acc_sum / n) : Eigen::Vector3d::Zero();
+  if (n > 0) {
+    mean.acc_imu /= n;
+    mean.gyro_imu /= n;
+  }
+  return mean;
 }
 
 // Associate -> RV -> Update, iterated inside the filter (paper Alg. 3).
@@ -295,7 +303,7 @@ ScanStatus IeskfPipeline::Correct(ScanResult* r) {
   r->rv = u.rv;
   r->degeneracy = u.degeneracy;
   r->health.nis_per_dof = u.nis_per_dof;
-  r->health.lidar_rotation_deg = u.lidar_rotation_deg;
+  r->health.lidar_rotation_imu = u.lidar_rotation_imu;
   if (u.ok) {
     r->health.residual_median_m = u.residuals.median_abs_m;
     r->health.residual_rms_m = u.residuals.rms_m;

@@ -27,6 +27,7 @@ HealthSample HealthSampleOf(const ScanResult& r) {
   s.points = r.downsampled_points;
   s.constraints = r.constraints;
   if (r.mean_acc_imu.squaredNorm() > 0.0) s.specific_force_mps2 = r.mean_acc_imu.norm();
+  s.mean_gyro_imu = r.mean_gyro_imu;
   s.health = r.health;
   return s;
 }

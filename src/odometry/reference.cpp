@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <tuple>
 #include <unordered_set>
 
@@ -118,6 +120,21 @@ std::vector<Eigen::Vector3d> FreeCellsNearSurfaces(
   return centres;
 }
 
+// Candidate positions near an initial position: a horizontal lattice of
+// half the search step (finer than the alignment's reach of about a metre)
+// within start_check_radius, at the initial height.
+std::vector<Eigen::Vector3d> PositionsAround(const Eigen::Vector3d& p,
+                                             const LocalizationOptions& options) {
+  const double step_m = 0.5 * options.search_step;
+  const int n = static_cast<int>(std::floor(options.start_check_radius / step_m));
+  std::vector<Eigen::Vector3d> positions;
+  for (int i = -n; i <= n; ++i)
+    for (int j = -n; j <= n; ++j)
+      if (std::hypot(i * step_m, j * step_m) <= options.start_check_radius)
+        positions.push_back(p + Eigen::Vector3d(i * step_m, j * step_m, 0.0));
+  return positions;
+}
+
 // Every n-th point, about `count` in all.
 std::vector<Eigen::Vector3d> Subsample(const std::vector<Eigen::Vector3d>& p, size_t count) {
   const size_t stride = std::max<size_t>(1, p.size() / std::max<size_t>(1, count));
@@ -126,18 +143,35 @@ std::vector<Eigen::Vector3d> Subsample(const std::vector<Eigen::Vector3d>& p, si
   return out;
 }
 
+// Two places, not one: more than 1 m or 10 degrees apart.
+bool DistinctPoses(const Pose3& a, const Pose3& b) {
+  constexpr double kDistinctM = 1.0, kDistinctRad = 10.0 * M_PI / 180.0;
+  return (a.t - b.t).norm() > kDistinctM || so3::Log(a.R.transpose() * b.R).norm() > kDistinctRad;
+}
+
+// Best fit first.
+void SortByFit(std::vector<ReferenceAlignment>* candidates) {
+  std::stable_sort(candidates->begin(), candidates->end(),
+                   [](const ReferenceAlignment& a, const ReferenceAlignment& b) {
+                     return a.fit > b.fit;
+                   });
+}
+
 }  // namespace
 
 std::vector<ReferenceAlignment> SearchReference(const std::vector<Eigen::Vector3d>& p_lidar,
                                                 const Pose3& T_imu_lidar,
                                                 const VoxelMap& reference,
-                                                const Eigen::Matrix3d& R_tilt,
+                                                const Eigen::Matrix3d& R_start,
                                                 const ConstraintOptions& constraints,
-                                                const LocalizationOptions& options) {
+                                                const LocalizationOptions& options,
+                                                const Eigen::Vector3d* around) {
   constexpr size_t kScorePoints = 256;
   const std::vector<Eigen::Vector3d> sample = Subsample(p_lidar, kScorePoints);
   const std::vector<Eigen::Vector3d> positions =
-      FreeCellsNearSurfaces(OccupiedCells(reference, options.search_step), options.search_step);
+      around != nullptr ? PositionsAround(*around, options)
+                        : FreeCellsNearSurfaces(OccupiedCells(reference, options.search_step),
+                                                options.search_step);
   const int yaws = std::max(1, static_cast<int>(std::lround(360.0 / options.search_yaw_step)));
   std::vector<std::pair<double, Pose3>> scored;
   scored.reserve(positions.size() * yaws);
@@ -146,21 +180,23 @@ std::vector<ReferenceAlignment> SearchReference(const std::vector<Eigen::Vector3
     for (int i = 0; i < yaws; ++i) {
       const Eigen::Matrix3d R =
           Eigen::AngleAxisd(2.0 * M_PI * i / yaws, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-          R_tilt;
+          R_start;
       const Pose3 T(R, p);
       scored.emplace_back(OverlapWith(sample, T, T_imu_lidar, reference, stage), T);
     }
-  const size_t keep = std::min(scored.size(), static_cast<size_t>(options.search_keep));
-  std::partial_sort(scored.begin(), scored.begin() + keep, scored.end(),
-                    [](const auto& a, const auto& b) { return a.first > b.first; });
+  // The best scored poses, one per place: a pose within the alignment's reach
+  // of a better one kept (DistinctPoses) would align to the same place.
+  std::stable_sort(scored.begin(), scored.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<Pose3> kept;
+  for (size_t i = 0; i < scored.size() && static_cast<int>(kept.size()) < options.search_keep; ++i)
+    if (std::all_of(kept.begin(), kept.end(),
+                    [&](const Pose3& k) { return DistinctPoses(k, scored[i].second); }))
+      kept.push_back(scored[i].second);
   std::vector<ReferenceAlignment> aligned;
-  for (size_t i = 0; i < keep; ++i)
-    aligned.push_back(
-        AlignToReference(p_lidar, T_imu_lidar, reference, scored[i].second, constraints, options));
-  std::stable_sort(aligned.begin(), aligned.end(),
-                   [](const ReferenceAlignment& a, const ReferenceAlignment& b) {
-                     return a.overlap > b.overlap;
-                   });
+  for (const Pose3& T : kept)
+    aligned.push_back(AlignToReference(p_lidar, T_imu_lidar, reference, T, constraints, options));
+  SortByFit(&aligned);
   return aligned;
 }
 
@@ -203,7 +239,139 @@ ReferenceAlignment AlignToReference(const std::vector<Eigen::Vector3d>& p_lidar,
   WeakestAxis(a.information, constraints.lidar_noise, &a);
   a.constraints = static_cast<int>(list.size());
   a.overlap = ReferenceOverlap(p_lidar, a.T_ref_imu, T_imu_lidar, reference, constraints);
+  ConstraintOptions tight = constraints;
+  tight.max_residual = std::min(constraints.max_residual, kStartFitNoises * constraints.lidar_noise);
+  a.fit = ReferenceOverlap(p_lidar, a.T_ref_imu, T_imu_lidar, reference, tight);
   return a;
+}
+
+namespace {
+
+std::string Vec(const Eigen::Vector3d& v, int digits) {
+  char text[96];
+  std::snprintf(text, sizeof(text), "(%.*f, %.*f, %.*f)", digits, v.x(), digits, v.y(), digits,
+                v.z());
+  return text;
+}
+
+// "(x, y, z) yaw Y deg, N % of the points on their planes", the position in
+// the map's frame as the user gave it.
+std::string Describe(const ReferenceAlignment& a, const LocalOrigin& origin) {
+  const Eigen::Vector3d x = a.T_ref_imu.R.col(0);
+  char text[96];
+  std::snprintf(text, sizeof(text), " yaw %.0f deg, %.0f %% of the points on their planes",
+                std::atan2(x.y(), x.x()) * 180.0 / M_PI, 100.0 * a.fit);
+  return Vec(origin.ToUser(a.T_ref_imu.t), 2) + text;
+}
+
+bool Distinct(const ReferenceAlignment& a, const ReferenceAlignment& b) {
+  return DistinctPoses(a.T_ref_imu, b.T_ref_imu);
+}
+
+// A candidate distinct from `start` whose fit is within search_ambiguity of
+// it or better, the best first (candidates sorted by fit), or null.
+const ReferenceAlignment* RivalOf(const ReferenceAlignment& start,
+                                  const std::vector<ReferenceAlignment>& candidates,
+                                  double ambiguity) {
+  for (const ReferenceAlignment& c : candidates) {
+    if (c.fit < start.fit - ambiguity) break;
+    if (Distinct(c, start)) return &c;
+  }
+  return nullptr;
+}
+
+std::string Percent(double share) {
+  return std::to_string(static_cast<int>(std::lround(100.0 * share))) + " %";
+}
+
+Status TooLittleOverlap(const ReferenceAlignment& a, const LocalizationOptions& options,
+                        const std::string& start_name) {
+  return Status::InvalidInput(
+      "the first scan does not match the reference map at " + start_name + " (" +
+      Percent(a.overlap) + " of its points on reference planes after alignment, "
+      "localization.min_start_overlap " + std::to_string(options.min_start_overlap) +
+      "): check " + start_name + " and that the map is in the same frame and in metres");
+}
+
+Status Unfixed(const ReferenceAlignment& a, const LocalizationOptions& options, bool guided,
+               const std::string& start_name) {
+  char text[160];
+  std::snprintf(text, sizeof(text), " (as %.1f constraints along it, "
+                "localization.min_start_axis_constraints %g): featureless there",
+                a.weakest_axis_constraints, options.min_start_axis_constraints);
+  return Status::InvalidInput(
+      "the first scan does not fix the start along " + Vec(a.weakest_axis, 2) +
+      " in the reference" + text +
+      (guided ? ", so " + start_name + " cannot be checked along it; start where the map has "
+                "features, or set localization.trust_initial_pose=true"
+              : "; give " + start_name));
+}
+
+// The map: even the best place fits the scan as no scan of the place fits
+// its map.
+Status MapDoesNotFit(const ReferenceAlignment& best, const LocalizationOptions& options,
+                     bool guided, const std::string& start_name, const LocalOrigin& origin) {
+  return Status::InvalidInput(
+      "the first scan fits the reference map " +
+      (guided ? "nowhere near " + start_name : std::string("nowhere the global search looked")) +
+      " as a scan of the mapped place would: at best " + Percent(best.Consistency()) +
+      " of its matched points lie on their reference planes (at " + Vec(origin.ToUser(best.T_ref_imu.t), 2) +
+      "), localization.min_start_fit " + Percent(options.min_start_fit) +
+      ": check that the map is of this place" +
+      (guided ? " (and " + start_name + ")" : ", or give " + start_name));
+}
+
+}  // namespace
+
+StatusOr<ReferenceAlignment> FindStartInReference(const std::vector<Eigen::Vector3d>& p_lidar,
+                                                  const Pose3& T_imu_lidar,
+                                                  const VoxelMap& reference,
+                                                  const Pose3* T_ref_imu_guess,
+                                                  const Eigen::Matrix3d& R_tilt,
+                                                  const ConstraintOptions& constraints,
+                                                  const LocalizationOptions& options,
+                                                  const std::string& start_name,
+                                                  const LocalOrigin& origin) {
+  const bool guided = T_ref_imu_guess != nullptr;
+  std::vector<ReferenceAlignment> candidates;
+  if (!guided || (!options.trust_initial_pose && options.start_check_radius > 0.0))
+    candidates = SearchReference(p_lidar, T_imu_lidar, reference,
+                                 guided ? T_ref_imu_guess->R : R_tilt, constraints, options,
+                                 guided ? &T_ref_imu_guess->t : nullptr);
+  if (!guided && (candidates.empty() || !(candidates.front().overlap >= options.min_start_overlap)))
+    return Status::InvalidInput(
+        "no place in the reference map matches the first scan (global search); check that the "
+        "map is in metres and covers the start, or give " + start_name);
+  const ReferenceAlignment start =
+      guided ? AlignToReference(p_lidar, T_imu_lidar, reference, *T_ref_imu_guess, constraints,
+                                options)
+             : candidates.front();
+  if (!(start.overlap >= options.min_start_overlap))
+    return TooLittleOverlap(start, options, start_name);
+  if (start.weakest_axis_constraints < options.min_start_axis_constraints &&
+      !(guided && options.trust_initial_pose))
+    return Unfixed(start, options, guided, start_name);
+  candidates.push_back(start);
+  SortByFit(&candidates);
+  const ReferenceAlignment& best = candidates.front();
+  if (!(best.Consistency() >= options.min_start_fit))
+    return MapDoesNotFit(best, options, guided, start_name, origin);
+  const ReferenceAlignment* rival = RivalOf(start, candidates, options.search_ambiguity);
+  if (rival == nullptr) return start;
+  if (!guided)
+    return Status::InvalidInput("the first scan matches the reference map equally well at " +
+                                Describe(start, origin) + " and at " + Describe(*rival, origin) +
+                                " (global search): give " + start_name);
+  if (rival->fit > start.fit + options.search_ambiguity)
+    return Status::InvalidInput(
+        "the first scan fits the reference map better at " + Describe(*rival, origin) +
+        " than at " + start_name + " (aligned to " + Describe(start, origin) + "): " + start_name +
+        " is wrong there");
+  return Status::InvalidInput(
+      "the first scan fits the reference map as well at " + Describe(*rival, origin) + " as at " +
+      start_name + " (aligned to " + Describe(start, origin) + "), within localization.search_ambiguity " +
+      std::to_string(options.search_ambiguity) + ": the start is ambiguous there; start where "
+      "the map has features, or set localization.trust_initial_pose=true");
 }
 
 }  // namespace rvlio

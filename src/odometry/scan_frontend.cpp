@@ -89,98 +89,27 @@ ReferenceLocalizer::ReferenceLocalizer(Localization localization,
                                        const ConstraintOptions& constraints)
     : localization_(std::move(localization)), options_(options), constraints_(constraints) {}
 
-namespace {
-
-std::string Vec(const Eigen::Vector3d& v, int digits) {
-  char text[96];
-  std::snprintf(text, sizeof(text), "(%.*f, %.*f, %.*f)", digits, v.x(), digits, v.y(), digits,
-                v.z());
-  return text;
-}
-
-// Another candidate as good as the best (within search_ambiguity of its
-// overlap) but elsewhere (more than 1 m or 10 degrees away), or null.
-const ReferenceAlignment* RivalOf(const std::vector<ReferenceAlignment>& candidates,
-                                  double ambiguity) {
-  constexpr double kDistinctM = 1.0, kDistinctRad = 10.0 * M_PI / 180.0;
-  const ReferenceAlignment& best = candidates.front();
-  for (size_t i = 1; i < candidates.size(); ++i) {
-    const ReferenceAlignment& c = candidates[i];
-    if (c.overlap < best.overlap - ambiguity) break;  // sorted by overlap
-    if ((c.T_ref_imu.t - best.T_ref_imu.t).norm() > kDistinctM ||
-        so3::Log(c.T_ref_imu.R.transpose() * best.T_ref_imu.R).norm() > kDistinctRad)
-      return &c;
-  }
-  return nullptr;
-}
-
-}  // namespace
-
-// From the initial pose (interpolated at t_ns when there are several).
-StatusOr<ReferenceAlignment> ReferenceLocalizer::AlignFromInitialPose(
-    TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_imu_lidar) const {
-  const Trajectory& initial = localization_.initial_poses;
-  Pose3 T_ref_imu_guess(initial.front().q_world_imu, initial.front().p_world_imu);
-  if (initial.size() > 1 && !InterpolatePose(initial, t_ns, &T_ref_imu_guess)) {
-    char text[160];
-    std::snprintf(text, sizeof(text), "the initial poses (%.3f to %.3f s) do not cover the first "
-                  "scan's time %.3f s", NsToSeconds(initial.front().t_ns),
-                  NsToSeconds(initial.back().t_ns), NsToSeconds(t_ns));
-    return Status::InvalidInput(text);
-  }
-  const ReferenceAlignment a = AlignToReference(p_lidar, T_imu_lidar, *localization_.reference,
-                                                T_ref_imu_guess, constraints_, options_);
-  if (!(a.overlap >= options_.min_start_overlap))
-    return Status::InvalidInput(
-        "the first scan does not match the reference map at the initial pose (" +
-        std::to_string(static_cast<int>(std::lround(100.0 * a.overlap))) +
-        " % of its points on reference planes after alignment, localization.min_start_overlap " +
-        std::to_string(options_.min_start_overlap) +
-        "): check --initial-pose and that the map is in the same frame and in metres");
-  return a;
-}
-
-// Without an initial pose: the global search, refused when nothing matches
-// or when two distinct places match as well.
-StatusOr<ReferenceAlignment> ReferenceLocalizer::SearchStart(
-    const std::vector<Eigen::Vector3d>& p_lidar, const Pose3& T_world_imu,
-    const Pose3& T_imu_lidar) const {
-  const std::vector<ReferenceAlignment> candidates = SearchReference(
-      p_lidar, T_imu_lidar, *localization_.reference, T_world_imu.R, constraints_, options_);
-  if (candidates.empty() || !(candidates.front().overlap >= options_.min_start_overlap))
-    return Status::InvalidInput(
-        "no place in the reference map matches the first scan (global search); check that the "
-        "map is in metres and covers the start, or give --initial-pose");
-  // Positions in the message are in the map's frame, as the user gave it.
-  const LocalOrigin& origin = localization_.origin;
-  if (const ReferenceAlignment* rival = RivalOf(candidates, options_.search_ambiguity))
-    return Status::InvalidInput(
-        "the first scan matches the reference map equally well at " +
-        Vec(origin.ToUser(candidates.front().T_ref_imu.t), 2) + " and at " +
-        Vec(origin.ToUser(rival->T_ref_imu.t), 2) +
-        " (global search): give --initial-pose");
-  return candidates.front();
-}
-
+// From the initial pose (interpolated at t_ns when there are several), or by
+// the global search without one; judged by FindStartInReference.
 StatusOr<Pose3> ReferenceLocalizer::Start(TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_lidar,
                                           const Pose3& T_world_imu, const Pose3& T_imu_lidar) {
-  const bool guided = !localization_.initial_poses.empty();
-  StatusOr<ReferenceAlignment> a = guided ? AlignFromInitialPose(t_ns, p_lidar, T_imu_lidar)
-                                          : SearchStart(p_lidar, T_world_imu, T_imu_lidar);
-  if (!a.ok()) return a.status();
-  if (a->weakest_axis_constraints < options_.min_start_axis_constraints &&
-      !(guided && options_.trust_initial_pose)) {
-    char text[160];
-    std::snprintf(text, sizeof(text), " (as %.1f constraints along it, "
-                  "localization.min_start_axis_constraints %g): featureless there",
-                  a->weakest_axis_constraints, options_.min_start_axis_constraints);
-    return Status::InvalidInput(
-        "the first scan does not fix the start along " + Vec(a->weakest_axis, 2) +
-        " in the reference" + text +
-        (guided ? ", so --initial-pose cannot be checked along it; start where the map has "
-                  "features, or set localization.trust_initial_pose=true"
-                : "; give --initial-pose"));
+  const Trajectory& initial = localization_.initial_poses;
+  std::optional<Pose3> guess;
+  if (!initial.empty()) {
+    guess = Pose3(initial.front().q_world_imu, initial.front().p_world_imu);
+    if (initial.size() > 1 && !InterpolatePose(initial, t_ns, &*guess)) {
+      char text[160];
+      std::snprintf(text, sizeof(text), "the initial poses (%.3f to %.3f s) do not cover the "
+                    "first scan's time %.3f s", NsToSeconds(initial.front().t_ns),
+                    NsToSeconds(initial.back().t_ns), NsToSeconds(t_ns));
+      return Status::InvalidInput(text);
+    }
   }
+  StatusOr<ReferenceAlignment> a =
+      FindStartInReference(p_lidar, T_imu_lidar, *localization_.reference,
+                           guess ? &*guess : nullptr, T_world_imu.R, constraints_, options_,
+                           "--initial-pose");
+  if (!a.ok()) return a.status();
   started_ = true;
   start_overlap_ = a->overlap;
   return a->T_ref_imu * T_world_imu.Inverse();

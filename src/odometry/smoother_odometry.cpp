@@ -32,15 +32,23 @@ ScanTimeMotion MotionAtEnd(const ImuPoseHistory& history) {
   return m;
 }
 
-Eigen::Vector3d MeanAcc(const std::vector<ImuSample>& samples, TimeNs t0_ns, TimeNs t1_ns) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+// The mean specific force and rate of the samples in (t0_ns, t1_ns] (zero
+// without samples).
+ImuSample MeanImu(const std::vector<ImuSample>& samples, TimeNs t0_ns, TimeNs t1_ns) {
+  ImuSample mean;
+  mean.t_ns = t1_ns;
   int n = 0;
   for (const ImuSample& s : samples) {
     if (s.t_ns <= t0_ns || s.t_ns > t1_ns) continue;
-    sum += s.acc_imu;
+    mean.acc_imu += s.acc_imu;
+    mean.gyro_imu += s.gyro_imu;
     ++n;
   }
-  return n > 0 ? Eigen::Vector3d(sum / n) : Eigen::Vector3d::Zero();
+  if (n > 0) {
+    mean.acc_imu /= n;
+    mean.gyro_imu /= n;
+  }
+  return mean;
 }
 
 }  // namespace
@@ -53,7 +61,8 @@ SmootherOdometry::SmootherOdometry(const OdometryOptions& options, Localization 
       preprocessor_(options.lidar),
       initializer_(options.imu.init_duration),
       T_imu_lidar_(ImuTLidar(options.extrinsics)),
-      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity),
+      monitor_(options.divergence, options.constraints.lidar_noise, options.imu.gravity,
+               options.lidar.time_offset_max),
       localizer_(std::move(localization), options.localization, options.constraints) {}
 
 void SmootherOdometry::AddImu(const ImuSample& imu) {
@@ -132,7 +141,9 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.degeneracy.method = options_.degeneracy.method;
   r.raw_points = static_cast<int>(scan.points.size());
   r.downsampled_points = static_cast<int>(p_lidar_end_.size());
-  r.mean_acc_imu = MeanAcc(samples, newest_.t_ns, scan.t_end_ns);
+  const ImuSample mean_imu = MeanImu(samples, newest_.t_ns, scan.t_end_ns);
+  r.mean_acc_imu = mean_imu.acc_imu;
+  r.mean_gyro_imu = mean_imu.gyro_imu;
   ImuKinematics predicted = history.Newest();
   if (localizer_.enabled() && !localizer_.started() && !StartInReference(&predicted)) return;
   r.status = window_->empty() ? StartWindow(scan.t_end_ns, predicted)

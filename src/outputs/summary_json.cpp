@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include "rvlio/common/text.h"
@@ -70,21 +71,34 @@ nlohmann::json DivergenceJson(const DivergenceReport& r) {
   nlohmann::json events = nlohmann::json::object();
   for (int k = 0; k < kNumDivergenceKinds; ++k)
     events[DivergenceKindName(static_cast<DivergenceKind>(k))] = r.episodes[k];
-  nlohmann::json episodes = nlohmann::json::array();
-  for (const DivergenceEvent& e : r.events)
-    episodes.push_back({{"kind", DivergenceKindName(e.kind)},
-                        {"time_s", NsToSeconds(e.t_ns)},
-                        {"value", e.value},
-                        {"threshold", e.threshold}});
+  // Divergence episodes, and the inconsistencies a clock offset explains.
+  nlohmann::json episodes = nlohmann::json::array(), inconsistencies = nlohmann::json::array();
+  for (const DivergenceEvent& e : r.events) {
+    nlohmann::json one = {{"kind", DivergenceKindName(e.kind)},
+                          {"time_s", NsToSeconds(e.t_ns)},
+                          {"value", e.value},
+                          {"threshold", e.threshold},
+                          {"still", e.still}};
+    if (e.lost) {
+      episodes.push_back(one);
+      continue;
+    }
+    one["clock_offset_s"] = e.clock_offset_s;
+    one["clock_explained"] = e.clock_explained;
+    inconsistencies.push_back(one);
+  }
   nlohmann::json j = {
       {"detected", r.detected},
       {"first_time_s", r.detected ? nlohmann::json(NsToSeconds(r.first_t_ns)) : nlohmann::json()},
       {"scans_flagged", r.scans_flagged},
       {"events", events},
-      {"episodes", episodes}};
-  // Residuals grown with the motion before the divergence: unsynchronized
-  // clocks (or wrong extrinsics) are the likely cause (`rvlio calibrate-time`).
-  if (r.detected) j["clock_suspect"] = r.clock_suspect;
+      {"episodes", episodes},
+      {"inconsistencies", inconsistencies}};
+  // Residuals grown with the motion before the divergence, or an
+  // inconsistency a clock offset explains: unsynchronized clocks are the
+  // likely cause (`rvlio calibrate-time`).
+  if (r.detected || r.inconsistencies > 0) j["clock_suspect"] = r.clock_suspect;
+  if (std::isfinite(r.clock_offset_s)) j["clock_offset_s"] = r.clock_offset_s;
   return j;
 }
 

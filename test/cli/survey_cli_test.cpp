@@ -160,5 +160,93 @@ TEST_F(SurveyBadInput, MalformedOrMissingInitialPose) {
   ExpectRefused(Pose(), "--map");
 }
 
+// The start judged from the static scans (docs/survey.md "Ambiguous starts
+// are refused"): a 6 s tunnel flight (3 s at rest) and its survey, and the
+// survey of another world (the hall). Runs of --duration 2.9 hold the static
+// scans only.
+class SurveyStartCheck : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = testing_cli::MakeTempDir("rvlio_startcheck");
+    ASSERT_FALSE(dir_.empty());
+    ToolRun sim = testing_cli::CachedSimulate(
+        "--preset tunnel --seed 1 --duration 6 --set lidar.columns=512 --reference-map"
+        " --set survey.x_min=-10 --set survey.x_max=30",
+        dir_ + "/sim", dir_);
+    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+    sim = testing_cli::CachedSimulate("--preset hall --seed 1 --duration 1 --reference-map-only"
+                                      " --set survey.x_min=-10 --set survey.x_max=30",
+                                      dir_ + "/hall", dir_);
+    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+  static std::string Survey() { return dir_ + "/sim/reference_map.pcd"; }
+  static std::string Hall() { return dir_ + "/hall/reference_map.pcd"; }
+  static std::string Truth() { return dir_ + "/sim/tunnel_gt.tum"; }
+  static ToolRun Run(const std::string& out, const std::string& args) {
+    return RunTool("run --quiet --bag " + dir_ + "/sim/tunnel.bag --config " + dir_ +
+                       "/sim/tunnel.yaml --out " + out + " " + args,
+                   dir_);
+  }
+  static void ExpectRefused(const std::string& args, const std::string& named,
+                            const std::string& reason) {
+    const std::string out = dir_ + "/refused";
+    const ToolRun r = Run(out, "--duration 2.9 " + args);
+    testing_cli::ExpectOneErrorLine(r, "run", named);
+    EXPECT_NE(r.err.find(reason), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << args;
+  }
+  static inline std::string dir_;
+};
+
+TEST_F(SurveyStartCheck, WrongStartOrMapIsRefusedFromTheStaticScans) {
+  ASSERT_EQ(Run(dir_ + "/true", "--duration 2.9 --map " + Survey() + " --initial-pose-tum " +
+                                    Truth()).exit_code, 0);
+  // 2 m along the tunnel, or turned round: the scan fits better at the truth.
+  ExpectRefused("--map " + Survey() + " --initial-pose 2,0,0,0,0,0", "--initial-pose",
+                "fits the reference map better at (0.00, ");
+  ExpectRefused("--map " + Survey() + " --initial-pose 0,0,0,0,0,180", "--initial-pose",
+                "fits the reference map better at (0.00, ");
+  // Another world's survey: nowhere as a scan of the mapped place fits it.
+  ExpectRefused("--map " + Hall() + " --initial-pose-tum " + Truth(), Hall(),
+                "check that the map is of this place");
+}
+
+// A start that is let through (trusted, and a looser fit) diverges while
+// the platform is still at rest: the message names the start and the map,
+// not the extrinsic or the clocks.
+TEST_F(SurveyStartCheck, DivergenceAtRestNamesTheStartAndTheMap) {
+  const ToolRun r = Run(dir_ + "/trusted", "--map " + Survey() +
+                                                " --initial-pose 2,0,0,0,0,0"
+                                                " --set localization.trust_initial_pose=true"
+                                                " --set localization.min_start_fit=0.8");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  const std::string last = r.err.substr(r.err.rfind("rvlio run: error:"));
+  EXPECT_NE(last.find("the start pose (--initial-pose) or the map (--map) is wrong"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("check the extrinsic rotation"), std::string::npos) << r.err;
+}
+
+// refine --map checks the map as run --map does: another world's map and a
+// map 1000 m away are refused (exit 2, one line naming --map, nothing written).
+TEST_F(SurveyStartCheck, RefineRefusesAMapThatDoesNotFit) {
+  const std::string run = dir_ + "/run";
+  ASSERT_EQ(Run(run, "--map " + Survey() + " --initial-pose-tum " + Truth()).exit_code, 0);
+  StatusOr<std::vector<Eigen::Vector3d>> points = ReadMapPcd(Survey());
+  ASSERT_TRUE(points.ok());
+  for (Eigen::Vector3d& p : *points) p.x() += 1000.0;
+  const std::string far = dir_ + "/far.pcd";
+  ASSERT_TRUE(WriteMapPcd(far, *points).ok());
+  for (const std::string& map : {Hall(), far}) {
+    const std::string out = dir_ + "/refined";
+    const ToolRun r = RunTool("refine --bag " + dir_ + "/sim/tunnel.bag --config " + dir_ +
+                                  "/sim/tunnel.yaml --init " + run + "/trajectory.tum --map " +
+                                  map + " --out " + out,
+                              dir_);
+    testing_cli::ExpectOneErrorLine(r, "refine", "--map " + map);
+    EXPECT_FALSE(std::filesystem::exists(out)) << map;
+  }
+}
+
 }  // namespace
 }  // namespace rvlio

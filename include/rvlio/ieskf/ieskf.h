@@ -44,12 +44,14 @@ struct IeskfUpdateResult {
   // Normalized innovation squared of the first iteration's constraints at the
   // prediction, z^T (H P H^T + R)^-1 z / n (Woodbury form); NaN if no iteration.
   double nis_per_dof = std::numeric_limits<double>::quiet_NaN();
-  // The rotation (deg) the first iteration's constraints alone ask of the
-  // prediction: one Gauss-Newton step in the rotation, position held, no
-  // prior. Small when the gyro and the LiDAR agree; a wrong extrinsic
-  // rotation (an upside-down mount) makes every turn of the platform look
-  // turned the other way to the LiDAR. NaN if no iteration.
-  double lidar_rotation_deg = std::numeric_limits<double>::quiet_NaN();
+  // The rotation (rad, IMU frame: R_world_imu * Exp(it)) the first
+  // iteration's constraints alone ask of the prediction: one Gauss-Newton
+  // step in the rotation, position held, no prior. Small when the gyro and
+  // the LiDAR agree; a wrong extrinsic rotation (an upside-down mount) makes
+  // every turn of the platform look turned the other way to the LiDAR, a
+  // clock offset tau makes it about tau times the change of the rotation rate
+  // (odometry/divergence.h). NaN if no iteration.
+  Eigen::Vector3d lidar_rotation_imu = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   ResidualStats residuals;    // last iteration's constraints at the updated state (ok only)
 };
 

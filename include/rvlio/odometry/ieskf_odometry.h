@@ -46,8 +46,9 @@ class IeskfPipeline {
  private:
   void TryInitialize(const ImuSample& imu);
   void ProcessFrontScan(std::vector<ScanResult>* out);
-  // Returns the mean specific force of the samples used (IMU frame).
-  Eigen::Vector3d Predict(TimeNs t_end_ns);
+  // Returns the mean of the samples used (specific force and rate, IMU
+  // frame; zero without samples).
+  ImuSample Predict(TimeNs t_end_ns);
   ScanStatus Correct(ScanResult* r);
   // Reference map: moves the state into the reference frame at the first scan.
   bool StartInReference();

@@ -44,6 +44,7 @@ struct ScanResult {
   DegeneracyReport degeneracy;  // the same fields for every degeneracy.method
   double ms = 0.0;  // processing time of this scan: CPU time of the calling thread
   Eigen::Vector3d mean_acc_imu = Eigen::Vector3d::Zero();  // mean specific force over the scan, m/s^2
+  Eigen::Vector3d mean_gyro_imu = Eigen::Vector3d::Zero();  // mean rotation rate over the scan, rad/s
   ScanHealth health;  // what the divergence monitor read, and what it flagged
   // The backend's LiDAR-IMU extrinsic after this scan; set only while it is
   // estimated online (ieskf/smoother.estimate_extrinsics), to follow its convergence.

@@ -53,7 +53,9 @@ struct LocalizationOptions {
   double search_step = 2.0;         // m, position grid of the global search (no initial pose)
   double search_yaw_step = 15.0;    // deg, yaw step of the global search
   int search_keep = 20;             // best grid candidates aligned in full
-  double search_ambiguity = 0.03;   // a distinct candidate within this overlap of the best: ambiguous
+  double search_ambiguity = 0.03;   // a distinct candidate within this fit of the best: ambiguous
+  double start_check_radius = 3.0;  // m, an initial pose is checked against the candidates within this of it (0: not)
+  double min_start_fit = 0.9;       // share of the aligned start's matched points within 3 lidar_noise of their plane
   double reference_voxel_size = 0.5;  // m, voxel edge of the reference's search structure
   // k-NN search in the reference: the 27 voxels around the query, or exact
   // (map.neighbor_search's choices). A reference is complete around the
@@ -88,7 +90,11 @@ struct LocalizationOptions {
     v.Field("search_keep", search_keep, Spec().Range(1, 1000)
         .Help("global search: the best grid candidates (overlap at the candidate) aligned in full"));
     v.Field("search_ambiguity", search_ambiguity, Spec().Range(0.0, 1.0)
-        .Help("global search: a candidate more than 1 m or 10 deg from the best with an overlap within this of the best's makes the start ambiguous (exit 2)"));
+        .Help("a start candidate more than 1 m or 10 deg from the best with a fit (share of the scan's points within 3 constraints.lidar_noise of a reference plane) within this of the best's makes the start ambiguous (exit 2); with an initial pose, a candidate whose fit beats it by more makes it wrong (exit 2)"));
+    v.Field("start_check_radius", start_check_radius, Spec().Unit("m").Range(0.0, 100.0)
+        .Help("an initial pose is checked as the global search checks its best candidate: against the candidates (every yaw) within this distance of it, aligned in full (0: not checked)"));
+    v.Field("min_start_fit", min_start_fit, Spec().Range(0.0, 1.0)
+        .Help("the best aligned start must have this share of its points with a reference plane within 3 constraints.lidar_noise of it, else the map is taken not to be of this place (exit 2)"));
     v.Field("reference_voxel_size", reference_voxel_size, Spec().Unit("m").Range(0.01, 20.0)
         .Help("voxel edge of the reference's search structure for association (thinned as the working map: 20 points per voxel, 0.1 m apart)"));
     v.Field("reference_neighbor_search", reference_neighbor_search, Spec().Choices({"exact", "nearby"})
@@ -125,9 +131,20 @@ struct Localization {
 std::shared_ptr<const VoxelMap> MakeReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
                                                  const LocalizationOptions& options);
 
+// How closely a start's points must lie on their reference planes to count
+// in its fit: this many constraints.lidar_noise.
+constexpr double kStartFitNoises = 3.0;
+
 struct ReferenceAlignment {
   Pose3 T_ref_imu;   // the aligned pose
   double overlap = 0.0;  // share of the points with an accepted plane at the final radius
+  // Share of the points within kStartFitNoises * lidar_noise of an accepted
+  // plane: what distinguishes the place from a look-alike (a start 2 m off
+  // along a tunnel, a half turn, another world's map still overlap well).
+  double fit = 0.0;
+  // fit / overlap: the share of the matched points that lie on their planes
+  // within the noise (near 1 at the right place in the right map).
+  double Consistency() const { return overlap > 0.0 ? fit / overlap : 0.0; }
   int constraints = 0;
   // Gauss-Newton information (sum J^T J / lidar_noise^2) at the aligned pose,
   // columns [dtheta, dp] as PointToPlaneResidual's.
@@ -149,18 +166,45 @@ ReferenceAlignment AlignToReference(const std::vector<Eigen::Vector3d>& p_lidar,
                                     const ConstraintOptions& constraints,
                                     const LocalizationOptions& options);
 
-// Global search without an initial pose: candidate poses on a grid over the
-// reference's free space near its surfaces (localization.search_step) and
-// over yaw (search_yaw_step; roll and pitch of R_tilt, the gravity-aligned
-// orientation of the estimator), each scored by the overlap of a subsample
-// of the scan at the candidate; the search_keep best are aligned in full
-// (AlignToReference). Returns the aligned candidates, best overlap first.
+// Global search: candidate poses on a grid over the reference's free space
+// near its surfaces (localization.search_step; with `around`, only those
+// within start_check_radius of around->t) and over yaw (search_yaw_step,
+// starting at the yaw of R_start, whose roll and pitch every candidate
+// keeps: the estimator's gravity-aligned orientation, or the initial pose's),
+// each scored by the overlap of a subsample of the scan at the candidate;
+// the search_keep best are aligned in full (AlignToReference). Returns the
+// aligned candidates, best fit first.
 std::vector<ReferenceAlignment> SearchReference(const std::vector<Eigen::Vector3d>& p_lidar,
                                                 const Pose3& T_imu_lidar,
                                                 const VoxelMap& reference,
-                                                const Eigen::Matrix3d& R_tilt,
+                                                const Eigen::Matrix3d& R_start,
                                                 const ConstraintOptions& constraints,
-                                                const LocalizationOptions& options);
+                                                const LocalizationOptions& options,
+                                                const Eigen::Vector3d* around = nullptr);
+
+// The start in the reference, judged by one test whatever the platform does
+// next: from T_ref_imu_guess (an initial pose; null: the global search from
+// the orientation R_tilt), aligned, then refused (InvalidInput, one line
+// naming `start_name` or the map) when it overlaps the reference less than
+// min_start_overlap, leaves a translation direction unfixed
+// (min_start_axis_constraints), fits nowhere near it as a scan of this place
+// fits its map (the best candidate's Consistency below min_start_fit: the
+// map), fits clearly better elsewhere (a distinct candidate's fit more than
+// search_ambiguity above: the start is wrong) or as well elsewhere (within
+// search_ambiguity: ambiguous). Distinct: more than 1 m or 10 deg apart.
+// Positions in the messages are moved by `origin` into the map's frame as the
+// user gave it (math/local_origin.h).
+// With an initial pose and trust_initial_pose only the overlap and the fit
+// of the aligned pose itself are checked.
+StatusOr<ReferenceAlignment> FindStartInReference(const std::vector<Eigen::Vector3d>& p_lidar,
+                                                  const Pose3& T_imu_lidar,
+                                                  const VoxelMap& reference,
+                                                  const Pose3* T_ref_imu_guess,
+                                                  const Eigen::Matrix3d& R_tilt,
+                                                  const ConstraintOptions& constraints,
+                                                  const LocalizationOptions& options,
+                                                  const std::string& start_name,
+                                                  const LocalOrigin& origin);
 
 // Share of p_lidar's points with an accepted reference plane at T_ref_imu
 // (the constraint options' radii).

@@ -114,11 +114,10 @@ class ReferenceLocalizer {
   double start_overlap() const { return start_overlap_; }  // of the aligned first scan
   // The first scan, ending at t_ns: aligns p_lidar (deskewed, LiDAR frame)
   // to the reference from the initial pose, or by the global search without
-  // one (SearchReference). Returns T_ref_world, the change of world frame
-  // that takes the estimator's current T_world_imu to the aligned pose, or
-  // InvalidInput when the initial poses do not cover t_ns, the aligned scan
-  // overlaps the reference too little, the search finds two places, or the
-  // scan leaves a translation direction unfixed (a featureless axis).
+  // one, and judges the start (FindStartInReference). Returns T_ref_world,
+  // the change of world frame that takes the estimator's current T_world_imu
+  // to the aligned pose, or InvalidInput when the initial poses do not cover
+  // t_ns or the start is refused (naming --initial-pose or the map).
   StatusOr<Pose3> Start(TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_lidar,
                         const Pose3& T_world_imu, const Pose3& T_imu_lidar);
   // Associates a scan at T_world_imu (threads as AssociateWith's): with the
@@ -132,12 +131,6 @@ class ReferenceLocalizer {
                             ScanResult* r) const;
 
  private:
-  StatusOr<ReferenceAlignment> AlignFromInitialPose(TimeNs t_ns,
-                                                    const std::vector<Eigen::Vector3d>& p_lidar,
-                                                    const Pose3& T_imu_lidar) const;
-  StatusOr<ReferenceAlignment> SearchStart(const std::vector<Eigen::Vector3d>& p_lidar,
-                                           const Pose3& T_world_imu, const Pose3& T_imu_lidar) const;
-
   Localization localization_;
   LocalizationOptions options_;
   ConstraintOptions constraints_;
