@@ -54,7 +54,8 @@ void PrintHelp() {
   }
   std::cout << "\nexit status: 0 success, 2 bad input or configuration, 3 divergence detected\n"
                "(run, refine; outputs written), 1 internal failure, 130 / 143 stopped by\n"
-               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate, export; live exits 0\nafter writing its outputs)\n";
+               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate, export; `live` ends\n"
+               "by them: outputs written, exit 0)\n";
 }
 
 }  // namespace
