@@ -57,7 +57,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # checked here by LasWriter.*); the LAS memory bounds measure a Release
 # build's peak, as the refine one does; MapLasCli runs run, refine and merge
 # end to end for the one call each makes to the LAS writer, which runs here in
-# LasExport.* and LasWriter.*.
+# LasExport.* and LasWriter.*. Live runs `rvlio live` against rosmaster,
+# rosbag and DDS in real time (about a minute of wall time whatever the
+# build); its queues, ordering and errors run here in LiveSensorSource.*,
+# the propagator in ImuPropagator.*, the output messages in CdrTest.*.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -106,6 +109,7 @@ ex=(
   Refine.SummarizedFactorsAgreeWithExactFactors
   'LasReaders\..*' LasWriter.MemoryStaysBoundedWhileMillionsOfPointsAreWritten
   LasExport.AMapOfMillionsOfPointsIsExportedInBoundedMemory MapLasCli.RunRefineAndMergeWriteMapLasWhenAsked
+  Live
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

@@ -265,12 +265,7 @@ void Process(const RunArgs& args, SensorBagReader* reader, Odometry* odo, TumStr
       result->read_error = m.status();  // keep what was read: outputs are still written
       break;
     }
-    if (*m == SensorMessage::kEnd) {
-      // A source that waits for its next message (live) ends when stopped.
-      if (args.stop) result->stop_reason = args.stop();
-      result->stopped = !result->stop_reason.empty();
-      break;
-    }
+    if (*m == SensorMessage::kEnd) break;
     t = *m == SensorMessage::kImu ? imu.t_ns : scan.t_end_ns;
     if (data->first_ns < 0) data->first_ns = t;
     data->last_ns = std::max(data->last_ns, t);

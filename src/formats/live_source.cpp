@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <utility>
 
 #include "rvlio/common/text.h"
@@ -124,11 +125,14 @@ LiveSensorSource::LiveSensorSource(LiveSourceOptions options)
       decoder_(std::make_unique<Decoder>(options_)),
       start_(std::chrono::steady_clock::now()) {}
 
+LiveSensorSource::~LiveSensorSource() = default;
+
 std::optional<ImuSample> LiveSensorSource::PushImu(const uint8_t* data, size_t size,
                                                    const std::string& type) {
   ImuSample sample;
   StatusOr<bool> got = decoder_->Imu(data, size, type, &sample);
   std::lock_guard<std::mutex> lock(mutex_);
+  if (ended_) return std::nullopt;
   ++live_stats_.imu_messages;
   got_imu_ = true;
   if (!got.ok()) {
@@ -162,6 +166,7 @@ void LiveSensorSource::PushLidar(const uint8_t* data, size_t size, const std::st
   item.arrival = arrival;
   StatusOr<bool> got = decoder_->Lidar(data, size, type, &item.scan);
   std::lock_guard<std::mutex> lock(mutex_);
+  if (ended_) return;
   ++live_stats_.lidar_messages;
   got_lidar_ = true;
   if (!got.ok()) {
@@ -186,7 +191,9 @@ void LiveSensorSource::QueueScan(Item item) {
 }
 
 void LiveSensorSource::ReleasePendingScans(TimeNs imu_t_ns) {
+  const auto now = std::chrono::steady_clock::now();
   while (!pending_.empty() && pending_.front().scan.t_end_ns <= imu_t_ns) {
+    pending_.front().covered = now;
     if (ready_scans_ >= options_.live.scan_queue) {  // the estimator fell behind
       const auto oldest = std::find_if(ready_.begin(), ready_.end(), [](const Item& i) {
         return i.kind == SensorMessage::kScan;
@@ -222,8 +229,12 @@ StatusOr<SensorMessage> LiveSensorSource::Next(ImuSample* imu, Scan* scan) {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     if (!error_.ok()) return error_;
+    if (!ended_ && options_.stopped && options_.stopped()) {
+      ended_ = true;  // the end of the input: what waits for the IMU is delivered first
+      ReleasePendingScans(std::numeric_limits<TimeNs>::max());
+    }
     if (!ready_.empty()) break;
-    if (options_.stopped && options_.stopped()) return SensorMessage::kEnd;
+    if (ended_) return SensorMessage::kEnd;
     if (!(got_lidar_ && got_imu_))
       if (Status s = WaitTimeout(); !s.ok()) return error_ = s;
     ready_cv_.wait_for(lock, std::chrono::milliseconds(kLivePollMs));
@@ -239,7 +250,7 @@ StatusOr<SensorMessage> LiveSensorSource::Next(ImuSample* imu, Scan* scan) {
   lock.unlock();
   constexpr size_t kKeptArrivals = 16;
   if (handed_.size() >= kKeptArrivals) handed_.pop_front();
-  handed_.push_back(LiveScanArrival{item.scan.t_end_ns, item.arrival, item.scan});
+  handed_.push_back(LiveScanArrival{item.scan.t_end_ns, item.arrival, item.covered, item.scan});
   *scan = std::move(item.scan);
   return SensorMessage::kScan;
 }
@@ -259,6 +270,11 @@ const SensorReaderStats& LiveSensorSource::stats() const {
 }
 
 std::string LiveSensorSource::lidar_layout() const { return decoder_->layout(); }
+
+Status LiveSensorSource::error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_;
+}
 
 LiveSourceStats LiveSensorSource::live_stats() const {
   std::lock_guard<std::mutex> lock(mutex_);

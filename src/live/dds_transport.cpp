@@ -182,7 +182,7 @@ int DdsTransport::MatchedReaders(const std::string& topic) const {
   return static_cast<int>(status.current_count);
 }
 
-std::optional<std::string> DdsTransport::DiscoveredType(const std::string& topic) {
+std::optional<DdsTransport::Offered> DdsTransport::DiscoveredWriter(const std::string& topic) {
   const std::string name = DdsTopicName(topic);
   std::lock_guard<std::mutex> lock(discovery_mutex_);
   constexpr int kBatch = 16;
@@ -193,8 +193,12 @@ std::optional<std::string> DdsTransport::DiscoveredType(const std::string& topic
     if (n <= 0) break;
     for (dds_return_t i = 0; i < n; ++i) {
       const auto* e = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
-      if (infos[i].valid_data && e->topic_name != nullptr && e->type_name != nullptr)
-        discovered_.emplace(e->topic_name, e->type_name);
+      if (!infos[i].valid_data || e->topic_name == nullptr || e->type_name == nullptr) continue;
+      dds_reliability_kind_t kind = DDS_RELIABILITY_BEST_EFFORT;
+      dds_duration_t blocking = 0;
+      const bool reliable = e->qos != nullptr && dds_qget_reliability(e->qos, &kind, &blocking) &&
+                            kind == DDS_RELIABILITY_RELIABLE;
+      discovered_.emplace(e->topic_name, Offered{e->type_name, reliable});
     }
     dds_return_loan(publications_, samples, n);
   }
@@ -204,21 +208,25 @@ std::optional<std::string> DdsTransport::DiscoveredType(const std::string& topic
 }
 
 // One topic's thread: waits for a writer of the topic to be discovered,
-// reads with its type, hands every sample to `callback` until Shutdown.
+// reads with its type and reliability, hands every sample to `callback`
+// until Shutdown.
 void DdsTransport::Receive(const std::string& topic, int depth, const MessageCallback& callback) {
-  std::optional<std::string> dds_type;
-  while (!stop_ && !(dds_type = DiscoveredType(topic))) dds_sleepfor(kPollNs);
+  std::optional<Offered> offered;
+  while (!stop_ && !(offered = DiscoveredWriter(topic))) dds_sleepfor(kPollNs);
   if (stop_) return;
-  ddsi_sertype* type = NewRawCdrType(*dds_type);
+  ddsi_sertype* type = NewRawCdrType(offered->dds_type);
   const dds_entity_t t = dds_create_topic_sertype(participant_, DdsTopicName(topic).c_str(), &type,
                                                   nullptr, nullptr, nullptr);
   DdsQos qos;
-  dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
+  if (offered->reliable)
+    dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  else
+    dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
   dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, depth);
   SetCdrOnly(qos.get());
   const dds_entity_t reader = t < 0 ? t : dds_create_reader(participant_, t, qos.get(), nullptr);
   if (reader < 0) return;  // the wait for the topic's first message reports it
-  const std::string ros_type = RosTypeName(*dds_type);
+  const std::string ros_type = RosTypeName(offered->dds_type);
   const dds_entity_t waitset = dds_create_waitset(participant_);
   const dds_entity_t readable = dds_create_readcondition(reader, DDS_ANY_STATE);
   dds_waitset_attach(waitset, readable, reader);

@@ -52,13 +52,18 @@ class DdsTransport final : public Transport {
     dds_entity_t entity = 0;
     const struct ddsi_sertype* type = nullptr;
   };
-  std::optional<std::string> DiscoveredType(const std::string& topic);
+  // The type and reliability of the first discovered writer of `topic`.
+  struct Offered {
+    std::string dds_type;
+    bool reliable = false;
+  };
+  std::optional<Offered> DiscoveredWriter(const std::string& topic);
   void Receive(const std::string& topic, int depth, const MessageCallback& callback);
 
   int domain_id_ = 0;
   dds_entity_t participant_ = 0, publications_ = 0;
   std::mutex discovery_mutex_;
-  std::map<std::string, std::string> discovered_;  // DDS topic -> DDS type
+  std::map<std::string, Offered> discovered_;  // by DDS topic
   std::map<std::string, Writer> writers_;          // by ROS topic
   std::unique_ptr<OutputTopics> topics_;
   std::atomic<bool> stop_{false};

@@ -29,7 +29,8 @@ nlohmann::json LiveJson(const LiveFigures& f) {
            {{"samples", f.latency_samples},
             {"median", f.latency_median_ms},
             {"p95", f.latency_p95_ms},
-            {"max", f.latency_max_ms}}}};
+            {"max", f.latency_max_ms},
+            {"imu_wait_median", f.imu_wait_median_ms}}}};
 }
 
 StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args) {
@@ -87,7 +88,10 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   run.initial_pose = args.initial_pose;
   run.initial_pose_tum = args.initial_pose_tum;
   run.source = &source;
-  run.stop = stop;
+  // No run.stop: a stop ends the live input (the source delivers what it
+  // received, then its end), and the run finishes as at the end of a
+  // recording, so the outputs hold every scan received, as `run` on a
+  // recording of the same messages.
   run.progress = args.progress;
   run.on_result = [&publisher](const ScanResult& r, const Odometry& odo) { publisher.OnResult(r, odo); };
   LiveFigures figures;
@@ -106,14 +110,24 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
     fill();
     (*summary)["command"] = "live";
     (*summary)["live"] = LiveJson(figures);
+    (*summary)["interrupted"] = !stop_reason.empty();
+    if (!stop_reason.empty()) (*summary)["signal"] = stop_reason;
   };
   StatusOr<RunResult> result = RunRecording(run);
   net.Shutdown();
-  if (!result.ok()) return result.status();
   fill();
   LiveResult out;
-  out.run = std::move(result).value();
   out.figures = figures;
+  if (!result.ok()) {
+    // Stopped before a scan was done: nothing written, as `run` stopped then.
+    if (stop_reason.empty() || !source.error().ok()) return result.status();
+    out.run.stopped = true;
+    out.run.stop_reason = stop_reason;
+    return out;
+  }
+  out.run = std::move(result).value();
+  out.run.stopped = !stop_reason.empty();
+  out.run.stop_reason = stop_reason;
   return out;
 }
 

@@ -117,9 +117,11 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
     tf.rotation_xyzw = message.pose.orientation_xyzw;
     transport_->PublishTf(tf);
   }
-  if (arrival)
-    latency_ms_.push_back(
-        std::chrono::duration<double, std::milli>(Clock::now() - arrival->arrival).count());
+  if (arrival) {
+    const auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
+    latency_ms_.push_back(ms(Clock::now() - arrival->arrival));
+    imu_wait_ms_.push_back(ms(arrival->covered - arrival->arrival));
+  }
   if (arrival && imu.size() >= 2) PublishRegisteredScan(r, arrival->scan, imu);
   path_.stamp_ns = r.t_ns;
   if (path_.poses.size() >= kMaxPathPoses) path_.poses.erase(path_.poses.begin());
@@ -196,6 +198,7 @@ void LivePublisher::Fill(LiveFigures* f) const {
   f->latency_median_ms = latency.median;
   f->latency_p95_ms = latency.p95;
   f->latency_max_ms = latency.max;
+  f->imu_wait_median_ms = ComputeStats(imu_wait_ms_).median;
 }
 
 }  // namespace rvlio::live_detail

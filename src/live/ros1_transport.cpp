@@ -101,7 +101,7 @@ class Ros1Transport final : public Transport {
   }
 
   void PublishTf(const TransformMessage& m) override {
-    tf2_msgs::TFMessage out(1);
+    tf2_msgs::TFMessage out;
     out.transforms.resize(1);
     geometry_msgs::TransformStamped& t = out.transforms[0];
     t.header = Header(m.stamp_ns, m.frame_id);

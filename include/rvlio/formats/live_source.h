@@ -75,12 +75,16 @@ struct LiveSourceStats {
 struct LiveScanArrival {
   TimeNs t_end_ns = 0;
   std::chrono::steady_clock::time_point arrival;
+  // When the IMU sample that covers its end arrived (the odometry needs it
+  // before it can estimate the scan): arrival or later.
+  std::chrono::steady_clock::time_point covered;
   Scan scan;
 };
 
 class LiveSensorSource final : public SensorBagReader {
  public:
   explicit LiveSensorSource(LiveSourceOptions options);
+  ~LiveSensorSource() override;
 
   // --- Transport threads (thread-safe) ---
   // An IMU message of type `type`. Returns the sample when it was accepted
@@ -95,8 +99,10 @@ class LiveSensorSource final : public SensorBagReader {
 
   // --- The estimator's thread ---
   // Waits for the next message. InvalidInput naming the topic when its first
-  // message does not arrive within lidar.wait_timeout of construction; kEnd
-  // once `stopped` says so.
+  // message does not arrive within lidar.wait_timeout of construction. Once
+  // `stopped` says so, the input has ended: the messages received so far are
+  // delivered (scans still waiting for the IMU too, as a recording's last
+  // scans are), then kEnd; later messages are ignored.
   StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override;
   const SensorReaderStats& stats() const override;
   std::string lidar_layout() const override;
@@ -105,13 +111,15 @@ class LiveSensorSource final : public SensorBagReader {
   std::optional<LiveScanArrival> TakeArrival(TimeNs t_end_ns);
 
   LiveSourceStats live_stats() const;
+  // The first error of the input (a transport's, a message's), if any.
+  Status error() const;
 
  private:
   struct Item {
     SensorMessage kind = SensorMessage::kImu;
     ImuSample imu;
     Scan scan;
-    std::chrono::steady_clock::time_point arrival;
+    std::chrono::steady_clock::time_point arrival, covered;
   };
   class Decoder;
 
@@ -128,6 +136,7 @@ class LiveSensorSource final : public SensorBagReader {
   std::deque<Item> pending_;  // scans waiting for an IMU sample at or after their end
   int ready_scans_ = 0, ready_imu_ = 0;
   bool got_lidar_ = false, got_imu_ = false;
+  bool ended_ = false;  // stopped: nothing more is queued
   Status error_;
   LiveSourceStats live_stats_;
   mutable SensorReaderStats stats_copy_;  // the gate's, read under the mutex

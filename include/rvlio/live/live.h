@@ -45,6 +45,9 @@ struct LiveFigures {
   // From a scan's arrival to the publication of its pose (ms).
   int64_t latency_samples = 0;
   double latency_median_ms = 0.0, latency_p95_ms = 0.0, latency_max_ms = 0.0;
+  // Of that, the wait for the IMU sample at or after the scan's end (which
+  // the odometry needs): its median (ms).
+  double imu_wait_median_ms = 0.0;
 };
 
 struct LiveResult {
