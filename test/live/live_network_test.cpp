@@ -247,15 +247,17 @@ TEST(LiveRos1, PublishesRunsEstimateTfAndCloud) {
   EXPECT_GT(imu_rate, 5 * static_cast<int>(run.size()));
   const json latency = live.Summary()["live"]["latency_ms"];
   EXPECT_EQ(latency["samples"], run.size());
-  std::printf("ros1 1x: latency median %.2f ms p95 %.2f ms, per scan median %.2f ms\n",
+  std::printf("ros1 1x: latency median %.2f ms p95 %.2f ms (IMU wait median %.2f ms), per scan "
+              "median %.2f ms\n",
               latency["median"].get<double>(), latency["p95"].get<double>(),
+              latency["imu_wait_median"].get<double>(),
               live.Summary()["per_scan_ms"]["median"].get<double>());
 }
 
 // SIGINT while scans arrive: complete outputs, the scans done so far are
 // run's first scans.
 TEST(LiveRos1, SigintMidRunWritesRunsPrefix) {
-  LiveProcess live("ros1_sigint", {"--ros1", "--quiet"});
+  LiveProcess live("ros1_sigint", {"--ros1"});
   ASSERT_TRUE(live.WaitReady()) << live.Err();
   const pid_t play = SpawnProgram({"rosbag", "play", "-q", "-d", "1", world->bag},
                                   world->dir + "/play2.out", world->dir + "/play2.err");
@@ -275,7 +277,7 @@ TEST(LiveRos1, SigintMidRunWritesRunsPrefix) {
 // The player at 20x: scans are dropped and counted, the IMU-rate output
 // keeps the IMU's rate, SIGTERM writes valid outputs.
 TEST(LiveRos1, FallingBehindDropsScansNotImu) {
-  LiveProcess live("ros1_20x", {"--ros1", "--quiet"});
+  LiveProcess live("ros1_20x", {"--ros1"});
   ASSERT_TRUE(live.WaitReady()) << live.Err();
   ASSERT_EQ(Play(20.0), 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -405,7 +407,7 @@ TEST(LiveRos2, PublishesRunsEstimate) {
 TEST(LiveRos2, WrongTopicTypeIsOneLine) {
   live_detail::DdsTransport dds;
   ASSERT_TRUE(dds.Init(world->domain).ok());
-  LiveProcess live("ros2_type", {"--ros2", "--quiet", "--set", "lidar.topic=/scan_as_string"});
+  LiveProcess live("ros2_type", {"--ros2", "--set", "lidar.topic=/scan_as_string"});
   ASSERT_TRUE(live.WaitReady()) << live.Err();
   ASSERT_TRUE(dds.AdvertiseRaw("/scan_as_string", cdr::kStringType, true).ok());
   ASSERT_TRUE(dds.AdvertiseRaw(kImuTopic, cdr::kImuType, true).ok());
