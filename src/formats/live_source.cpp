@@ -141,6 +141,7 @@ std::optional<ImuSample> LiveSensorSource::PushImu(const uint8_t* data, size_t s
     return std::nullopt;
   }
   if (!*got) return std::nullopt;
+  newest_imu_ns_ = sample.t_ns;
   ReleasePendingScans(sample.t_ns);
   if (ready_imu_ >= options_.live.imu_queue) {  // the estimator stalled: the oldest sample goes
     const auto oldest = std::find_if(ready_.begin(), ready_.end(), [](const Item& i) {
@@ -188,6 +189,8 @@ void LiveSensorSource::QueueScan(Item item) {
     pending_.pop_front();
     ++live_stats_.scans_dropped;
   }
+  // The IMU sample that covers it may have come while it was decoded.
+  if (newest_imu_ns_ >= t_end) ReleasePendingScans(newest_imu_ns_);
 }
 
 void LiveSensorSource::ReleasePendingScans(TimeNs imu_t_ns) {

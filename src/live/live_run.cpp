@@ -30,7 +30,9 @@ nlohmann::json LiveJson(const LiveFigures& f) {
             {"median", f.latency_median_ms},
             {"p95", f.latency_p95_ms},
             {"max", f.latency_max_ms},
-            {"imu_wait_median", f.imu_wait_median_ms}}}};
+            {"imu_wait_median", f.imu_wait_median_ms},
+            {"after_imu_median", f.after_imu_median_ms},
+            {"after_imu_p95", f.after_imu_p95_ms}}}};
 }
 
 StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args) {

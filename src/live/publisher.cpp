@@ -119,8 +119,10 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
   }
   if (arrival) {
     const auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
-    latency_ms_.push_back(ms(Clock::now() - arrival->arrival));
+    const Clock::time_point now = Clock::now();
+    latency_ms_.push_back(ms(now - arrival->arrival));
     imu_wait_ms_.push_back(ms(arrival->covered - arrival->arrival));
+    after_imu_ms_.push_back(ms(now - arrival->covered));
   }
   if (arrival && imu.size() >= 2) PublishRegisteredScan(r, arrival->scan, imu);
   path_.stamp_ns = r.t_ns;
@@ -199,6 +201,9 @@ void LivePublisher::Fill(LiveFigures* f) const {
   f->latency_p95_ms = latency.p95;
   f->latency_max_ms = latency.max;
   f->imu_wait_median_ms = ComputeStats(imu_wait_ms_).median;
+  const ErrorStats after_imu = ComputeStats(after_imu_ms_);
+  f->after_imu_median_ms = after_imu.median;
+  f->after_imu_p95_ms = after_imu.p95;
 }
 
 }  // namespace rvlio::live_detail

@@ -52,7 +52,7 @@ class LivePublisher {
 
   // Estimator thread only.
   PathMessage path_;
-  std::vector<double> latency_ms_, imu_wait_ms_;
+  std::vector<double> latency_ms_, imu_wait_ms_, after_imu_ms_;
   TimeNs last_map_ns_ = -1;
 };
 

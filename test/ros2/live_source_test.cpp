@@ -86,6 +86,18 @@ TEST(LiveSensorSource, ScanWaitsForTheImuSampleAfterItsEnd) {
   EXPECT_EQ(a->scan.points.size(), 100u);
 }
 
+// A scan decoded after its covering IMU sample arrived is not held for the next one.
+TEST(LiveSensorSource, ScanAlreadyCoveredIsDeliveredAtOnce) {
+  LiveSensorSource s(Options());
+  PushImu(&s, 0);
+  PushImu(&s, 100 * kMs);
+  PushLidar(&s, 10 * kMs);  // ends at 100 ms
+  EXPECT_EQ(Drain(&s, 3), "iis");
+  const std::optional<LiveScanArrival> a = s.TakeArrival(100 * kMs);
+  ASSERT_TRUE(a.has_value());
+  EXPECT_GE(a->covered, a->arrival);
+}
+
 // The estimator fell behind: beyond live.scan_queue ready scans the oldest
 // goes (counted); every IMU sample stays.
 TEST(LiveSensorSource, DropsOldestScansNeverImu) {

@@ -22,11 +22,13 @@ namespace rvlio::signals_test {
 using testing_cli::ReadFile;
 
 // `PROGRAM ARGS...` (argv_s[0]: a path, or a name looked up in PATH) with
-// stdout and stderr into files.
+// stdout and stderr into files; with own_group, in a process group of its
+// own (pid = group id), so that kill(-pid, ...) reaches the children it starts.
 inline pid_t SpawnProgram(std::vector<std::string> argv_s, const std::string& out_path,
-                          const std::string& err_path) {
+                          const std::string& err_path, bool own_group = false) {
   const pid_t pid = ::fork();
   if (pid != 0) return pid;
+  if (own_group) ::setpgid(0, 0);
   const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (out < 0 || err < 0) ::_exit(97);

@@ -13,6 +13,9 @@
 // sample anyway) and delivered just before it, which is a recording's
 // receive-time order (a scan recorded at its end, an IMU sample at its
 // stamp), whatever the order in which two network connections deliver them.
+// A scan whose covering sample came while it was being decoded is delivered
+// at once, after that sample: the odometry estimates it from the same
+// samples either way.
 //
 // Real time: at most live.scan_queue scans wait for the estimator; when one
 // more is ready, the oldest waiting scan is dropped (counted). IMU samples
@@ -22,6 +25,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -137,6 +141,7 @@ class LiveSensorSource final : public SensorBagReader {
   int ready_scans_ = 0, ready_imu_ = 0;
   bool got_lidar_ = false, got_imu_ = false;
   bool ended_ = false;  // stopped: nothing more is queued
+  TimeNs newest_imu_ns_ = std::numeric_limits<TimeNs>::min();  // newest accepted IMU stamp
   Status error_;
   LiveSourceStats live_stats_;
   mutable SensorReaderStats stats_copy_;  // the gate's, read under the mutex

@@ -46,8 +46,10 @@ struct LiveFigures {
   int64_t latency_samples = 0;
   double latency_median_ms = 0.0, latency_p95_ms = 0.0, latency_max_ms = 0.0;
   // Of that, the wait for the IMU sample at or after the scan's end (which
-  // the odometry needs): its median (ms).
+  // the odometry needs before it can estimate the scan): its median; and the
+  // time from that sample's arrival to the publication (median, p95).
   double imu_wait_median_ms = 0.0;
+  double after_imu_median_ms = 0.0, after_imu_p95_ms = 0.0;
 };
 
 struct LiveResult {
