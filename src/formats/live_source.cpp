@@ -176,6 +176,7 @@ void LiveSensorSource::PushLidar(const uint8_t* data, size_t size, const std::st
     return;
   }
   if (*got) QueueScan(std::move(item));
+  ready_cv_.notify_all();
 }
 
 // Pending scans are kept sorted by end time; at most scan_queue of them wait
