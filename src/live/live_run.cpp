@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "publisher.h"
+#include "rvlio/outputs/output_stage.h"
 #include "rvlio/live/live.h"
 #include "transport.h"
 
@@ -46,6 +47,10 @@ StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args) {
 StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   OdometryOptions options = args.options;
   if (Status s = options.Validate(); !s.ok()) return s;
+  if (!args.out_dir.empty()) {  // an unusable output folder is refused before connecting
+    OutputFolder check(args.out_dir);  // removes again what it created
+    if (Status s = check.Prepare(); !s.ok()) return s;
+  }
   StatusOr<std::unique_ptr<Transport>> transport = Connect(args);
   if (!transport.ok()) return transport.status();
   Transport& net = **transport;

@@ -175,6 +175,23 @@ class Ros1Transport final : public Transport {
   std::vector<std::thread> threads_;
 };
 
+// roscpp stops the process (ROS_BREAK) on a master URI it cannot split into
+// host and port: "http://HOST:PORT[/]" is checked here first.
+bool IsMasterUri(const std::string& uri) {
+  const std::string scheme = "http://";
+  if (uri.compare(0, scheme.size(), scheme) != 0) return false;
+  std::string rest = uri.substr(scheme.size());
+  if (!rest.empty() && rest.back() == '/') rest.pop_back();
+  const size_t colon = rest.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 >= rest.size()) return false;
+  if (rest.find('/') != std::string::npos) return false;
+  long long port = 0;
+  for (size_t i = colon + 1; i < rest.size(); ++i) {
+    if (rest[i] < '0' || rest[i] > '9' || (port = port * 10 + (rest[i] - '0')) > 65535) return false;
+  }
+  return port > 0;
+}
+
 }  // namespace
 
 StatusOr<std::unique_ptr<Transport>> ConnectRos1(const LiveOptions& live, const std::string& node_name) {
@@ -182,6 +199,9 @@ StatusOr<std::unique_ptr<Transport>> ConnectRos1(const LiveOptions& live, const 
   if (uri == nullptr || *uri == '\0')
     return Status::InvalidInput("--ros1: ROS_MASTER_URI is not set (e.g. http://localhost:11311)");
   const std::string master = uri;
+  if (!IsMasterUri(master))
+    return Status::InvalidInput("--ros1: ROS_MASTER_URI '" + master +
+                                "' is not http://HOST:PORT");
   if (ros::isInitialized())
     return Status::Internal("--ros1: roscpp is already initialized in this process");
   ros::M_string remappings;

@@ -411,7 +411,14 @@ TEST(LiveRos2, PublishesRunsEstimate) {
   std::lock_guard<std::mutex> lock(mutex);
   ExpectSamePoses(run, odometry);
   EXPECT_EQ(tf, static_cast<int>(run.size()));
-  EXPECT_EQ(live.Summary()["live"]["middleware"], "ros2");
+  const json l = live.Summary()["live"];
+  EXPECT_EQ(l["middleware"], "ros2");
+  EXPECT_EQ(l["scans_dropped"], 0);
+  std::printf("ros2 1x: latency median %.2f ms p95 %.2f ms, IMU-rate odometry %.1f Hz of %.1f Hz, "
+              "per scan median %.2f ms\n",
+              l["latency_ms"]["median"].get<double>(), l["latency_ms"]["p95"].get<double>(),
+              l["imu_odometry_hz"].get<double>(), l["imu_input_hz"].get<double>(),
+              live.Summary()["per_scan_ms"]["median"].get<double>());
 }
 
 TEST(LiveRos2, WrongTopicTypeIsOneLine) {
@@ -430,6 +437,26 @@ TEST(LiveRos2, WrongTopicTypeIsOneLine) {
   EXPECT_NE(live.Err().find("rvlio live: error: lidar.topic '/scan_as_string' (ROS 2 on DDS, domain " +
                             std::to_string(world->domain) + ") carries std_msgs/msg/String"),
             std::string::npos) << live.Err();
+}
+
+// A cloud whose bytes end early: the CDR decoder's one line, exit 2.
+TEST(LiveRos2, CorruptCloudIsOneLine) {
+  live_detail::DdsTransport dds;
+  ASSERT_TRUE(dds.Init(world->domain).ok());
+  LiveProcess live("ros2_corrupt", {"--ros2", "--set", "lidar.topic=/cut_cloud"});
+  ASSERT_TRUE(live.WaitReady()) << live.Err();
+  ASSERT_TRUE(dds.AdvertiseRaw("/cut_cloud", cdr::kPointCloud2Type, true).ok());
+  std::vector<uint8_t> cut = cdr::EncodeString("0123456789abcdef");  // a header, then too little
+  int status = 0;
+  signals_test::WaitUntil(live.pid, [&] {
+    dds.PublishRaw("/cut_cloud", cut);
+    return false;
+  }, &status);
+  EXPECT_EQ(status, 2);
+  const std::string err = live.Err();
+  EXPECT_NE(err.find("rvlio live: error: sensor_msgs/msg/PointCloud2 on /cut_cloud"), std::string::npos)
+      << err;
+  EXPECT_NE(err.find("(ROS 2 on DDS, domain"), std::string::npos) << err;
 }
 
 }  // namespace
