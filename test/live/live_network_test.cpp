@@ -454,7 +454,7 @@ TEST(LiveRos2, CorruptCloudIsOneLine) {
   }, &status);
   EXPECT_EQ(status, 2);
   const std::string err = live.Err();
-  EXPECT_NE(err.find("rvlio live: error: sensor_msgs/msg/PointCloud2 on /cut_cloud"), std::string::npos)
+  EXPECT_NE(err.find("rvlio live: error: CDR sensor_msgs/msg/PointCloud2 on /cut_cloud"), std::string::npos)
       << err;
   EXPECT_NE(err.find("(ROS 2 on DDS, domain"), std::string::npos) << err;
 }
