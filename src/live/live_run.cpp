@@ -36,9 +36,10 @@ nlohmann::json LiveJson(const LiveFigures& f) {
             {"after_imu_p95", f.after_imu_p95_ms}}}};
 }
 
-StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args) {
+StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args,
+                                             const std::function<bool()>& stopped) {
   if (args.middleware == LiveMiddleware::kRos1)
-    return live_detail::ConnectRos1(args.options.live, args.node_name);
+    return live_detail::ConnectRos1(args.options.live, args.node_name, stopped);
   return live_detail::ConnectRos2(args.options.live);
 }
 
@@ -51,16 +52,22 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
     OutputFolder check(args.out_dir);  // removes again what it created
     if (Status s = check.Prepare(); !s.ok()) return s;
   }
-  StatusOr<std::unique_ptr<Transport>> transport = Connect(args);
-  if (!transport.ok()) return transport.status();
-  Transport& net = **transport;
-
-  // The stop request, read by the source while it waits and by RunRecording.
+  // The stop request, read while connecting and by the source while it waits.
   std::string stop_reason;
   auto stop = [&args, &stop_reason]() -> std::string {
     if (stop_reason.empty() && args.stop) stop_reason = args.stop();
     return stop_reason;
   };
+  StatusOr<std::unique_ptr<Transport>> transport = Connect(args, [&stop] { return !stop().empty(); });
+  if (!transport.ok()) return transport.status();
+  if (*transport == nullptr) {  // stopped while waiting for the master
+    LiveResult out;
+    out.run.stopped = true;
+    out.run.stop_reason = stop_reason;
+    return out;
+  }
+  Transport& net = **transport;
+
   LiveSourceOptions source_options;
   source_options.encoding = net.encoding();
   source_options.origin = net.origin();

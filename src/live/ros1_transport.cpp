@@ -194,7 +194,8 @@ bool IsMasterUri(const std::string& uri) {
 
 }  // namespace
 
-StatusOr<std::unique_ptr<Transport>> ConnectRos1(const LiveOptions& live, const std::string& node_name) {
+StatusOr<std::unique_ptr<Transport>> ConnectRos1(const LiveOptions& live, const std::string& node_name,
+                                                 const std::function<bool()>& stopped) {
   const char* uri = std::getenv("ROS_MASTER_URI");
   if (uri == nullptr || *uri == '\0')
     return Status::InvalidInput("--ros1: ROS_MASTER_URI is not set (e.g. http://localhost:11311)");
@@ -210,6 +211,7 @@ StatusOr<std::unique_ptr<Transport>> ConnectRos1(const LiveOptions& live, const 
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration<double>(live.connect_timeout);
   while (!ros::master::check()) {
+    if (stopped()) return std::unique_ptr<Transport>();
     if (std::chrono::steady_clock::now() >= deadline)
       return Status::InvalidInput("--ros1: the ROS master " + master +
                                   " (ROS_MASTER_URI) did not answer within live.connect_timeout " +

@@ -63,8 +63,10 @@ class Transport {
 };
 
 // ROS 1: the master from ROS_MASTER_URI, answering within
-// live.connect_timeout; InvalidInput (one line) when it is unset or does not answer.
-StatusOr<std::unique_ptr<Transport>> ConnectRos1(const LiveOptions& live, const std::string& node_name);
+// live.connect_timeout; InvalidInput (one line) when it is unset or does not
+// answer. `stopped` is polled while waiting: true gives a null transport.
+StatusOr<std::unique_ptr<Transport>> ConnectRos1(const LiveOptions& live, const std::string& node_name,
+                                                 const std::function<bool()>& stopped);
 // ROS 2 on Cyclone DDS, domain live.ros2_domain_id (-1: $ROS_DOMAIN_ID, else 0).
 StatusOr<std::unique_ptr<Transport>> ConnectRos2(const LiveOptions& live);
 
