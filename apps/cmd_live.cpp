@@ -1,4 +1,6 @@
 // `rvlio live`: RunLive (rvlio/live/live.h) with the CLI's signals and lines.
+#include <unistd.h>
+
 #include <cstdio>
 
 #include "cli.h"
@@ -71,9 +73,11 @@ int CmdLive(int argc, char** argv) {
   live.initial_pose = args.Get("initial-pose");
   live.initial_pose_tum = args.Get("initial-pose-tum");
   live.stop = [] { return InterruptSignalName(); };
-  const bool quiet = args.Has("quiet");
-  live.on_ready = [quiet](const std::string& origin) {
-    if (!quiet) std::fprintf(stderr, "rvlio live: listening on %s\n", origin.c_str());
+  // For an operator at a terminal (as the progress lines of run): an error
+  // later stays the only line a script sees.
+  const bool tell = !args.Has("quiet") && ::isatty(STDERR_FILENO);
+  live.on_ready = [tell](const std::string& origin) {
+    if (tell) std::fprintf(stderr, "rvlio live: listening on %s (Ctrl-C ends it)\n", origin.c_str());
   };
   size_t divergence_warned = 0;
   live.progress = [&divergence_warned](const RunProgress& p) {

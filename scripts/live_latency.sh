@@ -32,7 +32,7 @@ for _ in $(seq 100); do python3 -c "import socket; socket.create_connection(('12
 setsid "$tool" live --ros1 --config "$config" --out "$work/out" "$@" >"$work/live.out" 2>"$work/live.err" &
 live=$!
 pids+=($live)
-for _ in $(seq 100); do grep -q "listening on" "$work/live.err" && break; sleep 0.1; done
+for _ in $(seq 100); do [[ -e $work/out/trajectory.partial.tum ]] && break; sleep 0.1; done  # subscribed
 setsid rosbag play -q -d 1 -r "$rate" "$bag" >"$work/play.log" 2>&1 &
 play=$!
 pids+=($play)

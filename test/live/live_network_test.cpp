@@ -124,7 +124,7 @@ class LiveEnvironment : public ::testing::Environment {
 ::testing::Environment* const kEnvironment =
     ::testing::AddGlobalTestEnvironment(new LiveEnvironment);
 
-// `rvlio live` as a child; Ready() once it subscribed.
+// `rvlio live` as a child; WaitReady() once it subscribed.
 struct LiveProcess {
   std::string out, log;
   pid_t pid = -1;
@@ -135,10 +135,11 @@ struct LiveProcess {
     args.insert(args.end(), extra.begin(), extra.end());
     pid = signals_test::Spawn(args, log + ".out", log);
   }
+  // Subscribed: RunRecording has started (it opens trajectory.partial.tum).
   bool WaitReady() const {
     int status = 0;
     return signals_test::WaitUntil(
-        pid, [&] { return ReadFile(log).find("listening on") != std::string::npos; }, &status);
+        pid, [&] { return std::filesystem::exists(out + "/trajectory.partial.tum"); }, &status);
   }
   int Stop(int signal = SIGINT) const {
     ::kill(pid, signal);
@@ -311,10 +312,10 @@ TEST(LiveRos1, WrongTopicTypeIsOneLine) {
   Wait(play);
   EXPECT_EQ(rc, 2);
   const std::string err = live.Err();
-  const std::string last = err.substr(err.rfind("rvlio live: error: "));
-  EXPECT_NE(last.find("carries sensor_msgs/Imu, expected sensor_msgs/PointCloud2"),
+  EXPECT_EQ(err.rfind("rvlio live: error: ", 0), 0u) << err;
+  EXPECT_NE(err.find("carries sensor_msgs/Imu, expected sensor_msgs/PointCloud2"),
             std::string::npos) << err;
-  EXPECT_EQ(last.find('\n'), last.size() - 1) << err;
+  EXPECT_EQ(err.find('\n'), err.size() - 1) << "more than one line: " << err;
   EXPECT_FALSE(std::filesystem::exists(live.out + "/summary.json"));
 }
 
@@ -322,8 +323,10 @@ TEST(LiveRos1, NoPublisherIsOneLineNamingTheTopic) {
   LiveProcess live("ros1_silent", {"--ros1", "--set", "lidar.wait_timeout=1"});
   EXPECT_EQ(Wait(live.pid), 2);
   const std::string err = live.Err();
-  EXPECT_NE(err.find("rvlio live: error: no message on lidar.topic '/os_cloud_node/points' "
-                     "within lidar.wait_timeout 1.0 s"), std::string::npos) << err;
+  EXPECT_EQ(err.rfind("rvlio live: error: no message on lidar.topic '/os_cloud_node/points' "
+                      "within lidar.wait_timeout 1.0 s", 0), 0u) << err;
+  EXPECT_EQ(err.find('\n'), err.size() - 1) << "more than one line: " << err;
+  EXPECT_FALSE(std::filesystem::exists(live.out)) << "an output folder was left";
 }
 
 TEST(LiveRos1, UnreachableMasterIsOneLine) {
