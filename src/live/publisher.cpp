@@ -13,6 +13,7 @@ namespace {
 
 constexpr TimeNs kImuKeepNs = 2000000000;  // IMU samples kept for propagation and deskew (2 s)
 constexpr size_t kMaxPathPoses = 10000;    // the published path keeps its newest poses
+constexpr TimeNs kPathPeriodNs = 1000000000;  // and is published at most once a second
 
 PoseMessage ToPose(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
   PoseMessage m;
@@ -125,10 +126,12 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
     after_imu_ms_.push_back(ms(now - arrival->covered));
   }
   if (arrival && imu.size() >= 2) PublishRegisteredScan(r, arrival->scan, imu);
-  path_.stamp_ns = r.t_ns;
   if (path_.poses.size() >= kMaxPathPoses) path_.poses.erase(path_.poses.begin());
   path_.poses.emplace_back(r.t_ns, message.pose);
-  transport_->Publish(path_);
+  if (path_.stamp_ns == 0 || r.t_ns - path_.stamp_ns >= kPathPeriodNs) {
+    path_.stamp_ns = r.t_ns;
+    transport_->Publish(path_);
+  }
   PublishStatus(r);
   PublishMap(r.t_ns, odometry);
 }

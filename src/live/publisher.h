@@ -6,8 +6,9 @@
 //     IMU-rate odometry, so it keeps the IMU's rate while the estimator works;
 //   - OnResult, on the estimator's thread, for every scan result: the
 //     scan-rate odometry and TF first (the latency is measured there), then
-//     the registered scan, the path, the status and, every live.map_period,
-//     the map. The propagator then restarts from the new estimate.
+//     the registered scan, the status, the path (at most once a second) and,
+//     every live.map_period, the map. The propagator restarts from the new
+//     estimate before the odometry is published.
 #include <chrono>
 #include <mutex>
 #include <vector>
