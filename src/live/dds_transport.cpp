@@ -145,6 +145,11 @@ void DdsTransport::Shutdown() {
   threads_.clear();
 }
 
+// Reliable writers wait until their readers acknowledged everything.
+void DdsTransport::Flush() {
+  for (const auto& [topic, writer] : writers_) (void)dds_wait_for_acks(writer.entity, DDS_MSECS(500));
+}
+
 Status DdsTransport::AdvertiseRaw(const std::string& topic, const std::string& ros_type,
                                   bool reliable) {
   // dds_create_topic_sertype may replace `type` by an equal one already registered.

@@ -38,6 +38,7 @@ class DdsTransport final : public Transport {
   void Publish(const PathMessage& msg) override;
   void Publish(const DiagnosticMessage& msg) override;
   void Shutdown() override;
+  void Flush() override;
 
   // A writer of `ros_type` ("sensor_msgs/msg/Imu") on `topic`: reliable, keep
   // last 10 (ROS 2's default) or best effort, keep last 5 (sensor data).

@@ -77,6 +77,12 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   source_options.stopped = [&stop] { return !stop().empty(); };
   LiveSensorSource source(source_options);
   live_detail::LivePublisher publisher(&net, &source, options);
+  // The transport's threads call into source and publisher: they stop
+  // before those go, on every way out of this function.
+  struct StopReceiving {
+    Transport* net;
+    ~StopReceiving() { net->Shutdown(); }
+  } stop_receiving{&net};
 
   if (Status s = net.Advertise(live_detail::OutputTopics(options.live.topic_namespace)); !s.ok())
     return s;
@@ -129,6 +135,7 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   };
   StatusOr<RunResult> result = RunRecording(run);
   net.Shutdown();
+  if (result.ok()) net.Flush();  // the poses of the last scans reach the subscribers
   fill();
   LiveResult out;
   out.figures = figures;

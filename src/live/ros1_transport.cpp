@@ -157,6 +157,10 @@ class Ros1Transport final : public Transport {
     status_.publish(out);
   }
 
+  // roscpp has no call that waits for its outgoing queues: the messages of
+  // the last results (published just before the end) get a moment to leave.
+  void Flush() override { std::this_thread::sleep_for(std::chrono::milliseconds(200)); }
+
   void Shutdown() override {
     stop_ = true;
     for (std::thread& t : threads_)

@@ -60,6 +60,9 @@ class Transport {
   virtual void Publish(const DiagnosticMessage& msg) = 0;
   // Stops the receiving threads (no callback runs after it returns).
   virtual void Shutdown() = 0;
+  // Gives what was published the time to leave before the process ends
+  // (at most about half a second).
+  virtual void Flush() = 0;
 };
 
 // ROS 1: the master from ROS_MASTER_URI, answering within
