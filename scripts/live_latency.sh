@@ -25,7 +25,8 @@ cleanup() {
 }
 trap cleanup EXIT
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-export ROS_HOME=$work/ros ROS_MASTER_URI=http://127.0.0.1:$port
+# Everything on the loopback interface (roscpp's URIs).
+export ROS_HOME=$work/ros ROS_MASTER_URI=http://127.0.0.1:$port ROS_IP=127.0.0.1
 setsid rosmaster --core -p "$port" >"$work/master.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do python3 -c "import socket; socket.create_connection(('127.0.0.1', $port))" 2>/dev/null && break; sleep 0.1; done

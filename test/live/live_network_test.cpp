@@ -42,6 +42,15 @@ using testing_cli::MakeTempDir;
 using testing_cli::ReadFile;
 using testing_cli::ToolRun;
 
+// Cyclone DDS configuration (CYCLONEDDS_URI accepts the XML itself): the
+// loopback interface only, discovery by unicast to the participants of this
+// host (participant indexes), no multicast.
+constexpr const char* kLoopbackOnlyDds =
+    "<CycloneDDS><Domain><General><Interfaces><NetworkInterface address=\"127.0.0.1\"/>"
+    "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
+    "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>20</MaxAutoParticipantIndex>"
+    "<Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>";
+
 constexpr const char* kLidarTopic = "/os_cloud_node/points";
 constexpr const char* kImuTopic = "/imu/data";
 
@@ -95,6 +104,10 @@ class LiveEnvironment : public ::testing::Environment {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     ASSERT_TRUE(PortOpen(port)) << ReadFile(world->dir + "/master.err");
     ::setenv("ROS_MASTER_URI", ("http://127.0.0.1:" + std::to_string(port)).c_str(), 1);
+    // Every process stays on the loopback interface: roscpp's URIs, and DDS
+    // discovery by unicast to 127.0.0.1 (no multicast onto another interface).
+    ::setenv("ROS_IP", "127.0.0.1", 1);
+    ::setenv("CYCLONEDDS_URI", kLoopbackOnlyDds, 1);
     std::random_device rd;
     world->domain = 1 + static_cast<int>(rd() % 200);  // no cross-talk with other runs
     ::setenv("ROS_DOMAIN_ID", std::to_string(world->domain).c_str(), 1);
