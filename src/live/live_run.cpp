@@ -1,5 +1,6 @@
 // RunLive (rvlio/live/live.h): a transport feeding a LiveSensorSource that
 // RunRecording reads, and a LivePublisher fed by both.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 
@@ -131,7 +132,10 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
     (*summary)["command"] = "live";
     (*summary)["live"] = LiveJson(figures);
     (*summary)["interrupted"] = !stop_reason.empty();
-    if (!stop_reason.empty()) (*summary)["signal"] = stop_reason;
+    if (!stop_reason.empty()) {  // as an interrupted `run` says it
+      (*summary)["signal"] = stop_reason;
+      (*summary)["last_stamp_s"] = NsToSeconds(std::max<TimeNs>(publisher.last_result_ns(), 0));
+    }
   };
   StatusOr<RunResult> result = RunRecording(run);
   net.Shutdown();

@@ -29,6 +29,8 @@ class LivePublisher {
   void OnResult(const ScanResult& result, const Odometry& odometry);
   // The figures of the publications (latency, IMU-rate output).
   void Fill(LiveFigures* figures) const;
+  // The stamp of the newest result (-1 before any).
+  TimeNs last_result_ns() const { return path_.poses.empty() ? -1 : path_.poses.back().first; }
 
  private:
   using Clock = std::chrono::steady_clock;
