@@ -67,7 +67,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # LasExport.* and LasWriter.*. The
 # survey-coordinates suite (SurveyCoordinates) runs a flight twice, a refine
 # and eval --map of a 590 k point survey; the local frame it checks runs here
-# in LocalOrigin, VoxelMap, ReferenceMap, MapMetrics and ReferenceMapFileTest.
+# in LocalOrigin, VoxelMap, ReferenceMap, MapMetrics and ReferenceMapFileTest. Live runs `rvlio live` against rosmaster,
+# rosbag and DDS in real time (about a minute of wall time whatever the
+# build); its queues, ordering and errors run here in LiveSensorSource.*,
+# the propagator in ImuPropagator.*, the output messages in CdrTest.*.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -117,6 +120,7 @@ ex=(
   Refine.SummarizedFactorsAgreeWithExactFactors
   'LasReaders\..*' LasWriter.MemoryStaysBoundedWhileMillionsOfPointsAreWritten
   LasExport.AMapOfMillionsOfPointsIsExportedInBoundedMemory MapLasCli.RunRefineAndMergeWriteMapLasWhenAsked
+  Live
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

@@ -76,6 +76,16 @@ struct RunArgs {
   StopFn stop;
   // Called after every message read and once after the end of the input.
   std::function<void(const RunProgress&)> progress;
+  // A source to read instead of the recording `bag` (not owned), e.g. the
+  // network messages of `rvlio live` (formats/live_source.h): read as it
+  // is (`window` must be the default; no extrinsic from the recording);
+  // `bag` then only names it in summary.json.
+  SensorBagReader* source = nullptr;
+  // Called on the calling thread with each scan result as it is estimated
+  // (in order, once each), with the odometry that made it.
+  std::function<void(const ScanResult&, const Odometry&)> on_result;
+  // Called with summary.json before it is written (e.g. `live` adds its figures).
+  std::function<void(nlohmann::json* summary)> annotate_summary;
 };
 
 struct RunResult {

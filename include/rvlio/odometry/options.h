@@ -9,6 +9,7 @@
 #include "rvlio/degeneracy/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
+#include "rvlio/formats/live_options.h"
 #include "rvlio/formats/reader_options.h"
 #include "rvlio/lidar/extrinsics.h"
 #include "rvlio/lidar/options.h"
@@ -44,6 +45,7 @@ struct OdometryOptions {
   DivergenceOptions divergence;
   LocalizationOptions localization;  // used only with a reference map (`run --map`)
   ReaderOptions io;
+  LiveOptions live;  // `rvlio live` only (docs/live.md)
   OutputOptions output;  // optional output files (map.las)
   SurveyOptions survey;  // the map frame's coordinate reference system
 
@@ -62,6 +64,7 @@ struct OdometryOptions {
     v.Section("divergence", divergence);
     v.Section("localization", localization);
     v.Section("io", io);
+    v.Section("live", live);
     v.Section("output", output);
     v.Section("survey", survey);
   }
@@ -72,7 +75,7 @@ struct OdometryOptions {
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), degeneracy.Validate(), ieskf.Validate(), smoother.Validate(),
-                     divergence.Validate(), localization.Validate(), io.Validate(),
+                     divergence.Validate(), localization.Validate(), io.Validate(), live.Validate(),
                      output.Validate(), survey.Validate()})
       if (!m.ok()) return m;
     if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
