@@ -16,6 +16,7 @@
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/reference.h"
 #include "rvlio/outputs/output_options.h"
+#include "rvlio/refine/control_options.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/window/options.h"
 
@@ -46,6 +47,8 @@ struct OdometryOptions {
   ReaderOptions io;
   OutputOptions output;  // optional output files (map.las)
   SurveyOptions survey;  // the map frame's coordinate reference system
+  ControlOptions control;  // control and check points (`refine --control`, docs/control.md)
+  GnssOptions gnss;        // GNSS fixes of the recording (refine, docs/control.md)
 
   template <class V>
   void Visit(V& v) {
@@ -64,6 +67,8 @@ struct OdometryOptions {
     v.Section("io", io);
     v.Section("output", output);
     v.Section("survey", survey);
+    v.Section("control", control);
+    v.Section("gnss", gnss);
   }
 
   // Ranges and choices of every key, then the cross-field rules of each module.
@@ -73,7 +78,7 @@ struct OdometryOptions {
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), degeneracy.Validate(), ieskf.Validate(), smoother.Validate(),
                      divergence.Validate(), localization.Validate(), io.Validate(),
-                     output.Validate(), survey.Validate()})
+                     output.Validate(), survey.Validate(), control.Validate(), gnss.Validate()})
       if (!m.ok()) return m;
     if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
       return Status::InvalidInput(
