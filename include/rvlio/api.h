@@ -137,6 +137,11 @@ struct RefineArgs {
   // A reference map (PCD or PLY, metres) in the initial trajectory's frame:
   // every scan is also held to it (`refine --map`, docs/survey.md).
   std::string map;
+  // A control file (`refine --control`, docs/control.md): the initial
+  // trajectory is brought into the survey frame and refined with the control
+  // points as factors; outputs in the survey frame, out_dir also receives
+  // control.csv. GNSS fixes (options.gnss.topic) are ties as well.
+  std::string control;
 };
 
 struct RefineRunResult {
@@ -149,6 +154,9 @@ struct RefineRunResult {
   bool written = false;
   std::optional<RefineJobSpan> job;  // a chunk job's span (chunk.json; none otherwise)
   nlohmann::json chunk;         // chunk.json of a chunk job (null otherwise)
+  // With a control file: control.csv's text (the residual of every row) and
+  // its rows; empty otherwise.
+  std::string control_csv;
 };
 
 // Errors: unreadable inputs, a checkpoint that is missing or belongs to other
@@ -240,6 +248,10 @@ struct SimulateResult {
   // localizability.csv (the true per-scan localizability, sim/localizability.h)
   // when localizability.enabled, else ""; its scans flagged degenerate.
   std::string localizability_path;
+  // NAME_control.csv (marks.enabled: the stop-and-go marks in the survey
+  // frame) and NAME_gt_survey.tum (marks or gnss: the ground truth in the
+  // survey frame), else "".
+  std::string control_path, gt_survey_path;
   int64_t degenerate_scans = 0;
   double reference_map_s = 0.0;  // wall time of the survey
   int64_t scans = 0, imu_samples = 0;

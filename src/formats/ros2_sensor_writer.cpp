@@ -78,6 +78,13 @@ class McapStorage final : public Ros2Storage {
     return writer_->Write(m);
   }
 
+  Status WriteNavSatFix(const std::string& topic, const NavSatFix& fix) override {
+    if (!storage_) return Closed();
+    if (Status s = CheckRos2Stamp(fix.header_stamp_ns, "NavSatFix stamp"); !s.ok()) return s;
+    return Write(topic, kNavSatFixRos2Type, cdr::NavSatFixDefinition(), fix.header_stamp_ns,
+                 EncodeNavSatFixCdr(fix));
+  }
+
   Status Close() override { return writer_->Close(); }
 
  private:

@@ -36,6 +36,7 @@ inline constexpr const char* kStringType = "std_msgs/msg/String";
 const std::string& PointCloud2Definition();
 const std::string& ImuDefinition();
 const std::string& LivoxCustomMsgDefinition();
+const std::string& NavSatFixDefinition();  // sensor_msgs/msg/NavSatFix (formats/navsatfix.h)
 
 // Bounds-checked sequential reader of one CDR payload.
 class Reader {

@@ -1,0 +1,144 @@
+#pragma once
+// `rvlio refine --control FILE` and `gnss.topic` (docs/control.md): what the
+// I/O layer does around the refinement to deliver it in the survey frame.
+//
+//   before reading   the control file and the GNSS fixes (already in the
+//                    survey frame through PROJ) are checked;
+//   while reading    every IMU sample is seen (the rest periods of
+//                    stop-and-go marks) and every raw scan (wall targets);
+//   before refining  each mark, target and fix becomes a PositionTie; the
+//                    initial trajectory is carried into the survey frame by
+//                    the yaw-and-translation fit (refine/control.h), then
+//                    into a local frame near the ties (the survey's
+//                    coordinates are large) where the refinement runs;
+//   after refining   the residual of every row of the control file
+//                    (control.csv), summary.json's "survey" and "control",
+//                    and the warnings.
+// Every refusal is InvalidInput naming the control file and line, or the key.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "rvlio/common/status.h"
+#include "rvlio/api.h"
+#include "rvlio/common/types.h"
+#include "rvlio/formats/control_file.h"
+#include "rvlio/formats/navsatfix.h"
+#include "rvlio/imu/rest.h"
+#include "rvlio/math/pose.h"
+#include "rvlio/odometry/options.h"
+#include "rvlio/refine/control.h"
+
+namespace rvlio {
+
+// A GNSS fix in the survey frame.
+struct SurveyFix {
+  TimeNs t_ns = 0;
+  Eigen::Vector3d p_survey = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d sqrt_information = Eigen::Matrix3d::Identity();
+  double sigma_m = 0.03;  // a scalar for the alignment's weight (root of the mean variance)
+};
+
+// One row of control.csv.
+struct ControlResidual {
+  ControlRow row;
+  std::string kind;  // "mark" or "target"
+  double sigma_m = 0.0;
+  TimeNs t_ns = 0;  // mark: the tie time (middle of the rest period); target: first sighting
+  int scans = 0;    // target: the scans that tie it
+  bool estimated = false;
+  Eigen::Vector3d p_estimated = Eigen::Vector3d::Zero();  // survey frame
+  Eigen::Vector3d Residual() const { return p_estimated - row.p_survey; }
+};
+
+class SurveyTies {
+ public:
+  // rows: the control file's (may be empty with GNSS only); fixes: GNSS.
+  SurveyTies(std::string control_path, std::vector<ControlRow> rows, std::vector<SurveyFix> fixes,
+             const OdometryOptions& options);
+
+  bool active() const { return !rows_.empty() || !fixes_.empty(); }
+  // The raw IMU samples and scans of the recording as they are read (scans
+  // with their --init pose at the end; see NeedsScans).
+  void ObserveImu(const ImuSample& imu);
+  bool NeedsScans() const { return !sightings_.empty(); }
+  void ObserveScan(const Scan& scan, const Trajectory& init);
+
+  // Builds the ties, fits the alignment (skipped with hold_frame: a --map
+  // fixes the frame and --init is in it) and carries `init` into the local
+  // survey frame. *ties: in that frame, control points and fixes only.
+  Status Prepare(bool hold_frame, Trajectory* init, std::vector<PositionTie>* ties);
+  // The survey frame's point that is the local frame's origin.
+  const Eigen::Vector3d& origin() const { return origin_; }
+  // After the refinement: the residuals at the refined trajectory (local frame).
+  void Evaluate(const Trajectory& refined_local);
+
+  std::string ControlCsv() const;  // control.csv
+  nlohmann::json SurveyJson(const std::string& crs) const;
+  nlohmann::json ControlJson() const;
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  const std::vector<ControlResidual>& residuals() const { return residuals_; }
+  bool has_control_file() const { return !control_path_.empty(); }
+  // FNV-1a of the rows and fixes: part of a checkpoint's fingerprint.
+  uint64_t ContentHash() const;
+  void set_gnss_stats(const NavSatFixStats& stats) { gnss_stats_ = stats; }
+
+ private:
+  Status PairRestPeriods();
+  Status MarkTies(const Trajectory& init);
+  Status TargetTies();
+  void FixTies(const Trajectory& init);
+  Status Align(bool hold_frame);
+  Status CheckDistances() const;
+  std::string Where(const ControlRow& row) const;
+
+  std::string control_path_;
+  std::vector<ControlRow> rows_;
+  std::vector<SurveyFix> fixes_;
+  ControlOptions control_;
+  GnssOptions gnss_;
+  std::vector<ImuSample> imu_;
+  Pose3 T_imu_lidar_;
+  std::vector<Eigen::Vector3d> target_points_;  // per target row, in the --init frame
+  std::vector<int> target_rows_;
+  TargetSightings sightings_;
+  // Per row: its tie time window (marks) and ties in the survey frame.
+  std::vector<ControlResidual> residuals_;
+  std::vector<std::vector<PositionTie>> row_ties_;  // survey frame
+  std::vector<Eigen::Vector3d> row_frame_points_;   // the row's point in the --init frame
+  std::vector<PositionTie> fix_ties_;               // survey frame
+  std::vector<Eigen::Vector3d> fix_frame_points_;
+  std::vector<double> fix_sigma_m_;
+  std::vector<bool> fix_outlier_;
+  int fixes_outside_init_ = 0;
+  YawTranslation alignment_;
+  bool aligned_ = false;
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+  std::vector<double> fix_residual_m_;
+  std::vector<std::string> warnings_;
+  NavSatFixStats gnss_stats_;
+};
+
+// The control file (empty path: none) and, with gnss.topic, the recording's
+// fixes in the survey frame (formats/navsatfix.h, PROJ); null when neither
+// is given. InvalidInput naming the file, line, topic or key.
+StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_path,
+                                                     const std::string& bag,
+                                                     const OdometryOptions& options);
+// The recording's NavSatFix fixes (gnss.topic) in survey.crs.
+StatusOr<std::vector<SurveyFix>> ReadSurveyFixes(const std::string& bag,
+                                                 const OdometryOptions& options,
+                                                 NavSatFixStats* stats);
+
+// After the refinement (local survey frame): the residuals, then the
+// trajectory and the map moved into the survey frame, control.csv's text and
+// the warnings into *r.
+void DeliverInSurveyFrame(SurveyTies* survey, RefineRunResult* r);
+// summary.json's "survey" and "control".
+void AddSurveySummary(const SurveyTies& survey, const std::string& crs, nlohmann::json* summary);
+
+}  // namespace rvlio
