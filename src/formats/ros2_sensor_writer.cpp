@@ -78,13 +78,6 @@ class McapStorage final : public Ros2Storage {
     return writer_->Write(m);
   }
 
-  Status WriteNavSatFix(const std::string& topic, const NavSatFix& fix) override {
-    if (!storage_) return Closed();
-    if (Status s = CheckRos2Stamp(fix.header_stamp_ns, "NavSatFix stamp"); !s.ok()) return s;
-    return Write(topic, kNavSatFixRos2Type, cdr::NavSatFixDefinition(), fix.header_stamp_ns,
-                 EncodeNavSatFixCdr(fix));
-  }
-
   Status Close() override { return writer_->Close(); }
 
  private:
@@ -258,6 +251,13 @@ class Ros2SensorWriter final : public SensorBagWriter {
     msg.angular_velocity = {sample.gyro_imu.x(), sample.gyro_imu.y(), sample.gyro_imu.z()};
     msg.linear_acceleration = {sample.acc_imu.x(), sample.acc_imu.y(), sample.acc_imu.z()};
     return Write(topic, cdr::kImuType, cdr::ImuDefinition(), sample.t_ns, cdr::EncodeImu(msg));
+  }
+
+  Status WriteNavSatFix(const std::string& topic, const NavSatFix& fix) override {
+    if (!storage_) return Closed();
+    if (Status s = CheckRos2Stamp(fix.header_stamp_ns, "NavSatFix stamp"); !s.ok()) return s;
+    return Write(topic, kNavSatFixRos2Type, cdr::NavSatFixDefinition(), fix.header_stamp_ns,
+                 EncodeNavSatFixCdr(fix));
   }
 
   Status Close() override {
