@@ -242,13 +242,6 @@ void SurveyTies::FixTies(const Trajectory& init) {
 // Fixes farther than gnss.max_distance_m after a first fit are outliers and
 // the fit is repeated without them.
 Status SurveyTies::Align(bool hold_frame) {
-  int control_rows = 0;
-  for (const ControlRow& row : rows_) control_rows += row.role == ControlRole::kControl ? 1 : 0;
-  if (fix_ties_.empty() && control_rows < 2)
-    return Status::InvalidInput(
-        control_path_ + ": " + std::to_string(control_rows) +
-        " control point(s) (role control); at least 2 are needed to fix the survey frame (check "
-        "points do not count), or GNSS fixes (gnss.topic)");
   if (hold_frame) return Status::Ok();
   for (int pass = 0; pass < 2; ++pass) {
     std::vector<AlignmentPoint> points;
@@ -297,6 +290,13 @@ Status SurveyTies::Prepare(bool hold_frame, Trajectory* init, std::vector<Positi
   for (size_t i = 0; i < rows_.size(); ++i) {
     residuals_[i].sigma_m = rows_[i].sigma_m > 0.0 ? rows_[i].sigma_m : control_.sigma_m;
   }
+  int control_rows = 0;
+  for (const ControlRow& row : rows_) control_rows += row.role == ControlRole::kControl ? 1 : 0;
+  if (fixes_.empty() && control_rows < 2)
+    return Status::InvalidInput(
+        control_path_ + ": " + std::to_string(control_rows) +
+        " control point(s) (role control); at least 2 are needed to fix the survey frame (check "
+        "points do not count), or GNSS fixes (gnss.topic)");
   if (Status s = PairRestPeriods(); !s.ok()) return s;
   for (size_t i = 0; i < rows_.size(); ++i) residuals_[i].row = rows_[i];
   imu_.clear();

@@ -1,0 +1,172 @@
+// `rvlio refine --control` end to end on one short simulated stop-and-go
+// flight (4 marks 10 m apart in a UTM-sized survey frame, 512 columns,
+// simulated once: CachedSimulate), and every bad input of the control file
+// with its one line and nothing written (docs/control.md).
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_util.h"
+#include "rvlio/formats/trajectory_io.h"
+#include "rvlio/refine/refine_states.h"
+
+namespace rvlio {
+namespace {
+
+using testing_cli::ExpectOneErrorLine;
+using testing_cli::ReadFile;
+using testing_cli::RunTool;
+namespace fs = std::filesystem;
+
+constexpr double kStartHeight = 0.3;  // world.start_height: the lever arm's z
+
+// marks at 0, 10, 20, 30 m; M3 is a check point (marks.check_every 3).
+const char* const kSimArgs =
+    "--preset stopgo --seed 4 --duration 50 --name sg --set lidar.columns=512"
+    " --set \"trajectory.waypoints=0,0,0; 0,0,1; 10,0,1; 10,0,0; 10,0,1; 20,0,1; 20,0,0;"
+    " 20,0,1; 30,0,1; 30,0,0\" --set trajectory.landing_time=3 --set marks.check_every=3"
+    " --set world.length=45";
+
+class ControlCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing_cli::MakeTempDir("rvlio_control");
+    data_ = dir_ + "/data";
+    const testing_cli::ToolRun sim = testing_cli::CachedSimulate(kSimArgs, data_, dir_);
+    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // refine with the ground truth (world frame) as --init: bad inputs are
+  // refused before the solve.
+  testing_cli::ToolRun Refine(const std::string& control, const std::string& out,
+                              const std::string& extra = "") {
+    return RunTool("refine --bag " + data_ + "/sg.bag --config " + data_ + "/sg.yaml --init " +
+                       data_ + "/sg_gt.tum --control " + control + " --out " + out + " " + extra,
+                   dir_);
+  }
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::string path = dir_ + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+  }
+  // The control file's rows after the header.
+  std::vector<std::string> MarkRows() {
+    std::vector<std::string> rows;
+    std::istringstream in(ReadFile(data_ + "/sg_control.csv"));
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) rows.push_back(line);
+    return rows;
+  }
+
+  std::string dir_, data_;
+};
+
+TEST_F(ControlCli, SimulatorWritesMarksInTheSurveyFrame) {
+  const std::vector<std::string> rows = MarkRows();
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[2].substr(0, 3), "M3,");
+  EXPECT_NE(rows[2].find(",check"), std::string::npos);
+  EXPECT_NE(rows[0].find(",control"), std::string::npos);
+  // M1 (the start) lies at the survey frame's origin (E, N) and 0.3 m below h + IMU height.
+  EXPECT_NE(rows[0].find("M1,500000.0"), std::string::npos) << rows[0];
+  EXPECT_TRUE(fs::exists(data_ + "/sg_gt_survey.tum"));
+  EXPECT_NE(ReadFile(data_ + "/sg.yaml").find("lever_arm: [0, 0, 0.3]"), std::string::npos);
+}
+
+// The flight tied to three control marks: outputs in the survey frame, the
+// check point's residual is its true error, summary and control.csv agree.
+TEST_F(ControlCli, RunThenRefineDeliversInTheSurveyFrame) {
+  const std::string run = dir_ + "/run", out = dir_ + "/refined";
+  const testing_cli::ToolRun r = RunTool("run --bag " + data_ + "/sg.bag --config " + data_ +
+                                             "/sg.yaml --out " + run + " --quiet --control " +
+                                             data_ + "/sg_control.csv",
+                                         dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("--control is used by refine"), std::string::npos) << r.err;
+  const testing_cli::ToolRun f =
+      RunTool("refine --bag " + data_ + "/sg.bag --config " + data_ + "/sg.yaml --init " + run +
+                  "/trajectory.tum --control " + data_ + "/sg_control.csv --out " + out,
+              dir_);
+  ASSERT_EQ(f.exit_code, 0) << f.err;
+  EXPECT_NE(f.out.find("control points: 3"), std::string::npos) << f.out;
+  // ATE without alignment against the survey-frame ground truth.
+  const double ate = testing_cli::AteNoAlign(data_ + "/sg_gt_survey.tum", out + "/trajectory.tum", dir_);
+  EXPECT_LT(ate, 0.05) << "ATE in the survey frame, no alignment";
+  // control.csv: the check point's residual equals its true error (the
+  // estimate against the true mark under the true IMU) within a few mm.
+  std::istringstream csv(ReadFile(out + "/control.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "name,role,kind,x,y,z,x_est,y_est,z_est,dx,dy,dz,d3d,sigma_m,t_s,scans");
+  StatusOr<Trajectory> gt = ReadTum(data_ + "/sg_gt_survey.tum");
+  ASSERT_TRUE(gt.ok());
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    std::vector<std::string> c;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) c.push_back(cell);
+    ASSERT_EQ(c.size(), 16u) << line;
+    const Eigen::Vector3d est(std::stod(c[6]), std::stod(c[7]), std::stod(c[8]));
+    const Eigen::Vector3d reported(std::stod(c[9]), std::stod(c[10]), std::stod(c[11]));
+    Pose3 T;
+    ASSERT_TRUE(InterpolatePose(*gt, SecondsToNs(std::stod(c[14])), &T));
+    const Eigen::Vector3d true_mark = T.t - Eigen::Vector3d(0, 0, kStartHeight);
+    const Eigen::Vector3d true_error = est - true_mark;
+    EXPECT_LT((reported - true_error).norm(), 0.008) << line;  // the marks' noise: 2 mm per axis
+    if (c[1] == "check") EXPECT_LT(reported.norm(), 0.05) << line;
+  }
+  EXPECT_EQ(rows, 4);
+  const nlohmann::json s = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+  EXPECT_EQ(s["survey"]["control_points"], 3);
+  EXPECT_EQ(s["survey"]["check_points"], 1);
+  EXPECT_NEAR(s["survey"]["alignment"]["yaw_deg"].get<double>(), 30.0, 1.0);
+  EXPECT_EQ(s["control"]["check"]["count"], 1);
+  EXPECT_EQ(s["control"]["check"]["max_name"], "M3");
+}
+
+TEST_F(ControlCli, BadControlFilesAreRefusedWithOneLineAndNothingWritten) {
+  const std::vector<std::string> m = MarkRows();
+  const std::string out = dir_ + "/never";
+  struct Case {
+    std::string name, text, part;
+  };
+  // A typo: M4's easting (5000xx.xxxx) 100 m off.
+  std::string typo = m[3];
+  ASSERT_EQ(typo.substr(3, 4), "5000");
+  typo[6] = '1';
+  const std::vector<Case> cases = {
+      {"nocol.csv", "name,x,y\nM1,1,2\n", "lacks the column 'z'"},
+      {"one.csv", "name,x,y,z,role\n" + m[0] + "\n" + m[2] + "\n", "at least 2 are needed"},
+      {"oneplace.csv",
+       "name,x,y,z,t_start,t_end\nA,500000,5400000,250,1700000000.2,1700000002\n"
+       "B,500000.2,5400000,250,1700000000.2,1700000002\n",
+       "cannot fix the heading"},
+      {"rests.csv", "name,x,y,z\n" + m[0] + "\n" + m[1] + "\n" + m[2] + "\n" + m[3] + "\nM5,1,2,3\n",
+       "5 stop-and-go row(s) without t_start,t_end, but the IMU shows 4 rest period(s)"},
+      {"target.csv", "name,x,y,z,role,map_x,map_y,map_z\n" + m[0] + ",,,\n" + m[1] + ",,,\n" +
+                         m[2] + ",,,\n" + m[3] + ",,,\n" + "T1,500000,5400000,255,,500,500,500\n",
+       "line 6 (T1): no scan saw the target"},
+      {"typo.csv", "name,x,y,z,role\n" + m[0] + "\n" + m[1] + "\n" + m[2] + "\n" + typo + "\n",
+       "line 5 (M4)"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    ExpectOneErrorLine(Refine(Write(c.name, c.text), out), "refine", c.part);
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // An unknown CRS with GNSS; a control file that is not there.
+  ExpectOneErrorLine(Refine(data_ + "/sg_control.csv", out,
+                            "--set gnss.topic=/gnss/fix --set survey.crs=EPSG:999999"),
+                     "refine", "EPSG:999999");
+  ExpectOneErrorLine(Refine(dir_ + "/missing.csv", out), "refine", "missing.csv");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace rvlio
