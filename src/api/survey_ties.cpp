@@ -253,7 +253,8 @@ Status SurveyTies::Align(bool hold_frame) {
       if (!fix_outlier_[i])
         points.push_back({fix_frame_points_[i], fix_ties_[i].p_world,
                           1.0 / (fix_sigma_m_[i] * fix_sigma_m_[i])});
-    StatusOr<YawTranslation> fit = FitYawTranslation(points, control_.min_spread_m);
+    StatusOr<YawTranslation> fit = FitYawTranslation(points, control_.min_spread_m,
+                                                     control_.tilt_sigma_deg * M_PI / 180.0);
     if (!fit.ok())
       return Status::InvalidInput((rows_.empty() ? "gnss.topic" : control_path_) +
                                   ": the control points and GNSS fixes: " + fit.status().message());
@@ -400,6 +401,7 @@ nlohmann::json SurveyTies::SurveyJson(const std::string& crs) const {
   if (aligned_) {
     const Eigen::Vector3d& t = alignment_.T_survey_frame.t;
     j["alignment"] = {{"yaw_deg", alignment_.yaw_deg},
+                      {"tilt_deg", {alignment_.tilt_deg[0], alignment_.tilt_deg[1]}},
                       {"translation_m", {t.x(), t.y(), t.z()}},
                       {"spread_m", alignment_.spread_m}};
   }

@@ -13,6 +13,7 @@
 #include "rvlio/common/check.h"
 #include "rvlio/common/text.h"
 #include "rvlio/factors/position_factor.h"
+#include "rvlio/math/so3.h"
 #include "rvlio/refine/refine_chunks.h"
 
 namespace rvlio {
@@ -122,8 +123,56 @@ double HorizontalSpread(const std::vector<Eigen::Vector3d>& p) {
 // Weighted centroids c_f, c_s; the yaw maximizing sum w (R d_f) . d_s over
 // the horizontal parts d of the centred points is atan2(sum w d_f x d_s,
 // sum w d_f . d_s); t = c_s - R c_f (z included: the height offset).
+namespace {
+
+// R = Rz(yaw) Exp((a, b, 0)).
+Eigen::Matrix3d YawTilt(double yaw, double a, double b) {
+  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+         so3::Exp(Eigen::Vector3d(a, b, 0.0));
+}
+
+// Weighted residuals of the centred points under x = (yaw, a, b) with t =
+// c_s - R c_f, and the tilt prior (a, b) / sigma.
+Eigen::VectorXd AlignmentResiduals(const std::vector<AlignmentPoint>& points,
+                                   const Eigen::Vector3d& c_f, const Eigen::Vector3d& c_s,
+                                   const Eigen::Vector3d& x, double tilt_sigma_rad) {
+  const Eigen::Matrix3d R = YawTilt(x[0], x[1], x[2]);
+  Eigen::VectorXd r(3 * points.size() + 2);
+  for (size_t i = 0; i < points.size(); ++i)
+    r.segment<3>(3 * i) = std::sqrt(points[i].weight) *
+                          (R * (points[i].p_frame - c_f) - (points[i].p_survey - c_s));
+  r.tail<2>() = x.tail<2>() / tilt_sigma_rad;
+  return r;
+}
+
+// Gauss-Newton over (yaw, a, b) from the yaw-only fit (numeric Jacobian:
+// three parameters); the translation follows from the centroids.
+Eigen::Vector3d RefineTilt(const std::vector<AlignmentPoint>& points, const Eigen::Vector3d& c_f,
+                           const Eigen::Vector3d& c_s, double yaw, double tilt_sigma_rad) {
+  Eigen::Vector3d x(yaw, 0.0, 0.0);
+  constexpr double kH = 1e-7;
+  for (int it = 0; it < 10; ++it) {
+    const Eigen::VectorXd r = AlignmentResiduals(points, c_f, c_s, x, tilt_sigma_rad);
+    Eigen::MatrixXd J(r.size(), 3);
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d xp = x, xm = x;
+      xp[k] += kH;
+      xm[k] -= kH;
+      J.col(k) = (AlignmentResiduals(points, c_f, c_s, xp, tilt_sigma_rad) -
+                  AlignmentResiduals(points, c_f, c_s, xm, tilt_sigma_rad)) /
+                 (2 * kH);
+    }
+    const Eigen::Vector3d dx = (J.transpose() * J).ldlt().solve(-J.transpose() * r);
+    x += dx;
+    if (dx.norm() < 1e-12) break;
+  }
+  return x;
+}
+
+}  // namespace
+
 StatusOr<YawTranslation> FitYawTranslation(const std::vector<AlignmentPoint>& points,
-                                           double min_spread_m) {
+                                           double min_spread_m, double tilt_sigma_rad) {
   std::vector<Eigen::Vector3d> p_survey;
   for (const AlignmentPoint& q : points) p_survey.push_back(q.p_survey);
   YawTranslation fit;
@@ -149,10 +198,13 @@ StatusOr<YawTranslation> FitYawTranslation(const std::vector<AlignmentPoint>& po
     dot += q.weight * f.dot(s);
     cross += q.weight * (f.x() * s.y() - f.y() * s.x());
   }
-  const double yaw = std::atan2(cross, dot);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Eigen::Vector3d x(std::atan2(cross, dot), 0.0, 0.0);
+  if (tilt_sigma_rad > 0.0) x = RefineTilt(points, c_f, c_s, x[0], tilt_sigma_rad);
+  const Eigen::Matrix3d R = YawTilt(x[0], x[1], x[2]);
   fit.T_survey_frame = Pose3(R, c_s - R * c_f);
-  fit.yaw_deg = yaw * 180.0 / M_PI;
+  fit.yaw_deg = x[0] * 180.0 / M_PI;
+  fit.tilt_deg[0] = x[1] * 180.0 / M_PI;
+  fit.tilt_deg[1] = x[2] * 180.0 / M_PI;
   return fit;
 }
 

@@ -119,7 +119,9 @@ TEST_F(ControlCli, RunThenRefineDeliversInTheSurveyFrame) {
     const Eigen::Vector3d true_mark = T.t - Eigen::Vector3d(0, 0, kStartHeight);
     const Eigen::Vector3d true_error = est - true_mark;
     EXPECT_LT((reported - true_error).norm(), 0.008) << line;  // the marks' noise: 2 mm per axis
-    if (c[1] == "check") EXPECT_LT(reported.norm(), 0.05) << line;
+    if (c[1] == "check") {
+      EXPECT_LT(reported.norm(), 0.05) << line;
+    }
   }
   EXPECT_EQ(rows, 4);
   const nlohmann::json s = nlohmann::json::parse(ReadFile(out + "/summary.json"));

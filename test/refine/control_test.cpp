@@ -161,3 +161,36 @@ TEST(PositionTies, PullFreePosesOntoTheMarksInTheirChunkOnly) {
 
 }  // namespace
 }  // namespace rvlio
+
+namespace rvlio {
+namespace {
+
+TEST(FitYawTranslation, RefinesATiltThePointsFixAndKeepsGravitysWhereTheyDoNot) {
+  // The frame is tilted by 0.25 deg in pitch (an accelerometer bias read as
+  // gravity): marks along x at one height in the survey frame.
+  const double pitch = 0.25 * M_PI / 180.0;
+  const Pose3 truth(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                        Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                    Eigen::Vector3d(500000.0, 5400000.0, 250.0));
+  std::vector<AlignmentPoint> points;
+  for (double x : {0.0, 10.0, 20.0, 30.0}) {
+    const Eigen::Vector3d p_survey = truth * Eigen::Vector3d(x, 0.0, 0.0);
+    points.push_back({truth.Inverse() * p_survey, p_survey, 1.0 / (0.005 * 0.005)});
+  }
+  StatusOr<YawTranslation> yaw_only = FitYawTranslation(points, 1.0);
+  StatusOr<YawTranslation> tilted = FitYawTranslation(points, 1.0, 0.5 * M_PI / 180.0);
+  ASSERT_TRUE(yaw_only.ok() && tilted.ok());
+  double worst_yaw_only = 0.0, worst_tilted = 0.0;
+  for (const AlignmentPoint& q : points) {
+    worst_yaw_only = std::max(worst_yaw_only, (yaw_only->T_survey_frame * q.p_frame - q.p_survey).norm());
+    worst_tilted = std::max(worst_tilted, (tilted->T_survey_frame * q.p_frame - q.p_survey).norm());
+  }
+  EXPECT_GT(worst_yaw_only, 0.05);  // 13 cm of height over 30 m, split
+  EXPECT_LT(worst_tilted, 0.002);
+  EXPECT_NEAR(tilted->tilt_deg[1], 0.25, 0.01);
+  // The roll about the line of marks is not fixed by them: the prior keeps it at 0.
+  EXPECT_NEAR(tilted->tilt_deg[0], 0.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace rvlio

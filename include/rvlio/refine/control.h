@@ -73,21 +73,29 @@ bool TiePointOnTrajectory(const Trajectory& trajectory, TimeNs t_ns,
                           const Eigen::Vector3d& p_imu_point, Eigen::Vector3d* p_world);
 
 // Rotation about z and translation from the frame of p_frame into the survey
-// frame of p_survey, weighted least squares.
+// frame of p_survey, weighted least squares (closed form). With
+// tilt_sigma_rad > 0, roll and pitch are then refined too (Gauss-Newton from
+// that fit): gravity fixes them only to within the accelerometer bias's
+// share of it (a static alignment reads a horizontal bias b as a tilt of
+// |b| / g: 0.04 m/s^2 gives 0.23 deg, 12 cm of height over 30 m), so they
+// are estimated with a prior of tilt_sigma_rad at gravity's; along
+// directions the points do not fix (the roll about a line of marks) the
+// prior keeps gravity's.
 struct AlignmentPoint {
   Eigen::Vector3d p_frame = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_survey = Eigen::Vector3d::Zero();
   double weight = 1.0;  // > 0
 };
 struct YawTranslation {
-  Pose3 T_survey_frame;  // R = Rz(yaw)
+  Pose3 T_survey_frame;  // R = Rz(yaw) Exp((tilt_x, tilt_y, 0))
   double yaw_deg = 0.0;
+  double tilt_deg[2] = {0.0, 0.0};  // the roll/pitch correction (about the frame's x and y)
   double spread_m = 0.0;  // the points' horizontal extent (survey frame)
 };
 // InvalidInput ("... points span X m horizontally ...") with fewer than two
 // points or a horizontal extent below min_spread_m.
 StatusOr<YawTranslation> FitYawTranslation(const std::vector<AlignmentPoint>& points,
-                                           double min_spread_m);
+                                           double min_spread_m, double tilt_sigma_rad = 0.0);
 // The largest horizontal distance between two of the points (m; exact for
 // points along a line, within a factor 2 otherwise: two passes).
 double HorizontalSpread(const std::vector<Eigen::Vector3d>& p);

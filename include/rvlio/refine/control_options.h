@@ -33,6 +33,7 @@ struct ControlOptions {
   std::array<double, 3> lever_arm = {0.0, 0.0, 0.0};
   double max_distance_m = 5.0;     // a mark farther from the aligned trajectory: refused (a typo)
   double min_spread_m = 1.0;       // the control points' least horizontal extent to fix the heading
+  double tilt_sigma_deg = 0.5;     // prior of the alignment's roll/pitch at gravity's (0: held)
   TieKernel kernel = TieKernel::kHuber;
   double kernel_sigmas = 3.0;      // kernel width in sigmas
   double warn_sigmas = 5.0;        // a control point's residual beyond this many sigmas: a warning
@@ -67,6 +68,11 @@ struct ControlOptions {
             Spec().Unit("m").Range(0.01, 1e6).Help(
                 "the control points (and GNSS fixes) must span at least this horizontally to fix "
                 "the heading"));
+    v.Field("tilt_sigma_deg", tilt_sigma_deg,
+            Spec().Unit("deg").Range(0.0, 10.0).Help(
+                "the alignment refines roll and pitch with this prior at gravity's (a static "
+                "alignment reads the accelerometer bias as a tilt, |b| / g); 0: roll and pitch "
+                "from gravity alone"));
     v.Field("kernel", kernel,
             Spec().Choices(EnumChoices<TieKernel>()).Help("robust kernel of a control point"));
     v.Field("kernel_sigmas", kernel_sigmas,
