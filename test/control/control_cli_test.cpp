@@ -66,18 +66,6 @@ class ControlCli : public ::testing::Test {
   std::string dir_, data_;
 };
 
-TEST_F(ControlCli, SimulatorWritesMarksInTheSurveyFrame) {
-  const std::vector<std::string> rows = MarkRows();
-  ASSERT_EQ(rows.size(), 4u);
-  EXPECT_EQ(rows[2].substr(0, 3), "M3,");
-  EXPECT_NE(rows[2].find(",check"), std::string::npos);
-  EXPECT_NE(rows[0].find(",control"), std::string::npos);
-  // M1 (the start) lies at the survey frame's origin (E, N) and 0.3 m below h + IMU height.
-  EXPECT_NE(rows[0].find("M1,500000.0"), std::string::npos) << rows[0];
-  EXPECT_TRUE(fs::exists(data_ + "/sg_gt_survey.tum"));
-  EXPECT_NE(ReadFile(data_ + "/sg.yaml").find("lever_arm: [0, 0, 0.3]"), std::string::npos);
-}
-
 // The flight tied to three control marks: outputs in the survey frame, the
 // check point's residual is its true error, summary and control.csv agree.
 TEST_F(ControlCli, RunThenRefineDeliversInTheSurveyFrame) {
@@ -90,7 +78,8 @@ TEST_F(ControlCli, RunThenRefineDeliversInTheSurveyFrame) {
   EXPECT_NE(r.err.find("--control is used by refine"), std::string::npos) << r.err;
   const testing_cli::ToolRun f =
       RunTool("refine --bag " + data_ + "/sg.bag --config " + data_ + "/sg.yaml --init " + run +
-                  "/trajectory.tum --control " + data_ + "/sg_control.csv --out " + out,
+                  "/trajectory.tum --control " + data_ + "/sg_control.csv --out " + out +
+                  " --set smoother.refine_rounds=2",
               dir_);
   ASSERT_EQ(f.exit_code, 0) << f.err;
   EXPECT_NE(f.out.find("control points: 3"), std::string::npos) << f.out;
@@ -132,8 +121,19 @@ TEST_F(ControlCli, RunThenRefineDeliversInTheSurveyFrame) {
   EXPECT_EQ(s["control"]["check"]["max_name"], "M3");
 }
 
-TEST_F(ControlCli, BadControlFilesAreRefusedWithOneLineAndNothingWritten) {
-  const std::vector<std::string> m = MarkRows();
+// The simulator's marks (one test process: each copies the simulation),
+// then every bad control file.
+TEST_F(ControlCli, SimulatedMarksAndBadControlFilesRefusedWithOneLineNothingWritten) {
+  const std::vector<std::string> rows = MarkRows();
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[2].substr(0, 3), "M3,");
+  EXPECT_NE(rows[2].find(",check"), std::string::npos);
+  EXPECT_NE(rows[0].find(",control"), std::string::npos);
+  // M1 (the start) lies at the survey frame's origin (E, N) and 0.3 m below h + IMU height.
+  EXPECT_NE(rows[0].find("M1,500000.0"), std::string::npos) << rows[0];
+  EXPECT_TRUE(fs::exists(data_ + "/sg_gt_survey.tum"));
+  EXPECT_NE(ReadFile(data_ + "/sg.yaml").find("lever_arm: [0, 0, 0.3]"), std::string::npos);
+  const std::vector<std::string> m = rows;
   const std::string out = dir_ + "/never";
   struct Case {
     std::string name, text, part;
@@ -149,7 +149,7 @@ TEST_F(ControlCli, BadControlFilesAreRefusedWithOneLineAndNothingWritten) {
        "name,x,y,z,t_start,t_end\nA,500000,5400000,250,1700000000.2,1700000002\n"
        "B,500000.2,5400000,250,1700000000.2,1700000002\n",
        "cannot fix the heading"},
-      {"rests.csv", "name,x,y,z\n" + m[0] + "\n" + m[1] + "\n" + m[2] + "\n" + m[3] + "\nM5,1,2,3\n",
+      {"rests.csv", "name,x,y,z,role\n" + m[0] + "\n" + m[1] + "\n" + m[2] + "\n" + m[3] + "\nM5,1,2,3,\n",
        "5 stop-and-go row(s) without t_start,t_end, but the IMU shows 4 rest period(s)"},
       {"target.csv", "name,x,y,z,role,map_x,map_y,map_z\n" + m[0] + ",,,\n" + m[1] + ",,,\n" +
                          m[2] + ",,,\n" + m[3] + ",,,\n" + "T1,500000,5400000,255,,500,500,500\n",
