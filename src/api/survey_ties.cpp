@@ -17,6 +17,7 @@ namespace {
 // The local frame's origin: the ties' median, per axis, rounded to this, so
 // that the refinement runs near the origin (float32 maps, voxel keys).
 constexpr double kOriginGrid_m = 1000.0;
+constexpr int kAlignmentPasses = 10;  // of the reweighted alignment (converged well before)
 
 Eigen::Vector3d MedianOrigin(std::vector<Eigen::Vector3d> p) {
   Eigen::Vector3d o = Eigen::Vector3d::Zero();
@@ -239,20 +240,23 @@ void SurveyTies::FixTies(const Trajectory& init) {
 }
 
 // Control rows and fixes (not outliers) fix the frame; check rows never do.
-// Fixes farther than gnss.max_distance_m after a first fit are outliers and
-// the fit is repeated without them.
+// Iteratively reweighted: each point's weight 1/sigma^2 times its kernel's
+// weight at its residual of the previous fit (the kernels of the solve:
+// Cauchy for fixes, Huber for marks), so that a few multipath fixes do not
+// shift the frame; fixes farther than gnss.max_distance_m are left out.
 Status SurveyTies::Align(bool hold_frame) {
   if (hold_frame) return Status::Ok();
-  for (int pass = 0; pass < 2; ++pass) {
+  std::vector<double> row_kernel(rows_.size(), 1.0), fix_kernel(fix_ties_.size(), 1.0);
+  for (int pass = 0; pass < kAlignmentPasses; ++pass) {
     std::vector<AlignmentPoint> points;
     for (size_t i = 0; i < rows_.size(); ++i)
       if (rows_[i].role == ControlRole::kControl)
         points.push_back({row_frame_points_[i], rows_[i].p_survey,
-                          1.0 / (residuals_[i].sigma_m * residuals_[i].sigma_m)});
+                          row_kernel[i] / (residuals_[i].sigma_m * residuals_[i].sigma_m)});
     for (size_t i = 0; i < fix_ties_.size(); ++i)
       if (!fix_outlier_[i])
         points.push_back({fix_frame_points_[i], fix_ties_[i].p_world,
-                          1.0 / (fix_sigma_m_[i] * fix_sigma_m_[i])});
+                          fix_kernel[i] / (fix_sigma_m_[i] * fix_sigma_m_[i])});
     StatusOr<YawTranslation> fit = FitYawTranslation(points, control_.min_spread_m,
                                                      control_.tilt_sigma_deg * M_PI / 180.0);
     if (!fit.ok())
@@ -260,9 +264,16 @@ Status SurveyTies::Align(bool hold_frame) {
                                   ": the control points and GNSS fixes: " + fit.status().message());
     alignment_ = *fit;
     aligned_ = true;
-    for (size_t i = 0; i < fix_ties_.size(); ++i)
-      fix_outlier_[i] = (alignment_.T_survey_frame * fix_frame_points_[i] - fix_ties_[i].p_world)
-                            .norm() > gnss_.max_distance_m;
+    const Pose3& T = alignment_.T_survey_frame;
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      const double d = (T * row_frame_points_[i] - rows_[i].p_survey).norm();
+      row_kernel[i] = TieKernelWeight(control_.kernel, control_.kernel_sigmas, d / residuals_[i].sigma_m);
+    }
+    for (size_t i = 0; i < fix_ties_.size(); ++i) {
+      const double d = (T * fix_frame_points_[i] - fix_ties_[i].p_world).norm();
+      fix_outlier_[i] = d > gnss_.max_distance_m;
+      fix_kernel[i] = TieKernelWeight(gnss_.kernel, gnss_.kernel_sigmas, d / fix_sigma_m_[i]);
+    }
   }
   return Status::Ok();
 }

@@ -34,6 +34,19 @@ bool SqrtInformationOf(const Eigen::Matrix3d& covariance, Eigen::Matrix3d* sqrt_
   return sqrt_information->allFinite();
 }
 
+double TieKernelWeight(TieKernel kernel, double kernel_sigmas, double s) {
+  const double c = kernel_sigmas;
+  switch (kernel) {
+    case TieKernel::kHuber:
+      return s <= c ? 1.0 : c / s;
+    case TieKernel::kCauchy:
+      return 1.0 / (1.0 + (s * s) / (c * c));
+    case TieKernel::kNone:
+      break;
+  }
+  return 1.0;
+}
+
 ceres::LossFunction* MakeTieLoss(const PositionTie& tie) {
   switch (tie.kernel) {
     case TieKernel::kHuber:

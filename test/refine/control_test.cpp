@@ -194,3 +194,16 @@ TEST(FitYawTranslation, RefinesATiltThePointsFixAndKeepsGravitysWhereTheyDoNot) 
 
 }  // namespace
 }  // namespace rvlio
+
+namespace rvlio {
+namespace {
+
+TEST(TieKernelWeight, HuberCauchyNone) {
+  EXPECT_DOUBLE_EQ(TieKernelWeight(TieKernel::kHuber, 3.0, 2.0), 1.0);
+  EXPECT_DOUBLE_EQ(TieKernelWeight(TieKernel::kHuber, 3.0, 6.0), 0.5);
+  EXPECT_DOUBLE_EQ(TieKernelWeight(TieKernel::kCauchy, 2.0, 2.0), 0.5);
+  EXPECT_DOUBLE_EQ(TieKernelWeight(TieKernel::kNone, 2.0, 100.0), 1.0);
+}
+
+}  // namespace
+}  // namespace rvlio

@@ -46,6 +46,10 @@ Eigen::Matrix3d IsotropicSqrtInformation(double sigma_m);
 // factor of its inverse. False when it is not positive definite.
 bool SqrtInformationOf(const Eigen::Matrix3d& covariance, Eigen::Matrix3d* sqrt_information);
 
+// The weight of iteratively reweighted least squares for a kernel at a
+// whitened residual norm s (sigmas): huber min(1, c / s), cauchy
+// 1 / (1 + s^2 / c^2), none 1 (c = kernel_sigmas).
+double TieKernelWeight(TieKernel kernel, double kernel_sigmas, double s);
 // A new ceres loss for the tie's kernel (null for none; the problem owns it).
 ceres::LossFunction* MakeTieLoss(const PositionTie& tie);
 
