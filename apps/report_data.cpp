@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/version.h"
 
 namespace rvlio::cli::report {
@@ -62,6 +64,20 @@ std::string Resolve(const std::string& recorded, const std::string& recorded_out
 
 float ToFloat(double v) { return static_cast<float>(v); }
 
+// What the page's float32 arrays are relative to: times to t0_s and
+// positions to a local origin (math/local_origin.h), both taken from the
+// ground truth, else from the first run's trajectory. A float32 keeps only
+// decimetres of a national grid's coordinates (UTM northings of 5e6 m) and
+// hundredths of a second of a Unix time stamp.
+struct PageFrame {
+  double t0_s = 0.0;
+  LocalOrigin origin;
+};
+
+PageFrame FrameOf(const Trajectory& t) {
+  return {NsToSeconds(t.front().t_ns), ChooseLocalOrigin(t)};
+}
+
 // ---------------------------------------------------------------------------
 // Runs
 // ---------------------------------------------------------------------------
@@ -98,11 +114,12 @@ std::optional<Aligned> AlignToTruth(const Trajectory& truth, const Trajectory& e
   return out;
 }
 
-json TrajectoryJson(const Trajectory& t, double t0_s) {
+json TrajectoryJson(const Trajectory& t, const PageFrame& frame) {
   std::vector<float> times, xyz;
   for (const StampedPose& p : t) {
-    times.push_back(ToFloat(NsToSeconds(p.t_ns) - t0_s));
-    for (int i = 0; i < 3; ++i) xyz.push_back(ToFloat(p.p_world_imu[i]));
+    times.push_back(ToFloat(NsToSeconds(p.t_ns) - frame.t0_s));
+    const Eigen::Vector3d p_local = frame.origin.ToLocal(p.p_world_imu);
+    for (int i = 0; i < 3; ++i) xyz.push_back(ToFloat(p_local[i]));
   }
   return {{"t", ReportArray(times)}, {"xyz", ReportArray(xyz)}, {"n", t.size()}};
 }
@@ -123,8 +140,9 @@ json ScansJson(const ScanTable& scans, double t0_s) {
   return {{"t", ReportArray(times)}, {"n", times.size()}, {"columns", columns}};
 }
 
-json RunJson(const RunEntry& run, const Trajectory* truth, double t0_s,
+json RunJson(const RunEntry& run, const Trajectory* truth, const PageFrame& frame,
              std::vector<std::string>* notes) {
+  const double t0_s = frame.t0_s;
   json j = {{"name", run.name}, {"label", run.label}, {"status", run.status}};
   StatusOr<Trajectory> est = ReadTrajectory(run.dir + "/trajectory.tum");
   if (!est.ok()) {
@@ -133,7 +151,7 @@ json RunJson(const RunEntry& run, const Trajectory* truth, double t0_s,
   }
   std::optional<Aligned> aligned;
   if (truth != nullptr) aligned = AlignToTruth(*truth, *est, t0_s, notes, run.name);
-  j["trajectory"] = TrajectoryJson(aligned ? aligned->est_in_ref : *est, t0_s);
+  j["trajectory"] = TrajectoryJson(aligned ? aligned->est_in_ref : *est, frame);
   j["aligned"] = aligned.has_value();
   if (aligned)
     j["axis_error"] = {{"t", ReportArray(aligned->axis_t)},
@@ -151,7 +169,7 @@ json RunJson(const RunEntry& run, const Trajectory* truth, double t0_s,
 // The map
 // ---------------------------------------------------------------------------
 
-json CloudJson(const std::string& run_name, const std::string& map_path,
+json CloudJson(const std::string& run_name, const std::string& map_path, const LocalOrigin& origin,
                const ReportOptions& options, std::vector<std::string>* notes) {
   PointCloudReadOptions read_options;
   read_options.allow_empty = true;  // a run over too few scans writes an empty map
@@ -166,7 +184,7 @@ json CloudJson(const std::string& run_name, const std::string& map_path,
   const size_t stride = ThinningStride(n, options.max_points);
   std::vector<float> xyz, value;
   for (size_t i = 0; i < n; i += stride) {
-    const Eigen::Vector3d& p = cloud->points[i];
+    const Eigen::Vector3d p = origin.ToLocal(cloud->points[i]);
     if (!p.allFinite()) continue;
     for (int k = 0; k < 3; ++k) xyz.push_back(ToFloat(p[k]));
     value.push_back(deviation ? (*deviation)[i] : ToFloat(p.z()));
@@ -447,15 +465,23 @@ StatusOr<json> BuildReportModel(const std::string& dir, const ReportOptions& opt
       c->notes.push_back("ground truth " + c->gt + " not readable: drawn without it");
   }
   if (truth && *kind == FolderKind::kRun) AddRunEvalColumns(*truth, dir, &c->table);
-  double t0_s = truth ? NsToSeconds(truth->front().t_ns) : kNaN;
+  std::optional<PageFrame> frame;
+  if (truth) frame = FrameOf(*truth);
   json runs = json::array();
   for (const RunEntry& r : c->runs) {
-    if (!std::isfinite(t0_s)) {
+    if (!frame) {
       StatusOr<Trajectory> est = ReadTrajectory(r.dir + "/trajectory.tum");
-      if (est.ok() && !est->empty()) t0_s = NsToSeconds(est->front().t_ns);
+      if (est.ok() && !est->empty()) frame = FrameOf(*est);
     }
-    runs.push_back(RunJson(r, truth ? &*truth : nullptr, std::isfinite(t0_s) ? t0_s : 0.0,
-                           &c->notes));
+    runs.push_back(RunJson(r, truth ? &*truth : nullptr, frame.value_or(PageFrame()), &c->notes));
+  }
+  const PageFrame shown = frame.value_or(PageFrame());
+  if (!shown.origin.IsZero()) {
+    char text[160];
+    const Eigen::Vector3d& t = shown.origin.t_user_local;
+    std::snprintf(text, sizeof(text), "positions are drawn relative to (%.3f, %.3f, %.3f) m",
+                  t.x(), t.y(), t.z());
+    c->notes.push_back(text);
   }
   json model = {{"title", c->title},
                 {"kind", FolderKindName(*kind)},
@@ -465,12 +491,12 @@ StatusOr<json> BuildReportModel(const std::string& dir, const ReportOptions& opt
                 {"gt", nullptr},
                 {"cloud", nullptr}};
   if (truth) {
-    model["gt"] = TrajectoryJson(*truth, t0_s);
+    model["gt"] = TrajectoryJson(*truth, shown);
     model["gt"]["file"] = c->gt;
   }
   for (const RunEntry& r : c->runs)
     if (r.name == c->map_run && IsFile(r.dir + "/map.pcd"))
-      model["cloud"] = CloudJson(r.name, r.dir + "/map.pcd", options, &c->notes);
+      model["cloud"] = CloudJson(r.name, r.dir + "/map.pcd", shown.origin, options, &c->notes);
   model["notes"] = c->notes;
   return model;
 }

@@ -45,6 +45,7 @@ set(rvlio_public_headers
   rvlio/map/voxel_key.h
   rvlio/map/voxel_map.h
   rvlio/math/extrinsic_excitation.h
+  rvlio/math/local_origin.h
   rvlio/math/pose.h
   rvlio/math/so3.h
   rvlio/math/time_offset_excitation.h

@@ -57,7 +57,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # checked here by LasWriter.*); the LAS memory bounds measure a Release
 # build's peak, as the refine one does; MapLasCli runs run, refine and merge
 # end to end for the one call each makes to the LAS writer, which runs here in
-# LasExport.* and LasWriter.*.
+# LasExport.* and LasWriter.*. The
+# survey-coordinates suite (SurveyCoordinates) runs a flight twice, a refine
+# and eval --map of a 590 k point survey; the local frame it checks runs here
+# in LocalOrigin, VoxelMap, ReferenceMap, MapMetrics and ReferenceMapFileTest.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -101,6 +104,7 @@ ex=(
   'TimeOffsetCliTest\..*'
   'DegeneracyCliTest\..*'
   'SurveyFlights\..*' SurveyFeatureless.StartTwentyMetresOffAlongTheAxisIsRefused
+  'SurveyCoordinates\..*'
   AssociationThreadsCliTest.TwoThreadsWriteTheSameOutputsAsOne
   BatchSignalsTest.InterruptedAblationKeepsFinishedCellsAndResumes
   Refine.SummarizedFactorsAgreeWithExactFactors

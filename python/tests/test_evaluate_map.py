@@ -115,6 +115,22 @@ def test_paths_arrays_and_the_command_line_agree(tmp_path, rvlio_bin):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["map.pcd", "ref.pcd"]  # read only
 
 
+def test_clouds_in_a_national_grid_give_the_figures_of_clouds_near_zero():
+    """Shifted to a UTM easting and northing (beyond float32's millimetres
+    and the search structure's key reach), both clouds are evaluated in the
+    reference's local frame: the same figures, the axis shifted back."""
+    mp, ref = scene(4)
+    near = rvlio.evaluate_map(mp, ref)
+    shift = np.array([500000.0, 5400000.0, 0.0])
+    far = rvlio.evaluate_map(mp + shift, ref + shift)
+    assert far["inliers"] == near["inliers"]
+    for key in ("completeness", "chamfer", "outlier_fraction"):
+        assert far[key] == pytest.approx(near[key], abs=TOL), key
+    for stat in ("mean", "rms", "median", "p95", "max"):
+        assert far["accuracy"][stat] == pytest.approx(near["accuracy"][stat], abs=TOL), stat
+    assert np.asarray(far["axis"]["origin"]) - shift == pytest.approx(near["axis"]["origin"], abs=TOL)
+
+
 def test_bad_input_raises_value_error(tmp_path):
     mp, ref = scene(3)
     with pytest.raises(ValueError, match="do not overlap"):

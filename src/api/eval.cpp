@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 #include "rvlio/api.h"
 #include "rvlio/api/refine_checkpoint.h"
@@ -154,7 +155,8 @@ StatusOr<MapEvalResult> EvaluateMapFiles(const std::string& map_path, const std:
   if (!map.ok()) return map.status();
   StatusOr<PointCloudFile> ref = ReadPointCloud(ref_path, xyz_only);
   if (!ref.ok()) return ref.status();
-  StatusOr<MapEvalResult> r = EvaluateMap(map->points, ref->points, options, progress);
+  StatusOr<MapEvalResult> r =
+      EvaluateMap(std::move(map->points), std::move(ref->points), options, progress);
   if (!r.ok()) return Status::InvalidInput(map_path + " vs " + ref_path + ": " + r.status().message());
   return r;
 }

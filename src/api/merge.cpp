@@ -172,13 +172,16 @@ Status CheckChunks(std::vector<ChunkFolder>* chunks) {
   return Status::Ok();
 }
 
-// Each chunk's map carried into the merged frame, re-voxelized at the chunks' resolution.
+// Each chunk's map carried into the merged frame, re-voxelized at the
+// chunks' resolution; in the local frame of `origin`, as the trajectories.
 StatusOr<std::vector<Eigen::Vector3d>> MergeMaps(const std::vector<ChunkFolder>& chunks,
-                                                 const RefineJobMerge& merge) {
+                                                 const RefineJobMerge& merge,
+                                                 const LocalOrigin& origin) {
   OutputMap output(chunks.front().manifest["map_output_resolution"].get<double>());
   for (size_t k = 0; k < chunks.size(); ++k) {
     StatusOr<std::vector<Eigen::Vector3d>> points = ReadMapPcd(FilePath(chunks[k].dir, "map.pcd"));
     if (!points.ok()) return points.status();
+    origin.ToLocal(&*points);
     const Pose3& T = merge.alignments[k].T_merged_chunk;
     for (Eigen::Vector3d& p : *points) p = T * p;
     output.Insert(*points);
@@ -234,11 +237,13 @@ Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
 // refined with (chunk.json's map_hash: the file's content), and the chunks'
 // deviation options. Null without --map.
 struct MergeReference {
-  std::shared_ptr<const ReferenceMap> surface;
+  std::shared_ptr<const ReferenceMap> surface;  // in its local frame
+  LocalOrigin origin;
   DeviationOptions options;
 };
 
-StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkFolder& first) {
+StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkFolder& first,
+                                            std::vector<std::string>* warnings) {
   MergeReference ref;
   if (map.empty()) return ref;
   const std::string manifest = FilePath(first.dir, "chunk.json");
@@ -257,7 +262,8 @@ StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkF
                                manifest + " deviation");
       !s.ok())
     return s;
-  StatusOr<std::shared_ptr<const ReferenceMap>> surface = LoadReferenceSurface(map);
+  StatusOr<std::shared_ptr<const ReferenceMap>> surface =
+      LoadReferenceSurface(map, &ref.origin, warnings);
   if (!surface.ok()) return surface.status();
   ref.surface = std::move(*surface);
   return ref;
@@ -287,35 +293,49 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   if (Status s = CheckChunks(&chunks); !s.ok()) return s;
   StatusOr<MapLasRequest> las = MergedLasRequest(chunks.front());
   if (!las.ok()) return las.status();
-  StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front());
+  std::vector<std::string> map_warnings;
+  StatusOr<MergeReference> reference = LoadMergeReference(args.map, chunks.front(), &map_warnings);
   if (!reference.ok()) return reference.status();
   OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
   if (!args.out_dir.empty())
     if (Status s = out_folder.Prepare(); !s.ok()) return s;
+  // The chunks are merged in a local frame: the reference's (the frame
+  // refine --map used), else one chosen from chunk 1's trajectory; the
+  // outputs go out in the chunks' frame.
+  const LocalOrigin origin = reference->surface != nullptr
+                                 ? reference->origin
+                                 : ChooseLocalOrigin(chunks.front().job.trajectory);
   std::vector<RefineJobTrajectory> jobs;
-  for (const ChunkFolder& c : chunks) jobs.push_back(c.job);
+  for (const ChunkFolder& c : chunks) {
+    jobs.push_back(c.job);
+    origin.ToLocal(&jobs.back().trajectory);
+  }
   StatusOr<RefineJobMerge> merge = MergeRefineJobs(jobs);
   if (!merge.ok()) return merge.status();
   MergeResult r;
   r.trajectory = merge->trajectory;
-  StatusOr<std::vector<Eigen::Vector3d>> map = MergeMaps(chunks, *merge);
+  StatusOr<std::vector<Eigen::Vector3d>> map = MergeMaps(chunks, *merge, origin);
   if (!map.ok()) return map.status();
   r.map_points = std::move(*map);
-  for (const ChunkFolder& c : chunks)
-    for (const std::string& w : c.warnings)
-      if (std::find(r.warnings.begin(), r.warnings.end(), w) == r.warnings.end())
-        r.warnings.push_back(w);
+  for (const ChunkFolder& c : chunks) map_warnings.insert(map_warnings.end(), c.warnings.begin(), c.warnings.end());
+  for (const std::string& w : map_warnings)  // each once
+    if (std::find(r.warnings.begin(), r.warnings.end(), w) == r.warnings.end())
+      r.warnings.push_back(w);
   const std::string chunk_map = chunks.front().manifest.value("map", std::string());
   if (args.map.empty() && !chunks.front().manifest.value("map_hash", std::string()).empty())
     r.warnings.push_back("the chunks were refined with --map " + chunk_map +
                          "; merge --map " + chunk_map + " writes the deviation from it");
   for (size_t k = 0; k < chunks.size(); ++k)
     r.chunks.push_back(Merged(chunks[k], merge->alignments[k]));
-  r.summary = Summary(chunks, r);
-  std::optional<MapDeviation> deviation;
-  if (reference->surface != nullptr) {
+  std::optional<MapDeviation> deviation;  // in the local frame, as the reference
+  if (reference->surface != nullptr)
     deviation = ComputeMapDeviation(r.map_points, *reference->surface, r.trajectory,
                                     reference->options);
+  origin.ToUser(&r.trajectory);
+  origin.ToUser(&r.map_points);
+  r.summary = Summary(chunks, r);
+  r.summary["local_origin"] = LocalOriginJson(origin);
+  if (deviation) {
     r.summary["map"] = args.map;
     r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   }

@@ -342,19 +342,24 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   const Trajectory init_span = {input.init.front(), input.init.back()};
   std::shared_ptr<const VoxelMap> reference;
   std::shared_ptr<const ReferenceMap> surface;  // the full cloud, for the deviation
+  // The refinement runs in a local frame: the map's (the frame run --map
+  // used), else one chosen from the initial trajectory; the outputs go out in
+  // the frame of --init and --map.
+  LocalOrigin origin = ChooseLocalOrigin(input.init);
   if (!args.map.empty()) {  // read before anything is written
     StatusOr<std::shared_ptr<const VoxelMap>> loaded =
-        LoadReferenceMap(args.map, args.options.localization, &surface);
+        LoadReferenceMap(args.map, args.options.localization, &surface, &origin, &notes);
     if (!loaded.ok()) return loaded.status();
     reference = std::move(*loaded);
   }
+  origin.ToLocal(&input.init);
   uint64_t map_hash = 0;  // what a checkpoint and chunk.json know the map by
   if (!args.map.empty() && (job || !args.checkpoint_dir.empty())) {
     StatusOr<uint64_t> hash = FileContentHash(args.map);
     if (!hash.ok()) return Status::InvalidInput("--map " + hash.status().message());
     map_hash = *hash;
   }
-  StatusOr<std::unique_ptr<SurveyTies>> survey = OpenSurveyTies(args.control, args.bag, args.options);
+  StatusOr<std::unique_ptr<SurveyTies>> survey = OpenSurveyTies(args.control, args.bag, args.options, origin);
   if (!survey.ok()) return survey.status();  // before anything is written
   const uint64_t inputs_hash =  // the control file and the fixes are inputs of a checkpoint
       *survey == nullptr ? map_hash : (map_hash * 1099511628211ULL) ^ (*survey)->ContentHash();
@@ -385,7 +390,8 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   times.read_s = SecondsSince(t0);
   std::vector<PositionTie> ties;  // in the local survey frame, where refine then runs
   if (*survey != nullptr)
-    if (Status s = (*survey)->Prepare(reference != nullptr, &input.init, &ties); !s.ok()) return s;
+    if (Status s = (*survey)->Prepare(reference != nullptr, &origin, &input.init, &ties); !s.ok())
+      return s;
   StatusOr<RefineResult> refined =
       RefineWithHooks(args, std::move(input), std::move(reference), inputs_hash, std::move(ties),
                       &r.stop_reason, &times.checkpoint_s);
@@ -403,19 +409,21 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (!r.stopped) r.stop_reason.clear();
   r.divergence = CheckRefineResult(r.refine, args.options.divergence,
                                    args.options.constraints.lidar_noise, args.options.imu.gravity);
-  if (*survey != nullptr) DeliverInSurveyFrame(survey->get(), &r);
+  std::optional<MapDeviation> deviation;  // in the local frame, as the reference
+  if (surface != nullptr && !r.refine.trajectory.empty())
+    deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
+                                    args.options.localization.deviation);
+  if (*survey != nullptr) DeliverInSurveyFrame(survey->get(), &r);  // residuals, local frame
+  origin.ToUser(&r.refine.trajectory);
+  origin.ToUser(&r.refine.map_points);
   times.wall_s = SecondsSince(t0);
   r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
+  r.summary["local_origin"] = LocalOriginJson(origin);
   if (*survey != nullptr) AddSurveySummary(**survey, args.options.survey.crs, &r.summary);
   r.summary["truncated"] = (*reader)->truncated();
   r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
   if (job) r.summary["chunk"] = r.chunk;
-  std::optional<MapDeviation> deviation;
-  if (surface != nullptr && !r.refine.trajectory.empty()) {
-    deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
-                                    args.options.localization.deviation);
-    r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
-  }
+  if (deviation) r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   if (!write) return r;
   if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr, *las); !s.ok())
     return s;

@@ -94,6 +94,11 @@ nlohmann::json LocalizationJson(const RunArgs& args, const std::vector<ScanResul
           {"longest_out_of_map_s", longest_s}};
 }
 
+// The odometry's results (its local frame) in the user's frame.
+void MoveToUserFrame(const LocalOrigin& origin, std::vector<ScanResult>* scans) {
+  for (ScanResult& r : *scans) r.T_world_imu.t = origin.ToUser(r.T_world_imu.t);
+}
+
 struct RunData {
   TimeNs first_ns = -1, last_ns = -1;
   double wall_s = 0.0;
@@ -202,15 +207,17 @@ std::string NoScanMessage(const std::string& bag, const OdometryOptions& o,
   return text;
 }
 
-// Appends the poses of the results not streamed yet to trajectory.partial.tum;
-// a write error stops the streaming with one warning (the run goes on).
-void StreamNewPoses(const std::vector<ScanResult>& results, size_t* streamed, TumStream* stream,
-                    std::vector<std::string>* warnings) {
+// Appends the poses of the results not streamed yet to trajectory.partial.tum,
+// in the user's frame (the estimation's local frame plus `origin`, as
+// trajectory.tum); a write error stops the streaming with one warning (the
+// run goes on).
+void StreamNewPoses(const std::vector<ScanResult>& results, const LocalOrigin& origin,
+                    size_t* streamed, TumStream* stream, std::vector<std::string>* warnings) {
   for (; *streamed < results.size(); ++*streamed) {
     if (!stream->is_open()) continue;
     StampedPose pose;
     pose.t_ns = results[*streamed].t_ns;
-    pose.p_world_imu = results[*streamed].T_world_imu.t;
+    pose.p_world_imu = origin.ToUser(results[*streamed].T_world_imu.t);
     pose.q_world_imu = results[*streamed].T_world_imu.quaternion();
     if (Status s = stream->Append(pose); !s.ok())
       warnings->push_back(s.message() + "; the partial trajectory is no longer written");
@@ -246,8 +253,9 @@ class ProgressReporter {
 };
 
 // Feeds the recording to the odometry until its end, a read error or a stop.
-void Process(const RunArgs& args, SensorBagReader* reader, Odometry* odo, TumStream* partial,
-             std::vector<std::string>* stream_warnings, RunData* data, RunResult* result) {
+void Process(const RunArgs& args, const LocalOrigin& origin, SensorBagReader* reader,
+             Odometry* odo, TumStream* partial, std::vector<std::string>* stream_warnings,
+             RunData* data, RunResult* result) {
   const ProgressReporter progress(args, Clock::now());
   size_t streamed = 0;
   ImuSample imu;
@@ -271,7 +279,7 @@ void Process(const RunArgs& args, SensorBagReader* reader, Odometry* odo, TumStr
     else odo->AddScan(std::move(scan));
     odo->Poll(&result->scans);
     if (!odo->status().ok()) return;  // the reference map did not fit: nothing is written
-    StreamNewPoses(result->scans, &streamed, partial, stream_warnings);
+    StreamNewPoses(result->scans, origin, &streamed, partial, stream_warnings);
     (void)partial->SyncIfDue();  // a failure surfaces at the next Append
     if (result->rss_mb.size() < result->scans.size())
       result->rss_mb.resize(result->scans.size(), CurrentMemoryMb());
@@ -297,14 +305,19 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   if (!las.ok()) return las.status();  // an unknown survey.crs, before anything is read
   Localization localization;
   std::shared_ptr<const ReferenceMap> reference;  // the full cloud, for the deviation
+  std::vector<std::string> map_warnings;  // e.g. a float32 map far from zero
   if (!args.map.empty()) {
-    StatusOr<Localization> loaded = LoadLocalization(args.map, args.initial_pose,
-                                                     args.initial_pose_tum, args.options, &reference);
+    StatusOr<Localization> loaded = LoadLocalization(
+        args.map, args.initial_pose, args.initial_pose_tum, args.options, &reference, &map_warnings);
     if (!loaded.ok()) return loaded.status();
     localization = std::move(*loaded);
+    notes.insert(notes.end(), map_warnings.begin(), map_warnings.end());
   } else if (!args.initial_pose.empty() || !args.initial_pose_tum.empty()) {
     return Status::InvalidInput("--initial-pose and --initial-pose-tum need --map");
   }
+  // The odometry runs in the map's local frame; its results go out in the
+  // map's frame (without a map the two are the IMU's start frame).
+  const LocalOrigin origin = localization.origin;
   StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(args.options, std::move(localization));
   if (!odo.ok()) return odo.status();
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
@@ -326,12 +339,14 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
         !s.ok())
       stream_warnings.push_back(s.message() + "; the partial trajectory is not written");
   const auto t0 = Clock::now();
-  Process(args, reader->get(), odo->get(), &partial, &stream_warnings, &data, &result);
+  Process(args, origin, reader->get(), odo->get(), &partial, &stream_warnings, &data, &result);
   data.wall_s = SecondsSince(t0);
   data.truncated = (*reader)->truncated();
   if (!(*odo)->status().ok()) {  // nothing new in the output folder
     if (write) partial.Remove();
-    return Status::InvalidInput("--map " + args.map + ": " + (*odo)->status().message());
+    std::string text = "--map " + args.map + ": " + (*odo)->status().message();
+    for (const std::string& w : map_warnings) text += "; " + w;  // maybe why the map did not fit
+    return Status::InvalidInput(text);
   }
 
   const SensorReaderStats& reader_stats = (*reader)->stats();
@@ -350,17 +365,19 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
     return Status::InvalidInput(
         NoScanMessage(args.bag, args.options, reader_stats, (*odo)->stats()));
   }
-  result.trajectory = ToTrajectory(result.scans);
   SetFigures(data, &result);
-  result.summary = Summary(args, **odo, reader_stats, data, result);
   std::vector<Eigen::Vector3d> p_map;  // the output map, when written or compared
   if (write || reference != nullptr) p_map = (*odo)->MapPoints();
-  std::optional<MapDeviation> deviation;
-  if (reference != nullptr) {
-    deviation = ComputeMapDeviation(p_map, *reference, result.trajectory,
+  std::optional<MapDeviation> deviation;  // in the local frame, as the reference
+  if (reference != nullptr)
+    deviation = ComputeMapDeviation(p_map, *reference, ToTrajectory(result.scans),
                                     args.options.localization.deviation);
-    result.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
-  }
+  MoveToUserFrame(origin, &result.scans);
+  origin.ToUser(&p_map);
+  result.trajectory = ToTrajectory(result.scans);
+  result.summary = Summary(args, **odo, reader_stats, data, result);
+  result.summary["local_origin"] = LocalOriginJson(origin);
+  if (deviation) result.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   if (!write) return result;
   const Status written =
       WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr, *las);

@@ -14,21 +14,7 @@
 namespace rvlio {
 namespace {
 
-// The local frame's origin: the ties' median, per axis, rounded to this, so
-// that the refinement runs near the origin (float32 maps, voxel keys).
-constexpr double kOriginGrid_m = 1000.0;
 constexpr int kAlignmentPasses = 10;  // of the reweighted alignment (converged well before)
-
-Eigen::Vector3d MedianOrigin(std::vector<Eigen::Vector3d> p) {
-  Eigen::Vector3d o = Eigen::Vector3d::Zero();
-  if (p.empty()) return o;
-  for (int a = 0; a < 3; ++a) {
-    std::nth_element(p.begin(), p.begin() + p.size() / 2, p.end(),
-                     [a](const Eigen::Vector3d& u, const Eigen::Vector3d& v) { return u[a] < v[a]; });
-    o[a] = std::round(p[p.size() / 2][a] / kOriginGrid_m) * kOriginGrid_m;
-  }
-  return o;
-}
 
 Eigen::Vector3d LeverArm(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
@@ -94,7 +80,8 @@ SurveyFix ToSurveyFix(const NavSatFix& m, const Eigen::Vector3d& p_survey,
 }  // namespace
 
 SurveyTies::SurveyTies(std::string control_path, std::vector<ControlRow> rows,
-                       std::vector<SurveyFix> fixes, const OdometryOptions& options)
+                       std::vector<SurveyFix> fixes, const OdometryOptions& options,
+                       const LocalOrigin& init_origin)
     : control_path_(std::move(control_path)),
       rows_(std::move(rows)),
       fixes_(std::move(fixes)),
@@ -103,7 +90,7 @@ SurveyTies::SurveyTies(std::string control_path, std::vector<ControlRow> rows,
       sightings_({}, options.control.target_radius_m, options.control.target_max_scans) {
   for (size_t i = 0; i < rows_.size(); ++i) {
     if (!rows_[i].target) continue;
-    target_points_.push_back(rows_[i].p_map);
+    target_points_.push_back(init_origin.ToLocal(rows_[i].p_map));
     target_rows_.push_back(static_cast<int>(i));
   }
   sightings_ = TargetSightings(target_points_, control_.target_radius_m, control_.target_max_scans);
@@ -201,7 +188,7 @@ Status SurveyTies::TargetTies() {
           " m) at the --init poses; is it a point of that run's map.pcd?");
     r.scans = static_cast<int>(seen.size());
     r.t_ns = seen.front().t_ns;
-    row_frame_points_[target_rows_[t]] = row.p_map;
+    row_frame_points_[target_rows_[t]] = target_points_[t];
     const double sigma = r.sigma_m * std::sqrt(static_cast<double>(seen.size()));
     for (const TargetSighting& s : seen) {
       PositionTie tie;
@@ -244,8 +231,11 @@ void SurveyTies::FixTies(const Trajectory& init) {
 // weight at its residual of the previous fit (the kernels of the solve:
 // Cauchy for fixes, Huber for marks), so that a few multipath fixes do not
 // shift the frame; fixes farther than gnss.max_distance_m are left out.
-Status SurveyTies::Align(bool hold_frame) {
-  if (hold_frame) return Status::Ok();
+Status SurveyTies::Align(bool hold_frame, const LocalOrigin& init_origin) {
+  if (hold_frame) {  // the --init frame is the survey frame, moved by init_origin
+    alignment_.T_survey_frame = Pose3(Eigen::Matrix3d::Identity(), init_origin.t_user_local);
+    return Status::Ok();
+  }
   std::vector<double> row_kernel(rows_.size(), 1.0), fix_kernel(fix_ties_.size(), 1.0);
   for (int pass = 0; pass < kAlignmentPasses; ++pass) {
     std::vector<AlignmentPoint> points;
@@ -281,7 +271,7 @@ Status SurveyTies::Align(bool hold_frame) {
 // Every mark and target (control or check) must lie within
 // control.max_distance_m of the aligned trajectory: the farthest is named.
 Status SurveyTies::CheckDistances() const {
-  const Pose3 T = aligned_ ? alignment_.T_survey_frame : Pose3();
+  const Pose3& T = alignment_.T_survey_frame;
   double worst = -1.0;
   size_t worst_row = 0;
   for (size_t i = 0; i < rows_.size(); ++i) {
@@ -295,13 +285,13 @@ Status SurveyTies::CheckDistances() const {
                               "); a typo in its coordinates, or another frame?");
 }
 
-Status SurveyTies::Prepare(bool hold_frame, Trajectory* init, std::vector<PositionTie>* ties) {
+Status SurveyTies::Prepare(bool hold_frame, LocalOrigin* origin, Trajectory* init,
+                           std::vector<PositionTie>* ties) {
   residuals_.assign(rows_.size(), {});
   row_ties_.assign(rows_.size(), {});
   row_frame_points_.assign(rows_.size(), Eigen::Vector3d::Zero());
-  for (size_t i = 0; i < rows_.size(); ++i) {
+  for (size_t i = 0; i < rows_.size(); ++i)
     residuals_[i].sigma_m = rows_[i].sigma_m > 0.0 ? rows_[i].sigma_m : control_.sigma_m;
-  }
   int control_rows = 0;
   for (const ControlRow& row : rows_) control_rows += row.role == ControlRole::kControl ? 1 : 0;
   if (fixes_.empty() && control_rows < 2)
@@ -316,15 +306,19 @@ Status SurveyTies::Prepare(bool hold_frame, Trajectory* init, std::vector<Positi
   if (Status s = MarkTies(*init); !s.ok()) return s;
   if (Status s = TargetTies(); !s.ok()) return s;
   FixTies(*init);
-  if (Status s = Align(hold_frame); !s.ok()) return s;
+  if (Status s = Align(hold_frame, *origin); !s.ok()) return s;
   if (Status s = CheckDistances(); !s.ok()) return s;
-  // The local frame: survey minus origin (the ties' median, rounded).
-  std::vector<Eigen::Vector3d> p_survey;
-  for (const ControlRow& row : rows_) p_survey.push_back(row.p_survey);
-  for (const PositionTie& t : fix_ties_) p_survey.push_back(t.p_world);
-  origin_ = hold_frame ? Eigen::Vector3d::Zero() : MedianOrigin(p_survey);
+  // The local frame: the survey frame minus an origin chosen from the ties
+  // (math/local_origin.h); with hold_frame the --init one.
+  if (!hold_frame) {
+    std::vector<Eigen::Vector3d> p_survey;
+    for (const ControlRow& row : rows_) p_survey.push_back(row.p_survey);
+    for (const PositionTie& t : fix_ties_) p_survey.push_back(t.p_world);
+    *origin = ChooseLocalOrigin(p_survey);
+  }
+  origin_ = *origin;
   const Pose3 T_local_frame =
-      Pose3(Eigen::Matrix3d::Identity(), -origin_) * (aligned_ ? alignment_.T_survey_frame : Pose3());
+      Pose3(Eigen::Matrix3d::Identity(), -origin_.t_user_local) * alignment_.T_survey_frame;
   for (StampedPose& p : *init) {
     const Pose3 T = T_local_frame * Pose3(p.q_world_imu, p.p_world_imu);
     p.p_world_imu = T.t;
@@ -332,7 +326,7 @@ Status SurveyTies::Prepare(bool hold_frame, Trajectory* init, std::vector<Positi
   }
   ties->clear();
   auto add = [&](PositionTie tie) {
-    tie.p_world -= origin_;
+    tie.p_world = origin_.ToLocal(tie.p_world);
     ties->push_back(tie);
   };
   for (size_t i = 0; i < rows_.size(); ++i)
@@ -358,7 +352,7 @@ void SurveyTies::Evaluate(const Trajectory& refined_local) {
     }
     r.estimated = n > 0;
     if (!r.estimated) continue;
-    r.p_estimated = sum / n + origin_;
+    r.p_estimated = origin_.ToUser(sum / n);
     const double d = r.Residual().norm();
     if (rows_[i].role == ControlRole::kControl && d > control_.warn_sigmas * r.sigma_m)
       warnings_.push_back("control point " + rows_[i].name + " (" + control_path_ + " line " +
@@ -370,7 +364,7 @@ void SurveyTies::Evaluate(const Trajectory& refined_local) {
   for (size_t i = 0; i < fix_ties_.size(); ++i) {
     Eigen::Vector3d p;
     if (TiePointOnTrajectory(refined_local, fix_ties_[i].t_ns, fix_ties_[i].p_imu_point, &p))
-      fix_residual_m_.push_back((p + origin_ - fix_ties_[i].p_world).norm());
+      fix_residual_m_.push_back((origin_.ToUser(p) - fix_ties_[i].p_world).norm());
   }
 }
 
@@ -407,8 +401,7 @@ nlohmann::json SurveyTies::SurveyJson(const std::string& crs) const {
                       {"gnss_outliers", outliers},
                       {"gnss_outside_init", fixes_outside_init_},
                       {"gnss_messages", gnss_stats_.messages},
-                      {"gnss_no_fix", gnss_stats_.no_fix},
-                      {"local_origin", {origin_.x(), origin_.y(), origin_.z()}}};
+                      {"gnss_no_fix", gnss_stats_.no_fix}};
   if (aligned_) {
     const Eigen::Vector3d& t = alignment_.T_survey_frame.t;
     j["alignment"] = {{"yaw_deg", alignment_.yaw_deg},
@@ -455,7 +448,8 @@ uint64_t SurveyTies::ContentHash() const {
 
 StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_path,
                                                      const std::string& bag,
-                                                     const OdometryOptions& options) {
+                                                     const OdometryOptions& options,
+                                                     const LocalOrigin& init_origin) {
   std::vector<ControlRow> rows;
   if (!control_path.empty()) {
     StatusOr<std::vector<ControlRow>> read = ReadControlFile(control_path);
@@ -475,7 +469,8 @@ StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_
                                 "': no fix with a solution (" + std::to_string(stats.messages) +
                                 " messages, " + std::to_string(stats.no_fix) + " without)");
   }
-  auto ties = std::make_unique<SurveyTies>(control_path, std::move(rows), std::move(fixes), options);
+  auto ties = std::make_unique<SurveyTies>(control_path, std::move(rows), std::move(fixes),
+                                           options, init_origin);
   ties->set_gnss_stats(stats);
   return ties;
 }
@@ -506,9 +501,6 @@ StatusOr<std::vector<SurveyFix>> ReadSurveyFixes(const std::string& bag,
 
 void DeliverInSurveyFrame(SurveyTies* survey, RefineRunResult* r) {
   survey->Evaluate(r->refine.trajectory);
-  const Eigen::Vector3d& o = survey->origin();
-  for (StampedPose& p : r->refine.trajectory) p.p_world_imu += o;
-  for (Eigen::Vector3d& p : r->refine.map_points) p += o;
   if (survey->has_control_file()) r->control_csv = survey->ControlCsv();
   r->refine.warnings.insert(r->refine.warnings.end(), survey->warnings().begin(),
                             survey->warnings().end());

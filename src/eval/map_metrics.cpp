@@ -11,6 +11,7 @@
 
 #include "rvlio/common/parallel.h"
 #include "rvlio/map/voxel_order.h"
+#include "rvlio/math/local_origin.h"
 
 namespace rvlio {
 
@@ -172,34 +173,11 @@ Status CheckCloud(const std::vector<Eigen::Vector3d>& points, const char* which)
   return Status::Ok();
 }
 
-}  // namespace
-
-ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points) {
-  ChainageAxis axis;
-  if (points.empty()) return axis;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points) mean += p;
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3d& p : points) C.noalias() += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
-  Eigen::Vector3d dir = es.eigenvectors().col(2);
-  Eigen::Index largest = 0;
-  dir.cwiseAbs().maxCoeff(&largest);
-  if (dir(largest) < 0.0) dir = -dir;
-  double min_c = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector3d& p : points) min_c = std::min(min_c, dir.dot(p - mean));
-  axis.origin = mean + min_c * dir;
-  axis.direction = dir;
-  return axis;
-}
-
-StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
-                                    const std::vector<Eigen::Vector3d>& ref_points,
-                                    const MapEvalOptions& options,
-                                    const MapEvalProgress& progress_fn) {
-  if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
-  if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+// EvaluateMap of clouds in the reference's local frame (checked).
+StatusOr<MapEvalResult> EvaluateLocal(const std::vector<Eigen::Vector3d>& map_points,
+                                      const std::vector<Eigen::Vector3d>& ref_points,
+                                      const MapEvalOptions& options,
+                                      const MapEvalProgress& progress_fn) {
   if (!(options.max_distance <= kMaxDistanceVoxels * options.search.voxel_size)) {
     char text[256];
     std::snprintf(text, sizeof(text),
@@ -227,6 +205,8 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
   MapPointDistances d;
   {
     const ReferenceMap ref(ref_points, ref_order, options.search);
+    if (Status s = CheckReach(ref.voxels(), ref_points); !s.ok())
+      return Status::InvalidInput("the reference: " + s.message());
     d = MapToReference(map_points, map_order, ref, options, &progress);
   }  // the reference's search structure is freed before the map's is built
   std::vector<double> plane, nearest;
@@ -266,6 +246,55 @@ StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_poin
   r.axis_direction = axis.direction;
   r.profile = Profile(map_points, ref_points, d, ref_nearest, axis, *bins, options);
   return r;
+}
+
+}  // namespace
+
+ChainageAxis PrincipalAxis(const std::vector<Eigen::Vector3d>& points) {
+  ChainageAxis axis;
+  if (points.empty()) return axis;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) C.noalias() += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+  Eigen::Vector3d dir = es.eigenvectors().col(2);
+  Eigen::Index largest = 0;
+  dir.cwiseAbs().maxCoeff(&largest);
+  if (dir(largest) < 0.0) dir = -dir;
+  double min_c = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& p : points) min_c = std::min(min_c, dir.dot(p - mean));
+  axis.origin = mean + min_c * dir;
+  axis.direction = dir;
+  return axis;
+}
+
+StatusOr<MapEvalResult> EvaluateMap(std::vector<Eigen::Vector3d>&& map_points,
+                                    std::vector<Eigen::Vector3d>&& ref_points,
+                                    const MapEvalOptions& options,
+                                    const MapEvalProgress& progress) {
+  if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
+  if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+  const LocalOrigin origin = ChooseLocalOrigin(ref_points);
+  origin.ToLocal(&map_points);
+  origin.ToLocal(&ref_points);
+  StatusOr<MapEvalResult> r = EvaluateLocal(map_points, ref_points, options, progress);
+  if (r.ok()) r->axis_origin = origin.ToUser(r->axis_origin);
+  return r;
+}
+
+StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
+                                    const std::vector<Eigen::Vector3d>& ref_points,
+                                    const MapEvalOptions& options,
+                                    const MapEvalProgress& progress) {
+  if (ChooseLocalOrigin(ref_points).IsZero()) {  // no copies needed
+    if (Status s = CheckCloud(map_points, "the map"); !s.ok()) return s;
+    if (Status s = CheckCloud(ref_points, "the reference"); !s.ok()) return s;
+    return EvaluateLocal(map_points, ref_points, options, progress);
+  }
+  return EvaluateMap(std::vector<Eigen::Vector3d>(map_points),
+                     std::vector<Eigen::Vector3d>(ref_points), options, progress);
 }
 
 }  // namespace rvlio

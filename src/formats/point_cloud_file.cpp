@@ -411,6 +411,9 @@ Status DecodeBinary(const std::string& path, const char* data, size_t size, cons
         path + ": truncated: the header declares " + std::to_string(n) + " points, the data holds " +
         std::to_string(layout.record_bytes == 0 ? 0 : size / layout.record_bytes));
   PrepareCloud(layout, plan, cloud);
+  for (int axis : {plan.x, plan.y, plan.z})
+    cloud->xyz_single_precision |=
+        layout.fields[axis].kind == ScalarKind::kFloat && layout.fields[axis].size == 4;
   const auto scalar = [&](const char* record, int f) {
     const FieldLayout& fl = layout.fields[f];
     return DecodeScalar(record + fl.offset, fl.kind, fl.size, layout.big_endian);

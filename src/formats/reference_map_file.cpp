@@ -1,11 +1,13 @@
 // Reading the inputs of `run --map` and `refine --map` (formats/reference_map_file.h).
 #include "rvlio/formats/reference_map_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -40,21 +42,56 @@ double NearestDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::
   return std::sqrt(best2);
 }
 
-StatusOr<std::vector<Eigen::Vector3d>> ReadReferencePoints(const std::string& path) {
+// The warning for a map stored as float32 where float32 steps by a
+// millimetre or more (empty otherwise): its points are no finer than that,
+// whatever the local frame does.
+std::string PrecisionWarning(const std::string& path, const PointCloudFile& cloud) {
+  if (!cloud.xyz_single_precision) return "";
+  double largest = 0.0;
+  for (const Eigen::Vector3d& p : cloud.points) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  if (largest < kFloat32MillimetreReach_m) return "";
+  char text[320];
+  std::snprintf(text, sizeof(text),
+                "--map %s: x y z are float32 and reach %.0f m, where float32 steps by %.3g m: "
+                "the map is no finer than that (store it with float64 x y z, or in a local frame)",
+                path.c_str(), largest, Float32Step(largest));
+  return text;
+}
+
+// The points of --map in their local frame (*origin, chosen from them): the
+// file's coordinates, read in double precision, minus the origin.
+StatusOr<std::vector<Eigen::Vector3d>> ReadReferencePoints(const std::string& path,
+                                                           LocalOrigin* origin,
+                                                           std::vector<std::string>* warnings) {
   PointCloudReadOptions read;
   read.keep_fields = false;
   StatusOr<PointCloudFile> cloud = ReadPointCloud(path, read);
   if (!cloud.ok()) return Status::InvalidInput("--map " + cloud.status().message());
+  if (std::string w = PrecisionWarning(path, *cloud); !w.empty() && warnings != nullptr)
+    warnings->push_back(w);
+  *origin = ChooseLocalOrigin(cloud->points);
+  origin->ToLocal(&cloud->points);
   return std::move(cloud->points);
+}
+
+// A reference its search structures could not hold whole is refused: a
+// dropped point would silently leave a hole in the association and the
+// deviation.
+Status CheckReferenceReach(const std::string& path, const VoxelMap& structure,
+                           const std::vector<Eigen::Vector3d>& p_ref) {
+  if (Status s = CheckReach(structure, p_ref); !s.ok())
+    return Status::InvalidInput("--map " + path + ": " + s.message());
+  return Status::Ok();
 }
 
 // The two search structures of one reference cloud, built side by side (they
 // only read p_ref): the thinned association map, and the full-resolution
 // surface for the deviation when `surface` is given. These two builds are
 // about a third of a large map's loading CPU time (perf, 10 M points).
-std::shared_ptr<const VoxelMap> BuildReferenceStructures(
-    const std::vector<Eigen::Vector3d>& p_ref, const LocalizationOptions& options,
-    std::shared_ptr<const ReferenceMap>* surface) {
+// Refused (CheckReferenceReach) when either could not hold every point.
+StatusOr<std::shared_ptr<const VoxelMap>> BuildReferenceStructures(
+    const std::string& path, const std::vector<Eigen::Vector3d>& p_ref,
+    const LocalizationOptions& options, std::shared_ptr<const ReferenceMap>* surface) {
   std::shared_ptr<const VoxelMap> association;
   ParallelFor(0, surface != nullptr ? 2 : 1, 2, [&](int structure, int) {
     if (structure == 0)
@@ -62,6 +99,9 @@ std::shared_ptr<const VoxelMap> BuildReferenceStructures(
     else
       *surface = std::make_shared<const ReferenceMap>(p_ref);
   });
+  if (Status s = CheckReferenceReach(path, *association, p_ref); !s.ok()) return s;
+  if (surface != nullptr)
+    if (Status s = CheckReferenceReach(path, (*surface)->voxels(), p_ref); !s.ok()) return s;
   return association;
 }
 
@@ -69,16 +109,20 @@ std::shared_ptr<const VoxelMap> BuildReferenceStructures(
 
 StatusOr<std::shared_ptr<const VoxelMap>> LoadReferenceMap(
     const std::string& path, const LocalizationOptions& options,
-    std::shared_ptr<const ReferenceMap>* surface) {
-  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path);
+    std::shared_ptr<const ReferenceMap>* surface, LocalOrigin* origin,
+    std::vector<std::string>* warnings) {
+  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path, origin, warnings);
   if (!p_ref.ok()) return p_ref.status();
-  return BuildReferenceStructures(*p_ref, options, surface);
+  return BuildReferenceStructures(path, *p_ref, options, surface);
 }
 
-StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(const std::string& path) {
-  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path);
+StatusOr<std::shared_ptr<const ReferenceMap>> LoadReferenceSurface(
+    const std::string& path, LocalOrigin* origin, std::vector<std::string>* warnings) {
+  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(path, origin, warnings);
   if (!p_ref.ok()) return p_ref.status();
-  return std::make_shared<const ReferenceMap>(std::move(*p_ref));
+  auto surface = std::make_shared<const ReferenceMap>(*p_ref);
+  if (Status s = CheckReferenceReach(path, surface->voxels(), *p_ref); !s.ok()) return s;
+  return surface;
 }
 
 StatusOr<Trajectory> ParseInitialPose(const std::string& text) {
@@ -110,27 +154,34 @@ StatusOr<Localization> LoadLocalization(const std::string& map_path,
                                         const std::string& initial_pose,
                                         const std::string& initial_pose_tum,
                                         const OdometryOptions& options,
-                                        std::shared_ptr<const ReferenceMap>* surface) {
+                                        std::shared_ptr<const ReferenceMap>* surface,
+                                        std::vector<std::string>* warnings) {
   StatusOr<Trajectory> poses = InitialPoses(initial_pose, initial_pose_tum);
   if (!poses.ok()) return poses.status();
-  StatusOr<std::vector<Eigen::Vector3d>> p_ref = ReadReferencePoints(map_path);
+  Localization loc;
+  StatusOr<std::vector<Eigen::Vector3d>> p_ref =
+      ReadReferencePoints(map_path, &loc.origin, warnings);
   if (!p_ref.ok()) return p_ref.status();
+  loc.origin.ToLocal(&*poses);  // the initial poses are given in the map's frame
   if (!poses->empty()) {
     const Eigen::Vector3d start = poses->front().p_world_imu;
     const double nearest_m = NearestDistance(*p_ref, start);
     if (!(nearest_m <= options.localization.max_start_distance)) {
-      char text[240];
+      const Eigen::Vector3d start_user = loc.origin.ToUser(start);
+      char text[320];
       std::snprintf(text, sizeof(text),
                     ": the nearest point is %.4g m from the initial position (%.3f, %.3f, %.3f), "
                     "more than localization.max_start_distance %.4g m: is the map in this frame "
                     "and in metres?",
-                    nearest_m, start.x(), start.y(), start.z(),
+                    nearest_m, start_user.x(), start_user.y(), start_user.z(),
                     options.localization.max_start_distance);
       return Status::InvalidInput("--map " + map_path + text);
     }
   }
-  Localization loc;
-  loc.reference = BuildReferenceStructures(*p_ref, options.localization, surface);
+  StatusOr<std::shared_ptr<const VoxelMap>> reference =
+      BuildReferenceStructures(map_path, *p_ref, options.localization, surface);
+  if (!reference.ok()) return reference.status();
+  loc.reference = std::move(*reference);
   loc.initial_poses = std::move(*poses);
   return loc;
 }

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+
+#include <Eigen/Geometry>
 
 #include "rvlio/common/check.h"
 #include "rvlio/common/memory.h"
@@ -21,8 +24,8 @@ constexpr size_t kInitialCapacity = 1024;  // slots (power of two)
 constexpr int kFirstBlockCapacity = 4;     // points in a new voxel's block
 
 // Voxel keys are packed into 64 bits, 21 per axis with a bias; points whose
-// voxel index reaches kKeyLimit in magnitude are not stored (at the smallest
-// voxel size, 0.05 m, that is 52 km from the origin).
+// voxel index reaches kKeyLimit in magnitude are not stored but counted
+// (VoxelMapReach: 104.8 km from the origin at 0.1 m voxels, 524 km at 0.5 m).
 constexpr int kKeyBits = 21;
 constexpr int64_t kKeyBias = int64_t{1} << (kKeyBits - 1);
 constexpr double kKeyLimit = static_cast<double>(kKeyBias - 1024);  // margin for neighbours
@@ -178,6 +181,7 @@ void VoxelMap::Clear() {
   pool_.clear();
   for (auto& list : free_blocks_) list.clear();
   num_points_ = 0;
+  num_out_of_reach_ = 0;
   Rebuild(kInitialCapacity, {});
 }
 
@@ -280,7 +284,14 @@ void VoxelMap::MoveBlock(Slot* s, int new_capacity) {
 // ------------------------------------------------------------------ updates
 
 bool VoxelMap::InsertPoint(const Eigen::Vector3d& p_world) {
-  if (!InKeyRange(p_world, inv_voxel_size_)) return false;
+  if (!InKeyRange(p_world, inv_voxel_size_)) {
+    num_out_of_reach_ += p_world.allFinite() ? 1 : 0;
+    return false;
+  }
+  return InsertKeyable(p_world);
+}
+
+bool VoxelMap::InsertKeyable(const Eigen::Vector3d& p_world) {
   const VoxelKey k = KeyOf(p_world, inv_voxel_size_);
   const uint64_t key = PackKey(k.x, k.y, k.z);
   const float px = static_cast<float>(p_world.x());
@@ -328,7 +339,10 @@ size_t VoxelMap::InsertInVoxelOrder(const std::vector<Eigen::Vector3d>& p_world,
   for (size_t j = 0; j < order.size(); ++j) {
     PrefetchAhead(p_world, order, j);
     const Eigen::Vector3d& p = p_world[order[j]];
-    if (!InKeyRange(p, inv_voxel_size_)) continue;
+    if (!InKeyRange(p, inv_voxel_size_)) {
+      num_out_of_reach_ += p.allFinite() ? 1 : 0;
+      continue;
+    }
     const VoxelKey k = KeyOf(p, inv_voxel_size_);
     const uint64_t key = PackKey(k.x, k.y, k.z);
     if (run_begin.empty() || key != run_key) {
@@ -348,7 +362,8 @@ size_t VoxelMap::InsertInVoxelOrder(const std::vector<Eigen::Vector3d>& p_world,
     ReserveRun(p_world[order[begin]], end - begin);
     for (size_t j = begin; j < end; ++j) {
       PrefetchAhead(p_world, order, j);
-      InsertPoint(p_world[order[j]]);
+      const Eigen::Vector3d& p = p_world[order[j]];
+      if (InKeyRange(p, inv_voxel_size_)) InsertKeyable(p);  // the others are counted above
     }
   }
   return num_points_ - before;
@@ -558,6 +573,25 @@ int VoxelMap::KNearest(const Eigen::Vector3d& q_world, int k, double max_dist,
     out->dist2[i] = (out->points[i] - q_world).squaredNorm();
   }
   return out->size;
+}
+
+double VoxelMapReach(double voxel_size) { return kKeyLimit * voxel_size; }
+
+Status CheckReach(const VoxelMap& map, const std::vector<Eigen::Vector3d>& p_inserted) {
+  if (map.NumOutOfReach() == 0) return Status::Ok();
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& p : p_inserted)
+    if (p.allFinite()) box.extend(p);
+  const Eigen::Vector3d span_km = box.sizes() / 1000.0;
+  const double reach_km = VoxelMapReach(map.options().voxel_size) / 1000.0;
+  char text[400];
+  std::snprintf(text, sizeof(text),
+                "%zu of %zu points lie more than %.1f km from the local origin along an axis, "
+                "beyond the reach of a voxel map of %g m voxels (the cloud spans %.1f x %.1f x "
+                "%.1f km in x, y, z): crop it to the area of interest, or remove stray points",
+                map.NumOutOfReach(), p_inserted.size(), reach_km, map.options().voxel_size,
+                span_km.x(), span_km.y(), span_km.z());
+  return Status::InvalidInput(text);
 }
 
 }  // namespace rvlio

@@ -67,11 +67,11 @@ const std::vector<ScanColumn> kColumns = {
    [](R r) { return r.scan.rv.localizability; }, nullptr},
   {"ms", "ms", T::kReal, F::kPlain, G::kAlways,  // CPU time of the scan
    [](R r) { return r.scan.ms; }, nullptr},
-  {"x", "m", T::kReal, F::kPlain, G::kAlways,  // IMU position in the world
+  {"x", "m", T::kReal, F::kPosition, G::kAlways,  // IMU position in the world
    [](R r) { return r.scan.T_world_imu.t.x(); }, nullptr},
-  {"y", "m", T::kReal, F::kPlain, G::kAlways,
+  {"y", "m", T::kReal, F::kPosition, G::kAlways,
    [](R r) { return r.scan.T_world_imu.t.y(); }, nullptr},
-  {"z", "m", T::kReal, F::kPlain, G::kAlways,
+  {"z", "m", T::kReal, F::kPosition, G::kAlways,
    [](R r) { return r.scan.T_world_imu.t.z(); }, nullptr},
   {"acc_x", "m/s^2", T::kReal, F::kPlain, G::kAlways,  // mean specific force, IMU frame
    [](R r) { return r.scan.mean_acc_imu.x(); }, nullptr},
@@ -178,6 +178,8 @@ std::string FormatScanCell(const ScanColumn& column, const ScanRecord& record) {
   if (column.format == F::kStatistic && !std::isfinite(v)) return "";
   std::ostringstream os;
   os.precision(column.format == F::kStatistic ? 6 : 9);
+  if (column.format == F::kPosition && std::isfinite(v) && std::abs(v) >= 1.0)  // >= 6 decimals
+    os.precision(std::max(9, static_cast<int>(std::floor(std::log10(std::abs(v)))) + 7));
   os << v;
   return os.str();
 }

@@ -158,10 +158,13 @@ StatusOr<ReferenceAlignment> ReferenceLocalizer::SearchStart(
     return Status::InvalidInput(
         "no place in the reference map matches the first scan (global search); check that the "
         "map is in metres and covers the start, or give --initial-pose");
+  // Positions in the message are in the map's frame, as the user gave it.
+  const LocalOrigin& origin = localization_.origin;
   if (const ReferenceAlignment* rival = RivalOf(candidates, options_.search_ambiguity))
     return Status::InvalidInput(
         "the first scan matches the reference map equally well at " +
-        Vec(candidates.front().T_ref_imu.t, 2) + " and at " + Vec(rival->T_ref_imu.t, 2) +
+        Vec(origin.ToUser(candidates.front().T_ref_imu.t), 2) + " and at " +
+        Vec(origin.ToUser(rival->T_ref_imu.t), 2) +
         " (global search): give --initial-pose");
   return candidates.front();
 }

@@ -10,28 +10,53 @@
 #include "rvlio/common/text.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/odometry/scan_columns.h"
 
 namespace rvlio {
 namespace {
 
-// The header of a binary PCD (v0.7) of n unorganized float32 points with the
-// fields x y z, plus `extra_field` when it is not empty: byte for byte the
-// header PCL's PCDWriter::writeBinary writes for such a cloud (test
-// MapPcdIsWhatPclWritesAndReads), also for n = 0, which PCL refuses to write.
-std::string PcdBinaryHeader(size_t n, const std::string& extra_field) {
+// The header of a binary PCD (v0.7) of n unorganized points with the fields
+// x y z (float32, or float64 when xyz_bytes is 8), plus the float32
+// `extra_field` when it is not empty: byte for byte the header PCL's
+// PCDWriter::writeBinary writes for such a cloud (tests MapPcdIsWhatPclWritesAndReads,
+// FarMapPcdIsFloat64AndWhatPclWrites), also for n = 0, which PCL refuses to write.
+std::string PcdBinaryHeader(size_t n, int xyz_bytes, const std::string& extra_field) {
   const bool extra = !extra_field.empty();
   const std::string count = std::to_string(n);
+  const std::string size = std::to_string(xyz_bytes);
   return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z" +
-         (extra ? " " + extra_field : std::string()) + "\nSIZE 4 4 4" + (extra ? " 4" : "") +
-         "\nTYPE F F F" + (extra ? " F" : "") + "\nCOUNT 1 1 1" + (extra ? " 1" : "") +
-         "\nWIDTH " + count + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + count +
-         "\nDATA binary\n";
+         (extra ? " " + extra_field : std::string()) + "\nSIZE " + size + " " + size + " " +
+         size + (extra ? " 4" : "") + "\nTYPE F F F" + (extra ? " F" : "") + "\nCOUNT 1 1 1" +
+         (extra ? " 1" : "") + "\nWIDTH " + count + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " +
+         count + "\nDATA binary\n";
 }
 
 constexpr size_t kPcdBlockPoints = 1 << 15;  // points per Append of map.pcd
 
+// One point's record: x y z as float32 or float64 (xyz_bytes), then the
+// float32 deviation when deviation_m is not null.
+void AppendPcdRecord(const Eigen::Vector3d& p, int xyz_bytes, const double* deviation_m,
+                     std::string* block) {
+  if (xyz_bytes == 8) {
+    block->append(reinterpret_cast<const char*>(p.data()), 3 * sizeof(double));
+  } else {
+    const float xyz[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()),
+                          static_cast<float>(p.z())};
+    block->append(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+  }
+  if (deviation_m == nullptr) return;
+  const float d = static_cast<float>(*deviation_m);
+  block->append(reinterpret_cast<const char*>(&d), sizeof(d));
+}
+
 }  // namespace
+
+bool MapNeedsFloat64(const std::vector<Eigen::Vector3d>& p_world) {
+  for (const Eigen::Vector3d& p : p_world)
+    if (p.cwiseAbs().maxCoeff() >= kFloat32MillimetreReach_m) return true;
+  return false;
+}
 
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world) {
   return WriteMapPcd(path, p_world, nullptr);
@@ -43,20 +68,19 @@ Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& 
   // on failure, where a full disk must be a clean error that leaves no half
   // file. The points go through the atomic writer, byte for byte what
   // PCDWriter::writeBinary produces.
+  const int xyz_bytes = MapNeedsFloat64(p_world) ? 8 : 4;
   const std::string header =
-      PcdBinaryHeader(p_world.size(), deviation_m != nullptr ? "deviation_m" : "");
-  const size_t fields = deviation_m != nullptr ? 4 : 3;
+      PcdBinaryHeader(p_world.size(), xyz_bytes, deviation_m != nullptr ? "deviation_m" : "");
+  const size_t record_bytes = 3 * xyz_bytes + (deviation_m != nullptr ? sizeof(float) : 0);
   AtomicFileWriter writer;
   if (Status s = writer.Open(path); !s.ok()) return s;
   if (Status s = writer.Append(header); !s.ok()) return s;
   std::string block;
-  block.reserve(kPcdBlockPoints * fields * sizeof(float));
+  block.reserve(kPcdBlockPoints * record_bytes);
   for (size_t i = 0; i < p_world.size(); ++i) {
-    const float row[4] = {static_cast<float>(p_world[i].x()), static_cast<float>(p_world[i].y()),
-                          static_cast<float>(p_world[i].z()),
-                          deviation_m != nullptr ? static_cast<float>((*deviation_m)[i]) : 0.0f};
-    block.append(reinterpret_cast<const char*>(row), fields * sizeof(float));
-    if (block.size() >= kPcdBlockPoints * fields * sizeof(float) || i + 1 == p_world.size()) {
+    AppendPcdRecord(p_world[i], xyz_bytes, deviation_m != nullptr ? &(*deviation_m)[i] : nullptr,
+                    &block);
+    if (block.size() >= kPcdBlockPoints * record_bytes || i + 1 == p_world.size()) {
       if (Status s = writer.Append(block); !s.ok()) return s;
       block.clear();
     }

@@ -61,6 +61,11 @@ std::vector<std::string> ReaderWarnings(const SensorReaderStats& r, const LidarO
   return w;
 }
 
+nlohmann::json LocalOriginJson(const LocalOrigin& origin) {
+  const Eigen::Vector3d& t = origin.t_user_local;
+  return {t.x(), t.y(), t.z()};
+}
+
 nlohmann::json DivergenceJson(const DivergenceReport& r) {
   nlohmann::json events = nlohmann::json::object();
   for (int k = 0; k < kNumDivergenceKinds; ++k)

@@ -10,7 +10,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -52,6 +55,32 @@ inline void ExpectOneErrorLine(const ToolRun& r, const std::string& command,
   EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "more than one line: " << r.err;
   EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+// A CSV file with a header line of names (scans.csv, deviation.csv) as rows
+// of named numbers; an empty or non-numeric field is NaN.
+inline std::vector<std::map<std::string, double>> ReadCsv(const std::string& path) {
+  std::istringstream in(ReadFile(path));
+  std::string line;
+  std::vector<std::string> names;
+  if (std::getline(in, line)) {
+    std::istringstream h(line);
+    for (std::string n; std::getline(h, n, ',');) names.push_back(n);
+  }
+  std::vector<std::map<std::string, double>> rows;
+  while (std::getline(in, line)) {
+    std::istringstream f(line);
+    std::map<std::string, double> row;
+    std::string v;
+    for (size_t i = 0; i < names.size(); ++i) {
+      if (!std::getline(f, v, ',')) v.clear();
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      row[names[i]] = v.empty() || *end != '\0' ? NAN : x;
+    }
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 inline std::string MakeTempDir(const std::string& stem) {

@@ -27,6 +27,7 @@ namespace {
 using testing_cli::AteNoAlign;
 using testing_cli::CachedSimulate;
 using testing_cli::MakeTempDir;
+using testing_cli::ReadCsv;
 using testing_cli::ReadFile;
 using testing_cli::RunTool;
 using testing_cli::ToolRun;
@@ -41,27 +42,6 @@ const std::string kWorld =
     " --set 'trajectory.waypoints=0,0,0; 0,0,2.5; 60,0,2.5' --set trajectory.cruise_speed=3"
     " --set world.deformation.amplitude=0.05 --set world.deformation.x_center=20"
     " --set world.deformation.length=10";
-
-// One CSV file as rows of named columns.
-std::vector<std::map<std::string, double>> ReadCsv(const std::string& path) {
-  std::istringstream in(ReadFile(path));
-  std::string line;
-  std::vector<std::string> names;
-  if (std::getline(in, line)) {
-    std::istringstream h(line);
-    for (std::string n; std::getline(h, n, ',');) names.push_back(n);
-  }
-  std::vector<std::map<std::string, double>> rows;
-  while (std::getline(in, line)) {
-    std::istringstream f(line);
-    std::map<std::string, double> row;
-    std::string v;
-    for (size_t i = 0; i < names.size() && std::getline(f, v, ','); ++i)
-      row[names[i]] = std::strtod(v.c_str(), nullptr);
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 Trajectory Tum(const std::string& path) {
   StatusOr<Trajectory> t = ReadTum(path);

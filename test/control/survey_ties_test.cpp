@@ -44,14 +44,15 @@ TEST(SurveyTies, GnssAlignmentShrugsOffMultipathOutliers) {
   SurveyTies ties("", {}, fixes, options);
   Trajectory init = flight;
   std::vector<PositionTie> out;
-  ASSERT_TRUE(ties.Prepare(false, &init, &out).ok());
+  LocalOrigin origin;
+  ASSERT_TRUE(ties.Prepare(false, &origin, &init, &out).ok());
   EXPECT_EQ(out.size(), fixes.size());
   // The initial trajectory in the local survey frame: within 1 cm of the truth.
   for (size_t k = 0; k < init.size(); ++k)
-    EXPECT_LT((init[k].p_world_imu + ties.origin() - T_survey_world * flight[k].p_world_imu).norm(),
+    EXPECT_LT((ties.origin().ToUser(init[k].p_world_imu) - T_survey_world * flight[k].p_world_imu).norm(),
               0.01)
         << k;
-  EXPECT_EQ(ties.origin(), Eigen::Vector3d(500000.0, 5400000.0, 0.0));
+  EXPECT_EQ(origin.t_user_local, Eigen::Vector3d(500000.0, 5400000.0, 0.0));
   const nlohmann::json j = ties.SurveyJson("EPSG:25832");
   EXPECT_NEAR(j["alignment"]["yaw_deg"].get<double>(), 30.0, 0.02);
   EXPECT_EQ(j["gnss_fixes"], fixes.size());
@@ -75,7 +76,8 @@ TEST(SurveyTies, ResidualsOfMarksAtTheRefinedTrajectory) {
   SurveyTies ties("marks.csv", rows, {}, options);
   Trajectory init = flight;
   std::vector<PositionTie> out;
-  ASSERT_TRUE(ties.Prepare(false, &init, &out).ok());
+  LocalOrigin origin;
+  ASSERT_TRUE(ties.Prepare(false, &origin, &init, &out).ok());
   EXPECT_EQ(out.size(), 2u);  // the check point does not enter the solve
   ties.Evaluate(init);
   const std::vector<ControlResidual>& r = ties.residuals();

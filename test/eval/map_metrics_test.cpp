@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -186,6 +188,42 @@ TEST(MapMetrics, RefusesEmptyNonFiniteAndDisjointClouds) {
   ASSERT_FALSE(disjoint.ok());
   EXPECT_EQ(disjoint.status().code(), StatusCode::kInvalidInput);
   EXPECT_NE(disjoint.status().message().find("do not overlap"), std::string::npos);
+}
+
+// The same two clouds shifted far from the origin (106 km: beyond the
+// reference structure's key reach at 0.1 m voxels; a UTM easting and
+// northing: beyond float32's millimetres) give the same figures: both are
+// evaluated in the reference's local frame; the axis comes back shifted.
+TEST(MapMetrics, CloudsFarFromTheOriginGiveTheSameFigures) {
+  const std::vector<Eigen::Vector3d> ref = Plane(40000, 0.0, 0.0005, 11);
+  const std::vector<Eigen::Vector3d> map = Plane(10000, 0.01, 0.002, 12);
+  const MapEvalOptions o;
+  const StatusOr<MapEvalResult> near = EvaluateMap(map, ref, o);
+  ASSERT_TRUE(near.ok()) << near.status().message();
+  for (const Eigen::Vector3d& shift :
+       {Eigen::Vector3d(106000.0, 0.0, 0.0), Eigen::Vector3d(500000.0, 5400000.0, 312.0)}) {
+    std::vector<Eigen::Vector3d> map_far = map, ref_far = ref;
+    for (Eigen::Vector3d& p : map_far) p += shift;
+    for (Eigen::Vector3d& p : ref_far) p += shift;
+    const StatusOr<MapEvalResult> far = EvaluateMap(map_far, ref_far, o);
+    ASSERT_TRUE(far.ok()) << far.status().message();
+    EXPECT_EQ(far->inliers, near->inliers);
+    EXPECT_NEAR(far->accuracy.rmse, near->accuracy.rmse, 1e-6);
+    EXPECT_NEAR(far->completeness, near->completeness, 1e-4);
+    EXPECT_NEAR(far->chamfer_m, near->chamfer_m, 1e-6);
+    EXPECT_NEAR((far->axis_origin - shift - near->axis_origin).norm(), 0.0, 1e-6);
+    // The moving overload gives the same.
+    const StatusOr<MapEvalResult> moved = EvaluateMap(std::move(map_far), std::move(ref_far), o);
+    ASSERT_TRUE(moved.ok());
+    EXPECT_EQ(moved->chamfer_m, far->chamfer_m);
+  }
+  // A reference point beyond the reach from the others is refused, not dropped.
+  std::vector<Eigen::Vector3d> stray = ref;
+  stray.push_back(Eigen::Vector3d(250000.0, 0.0, 0.0));
+  const StatusOr<MapEvalResult> refused = EvaluateMap(map, stray, o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("the reference: 1 of 40001 points"), std::string::npos)
+      << refused.status().message();
 }
 
 TEST(MapMetrics, PrincipalAxisStartsAtTheSmallestProjection) {

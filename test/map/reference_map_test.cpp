@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/common/cpu_time.h"
+#include "rvlio/math/local_origin.h"
 
 namespace rvlio {
 namespace {
@@ -37,6 +38,27 @@ TEST(ReferenceMap, SkipsNonFinitePointsAndCountsThem) {
   EXPECT_EQ(map.Size(), 100u);
   EXPECT_EQ(map.NumSkipped(), 2u);
   EXPECT_TRUE(map.Bounds().contains(Eigen::Vector3d(0.0, 0.0, 0.0)));
+}
+
+// At UTM coordinates (northing 5.4e6 m = 5.4e7 voxels of 0.1 m) not a point
+// fits the packed keys, and a float32 keeps only decimetres; in the cloud's
+// local frame (math/local_origin.h) every point is stored, to the micrometre.
+TEST(ReferenceMap, ASurveyInANationalGridFitsInItsLocalFrame) {
+  const Eigen::Vector3d utm(500000.0, 5400000.0, 0.0);
+  std::vector<Eigen::Vector3d> p = RandomCloud(2000, 20.0, 3);
+  for (Eigen::Vector3d& x : p) x += utm;
+  const ReferenceMap as_given(p);
+  EXPECT_EQ(as_given.Size(), 0u);
+  EXPECT_EQ(as_given.NumOutOfReach(), p.size());
+  const LocalOrigin origin = ChooseLocalOrigin(p);
+  EXPECT_EQ(origin.t_user_local, utm);
+  origin.ToLocal(&p);
+  const ReferenceMap local(p);
+  EXPECT_EQ(local.Size(), p.size());
+  EXPECT_EQ(local.NumOutOfReach(), 0u);
+  NeighborBuffer nb;
+  ASSERT_EQ(local.KNearest(p[17], 1, 0.1, &nb), 1);
+  EXPECT_LT(std::sqrt(nb.dist2[0]), 1e-5);
 }
 
 // Exact k nearest against brute force over the float-rounded points.

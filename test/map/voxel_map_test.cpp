@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -263,6 +264,38 @@ TEST(VoxelMap, RemoveFarKeepsTheWindow) {
   }
 }
 
+// A point beyond the packed keys' reach (~10^6 voxels along an axis: 104.8 km
+// at 0.1 m) is not stored, and says so: counted, and CheckReach refuses the
+// cloud with the counts, the reach and the cloud's span.
+TEST(VoxelMap, PointsBeyondTheReachAreCountedAndReported) {
+  MapOptions o;
+  o.voxel_size = 0.1;
+  o.min_point_distance = 0.0;
+  const double reach_m = VoxelMapReach(o.voxel_size);
+  EXPECT_NEAR(reach_m, 104755.2, 1e-6);  // (2^20 - 1024) voxels
+  EXPECT_NEAR(VoxelMapReach(0.5), 523776.0, 1e-6);
+  const std::vector<Eigen::Vector3d> p = {{1.0, 2.0, 3.0},
+                                          {reach_m - 1.0, 0.0, 0.0},
+                                          {0.0, -reach_m - 1.0, 0.0},
+                                          {500000.0, 5400000.0, 0.0},  // UTM, not in a local frame
+                                          {NAN, 0.0, 0.0}};
+  VoxelMap map(o);
+  map.Insert(p);
+  EXPECT_EQ(map.Size(), 2u);
+  EXPECT_EQ(map.NumOutOfReach(), 2u);
+  const Status s = CheckReach(map, p);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
+  for (const char* part : {"2 of 5 points", "104.8 km", "0.1 m voxels", "500.0 x 5504.8 x 0.0 km"})
+    EXPECT_NE(s.message().find(part), std::string::npos) << part << " not in: " << s.message();
+  VoxelMap bulk(o);
+  bulk.InsertInVoxelOrder(p, VoxelOrder(p, o.voxel_size));
+  EXPECT_EQ(bulk.NumOutOfReach(), 2u);
+  map.Clear();
+  EXPECT_EQ(map.NumOutOfReach(), 0u);
+  EXPECT_TRUE(CheckReach(map, {}).ok());
+}
+
 TEST(VoxelMap, ClearEmptiesTheMap) {
   VoxelMap map;
   std::mt19937 rng(1);
@@ -421,6 +454,8 @@ TEST(VoxelMap, InsertInVoxelOrderEqualsInsertingOneByOne) {
     ASSERT_EQ(stored, stored_single) << trial;
     ASSERT_EQ(bulk.Size(), single.Size()) << trial;
     ASSERT_EQ(bulk.NumVoxels(), single.NumVoxels()) << trial;
+    ASSERT_EQ(bulk.NumOutOfReach(), single.NumOutOfReach()) << trial;
+    EXPECT_EQ(bulk.NumOutOfReach(), 1u) << trial;  // 1e12 m; the NaN is not counted
     NeighborBuffer a, b;
     for (const Eigen::Vector3d& q : RandomCloud(&rng, 200, 3.0)) {
       ASSERT_EQ(bulk.KNearest(q, 8, 2.0, &a), single.KNearest(q, 8, 2.0, &b)) << trial;

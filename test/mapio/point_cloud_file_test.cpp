@@ -22,22 +22,15 @@
 
 #include <gtest/gtest.h>
 
+#include "test_dir.h"
+
 namespace rvlio {
 namespace {
 
 namespace fs = std::filesystem;
 
-class PointCloudFileTest : public ::testing::Test {
+class PointCloudFileTest : public MapioTestDir {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rvlio_pcf_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
   std::string Write(const std::string& name, const std::string& bytes) const {
     std::ofstream(Path(name), std::ios::binary) << bytes;
     return Path(name);
@@ -69,7 +62,6 @@ class PointCloudFileTest : public ::testing::Test {
       }
     }
   }
-  fs::path dir_;
 };
 
 TEST_F(PointCloudFileTest, ReadsPclPcdInEveryEncoding) {
@@ -149,6 +141,73 @@ TEST_F(PointCloudFileTest, MapPcdIsWhatPclWritesAndReads) {
   ASSERT_EQ(pcl::io::loadPCDFile(Path("deviation.pcd"), xyz), 0);
   ASSERT_EQ(xyz.size(), points.size());
   EXPECT_FLOAT_EQ(xyz[1].x, -4.5f);
+}
+
+// A map in a national grid (UTM: easting 5e5 m, northing 5.4e6 m, where a
+// float32 keeps only decimetres) is written with x y z as float64: the header
+// and the bytes are PCL's for such a cloud, PCL reads the doubles back, and so
+// does our reader, exactly. Below kFloat32MillimetreReach_m the map stays float32.
+TEST_F(PointCloudFileTest, FarMapPcdIsFloat64AndWhatPclWrites) {
+  const std::vector<Eigen::Vector3d> points = {{500000.0011, 5400000.0022, 312.0033},
+                                               {500012.25, 5399990.5, 300.0},
+                                               {499999.999, 5400000.001, -1.0}};
+  const std::vector<double> deviation_m = {0.012, std::numeric_limits<double>::quiet_NaN(), -0.03};
+  EXPECT_TRUE(MapNeedsFloat64(points));
+  EXPECT_FALSE(MapNeedsFloat64({{8191.9, -8191.9, 0.0}}));
+  EXPECT_TRUE(MapNeedsFloat64({{0.0, -8192.0, 0.0}}));
+  ASSERT_TRUE(WriteMapPcd(Path("ours.pcd"), points, &deviation_m).ok());
+
+  pcl::PCLPointCloud2 blob;  // the same cloud through PCL's writer
+  const char* names[] = {"x", "y", "z", "deviation_m"};
+  for (int f = 0; f < 4; ++f) {
+    pcl::PCLPointField field;
+    field.name = names[f];
+    field.offset = 8 * f;
+    field.datatype = f < 3 ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32;
+    field.count = 1;
+    blob.fields.push_back(field);
+  }
+  blob.point_step = 28;
+  blob.width = static_cast<uint32_t>(points.size());
+  blob.height = 1;
+  blob.row_step = blob.point_step * blob.width;
+  blob.data.resize(blob.row_step);
+  for (size_t i = 0; i < points.size(); ++i) {
+    std::memcpy(&blob.data[i * 28], points[i].data(), 24);
+    const float d = static_cast<float>(deviation_m[i]);
+    std::memcpy(&blob.data[i * 28 + 24], &d, 4);
+  }
+  ASSERT_EQ(pcl::PCDWriter().writeBinary(Path("pcl.pcd"), blob), 0);
+  auto bytes = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  // PCL's writer of a PCLPointCloud2 pads its file with zeros to a page.
+  const std::string ours_bytes = bytes(Path("ours.pcd")), pcl_bytes = bytes(Path("pcl.pcd"));
+  ASSERT_GE(pcl_bytes.size(), ours_bytes.size());
+  EXPECT_EQ(pcl_bytes.substr(0, ours_bytes.size()), ours_bytes);
+  EXPECT_EQ(pcl_bytes.find_first_not_of('\0', ours_bytes.size()), std::string::npos);
+  EXPECT_NE(ours_bytes.find("SIZE 8 8 8 4\nTYPE F F F F\n"), std::string::npos);
+
+  pcl::PCLPointCloud2 read;
+  ASSERT_EQ(pcl::io::loadPCDFile(Path("ours.pcd"), read), 0);
+  ASSERT_EQ(read.width * read.height, points.size());
+  ASSERT_EQ(read.fields[1].name, "y");
+  ASSERT_EQ(read.fields[1].datatype, pcl::PCLPointField::FLOAT64);
+  for (size_t i = 0; i < points.size(); ++i) {
+    double y = 0.0;
+    std::memcpy(&y, &read.data[i * read.point_step + read.fields[1].offset], sizeof(y));
+    EXPECT_EQ(y, points[i].y());
+  }
+  StatusOr<PointCloudFile> ours = ReadPointCloud(Path("ours.pcd"));
+  ASSERT_TRUE(ours.ok()) << ours.status().message();
+  EXPECT_EQ(ours->points, points);
+  ASSERT_NE(ours->Field("deviation_m"), nullptr);
+  EXPECT_FLOAT_EQ(ours->Field("deviation_m")->values[2], -0.03f);
+
+  // Near the origin map.pcd stays float32, byte for byte PCL's PointXYZ file.
+  ASSERT_TRUE(WriteMapPcd(Path("near.pcd"), {{8191.5, 0.0, 0.0}}).ok());
+  EXPECT_NE(bytes(Path("near.pcd")).find("SIZE 4 4 4\n"), std::string::npos);
 }
 
 TEST_F(PointCloudFileTest, ReadsPclPlyAsciiAndBinary) {

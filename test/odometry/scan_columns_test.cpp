@@ -135,6 +135,11 @@ TEST(ScanColumnsTest, CellsAreWrittenInTheirColumnsFormat) {
   EXPECT_EQ(Column("diverged").value(ScanRecord{r, 0.0}), 1.0);  // numeric readers: a flag
   EXPECT_EQ(Cell("weak_dir_x", r), "");                          // no weak direction
   EXPECT_EQ(Cell("condition_number", r), "inf");
+  // Positions in a national grid keep six decimals (a UTM northing, easting).
+  r.T_world_imu.t = Eigen::Vector3d(500000.0037144, 5400000.0005768, 312.25);
+  EXPECT_EQ(Cell("x", r), "500000.003714");
+  EXPECT_EQ(Cell("y", r), "5400000.000577");
+  EXPECT_EQ(Cell("z", r), "312.25");
 }
 
 }  // namespace

@@ -224,6 +224,36 @@ TEST_F(ReportDataTest, RunWithoutDeviationIsColouredByHeightAndBadGtIsInvalidInp
   EXPECT_NE(m.status().message().find("--gt"), std::string::npos) << m.status().message();
 }
 
+// A run in a national grid (UTM: a float32 steps by 0.5 m at a northing of
+// 5.4e6 m): the page's float32 positions are relative to the ground truth's
+// local origin, as fine as near zero, and a note gives that origin.
+TEST_F(ReportDataTest, PositionsFarFromZeroAreDrawnRelativeToALocalOrigin) {
+  const Eigen::Vector3d utm(500000.0, 5400000.0, 0.0);
+  Trajectory truth = Straight(0.0);
+  for (StampedPose& p : truth) p.p_world_imu += utm;
+  WriteRun("run", truth, 0, false);
+  std::vector<Eigen::Vector3d> map = {utm + Eigen::Vector3d(1.25, 0.5, 2.0)};
+  ASSERT_TRUE(WriteMapPcd(Path("run/map.pcd"), map).ok());  // float64 x y z
+  ASSERT_TRUE(WriteTum(Path("gt.tum"), truth).ok());
+  ReportOptions options;
+  options.gt = Path("gt.tum");
+  StatusOr<json> m = BuildReportModel(Path("run"), options);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  const Trajectory local = Straight(0.0);
+  for (const json* t : {&(*m)["gt"]["xyz"], &(*m)["runs"][0]["trajectory"]["xyz"]}) {
+    const std::vector<float> xyz = DecodeArray(*t);
+    ASSERT_EQ(xyz.size(), 3 * local.size());
+    for (size_t k = 0; k < local.size(); ++k)
+      for (int a = 0; a < 3; ++a)
+        EXPECT_NEAR(xyz[3 * k + a], local[k].p_world_imu[a], 1e-5) << k << " " << a;
+  }
+  EXPECT_EQ(DecodeArray((*m)["cloud"]["xyz"]), (std::vector<float>{1.25f, 0.5f, 2.0f}));
+  const std::vector<std::string> notes = (*m)["notes"];
+  EXPECT_NE(std::find(notes.begin(), notes.end(),
+                      "positions are drawn relative to (500000.000, 5400000.000, 0.000) m"),
+            notes.end());
+}
+
 // A compare folder as `rvlio compare` writes it, run from another directory
 // (paths in compare.json relative to that one), with a map column compare
 // does not have today.

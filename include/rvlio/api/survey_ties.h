@@ -29,6 +29,7 @@
 #include "rvlio/formats/control_file.h"
 #include "rvlio/formats/navsatfix.h"
 #include "rvlio/imu/rest.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/odometry/options.h"
 #include "rvlio/refine/control.h"
@@ -58,22 +59,27 @@ struct ControlResidual {
 class SurveyTies {
  public:
   // rows: the control file's (may be empty with GNSS only); fixes: GNSS.
+  // init_origin: of the local frame the --init trajectory is read into
+  // (targets' map_x, map_y, map_z are in the --init frame).
   SurveyTies(std::string control_path, std::vector<ControlRow> rows, std::vector<SurveyFix> fixes,
-             const OdometryOptions& options);
+             const OdometryOptions& options, const LocalOrigin& init_origin = LocalOrigin());
 
   bool active() const { return !rows_.empty() || !fixes_.empty(); }
   // The raw IMU samples and scans of the recording as they are read (scans
-  // with their --init pose at the end; see NeedsScans).
+  // with their --init pose at the end, local frame; see NeedsScans).
   void ObserveImu(const ImuSample& imu);
   bool NeedsScans() const { return !sightings_.empty(); }
   void ObserveScan(const Scan& scan, const Trajectory& init);
 
-  // Builds the ties, fits the alignment (skipped with hold_frame: a --map
-  // fixes the frame and --init is in it) and carries `init` into the local
-  // survey frame. *ties: in that frame, control points and fixes only.
-  Status Prepare(bool hold_frame, Trajectory* init, std::vector<PositionTie>* ties);
-  // The survey frame's point that is the local frame's origin.
-  const Eigen::Vector3d& origin() const { return origin_; }
+  // Builds the ties from `init` (in the local frame of *origin: the frame of
+  // --init, or of --map, minus *origin, math/local_origin.h), fits the
+  // alignment and carries `init` into the survey frame's local frame, whose
+  // origin (chosen from the ties) replaces *origin. With hold_frame (a --map
+  // fixes the frame and --init is in it) the frame and *origin stay. *ties:
+  // in the local frame, control points and fixes only.
+  Status Prepare(bool hold_frame, LocalOrigin* origin, Trajectory* init,
+                 std::vector<PositionTie>* ties);
+  const LocalOrigin& origin() const { return origin_; }
   // After the refinement: the residuals at the refined trajectory (local frame).
   void Evaluate(const Trajectory& refined_local);
 
@@ -92,7 +98,7 @@ class SurveyTies {
   Status MarkTies(const Trajectory& init);
   Status TargetTies();
   void FixTies(const Trajectory& init);
-  Status Align(bool hold_frame);
+  Status Align(bool hold_frame, const LocalOrigin& init_origin);
   Status CheckDistances() const;
   std::string Where(const ControlRow& row) const;
 
@@ -103,7 +109,7 @@ class SurveyTies {
   GnssOptions gnss_;
   std::vector<ImuSample> imu_;
   Pose3 T_imu_lidar_;
-  std::vector<Eigen::Vector3d> target_points_;  // per target row, in the --init frame
+  std::vector<Eigen::Vector3d> target_points_;  // per target row, in the --init local frame
   std::vector<int> target_rows_;
   TargetSightings sightings_;
   // Per row: its tie time window (marks) and ties in the survey frame.
@@ -115,9 +121,9 @@ class SurveyTies {
   std::vector<double> fix_sigma_m_;
   std::vector<bool> fix_outlier_;
   int fixes_outside_init_ = 0;
-  YawTranslation alignment_;
+  YawTranslation alignment_;  // T_survey_frame: from the --init local frame
   bool aligned_ = false;
-  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+  LocalOrigin origin_;  // of the local frame the refinement runs in
   std::vector<double> fix_residual_m_;
   std::vector<std::string> warnings_;
   NavSatFixStats gnss_stats_;
@@ -128,15 +134,15 @@ class SurveyTies {
 // is given. InvalidInput naming the file, line, topic or key.
 StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_path,
                                                      const std::string& bag,
-                                                     const OdometryOptions& options);
+                                                     const OdometryOptions& options,
+                                                     const LocalOrigin& init_origin);
 // The recording's NavSatFix fixes (gnss.topic) in survey.crs.
 StatusOr<std::vector<SurveyFix>> ReadSurveyFixes(const std::string& bag,
                                                  const OdometryOptions& options,
                                                  NavSatFixStats* stats);
 
-// After the refinement (local survey frame): the residuals, then the
-// trajectory and the map moved into the survey frame, control.csv's text and
-// the warnings into *r.
+// After the refinement, before its outputs leave the local frame: the
+// residuals, control.csv's text and the warnings into *r.
 void DeliverInSurveyFrame(SurveyTies* survey, RefineRunResult* r);
 // summary.json's "survey" and "control".
 void AddSurveySummary(const SurveyTies& survey, const std::string& crs, nlohmann::json* summary);

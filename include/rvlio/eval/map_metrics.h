@@ -112,13 +112,24 @@ inline constexpr double kMaxDistanceVoxels = 10.0;
 // calling thread, after blocks of 4096 points, and with 1 when all are done.
 using MapEvalProgress = std::function<void(double fraction)>;
 
-// Evaluates map_points against ref_points (same frame, m). InvalidInput
-// (message without file names; the caller adds them) for an empty cloud, a
-// non-finite point, a max_distance beyond kMaxDistanceVoxels search voxels,
-// a profile_step giving more than kMaxProfileBins bins, or
-// clouds that do not overlap (no MAP point within D of REF).
+// Evaluates map_points against ref_points (same frame, m). Both are moved
+// into the reference's local frame first (ChooseLocalOrigin(ref_points),
+// math/local_origin.h), so clouds in a national grid (UTM) are searched as
+// precisely as clouds near zero; axis_origin is given back in their frame.
+// InvalidInput (message without file names; the caller adds them) for an
+// empty cloud, a non-finite point, a max_distance beyond kMaxDistanceVoxels
+// search voxels, a profile_step giving more than kMaxProfileBins bins, a
+// reference point beyond its search structure's reach from the local origin
+// (CheckReach: 104.8 km along an axis at 0.1 m voxels), or clouds that do not
+// overlap (no MAP point within D of REF).
 StatusOr<MapEvalResult> EvaluateMap(const std::vector<Eigen::Vector3d>& map_points,
                                     const std::vector<Eigen::Vector3d>& ref_points,
+                                    const MapEvalOptions& options,
+                                    const MapEvalProgress& progress = nullptr);
+// The same, moving the clouds into the local frame in place (no copies: for
+// clouds read only for this).
+StatusOr<MapEvalResult> EvaluateMap(std::vector<Eigen::Vector3d>&& map_points,
+                                    std::vector<Eigen::Vector3d>&& ref_points,
                                     const MapEvalOptions& options,
                                     const MapEvalProgress& progress = nullptr);
 

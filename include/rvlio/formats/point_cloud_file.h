@@ -38,6 +38,10 @@ struct PointCloudFile {
   std::vector<PointCloudField> fields;  // other scalar fields, file order
   std::string format;                   // "pcd ascii", "pcd binary", "pcd binary_compressed",
                                         // "ply ascii", "ply binary_little_endian", ...
+  // x, y or z is stored as a 4-byte float (binary encodings; an ascii file's
+  // numbers have the digits they are written with): far from zero such a
+  // cloud is coarse (Float32Step, math/local_origin.h).
+  bool xyz_single_precision = false;
 
   // The field of that name, or nullptr.
   const PointCloudField* Field(const std::string& name) const;

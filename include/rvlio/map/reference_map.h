@@ -35,9 +35,12 @@ struct ReferenceMapOptions {
 
 class ReferenceMap {
  public:
-  // Stores every finite point of p_ref (reference frame, m). Points not
-  // stored (non-finite, farther than ~10^5 voxels from the origin, or beyond
-  // 65535 in one voxel) are counted in NumSkipped().
+  // Stores every finite point of p_ref (reference frame, m; a cloud in a
+  // national grid goes into its local frame first: math/local_origin.h).
+  // Points not stored (non-finite, beyond VoxelMapReach of the voxel size,
+  // about 10^6 voxels from the origin, or beyond 65535 in one voxel) are
+  // counted in NumSkipped(); those beyond the reach also in NumOutOfReach()
+  // (CheckReach(voxels(), n) turns them into an error).
   explicit ReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
                         const ReferenceMapOptions& options = ReferenceMapOptions());
   // The same, inserting the points in `order` (a permutation of p_ref's
@@ -54,6 +57,7 @@ class ReferenceMap {
 
   size_t Size() const { return map_.Size(); }
   size_t NumSkipped() const { return num_skipped_; }
+  size_t NumOutOfReach() const { return map_.NumOutOfReach(); }
   bool Empty() const { return map_.Empty(); }
   // Axis-aligned bounds of the stored points (empty box for an empty map).
   const Eigen::AlignedBox3d& Bounds() const { return bounds_; }

@@ -2,8 +2,11 @@
 // The working map of the odometry (docs/design.md "Modules and their dependencies", map/): an
 // incremental voxel-hash map with exact k-nearest-neighbour search.
 //
-// Points (world frame, m) live in cubic voxels of edge MapOptions::voxel_size
-// (within about 10^6 voxels of the origin; farther points are not stored).
+// Points (world frame, m) live in cubic voxels of edge MapOptions::voxel_size,
+// within about 10^6 voxels of the origin along each axis (VoxelMapReach:
+// 104.8 km at 0.1 m voxels); farther points are not stored but counted
+// (NumOutOfReach, CheckReach). Clouds in a national grid (UTM: northings of
+// millions of metres) are moved into a local frame first (math/local_origin.h).
 // A voxel keeps at most max_points_per_voxel points; a new point closer than
 // min_point_distance to a point already in its voxel is skipped. Voxels are
 // found through an open-addressing hash table (linear probing, power-of-two
@@ -20,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "rvlio/common/status.h"
 #include "rvlio/map/options.h"
 #include "rvlio/map/voxel_key.h"
 
@@ -36,14 +40,20 @@ struct NeighborBuffer {
   std::array<double, kMaxNeighbors> dist2;            // squared distance to the query, m^2
 };
 
+// The largest |coordinate| (m, per axis) a VoxelMap with voxels of
+// voxel_size stores: the packed keys hold 21 bits per axis (less a margin for
+// the neighbour offsets), about 1.047e6 voxels.
+double VoxelMapReach(double voxel_size);
+
 class VoxelMap {
  public:
   explicit VoxelMap(const MapOptions& options = MapOptions());
 
-  // Inserts points (world, m). Non-finite points are ignored.
+  // Inserts points (world, m). Non-finite points are ignored; points beyond
+  // VoxelMapReach are counted in NumOutOfReach.
   void Insert(const std::vector<Eigen::Vector3d>& p_world);
   // Inserts one point; true when it was stored (not skipped by the voxel's
-  // capacity or by min_point_distance).
+  // capacity, by min_point_distance, as non-finite or beyond the reach).
   bool InsertPoint(const Eigen::Vector3d& p_world);
   // Inserts p_world[order[0]], p_world[order[1]], ... as InsertPoint called
   // on each in that order would (the same points stored, the same results of
@@ -71,6 +81,9 @@ class VoxelMap {
 
   size_t Size() const { return num_points_; }       // stored points
   size_t NumVoxels() const { return num_voxels_; }  // occupied voxels
+  // Finite points not stored since construction or Clear() because a
+  // coordinate lay beyond VoxelMapReach(voxel_size).
+  size_t NumOutOfReach() const { return num_out_of_reach_; }
   bool Empty() const { return num_points_ == 0; }
   const MapOptions& options() const { return options_; }
 
@@ -112,6 +125,7 @@ class VoxelMap {
 
   int FindSlot(uint64_t key) const;  // slot index, or -1
   int CreateSlot(uint64_t key);      // key must be absent; returns its slot
+  bool InsertKeyable(const Eigen::Vector3d& p_world);  // InsertPoint of a point within the reach
   void ReserveSlots(size_t num_voxels);  // table room for num_voxels at load <= 1/2
   void InsertSlot(const Slot& s);    // key must be absent; no growth check
   void Rebuild(size_t capacity, const std::vector<Slot>& slots);
@@ -143,6 +157,7 @@ class VoxelMap {
   std::vector<Slot> scratch_slots_;                // reused by RemoveFar / growth
   size_t num_voxels_ = 0;
   size_t num_points_ = 0;
+  size_t num_out_of_reach_ = 0;
 
   // shells_[r]: voxel offsets with Chebyshev norm r in visiting order (see
   // MakeShell), for r <= kPrecomputedShells.
@@ -151,5 +166,12 @@ class VoxelMap {
   // the query lies in the lower half of its voxel along axis a).
   std::array<std::array<std::vector<OctantOffset>, 8>, kPrecomputedShells + 1> shells_;
 };
+
+// Ok when `map` stored every finite point it was given; else InvalidInput
+// saying how many of p_inserted (what the caller inserted) lay beyond its
+// reach, how far the reach is and how far the cloud spans. For a fixed cloud
+// (a reference map, a cloud under evaluation), where a dropped point would
+// silently change results.
+Status CheckReach(const VoxelMap& map, const std::vector<Eigen::Vector3d>& p_inserted);
 
 }  // namespace rvlio

@@ -36,6 +36,7 @@
 #include "rvlio/map/reference_map.h"
 #include "rvlio/odometry/deviation.h"
 #include "rvlio/map/voxel_map.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/math/pose.h"
 
 namespace rvlio {
@@ -107,13 +108,20 @@ struct LocalizationOptions {
 // What the odometry localizes in: the reference map (filled once, never
 // changed) and the IMU pose in the reference frame at the first scan: the
 // one pose of `initial_poses`, or the poses interpolated at the first scan's
-// time (sorted by time).
+// time (sorted by time). Both are in the reference's local frame (`origin`:
+// the reference frame translated to near the map, math/local_origin.h), and
+// so is everything the odometry estimates; the odometry reads `origin` only
+// to print positions in the map's frame in its messages: whoever writes its
+// results adds it back (api/run.cpp).
 struct Localization {
   std::shared_ptr<const VoxelMap> reference;
   Trajectory initial_poses;
+  LocalOrigin origin;
 };
 
-// Builds the reference's search structure from its points (reference frame, m).
+// Builds the reference's search structure from its points (reference frame,
+// m; a cloud far from zero, e.g. in UTM, first into its local frame:
+// ChooseLocalOrigin, math/local_origin.h, as LoadLocalization does).
 std::shared_ptr<const VoxelMap> MakeReferenceMap(const std::vector<Eigen::Vector3d>& p_ref,
                                                  const LocalizationOptions& options);
 

@@ -31,6 +31,8 @@ enum class ScanCsvFormat {
   kPlain,        // text, whole number, or 9 significant digits (nan and inf as printed)
   kRealOrEmpty,  // 9 significant digits; empty when NaN (none)
   kStatistic,    // 6 significant digits; empty when not finite (unknown)
+  kPosition,     // as kPlain, with at least 6 decimals: a coordinate in a national grid
+                 // (northings of 5e6 m) keeps its micrometres
 };
 
 // Columns that only some runs have: they are present when some scan carries

@@ -13,7 +13,16 @@
 
 namespace rvlio {
 
-// Binary PCD (x y z float32; header made by PCL), written atomically.
+// map.pcd stores x y z as float32 while every coordinate is below
+// kFloat32MillimetreReach_m (8192 m, math/local_origin.h) in magnitude, else
+// as float64 (PCD SIZE 8 TYPE F): a map in a national grid (UTM: eastings of
+// 5e5 m, northings of 5e6 m, where a float32 keeps only decimetres) keeps
+// its millimetres.
+// True when a coordinate of p_world reaches kFloat32MillimetreReach_m.
+bool MapNeedsFloat64(const std::vector<Eigen::Vector3d>& p_world);
+
+// Binary PCD (x y z float32, or float64 when MapNeedsFloat64; header made by
+// PCL), written atomically.
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
 // The same with a fourth float32 field deviation_m (one per point; NaN
 // allowed) when deviation_m is not null: what PCL viewers and CloudCompare

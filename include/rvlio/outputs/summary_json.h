@@ -9,6 +9,7 @@
 #include "rvlio/imu/options.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/lidar/options.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/odometry/divergence.h"
 
 namespace rvlio {
@@ -30,6 +31,11 @@ std::vector<std::string> ReaderWarnings(const SensorReaderStats& stats, const Li
 
 // {detected, first_time_s, scans_flagged, events: {kind: episodes}, episodes: [...]}.
 nlohmann::json DivergenceJson(const DivergenceReport& report);
+
+// summary.json "local_origin": [x, y, z], m: the offset added to the
+// estimation's local frame to give the frame of the outputs (the frame of
+// --map or --init; math/local_origin.h). [0, 0, 0] when they coincide.
+nlohmann::json LocalOriginJson(const LocalOrigin& origin);
 
 // Peak resident memory of this process, MB.
 double PeakMemoryMb();
