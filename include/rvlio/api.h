@@ -30,6 +30,7 @@
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/config/config.h"
+#include "rvlio/formats/control_file.h"
 #include "rvlio/formats/sensor_stream.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/odometry.h"
@@ -197,6 +198,10 @@ struct MergeResult {
   std::vector<MergedChunk> chunks;          // in order 1..N
   nlohmann::json summary;                   // summary.json
   std::vector<std::string> warnings;        // the chunks' warnings, each once
+  // Chunks refined with --control: the merged control.csv (each row from the
+  // chunk that owns its tie time, in the merged frame); empty otherwise.
+  std::string control_csv;
+  std::vector<ControlResidual> control;
   bool written = false;
 };
 

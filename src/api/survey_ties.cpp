@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <sstream>
 
 #include "rvlio/common/check.h"
 #include "rvlio/common/fnv1a.h"
 #include "rvlio/common/text.h"
 #include "rvlio/formats/crs.h"
+#include "rvlio/formats/trajectory_io.h"
 #include "rvlio/lidar/extrinsics.h"
 
 namespace rvlio {
@@ -368,22 +371,7 @@ void SurveyTies::Evaluate(const Trajectory& refined_local) {
   }
 }
 
-std::string SurveyTies::ControlCsv() const {
-  std::string text = "name,role,kind,x,y,z,x_est,y_est,z_est,dx,dy,dz,d3d,sigma_m,t_s,scans\n";
-  for (const ControlResidual& r : residuals_) {
-    const Eigen::Vector3d d = r.Residual();
-    std::vector<std::string> cells = {r.row.name, ControlRoleName(r.row.role), r.kind};
-    for (int a = 0; a < 3; ++a) cells.push_back(FormatFixed(r.row.p_survey[a], 4));
-    for (int a = 0; a < 3; ++a) cells.push_back(r.estimated ? FormatFixed(r.p_estimated[a], 4) : "");
-    for (int a = 0; a < 3; ++a) cells.push_back(r.estimated ? FormatFixed(d[a], 4) : "");
-    cells.push_back(r.estimated ? FormatFixed(d.norm(), 4) : "");
-    cells.push_back(FormatG(r.sigma_m));
-    cells.push_back(FormatFixed(NsToSeconds(r.t_ns), 3));
-    cells.push_back(std::to_string(r.kind == "target" ? r.scans : 0));
-    text += Join(cells, ",") + "\n";
-  }
-  return text;
-}
+std::string SurveyTies::ControlCsv() const { return ControlCsvText(residuals_); }
 
 nlohmann::json SurveyTies::SurveyJson(const std::string& crs) const {
   int control = 0, check = 0, targets = 0, outliers = 0;
@@ -417,10 +405,7 @@ nlohmann::json SurveyTies::SurveyJson(const std::string& crs) const {
   return j;
 }
 
-nlohmann::json SurveyTies::ControlJson() const {
-  return {{"control", RoleJson(residuals_, ControlRole::kControl)},
-          {"check", RoleJson(residuals_, ControlRole::kCheck)}};
-}
+nlohmann::json SurveyTies::ControlJson() const { return ControlSummaryJson(residuals_); }
 
 }  // namespace rvlio
 
@@ -509,6 +494,28 @@ void DeliverInSurveyFrame(SurveyTies* survey, RefineRunResult* r) {
 void AddSurveySummary(const SurveyTies& survey, const std::string& crs, nlohmann::json* summary) {
   (*summary)["survey"] = survey.SurveyJson(crs);
   (*summary)["control"] = survey.ControlJson();
+}
+
+nlohmann::json ControlSummaryJson(const std::vector<ControlResidual>& rows) {
+  return {{"control", RoleJson(rows, ControlRole::kControl)},
+          {"check", RoleJson(rows, ControlRole::kCheck)}};
+}
+
+std::vector<ControlResidual> MergeChunkControl(const std::vector<ChunkControl>& chunks) {
+  std::vector<ControlResidual> merged = chunks.front().rows;
+  for (ControlResidual& r : merged) {
+    r.estimated = false;
+    for (const ChunkControl& c : chunks) {
+      if (r.t_ns < c.core_begin_ns || r.t_ns > c.core_end_ns) continue;
+      for (const ControlResidual& e : c.rows) {
+        if (e.row.name != r.row.name || !e.estimated) continue;
+        r.p_estimated = c.T_merged_chunk * e.p_estimated;
+        r.estimated = true;
+      }
+      if (r.estimated) break;
+    }
+  }
+  return merged;
 }
 
 }  // namespace rvlio

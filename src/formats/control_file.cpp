@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "rvlio/common/text.h"
+#include "rvlio/common/check.h"
 #include "rvlio/formats/trajectory_io.h"
 
 namespace rvlio {
@@ -185,6 +186,73 @@ StatusOr<std::vector<ControlRow>> ReadControlFile(const std::string& path) {
   text << in.rdbuf();
   if (in.bad()) return Status::InvalidInput("cannot read the control file '" + path + "'");
   return ParseControlFile(text.str(), path);
+}
+
+constexpr const char* kControlCsvHeader =
+    "name,role,kind,x,y,z,x_est,y_est,z_est,dx,dy,dz,d3d,sigma_m,t_s,scans";
+
+std::string ControlCsvText(const std::vector<ControlResidual>& rows) {
+  std::string text = std::string(kControlCsvHeader) + "\n";
+  for (const ControlResidual& r : rows) {
+    const Eigen::Vector3d d = r.Residual();
+    std::vector<std::string> cells = {r.row.name, ControlRoleName(r.row.role), r.kind};
+    for (int a = 0; a < 3; ++a) cells.push_back(FormatFixed(r.row.p_survey[a], 4));
+    for (int a = 0; a < 3; ++a) cells.push_back(r.estimated ? FormatFixed(r.p_estimated[a], 4) : "");
+    for (int a = 0; a < 3; ++a) cells.push_back(r.estimated ? FormatFixed(d[a], 4) : "");
+    cells.push_back(r.estimated ? FormatFixed(d.norm(), 4) : "");
+    cells.push_back(FormatG(r.sigma_m));
+    cells.push_back(FormatFixed(NsToSeconds(r.t_ns), 3));
+    cells.push_back(std::to_string(r.scans));
+    text += Join(cells, ",") + "\n";
+  }
+  return text;
+}
+
+namespace {
+
+bool ParseDouble(const std::string& text, double* v) {
+  char* end = nullptr;
+  *v = std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size() && std::isfinite(*v);
+}
+
+// One row of control.csv as ControlResidualText writes it.
+bool ParseControlCsvRow(const std::string& line, ControlResidual* r) {
+  std::vector<std::string> c;
+  std::stringstream cells(line);
+  for (std::string cell; std::getline(cells, cell, ',');) c.push_back(cell);
+  if (!line.empty() && line.back() == ',') c.push_back("");
+  if (c.size() != 16 || (c[1] != "control" && c[1] != "check")) return false;
+  r->row.name = c[0];
+  r->row.role = c[1] == "check" ? ControlRole::kCheck : ControlRole::kControl;
+  r->kind = c[2];
+  for (int a = 0; a < 3; ++a)
+    if (!ParseDouble(c[3 + a], &r->row.p_survey[a])) return false;
+  r->estimated = !c[6].empty();
+  for (int a = 0; a < 3 && r->estimated; ++a)
+    if (!ParseDouble(c[6 + a], &r->p_estimated[a])) return false;
+  if (!ParseDouble(c[13], &r->sigma_m) || !ParseSecondsToNs(c[14], &r->t_ns)) return false;
+  r->scans = std::atoi(c[15].c_str());
+  return true;
+}
+
+}  // namespace
+
+StatusOr<std::vector<ControlResidual>> ParseControlCsv(const std::string& text,
+                                                       const std::string& path) {
+  std::stringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line != kControlCsvHeader)
+    return Status::InvalidInput(path + ": not a control.csv of rvlio refine (header)");
+  std::vector<ControlResidual> rows;
+  for (int number = 2; std::getline(in, line); ++number) {
+    ControlResidual r;
+    if (!ParseControlCsvRow(line, &r))
+      return Status::InvalidInput(path + " line " + std::to_string(number) + ": not a row of " +
+                                  kControlCsvHeader);
+    rows.push_back(r);
+  }
+  return rows;
 }
 
 }  // namespace rvlio

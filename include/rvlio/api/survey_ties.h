@@ -44,18 +44,6 @@ struct SurveyFix {
   double sigma_m = 0.03;  // a scalar for the alignment's weight (root of the mean variance)
 };
 
-// One row of control.csv.
-struct ControlResidual {
-  ControlRow row;
-  std::string kind;  // "mark" or "target"
-  double sigma_m = 0.0;
-  TimeNs t_ns = 0;  // mark: the tie time (middle of the rest period); target: first sighting
-  int scans = 0;    // target: the scans that tie it
-  bool estimated = false;
-  Eigen::Vector3d p_estimated = Eigen::Vector3d::Zero();  // survey frame
-  Eigen::Vector3d Residual() const { return p_estimated - row.p_survey; }
-};
-
 class SurveyTies {
  public:
   // rows: the control file's (may be empty with GNSS only); fixes: GNSS.
@@ -140,6 +128,20 @@ StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_
 StatusOr<std::vector<SurveyFix>> ReadSurveyFixes(const std::string& bag,
                                                  const OdometryOptions& options,
                                                  NavSatFixStats* stats);
+
+// summary.json "control": per role count, rms_m, rms_xyz_m, max_m, max_name.
+nlohmann::json ControlSummaryJson(const std::vector<ControlResidual>& rows);
+
+// `rvlio merge` of chunk jobs refined with --control: each row's estimate
+// from the chunk whose own span (chunk.json core_begin_ns .. core_end_ns)
+// holds the row's tie time, carried into the merged frame by that chunk's
+// transform (user frame); rows no chunk estimated stay without an estimate.
+struct ChunkControl {
+  std::vector<ControlResidual> rows;  // the chunk's control.csv
+  TimeNs core_begin_ns = 0, core_end_ns = 0;
+  Pose3 T_merged_chunk;  // in the user (survey) frame
+};
+std::vector<ControlResidual> MergeChunkControl(const std::vector<ChunkControl>& chunks);
 
 // After the refinement, before its outputs leave the local frame: the
 // residuals, control.csv's text and the warnings into *r.

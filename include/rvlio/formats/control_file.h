@@ -42,4 +42,24 @@ StatusOr<std::vector<ControlRow>> ReadControlFile(const std::string& path);
 StatusOr<std::vector<ControlRow>> ParseControlFile(const std::string& text,
                                                    const std::string& path);
 
+// One row of control.csv.
+struct ControlResidual {
+  ControlRow row;
+  std::string kind;  // "mark" or "target"
+  double sigma_m = 0.0;
+  TimeNs t_ns = 0;  // mark: the tie time (middle of the rest period); target: first sighting
+  int scans = 0;    // target: the scans that tie it
+  bool estimated = false;
+  Eigen::Vector3d p_estimated = Eigen::Vector3d::Zero();  // survey frame
+  Eigen::Vector3d Residual() const { return p_estimated - row.p_survey; }
+};
+
+// control.csv's text of the rows (name, role, kind, x, y, z, x_est, y_est,
+// z_est, dx, dy, dz, d3d, sigma_m, t_s, scans; coordinates with 4 decimals;
+// the estimate's cells empty when there is none) and back (InvalidInput
+// naming the file and line).
+std::string ControlCsvText(const std::vector<ControlResidual>& rows);
+StatusOr<std::vector<ControlResidual>> ParseControlCsv(const std::string& text,
+                                                       const std::string& path);
+
 }  // namespace rvlio
