@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_util.h"
+#include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/refine/refine_states.h"
 
@@ -67,8 +68,9 @@ class ControlCli : public ::testing::Test {
 };
 
 // The flight tied to three control marks: outputs in the survey frame, the
-// check point's residual is its true error, summary and control.csv agree.
-TEST_F(ControlCli, RunThenRefineDeliversInTheSurveyFrame) {
+// check point's residual is its true error, summary and control.csv agree;
+// then tied by three wall targets instead.
+TEST_F(ControlCli, RunThenRefineWithMarksOrWallTargetsDeliversInTheSurveyFrame) {
   const std::string run = dir_ + "/run", out = dir_ + "/refined";
   const testing_cli::ToolRun r = RunTool("run --bag " + data_ + "/sg.bag --config " + data_ +
                                              "/sg.yaml --out " + run + " --quiet --control " +
@@ -119,6 +121,47 @@ TEST_F(ControlCli, RunThenRefineDeliversInTheSurveyFrame) {
   EXPECT_NEAR(s["survey"]["alignment"]["yaw_deg"].get<double>(), 30.0, 1.0);
   EXPECT_EQ(s["control"]["check"]["count"], 1);
   EXPECT_EQ(s["control"]["check"]["max_name"], "M3");
+
+  // The same flight tied by wall targets instead of marks: three spots on
+  // the walls of the run's map.pcd, their survey coordinates carried over
+  // from the run's frame by the true pose at the nearest moment.
+  StatusOr<PointCloudFile> map = ReadPointCloud(run + "/map.pcd");
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  StatusOr<Trajectory> est = ReadTum(run + "/trajectory.tum");
+  ASSERT_TRUE(est.ok());
+  std::string targets = "name,x,y,z,map_x,map_y,map_z\n";
+  for (double x : {4.0, 15.0, 26.0}) {
+    const Eigen::Vector3d* spot = nullptr;
+    for (const Eigen::Vector3d& p : map->points)
+      if (std::abs(p.x() - x) < 0.3 && p.y() > 4.0 && p.z() > 0.5 && p.z() < 2.5) spot = &p;
+    ASSERT_NE(spot, nullptr) << x;
+    const StampedPose* near = &est->front();
+    for (const StampedPose& q : *est)
+      if ((q.p_world_imu - *spot).norm() < (near->p_world_imu - *spot).norm()) near = &q;
+    Pose3 T_survey_imu;
+    ASSERT_TRUE(InterpolatePose(*gt, near->t_ns, &T_survey_imu));
+    const Eigen::Vector3d p_survey =
+        T_survey_imu * (Pose3(near->q_world_imu, near->p_world_imu).Inverse() * *spot);
+    char text[256];
+    std::snprintf(text, sizeof(text), "T%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", static_cast<int>(x),
+                  p_survey.x(), p_survey.y(), p_survey.z(), spot->x(), spot->y(), spot->z());
+    targets += text;
+  }
+  std::ofstream(dir_ + "/targets.csv") << targets;
+  const std::string tied = dir_ + "/targets";
+  const testing_cli::ToolRun t =
+      RunTool("refine --bag " + data_ + "/sg.bag --config " + data_ + "/sg.yaml --init " + run +
+                  "/trajectory.tum --control " + dir_ + "/targets.csv --out " + tied +
+                  " --set smoother.refine_rounds=2",
+              dir_);
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  EXPECT_LT(testing_cli::AteNoAlign(data_ + "/sg_gt_survey.tum", tied + "/trajectory.tum", dir_),
+            0.06);
+  const std::string tied_csv = ReadFile(tied + "/control.csv");
+  EXPECT_NE(tied_csv.find("T15,control,target,"), std::string::npos) << tied_csv;
+  const nlohmann::json ts = nlohmann::json::parse(ReadFile(tied + "/summary.json"));
+  EXPECT_EQ(ts["survey"]["targets"], 3);
+  EXPECT_LT(ts["control"]["control"]["max_m"].get<double>(), 0.05);
 }
 
 // The simulator's marks (one test process: each copies the simulation),
