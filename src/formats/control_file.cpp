@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -21,6 +22,14 @@ std::string Trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t\r\n");
   if (a == std::string::npos) return "";
   return s.substr(a, s.find_last_not_of(" \t\r\n") - a + 1);
+}
+
+// A cell as an error message shows it: printable ASCII (others '?'), at most
+// 40 characters (a binary file's "header" stays one short line).
+std::string Shown(const std::string& cell) {
+  std::string out;
+  for (char c : cell.substr(0, 40)) out += (c >= 32 && c < 127) ? c : '?';
+  return cell.size() > 40 ? out + "..." : out;
 }
 
 std::vector<std::string> SplitCells(const std::string& line) {
@@ -53,7 +62,7 @@ class RowParser {
     char* end = nullptr;
     *v = std::strtod(text.c_str(), &end);
     if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(*v))
-      return Error(std::string(column) + " '" + text + "' is not a number");
+      return Error(std::string(column) + " '" + Shown(text) + "' is not a number");
     return Status::Ok();
   }
 
@@ -65,7 +74,7 @@ class RowParser {
     const std::string role = Cell("role");
     if (role == "check") row->role = ControlRole::kCheck;
     else if (role.empty() || role == "control") row->role = ControlRole::kControl;
-    else return Error("role '" + role + "' is neither control nor check");
+    else return Error("role '" + Shown(role) + "' is neither control nor check");
     bool has = false;
     if (Status s = Number("sigma_m", &row->sigma_m, &has); !s.ok()) return s;
     if (has && row->sigma_m <= 0.0) return Error("sigma_m must be positive");
@@ -80,7 +89,7 @@ class RowParser {
     const std::string text = Cell(column);
     *present = !text.empty();
     if (*present && !ParseSecondsToNs(text, t_ns))
-      return Error(std::string(column) + " '" + text + "' is not a time in seconds");
+      return Error(std::string(column) + " '" + Shown(text) + "' is not a time in seconds");
     return Status::Ok();
   }
 
@@ -123,7 +132,7 @@ StatusOr<std::map<std::string, size_t>> HeaderColumns(const std::string& line,
   const std::set<std::string> known(std::begin(kColumns), std::end(kColumns));
   for (size_t i = 0; i < cells.size(); ++i) {
     if (known.count(cells[i]) == 0)
-      return Status::InvalidInput(where + ": unknown column '" + cells[i] +
+      return Status::InvalidInput(where + ": unknown column '" + Shown(cells[i]) +
                                   "' (columns: name, x, y, z, role, sigma_m, t_start, t_end, "
                                   "map_x, map_y, map_z)");
     if (!columns.emplace(cells[i], i).second)
@@ -144,7 +153,9 @@ const char* ControlRoleName(ControlRole role) {
 
 StatusOr<std::vector<ControlRow>> ParseControlFile(const std::string& text,
                                                    const std::string& path) {
-  std::stringstream in(text);
+  // A spreadsheet's UTF-8 byte-order mark before the header is not a column.
+  const bool bom = text.rfind("\xEF\xBB\xBF", 0) == 0;
+  std::stringstream in(bom ? text.substr(3) : text);
   std::string line;
   int number = 0;
   std::map<std::string, size_t> columns;
@@ -180,6 +191,9 @@ StatusOr<std::vector<ControlRow>> ParseControlFile(const std::string& text,
 }
 
 StatusOr<std::vector<ControlRow>> ReadControlFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    return Status::InvalidInput("the control file '" + path + "' is a folder");
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::InvalidInput("cannot read the control file '" + path + "'");
   std::stringstream text;

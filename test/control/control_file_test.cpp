@@ -53,7 +53,8 @@ TEST(ControlFile, ReadsMarksTargetsRolesSigmasAndTimes) {
 }
 
 TEST(ControlFile, ColumnsInAnyOrderAndOnlyTheRequiredOnes) {
-  StatusOr<std::vector<ControlRow>> rows = Parse("z,name,y,x\n1,A,2,3\n4,B,5,6\n");
+  // Also: a spreadsheet's byte-order mark and Windows line ends.
+  StatusOr<std::vector<ControlRow>> rows = Parse("\xEF\xBB\xBFz,name,y,x\r\n1,A,2,3\r\n4,B,5,6\r\n");
   ASSERT_TRUE(rows.ok()) << rows.status().message();
   EXPECT_TRUE((*rows)[1].p_survey.isApprox(Eigen::Vector3d(6, 5, 4)));
 }
@@ -76,6 +77,17 @@ TEST(ControlFile, RefusesWhatItCannotRead) {
   ExpectRefused("name,x,y,z,map_x,map_y,map_z\nA,1,2,3,1,2,\n", "go together");
   ExpectRefused("name,x,y,z,t_start,t_end,map_x,map_y,map_z\nA,1,2,3,1,2,1,2,3\n", "not both");
   EXPECT_FALSE(ReadControlFile("/nonexistent/marks.csv").ok());
+  StatusOr<std::vector<ControlRow>> folder = ReadControlFile("/tmp");
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.status().message().find("is a folder"), std::string::npos);
+  // Binary bytes as a header: one short printable line.
+  std::string garbage(3000, '\x01');
+  garbage[7] = '\n';
+  StatusOr<std::vector<ControlRow>> bad = Parse(garbage);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_LT(bad.status().message().size(), 250u);
+  EXPECT_NE(bad.status().message().find("unknown column '???????'"), std::string::npos)
+      << bad.status().message();
 }
 
 TEST(NavSatFix, CdrRoundTrip) {
