@@ -215,3 +215,53 @@ TEST_F(ControlCli, SimulatedMarksAndBadControlFilesRefusedWithOneLineNothingWrit
 
 }  // namespace
 }  // namespace rvlio
+
+namespace rvlio {
+namespace {
+
+// A 40 s flight through an 8 m tunnel open at both ends: out of the entrance,
+// back in to land on a mark 3 m inside, and out beyond the far portal. GNSS
+// fixes (with dropouts and multipath outliers) outside only; the start and
+// the landing are the marks inside.
+const char* const kPortalArgs =
+    "--preset portals --seed 6 --duration 40 --name po --set lidar.columns=512"
+    " --set world.length=8 --set \"trajectory.waypoints=0,0,0; 0,0,1; -6,0,1; 3,0,1; 3,0,0;"
+    " 3,0,1; 14,0,1\" --set trajectory.landing_time=3 --set trajectory.yaw_amplitude=0"
+    " --set imu.vibration_accel=0.3 --set imu.vibration_gyro=0.02 --set marks.enabled=true"
+    " --set gnss.outlier_rate=0.05";
+
+TEST(ControlGnssCli, GnssAtBothPortalsWithAndWithoutControlPointsInside) {
+  const std::string dir = testing_cli::MakeTempDir("rvlio_gnss"), data = dir + "/data";
+  const testing_cli::ToolRun sim = testing_cli::CachedSimulate(kPortalArgs, data, dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const std::string common = "--bag " + data + "/po.bag --config " + data + "/po.yaml";
+  ASSERT_EQ(RunTool("run " + common + " --out " + dir + "/run --quiet", dir).exit_code, 0);
+  for (const bool marks : {false, true}) {
+    SCOPED_TRACE(marks ? "GNSS and the marks inside" : "GNSS alone");
+    const std::string out = dir + (marks ? "/both" : "/gnss");
+    const testing_cli::ToolRun f =
+        RunTool("refine " + common + " --init " + dir + "/run/trajectory.tum --out " + out +
+                    " --set smoother.refine_rounds=2" +
+                    (marks ? " --control " + data + "/po_control.csv" : std::string()),
+                dir);
+    ASSERT_EQ(f.exit_code, 0) << f.err;
+    EXPECT_LT(testing_cli::AteNoAlign(data + "/po_gt_survey.tum", out + "/trajectory.tum", dir),
+              0.05);
+    const nlohmann::json s = nlohmann::json::parse(ReadFile(out + "/summary.json"));
+    EXPECT_EQ(s["survey"]["crs"], "EPSG:25832");
+    EXPECT_GT(s["survey"]["gnss_fixes"].get<int>(), 20);
+    EXPECT_EQ(s["survey"]["control_points"], marks ? 2 : 0);
+    EXPECT_EQ(fs::exists(out + "/control.csv"), marks);
+  }
+  // An unknown CRS for the fixes: one line, nothing written.
+  ExpectOneErrorLine(RunTool("refine " + common + " --init " + dir +
+                                 "/run/trajectory.tum --out " + dir + "/never" +
+                                 " --set survey.crs=EPSG:999999",
+                             dir),
+                     "refine", "EPSG:999999");
+  EXPECT_FALSE(fs::exists(dir + "/never"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rvlio

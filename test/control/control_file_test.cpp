@@ -4,6 +4,7 @@
 
 #include "rvlio/formats/control_file.h"
 #include "rvlio/formats/navsatfix.h"
+#include "rvlio/formats/sensor_bag.h"
 
 namespace rvlio {
 namespace {
@@ -86,7 +87,7 @@ TEST(ControlFile, RefusesWhatItCannotRead) {
   StatusOr<std::vector<ControlRow>> bad = Parse(garbage);
   ASSERT_FALSE(bad.ok());
   EXPECT_LT(bad.status().message().size(), 250u);
-  EXPECT_NE(bad.status().message().find("unknown column '???????'"), std::string::npos)
+  EXPECT_NE(bad.status().message().find("unknown column '\?\?\?\?\?\?\?'"), std::string::npos)
       << bad.status().message();
 }
 
@@ -113,6 +114,52 @@ TEST(NavSatFix, CdrRoundTrip) {
   // Cut short: refused, not read past the end.
   EXPECT_FALSE(DecodeNavSatFixCdr(bytes.data(), bytes.size() - 3, "fix").ok());
   EXPECT_FALSE(ParseRos1NavSatFix(bytes.data(), 10, "fix").ok());
+}
+
+// NavSatFix messages written into a ROS1 bag and a ROS 2 MCAP and read back:
+// fixes without a solution are skipped and counted, a latitude out of range
+// is refused naming the message.
+TEST(NavSatFix, ReadFromRos1AndRos2RecordingsWithNoFixCountedAndBadLatitudeRefused) {
+  const std::string dir = ::testing::TempDir();
+  for (const std::string format : {"ros1", "mcap"}) {
+    SCOPED_TRACE(format);
+    const std::string path = dir + "/fixes_" + format + (format == "ros1" ? ".bag" : ".mcap");
+    for (const bool bad : {false, true}) {
+      BagWriterOptions options;
+      options.format = format;
+      StatusOr<std::unique_ptr<SensorBagWriter>> w = SensorBagWriter::Create(path, options);
+      ASSERT_TRUE(w.ok()) << w.status().message();
+      for (int k = 0; k < 4; ++k) {
+        NavSatFix f;
+        f.header_stamp_ns = 1700000000000000000 + k * 200000000LL;
+        f.latitude_deg = 48.7 + 1e-6 * k;
+        f.longitude_deg = 9.1;
+        f.altitude_m = 300.0;
+        if (k == 1) f.status = kNavSatStatusNoFix;
+        if (bad && k == 2) f.latitude_deg = 95.0;
+        ASSERT_TRUE((*w)->WriteNavSatFix("/gnss/fix", f).ok());
+      }
+      ASSERT_TRUE((*w)->Close().ok());
+      NavSatFixStats stats;
+      StatusOr<std::vector<NavSatFix>> read = ReadNavSatFixes(path, "/gnss/fix", &stats);
+      if (!bad) {
+        ASSERT_TRUE(read.ok()) << read.status().message();
+        EXPECT_EQ(read->size(), 3u);
+        EXPECT_EQ(stats.messages, 4);
+        EXPECT_EQ(stats.no_fix, 1);
+        EXPECT_EQ((*read)[1].latitude_deg, 48.7 + 2e-6);
+        continue;
+      }
+      ASSERT_FALSE(read.ok());
+      EXPECT_NE(read.status().message().find("gnss.topic '/gnss/fix' in '" + path +
+                                             "': message 2"),
+                std::string::npos)
+          << read.status().message();
+      EXPECT_NE(read.status().message().find("latitude 95"), std::string::npos);
+    }
+    NavSatFixStats stats;
+    EXPECT_FALSE(ReadNavSatFixes(path, "/other", &stats).ok());
+  }
 }
 
 }  // namespace
