@@ -33,10 +33,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 RefineConfig ToRefineConfig(const OdometryOptions& o, std::shared_ptr<const VoxelMap> reference,
-                            std::vector<PositionTie> ties) {
+                            SurveyFactors survey) {
   RefineConfig c;
   c.reference = std::move(reference);
-  c.ties = std::move(ties);
+  c.survey = std::move(survey);
   c.imu = o.imu;
   c.T_imu_lidar = ImuTLidar(o.extrinsics);
   c.map = o.map;
@@ -272,7 +272,7 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
 // inputs_hash: of --map and --control / the fixes (0 without them).
 StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input,
                                        std::shared_ptr<const VoxelMap> reference,
-                                       uint64_t inputs_hash, std::vector<PositionTie> ties,
+                                       uint64_t inputs_hash, SurveyFactors survey,
                                        std::string* stop_reason, double* checkpoint_s) {
   RefineHooks hooks;
   hooks.on_round = args.on_round;
@@ -289,13 +289,13 @@ StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input
       return s;
     };
   if (!args.resume)
-    return Refine(ToRefineConfig(args.options, std::move(reference), std::move(ties)),
+    return Refine(ToRefineConfig(args.options, std::move(reference), std::move(survey)),
                   std::move(input), hooks);
   StatusOr<RefineRoundState> resume = ReadRefineCheckpoint(args.checkpoint_dir, fingerprint);
   if (!resume.ok()) return resume.status();
   hooks.resume = &*resume;
   if (args.on_resume) args.on_resume(resume->rounds_done);
-  return Refine(ToRefineConfig(args.options, std::move(reference), std::move(ties)),
+  return Refine(ToRefineConfig(args.options, std::move(reference), std::move(survey)),
                 std::move(input), hooks);
 }
 
@@ -388,7 +388,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     return Status::InvalidInput(ShortChunk(*job, input.scans.size()));
   Times times;
   times.read_s = SecondsSince(t0);
-  std::vector<PositionTie> ties;  // in the local survey frame, where refine then runs
+  SurveyFactors ties;  // in the local survey frame, where refine then runs
   if (*survey != nullptr)
     if (Status s = (*survey)->Prepare(reference != nullptr, &origin, &input.init, &ties); !s.ok())
       return s;

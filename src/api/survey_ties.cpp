@@ -289,7 +289,8 @@ Status SurveyTies::CheckDistances() const {
 }
 
 Status SurveyTies::Prepare(bool hold_frame, LocalOrigin* origin, Trajectory* init,
-                           std::vector<PositionTie>* ties) {
+                           SurveyFactors* out) {
+  std::vector<PositionTie>* ties = &out->ties;
   residuals_.assign(rows_.size(), {});
   row_ties_.assign(rows_.size(), {});
   row_frame_points_.assign(rows_.size(), Eigen::Vector3d::Zero());
@@ -339,6 +340,10 @@ Status SurveyTies::Prepare(bool hold_frame, LocalOrigin* origin, Trajectory* ini
     if (!fix_outlier_[i]) add(fix_ties_[i]);
   std::sort(ties->begin(), ties->end(),
             [](const PositionTie& a, const PositionTie& b) { return a.t_ns < b.t_ns; });
+  out->rests.clear();
+  for (const ControlRow& row : rows_)  // a check mark's rest is a rest too
+    if (!row.target) out->rests.push_back({row.t_start_ns, row.t_end_ns});
+  out->rest_sigma_v = control_.rest_sigma_v;
   return Status::Ok();
 }
 

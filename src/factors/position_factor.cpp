@@ -51,4 +51,19 @@ bool PositionFactor::Evaluate(double const* const* parameters, double* residuals
   return true;
 }
 
+ZeroVelocityFactor::ZeroVelocityFactor(double sigma_v) : inv_sigma_(1.0 / sigma_v) {
+  RVLIO_CHECK(sigma_v > 0.0);
+}
+
+bool ZeroVelocityFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  Eigen::Map<Eigen::Vector3d> r(residuals);
+  r = inv_sigma_ * Eigen::Map<const Eigen::Vector3d>(parameters[0] + SpeedBiasBlock::kVel);
+  if (jacobians == nullptr || jacobians[0] == nullptr) return true;
+  Eigen::Map<Eigen::Matrix<double, 3, 9, Eigen::RowMajor>> J(jacobians[0]);
+  J.setZero();
+  J.block<3, 3>(0, SpeedBiasBlock::kVel) = inv_sigma_ * Eigen::Matrix3d::Identity();
+  return true;
+}
+
 }  // namespace rvlio

@@ -102,6 +102,23 @@ int AddRefinePositionTies(const std::vector<PositionTie>& ties, const ScanRange&
   return added;
 }
 
+int AddRefineRestFactors(const std::vector<TimeInterval>& rests, double sigma_v,
+                         const ScanRange& range, std::vector<RefineState>* states,
+                         ceres::Problem* problem) {
+  int added = 0;
+  for (int k = range.begin; k < range.end; ++k) {
+    const TimeNs t = (*states)[k].t_ns;
+    for (const TimeInterval& rest : rests) {
+      if (t < rest.begin_ns || t > rest.end_ns) continue;
+      problem->AddResidualBlock(new ZeroVelocityFactor(sigma_v), nullptr,
+                                (*states)[k].speed_bias.data());
+      ++added;
+      break;
+    }
+  }
+  return added;
+}
+
 bool RangeHoldsTie(const std::vector<PositionTie>& ties, const ScanRange& range,
                    const std::vector<RefineState>& states) {
   for (const PositionTie& tie : ties)

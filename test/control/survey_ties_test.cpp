@@ -43,10 +43,11 @@ TEST(SurveyTies, GnssAlignmentShrugsOffMultipathOutliers) {
   OdometryOptions options;
   SurveyTies ties("", {}, fixes, options);
   Trajectory init = flight;
-  std::vector<PositionTie> out;
+  SurveyFactors out;
   LocalOrigin origin;
   ASSERT_TRUE(ties.Prepare(false, &origin, &init, &out).ok());
-  EXPECT_EQ(out.size(), fixes.size());
+  EXPECT_EQ(out.ties.size(), fixes.size());
+  EXPECT_TRUE(out.rests.empty());
   // The initial trajectory in the local survey frame: within 1 cm of the truth.
   for (size_t k = 0; k < init.size(); ++k)
     EXPECT_LT((ties.origin().ToUser(init[k].p_world_imu) - T_survey_world * flight[k].p_world_imu).norm(),
@@ -75,10 +76,11 @@ TEST(SurveyTies, ResidualsOfMarksAtTheRefinedTrajectory) {
   options.control.lever_arm = {0.0, 0.0, 0.3};
   SurveyTies ties("marks.csv", rows, {}, options);
   Trajectory init = flight;
-  std::vector<PositionTie> out;
+  SurveyFactors out;
   LocalOrigin origin;
   ASSERT_TRUE(ties.Prepare(false, &origin, &init, &out).ok());
-  EXPECT_EQ(out.size(), 2u);  // the check point does not enter the solve
+  EXPECT_EQ(out.ties.size(), 2u);  // the check point does not enter the solve
+  EXPECT_EQ(out.rests.size(), 3u);  // every mark's rest
   ties.Evaluate(init);
   const std::vector<ControlResidual>& r = ties.residuals();
   ASSERT_EQ(r.size(), 3u);

@@ -59,3 +59,20 @@ TEST(PositionFactor, ResidualIsTheWhitenedInterpolatedPointError) {
 
 }  // namespace
 }  // namespace rvlio
+
+namespace rvlio {
+namespace {
+
+TEST(ZeroVelocityFactor, ResidualAndJacobian) {
+  std::mt19937 rng(43);
+  const ZeroVelocityFactor f(0.002);
+  const std::vector<double> sb = test::ToVector(test::RandomSpeedBias(rng));
+  EXPECT_LT(test::TangentJacobianError(f, {sb}, {nullptr}), 1e-6);
+  const double* params[] = {sb.data()};
+  Eigen::Vector3d r;
+  ASSERT_TRUE(f.Evaluate(params, r.data(), nullptr));
+  EXPECT_TRUE(r.isApprox(Eigen::Vector3d(sb[0], sb[1], sb[2]) / 0.002));
+}
+
+}  // namespace
+}  // namespace rvlio

@@ -63,10 +63,10 @@ class SurveyTies {
   // --init, or of --map, minus *origin, math/local_origin.h), fits the
   // alignment and carries `init` into the survey frame's local frame, whose
   // origin (chosen from the ties) replaces *origin. With hold_frame (a --map
-  // fixes the frame and --init is in it) the frame and *origin stay. *ties:
-  // in the local frame, control points and fixes only.
-  Status Prepare(bool hold_frame, LocalOrigin* origin, Trajectory* init,
-                 std::vector<PositionTie>* ties);
+  // fixes the frame and --init is in it) the frame and *origin stay. *out:
+  // the ties in the local frame (control points and fixes only) and the rests
+  // of the stop-and-go control and check marks.
+  Status Prepare(bool hold_frame, LocalOrigin* origin, Trajectory* init, SurveyFactors* out);
   const LocalOrigin& origin() const { return origin_; }
   // After the refinement: the residuals at the refined trajectory (local frame).
   void Evaluate(const Trajectory& refined_local);

@@ -17,6 +17,7 @@
 // The robust kernel is the caller's (a ceres::LossFunction on the block).
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include "rvlio/factors/parameter_blocks.h"
 
@@ -42,6 +43,19 @@ class PositionFactor final : public ceres::CostFunction {
   Eigen::Matrix3d sqrt_information_;
   double alpha_ = 0.0;
   int blocks_ = 1;
+};
+
+// ZeroVelocityFactor: the device at rest (a stop-and-go landing): the
+// velocity of a speed-bias block (9) is zero,
+//   r = v_world_imu / sigma_v,   d r / d sb = [I3 / sigma_v, 0, 0].
+class ZeroVelocityFactor final : public ceres::SizedCostFunction<3, 9> {
+ public:
+  explicit ZeroVelocityFactor(double sigma_v);  // m/s, > 0
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  double inv_sigma_;
 };
 
 }  // namespace rvlio

@@ -63,6 +63,22 @@ struct TieAttachment {
 TieAttachment AttachTie(const std::vector<RefineState>& states, TimeNs t_ns);
 
 struct ScanRange;
+// A span of time, both ends included (ns).
+struct TimeInterval {
+  TimeNs begin_ns = 0, end_ns = 0;
+};
+// What the survey adds to a refinement: the ties (control points, fixes) and
+// the rests of the stop-and-go marks.
+struct SurveyFactors {
+  std::vector<PositionTie> ties;
+  std::vector<TimeInterval> rests;
+  double rest_sigma_v = 0.001;  // m/s; 0: no zero-velocity factors
+};
+// A ZeroVelocityFactor (factors/position_factor.h) on every state of `range`
+// inside one of the rests. Returns how many.
+int AddRefineRestFactors(const std::vector<TimeInterval>& rests, double sigma_v,
+                         const ScanRange& range, std::vector<RefineState>* states,
+                         ceres::Problem* problem);
 // The ties whose state(s) lie in [range.begin, range.end) as PositionFactors
 // on those states' pose blocks (already in the problem). Returns how many.
 int AddRefinePositionTies(const std::vector<PositionTie>& ties, const ScanRange& range,

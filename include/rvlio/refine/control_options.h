@@ -29,6 +29,7 @@ struct ControlOptions {
   double rest_window_s = 0.5;      // IMU window of the stillness test
   double rest_gyro_std = 0.01;     // rad/s: stillness when the gyro's std is below (norm over axes)
   double rest_accel_std = 0.1;     // m/s^2: ... and the accelerometer's std is below
+  double rest_sigma_v = 0.001;     // m/s: zero-velocity factor on a mark's rest (0: none)
   // The IMU origin relative to the mark, in the body frame at rest (m).
   std::array<double, 3> lever_arm = {0.0, 0.0, 0.0};
   double max_distance_m = 5.0;     // a mark farther from the aligned trajectory: refused (a typo)
@@ -57,6 +58,10 @@ struct ControlOptions {
     v.Field("rest_accel_std", rest_accel_std,
             Spec().Unit("m/s^2").Range(1e-4, 10.0).Help(
                 "... and the accelerometer's is below this"));
+    v.Field("rest_sigma_v", rest_sigma_v,
+            Spec().Unit("m/s").Range(0.0, 10.0).Help(
+                "refine holds the velocity of every state inside a stop-and-go mark's rest at zero "
+                "with this sigma (0: no such factor)"));
     v.Field("lever_arm", lever_arm,
             Spec().Unit("m").Range(-100.0, 100.0).Help(
                 "the IMU origin relative to a stop-and-go mark, in the body frame at rest"));
