@@ -84,6 +84,19 @@ const std::string& ImuDefinition() {
   return def;
 }
 
+const std::string& NavSatFixDefinition() {
+  static const std::string def = WithDependencies(
+      "std_msgs/Header header\n"
+      "NavSatStatus status\n"
+      "float64 latitude\n"
+      "float64 longitude\n"
+      "float64 altitude\n"
+      "float64[9] position_covariance\n"
+      "uint8 position_covariance_type",
+      {kHeaderDef, kTimeDef, "MSG: sensor_msgs/NavSatStatus\nint8 status\nuint16 service"});
+  return def;
+}
+
 const std::string& LivoxCustomMsgDefinition() {
   static const std::string def = WithDependencies(
       "std_msgs/Header header\n"

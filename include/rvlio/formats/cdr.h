@@ -42,6 +42,7 @@ inline constexpr const char* kDiagnosticArrayType = "diagnostic_msgs/msg/Diagnos
 const std::string& PointCloud2Definition();
 const std::string& ImuDefinition();
 const std::string& LivoxCustomMsgDefinition();
+const std::string& NavSatFixDefinition();  // sensor_msgs/msg/NavSatFix (formats/navsatfix.h)
 
 // Bounds-checked sequential reader of one CDR payload.
 class Reader {

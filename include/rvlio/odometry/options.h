@@ -17,6 +17,7 @@
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/reference.h"
 #include "rvlio/outputs/output_options.h"
+#include "rvlio/refine/control_options.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/window/options.h"
 
@@ -48,6 +49,8 @@ struct OdometryOptions {
   LiveOptions live;  // `rvlio live` only (docs/live.md)
   OutputOptions output;  // optional output files (map.las)
   SurveyOptions survey;  // the map frame's coordinate reference system
+  ControlOptions control;  // control and check points (`refine --control`, docs/control.md)
+  GnssOptions gnss;        // GNSS fixes of the recording (refine, docs/control.md)
 
   template <class V>
   void Visit(V& v) {
@@ -67,6 +70,8 @@ struct OdometryOptions {
     v.Section("live", live);
     v.Section("output", output);
     v.Section("survey", survey);
+    v.Section("control", control);
+    v.Section("gnss", gnss);
   }
 
   // Ranges and choices of every key, then the cross-field rules of each module.
@@ -76,7 +81,7 @@ struct OdometryOptions {
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), degeneracy.Validate(), ieskf.Validate(), smoother.Validate(),
                      divergence.Validate(), localization.Validate(), io.Validate(), live.Validate(),
-                     output.Validate(), survey.Validate()})
+                     output.Validate(), survey.Validate(), control.Validate(), gnss.Validate()})
       if (!m.ok()) return m;
     if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
       return Status::InvalidInput(
