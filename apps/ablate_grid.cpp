@@ -505,7 +505,7 @@ Status CheckCellConfig(const GridContext& g, const Cell& c, const Plan& plan) {
   std::vector<std::string> files;
   for (const auto& f : c.config_files)
     if (c.data_index < 0 || f != plan.data[c.data_index].sensor_config) files.push_back(f);
-  StatusOr<OdometryOptions> options = LoadConfig(files, c.overrides);
+  StatusOr<Configuration> options = LoadConfig(files, c.overrides);
   if (options.ok()) return Status::Ok();
   return g.Error(Node(), "cell " + c.sequence + "/" + c.label, options.status().message());
 }

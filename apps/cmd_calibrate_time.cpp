@@ -65,7 +65,7 @@ class ScreenedScans {
   Recording* rec_;
 };
 
-Status Read(const std::string& bag, const OdometryOptions& o, Recording* rec) {
+Status Read(const std::string& bag, const Configuration& o, Recording* rec) {
   StatusOr<std::unique_ptr<SensorBagReader>> reader =
       OpenSensorStream(bag, o.lidar, o.imu, ReadWindow(), o.io);
   if (!reader.ok()) return reader.status();
@@ -140,7 +140,7 @@ std::string CannotJudge(const ClockCheckResult& r, const ClockCheckOptions& c) {
   return "";
 }
 
-void PrintOffset(const ClockCheckResult& r, const OdometryOptions& o, const ClockCheckOptions& c) {
+void PrintOffset(const ClockCheckResult& r, const Configuration& o, const ClockCheckOptions& c) {
   std::printf(
       "clock offset (scan-to-scan rotation vs gyroscope, %d intervals, lag searched +-%.0f ms):\n"
       "  rotation excitation: gyro rate spread %.3f rad/s RMS (needed: %.3f), %.1f s rotating "
@@ -183,7 +183,7 @@ int CmdCalibrateTime(int argc, char** argv) {
   Args args;
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   std::vector<std::string> warnings;
-  StatusOr<OdometryOptions> o = LoadConfig(args.GetAll("config"), args.GetAll("set"), &warnings);
+  StatusOr<Configuration> o = LoadConfig(args.GetAll("config"), args.GetAll("set"), &warnings);
   if (!o.ok()) return Fail(kCalibrateTime, o.status().message());
   for (const auto& w : warnings) std::fprintf(stderr, "rvlio %s: warning: %s\n", kCalibrateTime, w.c_str());
   Recording rec;

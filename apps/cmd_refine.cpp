@@ -94,10 +94,10 @@ int CmdRefine(int argc, char** argv) {
                      "after each round, write the state to continue from to DIR/refine.checkpoint"},
                     {"resume", "DIR",
                      "continue from DIR/refine.checkpoint (same --bag, --init, --map, --config and --set; "
-                     "smoother.refine_rounds may differ) and go on checkpointing there"},
+                     "refine.rounds may differ) and go on checkpointing there"},
                     {"chunk", "K",
                      "refine only chunk K (1-based) of --of N overlapping chunks of the initial "
-                     "trajectory's span (smoother.refine_job_overlap_s); writes chunk.json too, "
+                     "trajectory's span (refine.job_overlap_s); writes chunk.json too, "
                      "for `rvlio merge`"},
                     {"of", "N", "the number of chunks (with --chunk)"},
                     {"map", "REF", "reference map (PCD or PLY, metres) in the --init trajectory's frame: every scan is also held to it (docs/survey.md)"},
@@ -158,7 +158,7 @@ int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
   RefineArgs& req = request.args;
   std::FILE* out = request.out;
   std::vector<std::string> config_warnings;
-  StatusOr<OdometryOptions> options =
+  StatusOr<Configuration> options =
       LoadConfig(request.config_files, request.overrides, &config_warnings);
   if (!options.ok()) return Fail("refine", options.status().message());
   for (const auto& w : config_warnings)
@@ -169,7 +169,7 @@ int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
     if (!init.ok()) return Fail("refine", "--init: " + init.status().message());
     req.init = std::move(*init);
   }
-  const int rounds = req.options.smoother.refine_rounds;
+  const int rounds = req.options.refine.rounds;
   req.on_round = [out, rounds](const RefineRound& r) { PrintRound(out, r, rounds); };
   req.on_resume = [out, &req](int rounds_done) {
     std::fprintf(out, "rvlio refine: resuming after round %d from %s\n", rounds_done,

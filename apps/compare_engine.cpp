@@ -118,12 +118,12 @@ struct Truth {
 // ---------------------------------------------------------------------------
 
 int CheckInputs(const CompareRequest& req, Truth* truth) {
-  StatusOr<OdometryOptions> options = LoadConfig(req.config_files, req.overrides);
+  StatusOr<Configuration> options = LoadConfig(req.config_files, req.overrides);
   if (!options.ok()) return Fail(kCompare, options.status().message());
   for (const Variant& v : StandardVariants()) {
     std::vector<std::string> sets = req.overrides;
     sets.insert(sets.end(), v.overrides.begin(), v.overrides.end());
-    if (StatusOr<OdometryOptions> o = LoadConfig(req.config_files, sets); !o.ok())
+    if (StatusOr<Configuration> o = LoadConfig(req.config_files, sets); !o.ok())
       return Fail(kCompare, "variant " + v.name + ": " + o.status().message());
   }
   StatusOr<Trajectory> gt = ReadTrajectory(req.gt);

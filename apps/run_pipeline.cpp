@@ -45,7 +45,7 @@ int ReportInterrupt(const RunRequest& req, const RunResult& r) {
 
 int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   std::vector<std::string> config_warnings;
-  StatusOr<OdometryOptions> options =
+  StatusOr<Configuration> options =
       LoadConfig(req.config_files, req.overrides, &config_warnings);
   if (!options.ok()) return Fail("run", options.status().message());
   for (const auto& w : config_warnings) std::fprintf(stderr, "rvlio run: warning: %s\n", w.c_str());

@@ -16,6 +16,7 @@ set(rvlio_public_headers
   rvlio/common/time.h
   rvlio/common/types.h
   rvlio/config/config.h
+  rvlio/config/configuration.h
   rvlio/constraints/constraint.h
   rvlio/constraints/options.h
   rvlio/constraints/plane_fit.h
@@ -57,6 +58,7 @@ set(rvlio_public_headers
   rvlio/odometry/reference.h
   rvlio/outputs/output_options.h
   rvlio/outputs/run_outputs.h
+  rvlio/refine/options.h
   rvlio/refine/refine.h
   rvlio/refine/refine_jobs.h
   rvlio/refine/refine_states.h

@@ -1,5 +1,5 @@
 // libFuzzer target: the configuration loader of `rvlio run --config F --set
-// k=v` (config/config.h LoadOptions<OdometryOptions>: defaults, YAML, overrides,
+// k=v` (config/config.h LoadOptions<Configuration>: defaults, YAML, overrides,
 // Validate, source attribution) on fuzzed YAML text and override strings.
 // Only ParseYamlFile's reading of the file is replaced by the text itself
 // (ApplyYamlText is ApplyYamlFile after the read).
@@ -25,7 +25,7 @@
 
 namespace {
 
-using rvlio::OdometryOptions;
+using rvlio::Configuration;
 using rvlio::Status;
 
 [[noreturn]] void Fail(const char* what, const std::string& detail) {
@@ -38,9 +38,9 @@ void RequireInvalidInput(const Status& s) {
     Fail("a failure is not InvalidInput with a message", s.message());
 }
 
-// LoadOptions<OdometryOptions> with the file replaced by its text.
+// LoadOptions<Configuration> with the file replaced by its text.
 Status Load(const std::string& yaml, const std::vector<std::string>& overrides,
-            OdometryOptions* options) {
+            Configuration* options) {
   rvlio::ConfigSources sources;
   Status s = rvlio::ApplyYamlText(*options, yaml, "fuzz.yaml", &sources);
   if (!s.ok()) return s;
@@ -62,7 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (int i = 0; i < n_overrides; ++i) overrides.push_back(fdp.ConsumeRandomLengthString(256));
   const std::string yaml = fdp.ConsumeRemainingBytesAsString();
 
-  OdometryOptions options;
+  Configuration options;
   const Status s = Load(yaml, overrides, &options);
 #ifdef RVLIO_FUZZ_VERBOSE  // seed checks: what an input loads to
   std::fprintf(stderr, "%zu overrides: %s\n", overrides.size(),
@@ -75,7 +75,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!options.Validate().ok()) Fail("a loaded configuration does not validate", yaml);
 
   const std::string dumped = rvlio::DumpYaml(options);
-  OdometryOptions restored;
+  Configuration restored;
   const Status r = Load(dumped, {}, &restored);
   if (!r.ok()) Fail("DumpYaml output does not load", r.message() + "\n" + dumped);
   if (rvlio::DumpYaml(restored) != dumped) Fail("DumpYaml round trip changed a value", dumped);

@@ -7,7 +7,9 @@
 # Runs, on short simulated flights (6 s, 512 columns; presets tunnel and corridor,
 # seeds 1 and 2): simulate; run with both backends (ieskf, smoother); and on the
 # first flight refine (whole, and --chunk 1/2 + 2/2 then merge), compare and a
-# 2-cell ablate. The outputs are normalized (scans.csv without the time and memory
+# 2-cell ablate; on a tunnel simulated with its reference map, run in that map
+# (--map, --initial-pose-tum) and with the online time offset and extrinsic
+# estimated (each backend), and refine --map. The outputs are normalized (scans.csv without the time and memory
 # columns `ms` and `rss_mb`; JSON files without timing/memory/environment keys) and
 # saved to, or diffed against, DIR. Exit 0 when every file is identical.
 set -euo pipefail
@@ -42,6 +44,23 @@ for preset in tunnel corridor; do
   done
 done
 s="$first"
+# Localization in a reference map, and the online estimation of the time
+# offset and the extrinsic (each backend), on the tunnel with a survey map.
+m="$raw/map"
+Rq simulate --preset tunnel --seed 1 --duration 6 --set lidar.columns=512 --reference-map \
+  --set survey.x_min=-10 --set survey.x_max=30 --out "$m/sim" --name seq
+for backend in ieskf smoother; do
+  R run --bag "$m/sim/seq.bag" --config "$m/sim/seq.yaml" --set backend=$backend \
+    --map "$m/sim/reference_map.pcd" --initial-pose-tum "$m/sim/seq_gt.tum" --out "$m/run_map_$backend" --allow-divergence
+  R run --bag "$m/sim/seq.bag" --config "$m/sim/seq.yaml" --set backend=$backend \
+    --set lidar.estimate_time_offset=true --out "$m/run_td_$backend" --allow-divergence
+done
+R run --bag "$m/sim/seq.bag" --config "$m/sim/seq.yaml" --set ieskf.estimate_extrinsics=true \
+  --out "$m/run_ext_ieskf" --allow-divergence
+R run --bag "$m/sim/seq.bag" --config "$m/sim/seq.yaml" --set backend=smoother \
+  --set smoother.estimate_extrinsics=true --out "$m/run_ext_smoother" --allow-divergence
+Rq refine --bag "$m/sim/seq.bag" --config "$m/sim/seq.yaml" --init "$m/run_map_ieskf/trajectory.tum" \
+  --map "$m/sim/reference_map.pcd" --out "$m/refine_map" --allow-divergence
 Rq refine --bag "$s/sim/seq.bag" --config "$s/sim/seq.yaml" --init "$s/run_ieskf/trajectory.tum" --out "$s/refine" --allow-divergence
 for k in 1 2; do
   Rq refine --bag "$s/sim/seq.bag" --config "$s/sim/seq.yaml" --init "$s/run_ieskf/trajectory.tum" \

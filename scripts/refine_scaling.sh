@@ -62,7 +62,7 @@ for n in $scans_list; do
   rm -rf "$out"
   /usr/bin/time -f %M -o "$dir.maxrss_kb" "$bin" refine --bag "$dir/tunnel.bag" \
     --init "$dir/init/trajectory.tum" --config "$dir/tunnel.yaml" \
-    --set smoother.refine_rounds="$rounds" --set smoother.refine_threads="$threads" \
+    --set refine.rounds="$rounds" --set refine.threads="$threads" \
     --out "$out" > "$dir.refine.log"
   python3 - "$out/summary.json" "$(tail -n 1 "$dir.maxrss_kb")" <<'EOF'
 import json, sys

@@ -282,7 +282,7 @@ check "a job cancelled while running ($retried_job, cell $retried_cell) was subm
 chunks_cfg() {  # the --config of workflow/refine_chunks.smk for output folder $1
   echo bag="$work/chunks_data/tunnel.bag" init="$work/chunks_init/trajectory.tum" chunks=3 \
     out="$1" config="[$work/chunks_data/tunnel.yaml]" rvlio="$rvlio" \
-    "set=[smoother.refine_rounds=2,smoother.refine_job_overlap_s=3]" cpus="$cpus" mem_mb="$mem_mb" \
+    "set=[refine.rounds=2,refine.job_overlap_s=3]" cpus="$cpus" mem_mb="$mem_mb" \
     runtime="$minutes"
 }
 chunks_ready() {

@@ -5,7 +5,7 @@
 #
 #   snakemake -s workflow/refine_chunks.smk -j 2 \
 #             --config bag=rec.bag init=run/trajectory.tum chunks=4 out=out/refined \
-#                      config=[sensors.yaml] set=[smoother.refine_job_overlap_s=10]
+#                      config=[sensors.yaml] set=[refine.job_overlap_s=10]
 #   snakemake -s workflow/refine_chunks.smk --profile workflow/profiles/slurm --config ...
 #
 # config: bag, init (required), chunks (N, default 4), out (default
@@ -85,7 +85,7 @@ rule chunk:
         mem_mb=MEM_MB,
         runtime=RUNTIME,
     shell:
-        "{params.refine:q} --set smoother.refine_threads={threads} --chunk {wildcards.k} "
+        "{params.refine:q} --set refine.threads={threads} --chunk {wildcards.k} "
         "--of {params.n} --out {params.dir:q} > {log:q} 2>&1"
 
 

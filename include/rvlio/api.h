@@ -14,7 +14,7 @@
 // nothing is printed and the process is never exited. A
 // call that is stopped (`stop`) returns normally with `stopped` set.
 //
-// Configuration: LoadConfig (rvlio/config/config.h) gives OdometryOptions from
+// Configuration: LoadConfig (rvlio/config/config.h) gives the Configuration from
 // YAML files plus `key=value` overrides; DumpYaml / ToJson write it back.
 #include <cstdint>
 #include <functional>
@@ -34,7 +34,7 @@
 #include "rvlio/formats/sensor_stream.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/odometry.h"
-#include "rvlio/odometry/options.h"
+#include "rvlio/config/configuration.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/refine/refine.h"
 #include "rvlio/refine/refine_jobs.h"
@@ -61,7 +61,7 @@ struct RunProgress {
 
 struct RunArgs {
   std::string bag;          // ROS1 .bag, ROS 2 .db3, .mcap or bag folder
-  OdometryOptions options;  // e.g. LoadConfig(files, overrides)
+  Configuration options;  // e.g. LoadConfig(files, overrides)
   // When not empty: created if needed; receives trajectory.tum, map.pcd,
   // scans.csv and summary.json (all or none, atomically) and, while the run
   // goes, trajectory.partial.tum. Empty: nothing is written.
@@ -127,7 +127,7 @@ struct RefineArgs {
   std::string bag;
   std::string init_path;  // TUM file, read when `init` is empty; summary.json "init"
   Trajectory init;        // the initial trajectory (e.g. RunResult::trajectory)
-  OdometryOptions options;
+  Configuration options;
   std::string out_dir;    // empty: nothing written; else trajectory.tum, map.pcd, summary.json
   ReadWindow window;
   // When not empty, the state after each round goes to checkpoint_dir/refine.checkpoint;
@@ -140,7 +140,7 @@ struct RefineArgs {
   // Chunk job (`rvlio refine --chunk K --of N`, refine/refine_jobs.h): when
   // chunk_count > 0, refines only chunk `chunk` (1-based) of chunk_count
   // chunks of the initial trajectory's span, overlapping by
-  // smoother.refine_job_overlap_s; only that chunk's scans (and the IMU
+  // refine.job_overlap_s; only that chunk's scans (and the IMU
   // samples around them) are kept while reading. out_dir then also receives
   // chunk.json, which MergeRefineChunks reads.
   int chunk = 0;

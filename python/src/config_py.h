@@ -3,14 +3,14 @@
 #include <vector>
 
 #include "common.h"
-#include "rvlio/odometry/options.h"
+#include "rvlio/config/configuration.h"
 
 namespace rvlio::python {
 
 // rvlio.Config: the resolved options and what they were loaded from (the
 // files and `set` overrides, as `rvlio run --config F --set K=V` takes them).
 struct Config {
-  OdometryOptions options;
+  Configuration options;
   std::vector<std::string> files;
   std::vector<std::string> overrides;  // "key=value"
 };

@@ -15,7 +15,7 @@
 #include "config_py.h"
 #include "odometry_py.h"
 #include "rvlio/api.h"
-#include "rvlio/odometry/scan_columns.h"
+#include "rvlio/outputs/scan_columns.h"
 
 namespace rvlio::python {
 namespace {
@@ -25,7 +25,7 @@ constexpr const char* kStopReason = "KeyboardInterrupt";
 // while reading without new results at most this often.
 constexpr std::chrono::milliseconds kProgressPeriod{200};
 
-// The per-scan table: the columns of scans.csv (odometry/scan_columns.h) as
+// The per-scan table: the columns of scans.csv (outputs/scan_columns.h) as
 // numpy arrays, one row per scan: text columns as strings, flags as bool,
 // counts as int, the rest float (NaN: none).
 py::dict ScanTable(const std::vector<ScanResult>& scans, const std::vector<double>& rss_mb) {

@@ -24,7 +24,7 @@ def stopgo(tmp_path_factory, rvlio_bin):
 
 
 def test_refine_with_control_gives_the_report_and_the_command_files(rvlio_bin, stopgo, tmp_path):
-    config = rvlio.Config.load(stopgo["config"], set={"smoother.refine_rounds": 1})
+    config = rvlio.Config.load(stopgo["config"], set={"refine.rounds": 1})
     py = rvlio.refine(stopgo["bag"], stopgo["run"] / "trajectory.tum", config,
                       out=tmp_path / "py", control=stopgo["control"])
     table = py.control
@@ -37,7 +37,7 @@ def test_refine_with_control_gives_the_report_and_the_command_files(rvlio_bin, s
     cli = tmp_path / "cli"
     run_cli(rvlio_bin, "refine", "--bag", stopgo["bag"], "--config", stopgo["config"], "--init",
             stopgo["run"] / "trajectory.tum", "--control", stopgo["control"], "--out", cli,
-            "--set", "smoother.refine_rounds=1")
+            "--set", "refine.rounds=1")
     assert (tmp_path / "py" / "control.csv").read_bytes() == (cli / "control.csv").read_bytes()
     assert (tmp_path / "py" / "trajectory.tum").read_bytes() == (cli / "trajectory.tum").read_bytes()
 

@@ -56,7 +56,7 @@ def test_run_result_table(py_run, cli_run):
 
 
 def test_run_table_has_the_columns_of_scans_csv_in_its_order(py_run, cli_run):
-    # Both come from one table (odometry/scan_columns.h): same names, same order.
+    # Both come from one table (outputs/scan_columns.h): same names, same order.
     out, result = py_run
     for folder in (cli_run, out):
         header = (folder / "scans.csv").read_text().splitlines()[0].split(",")
@@ -82,10 +82,10 @@ def test_run_without_out_writes_nothing(tunnel, py_run, tmp_path):
 
 
 def test_refine_gives_the_cli_trajectory(rvlio_bin, tunnel, cli_run, py_run, tmp_path):
-    config = rvlio.Config.load(tunnel["config"], set={"smoother.refine_rounds": 2})
+    config = rvlio.Config.load(tunnel["config"], set={"refine.rounds": 2})
     cli_out = tmp_path / "cli_refine"
     run_cli(rvlio_bin, "refine", "--bag", tunnel["bag"], "--init", cli_run / "trajectory.tum",
-            "--config", tunnel["config"], "--set", "smoother.refine_rounds=2", "--out", cli_out)
+            "--config", tunnel["config"], "--set", "refine.rounds=2", "--out", cli_out)
     _, run_result = py_run
     out = tmp_path / "py_refine"
     refined = rvlio.refine(tunnel["bag"], cli_run / "trajectory.tum", config, out=out)
@@ -133,9 +133,9 @@ def test_an_exception_in_progress_stops_the_run(tunnel):
 
 
 def test_refine_chunks_and_merge_give_the_cli_files(rvlio_bin, tunnel, cli_run, tmp_path):
-    sets = ["smoother.refine_rounds=1", "smoother.refine_job_overlap_s=1"]
-    config = rvlio.Config.load(tunnel["config"], set={"smoother.refine_rounds": 1,
-                                                      "smoother.refine_job_overlap_s": 1})
+    sets = ["refine.rounds=1", "refine.job_overlap_s=1"]
+    config = rvlio.Config.load(tunnel["config"], set={"refine.rounds": 1,
+                                                      "refine.job_overlap_s": 1})
     init = cli_run / "trajectory.tum"
     cli_dirs, py_dirs = [], []
     for k in (1, 2):

@@ -36,7 +36,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-RefineConfig ToRefineConfig(const OdometryOptions& o, std::shared_ptr<const VoxelMap> reference,
+RefineConfig ToRefineConfig(const Configuration& o, std::shared_ptr<const VoxelMap> reference,
                             SurveyFactors survey) {
   RefineConfig c;
   c.reference = std::move(reference);
@@ -47,7 +47,7 @@ RefineConfig ToRefineConfig(const OdometryOptions& o, std::shared_ptr<const Voxe
   c.constraints = o.constraints;
   c.rv = EffectiveRvOptions(o.rv, o.degeneracy);
   c.degeneracy = o.degeneracy;
-  c.smoother = o.smoother;
+  c.refine = o.refine;
   return c;
 }
 
@@ -182,7 +182,7 @@ nlohmann::json ChunkJson(const RefineArgs& args, const RefineJobSpan& job, const
   return {{"format", 1},
           {"chunk", job.chunk},
           {"of", job.count},
-          {"overlap_s", args.options.smoother.refine_job_overlap_s},
+          {"overlap_s", args.options.refine.job_overlap_s},
           {"core_begin_ns", job.core_begin_ns},
           {"core_end_ns", job.core_end_ns},
           {"begin_ns", job.begin_ns},
@@ -410,7 +410,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (args.chunk_count > 0) {
     StatusOr<RefineJobSpan> span =
         MakeRefineJobSpan(input.init.front().t_ns, input.init.back().t_ns, args.chunk,
-                          args.chunk_count, args.options.smoother.refine_job_overlap_s);
+                          args.chunk_count, args.options.refine.job_overlap_s);
     if (!span.ok()) return span.status();
     job = *span;
   }

@@ -114,11 +114,13 @@ json RoundJson(const RefineRound& r) {
             {"total", r.total_s}}}};
 }
 
-uint64_t RefineOptionsHash(const OdometryOptions& options) {
-  OdometryOptions config = options;
-  config.smoother.refine_threads = 0;
+uint64_t RefineOptionsHash(const Configuration& options) {
+  Configuration config = options;
+  config.refine.threads = 0;
+  nlohmann::json json = ToJson(config);
+  json.erase("output");  // which files are written, not what is computed
   Fnv1a h;
-  h.AddText(ToJson(config).dump());
+  h.AddText(json.dump());
   return h.value();
 }
 
@@ -156,10 +158,10 @@ StatusOr<uint64_t> FileContentHash(const std::string& path) {
   return h.value();
 }
 
-uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input,
+uint64_t RefineFingerprint(const Configuration& options, const RefineInput& input,
                            uint64_t reference_hash) {
-  OdometryOptions config = options;
-  config.smoother.refine_rounds = 0;  // resuming may go on for more rounds
+  Configuration config = options;
+  config.refine.rounds = 0;  // resuming may go on for more rounds
   Fnv1a h;
   h.Add(kFormat);
   h.AddText(ToJson(config).dump());
@@ -218,7 +220,7 @@ StatusOr<RefineRoundState> ReadRefineCheckpoint(const std::string& dir, uint64_t
                                 std::to_string(kFormat) + ")");
   if (j.value("fingerprint", uint64_t{0}) != fingerprint)
     return Status::InvalidInput(what + " was written for another bag, initial trajectory, --map or "
-                                "configuration (only smoother.refine_rounds may differ)");
+                                "configuration (only refine.rounds may differ)");
   try {
     return StateFrom(j);
   } catch (const json::exception& e) {

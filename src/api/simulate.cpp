@@ -406,7 +406,7 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   // The sensor configuration must be one that `rvlio run` accepts.
   const bool livox = args.lidar_msg == "livox";
   const std::string yaml = SensorYaml(options, name, livox, name + extension);
-  OdometryOptions check;
+  Configuration check;
   if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
       !s.ok() || !(s = check.Validate()).ok())
     return Status::Internal("generated sensor configuration is rejected: " + s.message());

@@ -83,7 +83,7 @@ SurveyFix ToSurveyFix(const NavSatFix& m, const Eigen::Vector3d& p_survey,
 }  // namespace
 
 SurveyTies::SurveyTies(std::string control_path, std::vector<ControlRow> rows,
-                       std::vector<SurveyFix> fixes, const OdometryOptions& options,
+                       std::vector<SurveyFix> fixes, const Configuration& options,
                        const LocalOrigin& init_origin)
     : control_path_(std::move(control_path)),
       rows_(std::move(rows)),
@@ -438,7 +438,7 @@ uint64_t SurveyTies::ContentHash() const {
 
 StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_path,
                                                      const std::string& bag,
-                                                     const OdometryOptions& options,
+                                                     const Configuration& options,
                                                      const LocalOrigin& init_origin) {
   std::vector<ControlRow> rows;
   if (!control_path.empty()) {
@@ -466,7 +466,7 @@ StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_
 }
 
 StatusOr<std::vector<SurveyFix>> ReadSurveyFixes(const std::string& bag,
-                                                 const OdometryOptions& options,
+                                                 const Configuration& options,
                                                  NavSatFixStats* stats) {
   if (IsLocalCrs(options.survey.crs))
     return Status::InvalidInput(

@@ -277,6 +277,59 @@ bool IsPlainSafe(const std::string& s) {
   return true;
 }
 
+std::vector<std::string> SplitDotted(const std::string& key) {
+  std::vector<std::string> parts;
+  size_t begin = 0;
+  for (size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.', begin)) {
+    parts.push_back(key.substr(begin, dot - begin));
+    begin = dot + 1;
+  }
+  parts.push_back(key.substr(begin));
+  return parts;
+}
+
+size_t KeyIndex(const Node& map, const std::string& key) {
+  for (size_t i = 0; i < map.keys.size(); ++i)
+    if (map.keys[i] == key) return i;
+  return map.keys.size();
+}
+
+// The mapping holding the last part of `parts` (null when a section on the
+// way is absent or not a mapping) and that part's index in it (its size when
+// absent).
+Node* ParentOf(Node* root, const std::vector<std::string>& parts, size_t* index) {
+  Node* map = root;
+  for (size_t p = 0; p + 1 < parts.size(); ++p) {
+    const size_t i = KeyIndex(*map, parts[p]);
+    if (i == map->keys.size() || map->items[i].kind != Node::Kind::kMap) return nullptr;
+    map = &map->items[i];
+  }
+  *index = KeyIndex(*map, parts.back());
+  return map;
+}
+
+// The mapping of the sections `parts` (but the last), created where absent.
+StatusOr<Node*> MakeSections(Node* root, const std::vector<std::string>& parts, int line,
+                             const std::string& source) {
+  Node* map = root;
+  std::string key;
+  for (size_t p = 0; p + 1 < parts.size(); ++p) {
+    key = key.empty() ? parts[p] : key + "." + parts[p];
+    size_t i = KeyIndex(*map, parts[p]);
+    if (i == map->keys.size()) {
+      map->keys.push_back(parts[p]);
+      map->key_lines.push_back(line);
+      map->items.push_back(Node{});
+    }
+    Node& section = map->items[i];
+    if (section.kind == Node::Kind::kNull) section.kind = Node::Kind::kMap;  // "refine:" alone
+    if (section.kind != Node::Kind::kMap)
+      return NotASection(section, key, Where(source, map->key_lines[i]));
+    map = &section;
+  }
+  return map;
+}
+
 }  // namespace
 
 std::string Where(const std::string& source, int line) {
@@ -422,6 +475,33 @@ Status NotOneOf(const std::string& key, const std::string& where, const std::str
   return Status::InvalidInput(where + ": " + key + " = '" + value + "' is not one of " + list);
 }
 
+Status RelocateMovedKeys(Node* root, const std::vector<DeprecatedName>& moved,
+                         const std::string& source, std::vector<std::string>* deprecations) {
+  for (const DeprecatedName& m : moved) {
+    const std::vector<std::string> from = SplitDotted(m.old_name), to = SplitDotted(m.new_name);
+    size_t i = 0;
+    Node* old_map = ParentOf(root, from, &i);
+    if (old_map == nullptr || i == old_map->keys.size()) continue;
+    const int line = old_map->key_lines[i];
+    const std::string where = Where(source, line);
+    size_t j = 0;
+    if (Node* new_map = ParentOf(root, to, &j); new_map != nullptr && j < new_map->keys.size())
+      return BothNames(m.old_name, m.new_name, where);
+    Node value = std::move(old_map->items[i]);
+    old_map->items.erase(old_map->items.begin() + static_cast<std::ptrdiff_t>(i));
+    old_map->keys.erase(old_map->keys.begin() + static_cast<std::ptrdiff_t>(i));
+    old_map->key_lines.erase(old_map->key_lines.begin() + static_cast<std::ptrdiff_t>(i));
+    StatusOr<Node*> new_map = MakeSections(root, to, line, source);
+    if (!new_map.ok()) return new_map.status();
+    (*new_map)->keys.push_back(to.back());
+    (*new_map)->key_lines.push_back(line);
+    (*new_map)->items.push_back(std::move(value));
+    if (deprecations != nullptr)
+      deprecations->push_back(DeprecationWarning(m.old_name, m.new_name, where));
+  }
+  return Status::Ok();
+}
+
 Status BothNames(const std::string& old_key, const std::string& new_key,
                  const std::string& where) {
   return Status::InvalidInput(old_key + ": given together with its new name " + new_key + " in " +
@@ -551,10 +631,10 @@ Status AttributeToSources(const Status& status, const std::vector<std::string>& 
   return Status::InvalidInput(out);
 }
 
-StatusOr<OdometryOptions> LoadConfig(const std::vector<std::string>& config_files,
+StatusOr<Configuration> LoadConfig(const std::vector<std::string>& config_files,
                                      const std::vector<std::string>& set_overrides,
                                      std::vector<std::string>* warnings) {
-  return LoadOptions<OdometryOptions>(config_files, set_overrides, nullptr, warnings);
+  return LoadOptions<Configuration>(config_files, set_overrides, nullptr, warnings);
 }
 
 }  // namespace rvlio

@@ -47,7 +47,7 @@ StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args,
 }  // namespace
 
 StatusOr<LiveResult> RunLive(const LiveArgs& args) {
-  OdometryOptions options = args.options;
+  Configuration options = args.options;
   if (Status s = options.Validate(); !s.ok()) return s;
   if (!args.out_dir.empty()) {  // an unusable output folder is refused before connecting
     OutputFolder check(args.out_dir);  // removes again what it created

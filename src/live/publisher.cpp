@@ -49,7 +49,7 @@ struct XyziCloud {
 }  // namespace
 
 LivePublisher::LivePublisher(Transport* transport, LiveSensorSource* source,
-                             const OdometryOptions& options)
+                             const Configuration& options)
     : transport_(transport),
       source_(source),
       options_(options),

@@ -16,14 +16,14 @@
 #include "rvlio/formats/live_source.h"
 #include "rvlio/imu/propagator.h"
 #include "rvlio/live/live.h"
-#include "rvlio/odometry/options.h"
+#include "rvlio/config/configuration.h"
 #include "transport.h"
 
 namespace rvlio::live_detail {
 
 class LivePublisher {
  public:
-  LivePublisher(Transport* transport, LiveSensorSource* source, const OdometryOptions& options);
+  LivePublisher(Transport* transport, LiveSensorSource* source, const Configuration& options);
 
   void OnImu(const ImuSample& sample);
   void OnResult(const ScanResult& result, const Odometry& odometry);
@@ -42,7 +42,7 @@ class LivePublisher {
 
   Transport* transport_;
   LiveSensorSource* source_;
-  OdometryOptions options_;
+  Configuration options_;
   Pose3 T_imu_lidar_config_;
 
   mutable std::mutex mutex_;  // guards the propagator and what the IMU thread reads

@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "rvlio/math/so3.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/math/pose_interpolation.h"
 
 namespace rvlio {
 namespace {

@@ -11,7 +11,7 @@
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/math/local_origin.h"
-#include "rvlio/odometry/scan_columns.h"
+#include "rvlio/outputs/scan_columns.h"
 
 namespace rvlio {
 namespace {

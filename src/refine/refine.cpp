@@ -36,7 +36,7 @@ class BatchRefiner {
       : config_(config),
         input_(std::move(input)),
         noise_(ImuNoise::FromOptions(config.imu)),
-        solver_(RefineSolver::Make(ResolveThreads(config.smoother.refine_threads))),
+        solver_(RefineSolver::Make(ResolveThreads(config.refine.threads))),
         round_map_(config.map) {
     result_.linear_solver = solver_.name;
     result_.threads = solver_.threads;
@@ -111,7 +111,7 @@ void BatchRefiner::SolveChunk(const ScanRange& chunk, int next_begin, RefineRoun
     AddRefineRestFactors(config_.survey.rests, config_.survey.rest_sigma_v, chunk, &states_,
                          &problem);
   const RefineSolveReport r = SolveRefineProblem(
-      &problem, solver_.Options(config_.smoother.refine_solver_iterations), chunk, stop_, &states_);
+      &problem, solver_.Options(config_.refine.solver_iterations), chunk, stop_, &states_);
   if (!r.accepted) {
     ++report->solve_failures;
     result_.warnings.push_back("round " + std::to_string(report->round) + ": the solve of scans " +
@@ -151,7 +151,7 @@ bool BatchRefiner::RunRound(int round, RefineRound* out) {
   report.map_s = SecondsSince(t0);
   if (stopped()) return false;
   const std::vector<ScanRange> chunks =
-      MakeRefineChunks(sequence_.size(), config_.smoother.refine_chunk_scans);
+      MakeRefineChunks(sequence_.size(), config_.refine.chunk_scans);
   report.chunks = static_cast<int>(chunks.size());
   result_.stats.chunks = report.chunks;
   for (size_t c = 0; c < chunks.size(); ++c) {
@@ -241,7 +241,7 @@ StatusOr<RefineResult> BatchRefiner::Run(const RefineHooks& hooks) {
       if (Status s = hooks.on_state(State()); !s.ok()) return s;
   }
   const int first = hooks.resume != nullptr ? hooks.resume->rounds_done + 1 : 1;
-  for (int round = first; !result_.converged && round <= config_.smoother.refine_rounds; ++round) {
+  for (int round = first; !result_.converged && round <= config_.refine.rounds; ++round) {
     RefineRound r;
     if (StopRequested() || !RunRound(round, &r)) {
       result_.stopped = true;
@@ -272,7 +272,7 @@ StatusOr<RefineResult> Refine(const RefineConfig& config, RefineInput input,
                               const RefineHooks& hooks) {
   RefineConfig checked = config;
   for (Status s : {checked.imu.Validate(), checked.map.Validate(), checked.constraints.Validate(),
-                   checked.rv.Validate(), checked.degeneracy.Validate(), checked.smoother.Validate()})
+                   checked.rv.Validate(), checked.degeneracy.Validate(), checked.refine.Validate()})
     if (!s.ok()) return s;
   BatchRefiner refiner(config, std::move(input));
   return refiner.Run(hooks);

@@ -184,18 +184,18 @@ ScanFactors AssociateRefineScan(const RefineConfig& config, const RefineRoundMap
       AnalyzeRefineDegeneracy(config, states[k].T_world_imu(), w);
   // Huber weights at the association estimate (constraints/robust_kernel.h),
   // the reference planes' as the scans' own.
-  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->list);
-  ApplyHuberWeights(config.smoother.refine_huber_delta, &w->reference);
+  ApplyHuberWeights(config.refine.huber_delta, &w->list);
+  ApplyHuberWeights(config.refine.huber_delta, &w->reference);
   w->fixed.clear();
   w->attached.clear();
   if (!w->list.empty())
-    SplitScanConstraints(k, chunk, config.smoother.refine_plane_window, w->list, w->sources,
+    SplitScanConstraints(k, chunk, config.refine.plane_window, w->list, w->sources,
                          states, round.map_poses, &w->fixed, &w->attached);
   w->fixed.insert(w->fixed.end(), w->reference.begin(), w->reference.end());
   ScanFactors f;
   if (!w->fixed.empty() || !w->attached.empty())
     f = MakeScanFactors(*w, round.map_poses, config.T_imu_lidar, config.constraints.lidar_noise,
-                        config.smoother.refine_summarize_pairs, states[k].T_world_imu().t);
+                        config.refine.summarize_pairs, states[k].T_world_imu().t);
   f.degeneracy = degeneracy.report;
   f.has_degeneracy_prior = degeneracy.has_prior;
   f.degeneracy_sqrt_information = degeneracy.sqrt_information;

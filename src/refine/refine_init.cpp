@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "rvlio/imu/static_init.h"
+#include "rvlio/math/pose_interpolation.h"
 
 namespace rvlio {
 namespace {

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "rvlio/common/text.h"
+#include "rvlio/math/pose_interpolation.h"
 
 namespace rvlio {
 namespace {
@@ -103,14 +104,14 @@ StatusOr<RefineJobSpan> MakeRefineJobSpan(TimeNs t0_ns, TimeNs t1_ns, int chunk,
   if (t1_ns <= t0_ns)
     return Status::InvalidInput("the initial trajectory spans no time: it cannot be cut into chunks");
   if (!(overlap_s >= 0.0))
-    return Status::InvalidInput("smoother.refine_job_overlap_s must be >= 0");
+    return Status::InvalidInput("refine.job_overlap_s must be >= 0");
   const double length_s = NsToSeconds(t1_ns - t0_ns);
   const double core_s = length_s / count;
   if (count > 1 && core_s < overlap_s)
     return Status::InvalidInput("--of " + std::to_string(count) + ": chunks of " +
                                 FormatFixed(core_s, 3) + " s (" + FormatFixed(length_s, 3) +
                                 " s of initial trajectory) are shorter than their overlap "
-                                "smoother.refine_job_overlap_s = " +
+                                "refine.job_overlap_s = " +
                                 FormatFixed(overlap_s, 3) +
                                 " s; use fewer chunks or a "
                                 "shorter overlap");
@@ -131,9 +132,7 @@ StatusOr<RefineJobSpan> MakeRefineJobSpan(TimeNs t0_ns, TimeNs t1_ns, int chunk,
 }
 
 StampedPose BlendPoses(const StampedPose& a, const StampedPose& b, double w) {
-  StampedPose out = a;
-  out.p_world_imu = (1.0 - w) * a.p_world_imu + w * b.p_world_imu;
-  out.q_world_imu = a.q_world_imu.normalized().slerp(w, b.q_world_imu.normalized());
+  StampedPose out = InterpolateBetween(a, b, w);
   out.q_world_imu.normalize();
   return out;
 }
@@ -152,7 +151,7 @@ StatusOr<RefineJobMerge> MergeRefineJobs(const std::vector<RefineJobTrajectory>&
       return Status::InvalidInput(
           "chunks " + std::to_string(k) + " and " + std::to_string(k + 1) + " share " +
           std::to_string(shared.merged.size()) + " poses (need " +
-          std::to_string(kRefineJobMinSharedPoses) + "): a longer smoother.refine_job_overlap_s");
+          std::to_string(kRefineJobMinSharedPoses) + "): a longer refine.job_overlap_s");
     RefineJobAlignment a;
     a.chunk = static_cast<int>(k) + 1;
     a.T_merged_chunk = AlignShared(shared);

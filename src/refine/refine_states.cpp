@@ -6,20 +6,11 @@
 #include "rvlio/common/check.h"
 #include "rvlio/imu/pose_history.h"
 #include "rvlio/lidar/deskew.h"
+#include "rvlio/math/pose_interpolation.h"
 #include "rvlio/math/so3.h"
 
 namespace rvlio {
 namespace {
-
-Pose3 ToPose(const StampedPose& s) { return Pose3(s.q_world_imu, s.p_world_imu); }
-
-// Index of the first pose with t > t_ns.
-size_t UpperIndex(const Trajectory& trajectory, TimeNs t_ns) {
-  return static_cast<size_t>(
-      std::upper_bound(trajectory.begin(), trajectory.end(), t_ns,
-                       [](TimeNs t, const StampedPose& s) { return t < s.t_ns; }) -
-      trajectory.begin());
-}
 
 Eigen::Vector3d PositionAt(const Trajectory& trajectory, TimeNs t_ns) {
   Pose3 T;
@@ -29,22 +20,6 @@ Eigen::Vector3d PositionAt(const Trajectory& trajectory, TimeNs t_ns) {
 }
 
 }  // namespace
-
-bool InterpolatePose(const Trajectory& trajectory, TimeNs t_ns, Pose3* T_world_imu) {
-  RVLIO_CHECK(!trajectory.empty());
-  if (t_ns < trajectory.front().t_ns || t_ns > trajectory.back().t_ns) return false;
-  const size_t hi = UpperIndex(trajectory, t_ns);
-  if (hi == trajectory.size()) {  // t_ns == back
-    *T_world_imu = ToPose(trajectory.back());
-    return true;
-  }
-  const StampedPose& a = trajectory[hi - 1];
-  const StampedPose& b = trajectory[hi];
-  const double s = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
-  const Eigen::Quaterniond q = a.q_world_imu.normalized().slerp(s, b.q_world_imu.normalized());
-  *T_world_imu = Pose3(q, (1.0 - s) * a.p_world_imu + s * b.p_world_imu);
-  return true;
-}
 
 Eigen::Vector3d FiniteDifferenceVelocity(const Trajectory& trajectory, TimeNs t_ns,
                                          TimeNs half_window_ns) {

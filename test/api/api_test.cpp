@@ -13,7 +13,7 @@
 #include "rvlio/api.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
-#include "rvlio/odometry/scan_columns.h"
+#include "rvlio/outputs/scan_columns.h"
 
 namespace rvlio {
 namespace {
@@ -38,11 +38,11 @@ class ApiTest : public ::testing::Test {
   static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
 
   static RunArgs Run(const std::string& out_dir) {
-    StatusOr<OdometryOptions> config = LoadConfig({recording_.config_path}, {});
+    StatusOr<Configuration> config = LoadConfig({recording_.config_path}, {});
     EXPECT_TRUE(config.ok()) << config.status().message();
     RunArgs args;
     args.bag = recording_.bag_path;
-    args.options = config.ok() ? *config : OdometryOptions();
+    args.options = config.ok() ? *config : Configuration();
     args.out_dir = out_dir;
     return args;
   }
@@ -107,7 +107,7 @@ TEST_F(ApiTest, RunWithAndWithoutOutputFolderGivesTheSameTrajectory) {
   EXPECT_FALSE(summary["interrupted"].get<bool>());
   for (const char* f : {"map.pcd", "scans.csv"})
     EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << f;
-  // scans.csv has the columns of the table (odometry/scan_columns.h), in its order.
+  // scans.csv has the columns of the table (outputs/scan_columns.h), in its order.
   StatusOr<ScanTable> csv = ReadScanTable(out + "/scans.csv");
   ASSERT_TRUE(csv.ok()) << csv.status().message();
   std::vector<std::string> table_names;
@@ -215,7 +215,7 @@ TEST_F(ApiTest, RefineFromAnInMemoryTrajectory) {
   args.bag = recording_.bag_path;
   args.init = run->trajectory;
   args.options = Run("").options;
-  args.options.smoother.refine_rounds = 1;
+  args.options.refine.rounds = 1;
   args.out_dir = dir_ + "/refine";
   int rounds = 0;
   args.on_round = [&rounds](const RefineRound&) { ++rounds; };

@@ -162,7 +162,7 @@ TEST_F(BadConfigOutputTest, DiskFullDuringRefineLeavesTheEarlierRunIntact) {
     fs::copy_file(Clean(f), out + "/" + f);
   const ToolRun r = RunToolWith("refine --bag " + Bag() + " --config " + Sensors() + " --init " +
                                     Clean("trajectory.tum") +
-                                    " --set smoother.refine_rounds=1 --out " + out,
+                                    " --set refine.rounds=1 --out " + out,
                                 dir_, "", "", 20000);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(r.err.substr(r.err.find("rvlio refine: error")),

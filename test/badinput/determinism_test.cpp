@@ -56,7 +56,7 @@ TEST_F(DeterminismTest, RefineIsByteIdentical) {
   for (int i = 0; i < 2; ++i) {
     outs[i] = dir_ + "/refine_" + std::to_string(i);
     const ToolRun r = RunToolWith("refine --bag " + Bag() + " --config " + Sensors() + " --init " +
-                                      Clean("trajectory.tum") + " --set smoother.refine_rounds=2 --out " +
+                                      Clean("trajectory.tum") + " --set refine.rounds=2 --out " +
                                       outs[i],
                                   dir_, i == 0 ? "" : dir_, i == 0 ? "" : "OMP_NUM_THREADS=2");
     ASSERT_EQ(r.exit_code, 0) << r.err;

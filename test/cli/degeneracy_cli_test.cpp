@@ -147,7 +147,7 @@ TEST_F(DegeneracyCliTest, EveryMethodRunsInTheSmootherAndInRefine) {
 
     const std::string refine = dir_ + "/refine_" + method;
     const ToolRun r = RunTool("refine --bag " + data_ + ".bag --config " + data_ + ".yaml --init " +
-                                  base + "/trajectory.tum --set smoother.refine_rounds=2 " + sets +
+                                  base + "/trajectory.tum --set refine.rounds=2 " + sets +
                                   " --out " + refine,
                               dir_);
     ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -163,7 +163,7 @@ TEST_F(DegeneracyCliTest, EveryMethodRunsInTheSmootherAndInRefine) {
   // remap's project form in refine (degeneracy.remap_refine_form).
   const std::string projected = dir_ + "/refine_remap_project";
   const ToolRun p = RunTool("refine --bag " + data_ + ".bag --config " + data_ + ".yaml --init " +
-                                base + "/trajectory.tum --set smoother.refine_rounds=2 " +
+                                base + "/trajectory.tum --set refine.rounds=2 " +
                                 "--set degeneracy.method=remap --set degeneracy.remap_refine_form=project --out " +
                                 projected,
                             dir_);

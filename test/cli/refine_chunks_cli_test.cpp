@@ -25,7 +25,7 @@ using testing_cli::ToolRun;
 
 // Two rounds and a 3 s overlap keep the suite short: three chunks of a 14 s
 // tunnel (cores of ~4.3 s).
-const char* const kFast = " --set smoother.refine_rounds=2 --set smoother.refine_job_overlap_s=3";
+const char* const kFast = " --set refine.rounds=2 --set refine.job_overlap_s=3";
 
 class RefineChunksCliTest : public testing_cli::IeskfTunnelSuite {
  protected:
@@ -181,7 +181,7 @@ TEST_F(RefineChunksCliTest, BadChunkParametersAreExit2WithOneLine) {
       {Refine("--chunk 1" + out), "--chunk needs --of"},
       {Refine("--chunk one --of 3" + out), "--chunk one"},
       {Refine("--chunk 1 --of 10" + out), "shorter than their overlap"},
-      {Refine("--chunk 1 --of 200 --set smoother.refine_job_overlap_s=0" + out), "fewer than 10"},
+      {Refine("--chunk 1 --of 200 --set refine.job_overlap_s=0" + out), "fewer than 10"},
   };
   for (const auto& c : cases) {
     const ToolRun r = RunTool(c.args, dir_);
@@ -212,7 +212,7 @@ void RefineChunksCliTest::CheckBadMerges() {
 
   // A chunk refined with other options (one round) does not merge with the others.
   const std::string foreign = dir_ + "/foreign2";
-  ToolRun chunk = RunTool(Refine("--chunk 2 --of 3 --set smoother.refine_rounds=1 --out " + foreign), dir_);
+  ToolRun chunk = RunTool(Refine("--chunk 2 --of 3 --set refine.rounds=1 --out " + foreign), dir_);
   ASSERT_EQ(chunk.exit_code, 0) << chunk.err;
   r = RunTool("merge --out " + out + " --chunks " + ChunkDir(1) + " --chunks " + foreign +
                   " --chunks " + ChunkDir(3), dir_);

@@ -64,7 +64,7 @@ TEST_F(RefineCliTest, RefineFromAnIeskfRunLowersItsAteAndWritesTheOutputs) {
   EXPECT_GT(summary["scan_count"].get<int>(), 100);
   EXPECT_TRUE(summary["stats"]["gravity_from_static"].get<bool>());
   EXPECT_GT(summary["peak_memory_mb"].get<double>(), 1.0);
-  EXPECT_EQ(summary["config"]["smoother"]["refine_rounds"], 4);
+  EXPECT_EQ(summary["config"]["refine"]["rounds"], 4);
 
   const auto before = EvalJson(Truth(), Init(), dir_);
   const auto after = EvalJson(Truth(), out + "/trajectory.tum", dir_);
@@ -129,8 +129,8 @@ TEST_F(RefineCliTest, BadInputIsOneLineAndExitTwo) {
       {"refine --bag " + Bag() + " --init " + empty + cfg + out, empty},
       {"refine --bag " + Bag() + " --init " + garbled + cfg + out, garbled},
       {"refine --bag " + Bag() + cfg + out, "--init"},
-      {"refine --bag " + Bag() + " --init " + Init() + cfg + " --set smoother.refine_rounds=0" +
-           out, "smoother.refine_rounds"},
+      {"refine --bag " + Bag() + " --init " + Init() + cfg + " --set refine.rounds=0" +
+           out, "refine.rounds"},
       {"refine --bag " + Bag() + " --init " + Init() + cfg + " --out /proc/rvlio_cannot_write",
        "/proc/rvlio_cannot_write"},
   };

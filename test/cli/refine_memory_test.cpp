@@ -54,8 +54,8 @@ TEST(RefineMemory, PeakPerScanOfA400ScanRefineStaysBounded) {
                                   " --set backend=ieskf --quiet --out " + dir + "/ieskf", dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const long kib = PeakKib("refine --bag " + bag + " --init " + dir + "/ieskf/trajectory.tum" +
-                               " --config " + sensors + " --set smoother.refine_rounds=1" +
-                               " --set smoother.refine_threads=2 --out " + dir + "/refined",
+                               " --config " + sensors + " --set refine.rounds=1" +
+                               " --set refine.threads=2 --out " + dir + "/refined",
                            dir);
   ASSERT_GT(kib, 0) << ReadFile(dir + "/refine.err");
   const auto summary = nlohmann::json::parse(ReadFile(dir + "/refined/summary.json"));

@@ -75,7 +75,7 @@ TEST_F(SmootherCliTest, WritesTheOutputContractWithinTheAccuracyBound) {
 // [t_gap, t_gap + gap_s): the window bridges the gap with its weak
 // continuity prior, and the output stays finite and accurate.
 TEST_F(SmootherCliTest, AnImuGapInsideTheWindowIsBridged) {
-  StatusOr<OdometryOptions> options = LoadConfig({Sensors()}, {"backend=smoother"});
+  StatusOr<Configuration> options = LoadConfig({Sensors()}, {"backend=smoother"});
   ASSERT_TRUE(options.ok()) << options.status().message();
   StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(*options);
   ASSERT_TRUE(odo.ok()) << odo.status().message();

@@ -143,7 +143,7 @@ TEST_F(SurveyCoordinates, RefineHeldToTheShiftedMap) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = RunTool("refine --bag " + dir_ + "/sim/tunnel.bag --config " + dir_ + "/sim/tunnel.yaml" +
                   " --init " + run + "/trajectory.tum --map " + ShiftedMap() +
-                  " --set smoother.refine_rounds=2 --out " + refined,
+                  " --set refine.rounds=2 --out " + refined,
               dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const double ate = testing_cli::AteNoAlign(ShiftedTruth(), refined + "/trajectory.tum", dir_);

@@ -19,7 +19,7 @@
 #include "cli_util.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/math/pose_interpolation.h"
 
 namespace rvlio {
 namespace {
@@ -249,7 +249,7 @@ TEST_F(SurveyFlights, RefineMapInChunksMergesAndResumesOnlyWithItsMap) {
   const auto refine = [&](const std::string& map, const std::string& extra) {
     return RunTool("refine --bag " + dir_ + "/b/tunnel.bag --config " + dir_ +
                        "/b/tunnel.yaml --init " + init + " --map " + map +
-                       " --set smoother.refine_job_overlap_s=3 --set smoother.refine_rounds=2 " + extra,
+                       " --set refine.job_overlap_s=3 --set refine.rounds=2 " + extra,
                    dir_);
   };
   for (int k = 1; k <= 2; ++k) {
@@ -297,7 +297,7 @@ TEST_F(SurveyFlights, RefineMapInChunksMergesAndResumesOnlyWithItsMap) {
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/merged_other_map"));
 
   const std::string checkpoint = dir_ + "/checkpoint";
-  r = refine(Survey(), "--checkpoint " + checkpoint + " --set smoother.refine_rounds=1 --out " +
+  r = refine(Survey(), "--checkpoint " + checkpoint + " --set refine.rounds=1 --out " +
                            dir_ + "/round1");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = refine(short_map, "--resume " + checkpoint + " --out " + dir_ + "/resumed_other_map");

@@ -269,7 +269,7 @@ void CheckPlots(const std::string& out) {
 // reaches refine too.
 TEST_F(CompareTest, FullCompareWritesTablesEqualToEvalAndPlots) {
   const std::string out = dir_ + "/full";
-  const ToolRun full = RunTool(CompareArgs(out, "--set smoother.refine_rounds=2"), dir_);
+  const ToolRun full = RunTool(CompareArgs(out, "--set refine.rounds=2"), dir_);
   ASSERT_EQ(full.exit_code, 0) << full.err;
   CheckOutputs(out, full);
   CheckNumbersEqualEval(out, Truth(), dir_);
@@ -325,7 +325,7 @@ TEST_F(CompareTest, RefMapAddsMapColumnsInTheGroundTruthFrame) {
   const std::string ref = dir_ + "/ref_run";
   const ToolRun run = RunTool("refine --bag " + Bag() + " --config " + dir_ +
                                   "/data/tunnel.yaml --init " + Truth() +
-                                  " --set smoother.refine_rounds=1 --out " + ref,
+                                  " --set refine.rounds=1 --out " + ref,
                               dir_);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const std::string out = dir_ + "/with_map";

@@ -107,7 +107,7 @@ Opts RandomOptions(uint32_t seed) {
 }
 
 TEST(ConfigJson, ContainsEveryKeyWithItsValue) {
-  OdometryOptions o;
+  Configuration o;
   o.rv.eps0 = 0.42;
   o.imu.topic = "/x";
   o.extrinsics.imu_T_lidar.translation = {1.0, 2.0, 3.0};
@@ -134,7 +134,7 @@ TEST(ConfigJson, NonFiniteNumbersBecomeNull) {
 }
 
 TEST(ConfigDump, HasEveryKeyWithUnitsAndHelpAsComments) {
-  const std::string text = DumpYaml(OdometryOptions{});
+  const std::string text = DumpYaml(Configuration{});
   // Every key appears as "name:" under its section: count the leaf lines.
   size_t value_lines = 0;
   std::istringstream in(text);
@@ -142,7 +142,7 @@ TEST(ConfigDump, HasEveryKeyWithUnitsAndHelpAsComments) {
     const size_t colon = line.find(':');
     if (colon != std::string::npos && colon + 1 < line.size()) ++value_lines;
   }
-  EXPECT_EQ(value_lines, ListKeys(OdometryOptions{}).size());
+  EXPECT_EQ(value_lines, ListKeys(Configuration{}).size());
   EXPECT_NE(text.find("  min_range: 0.5"), std::string::npos) << text;
   EXPECT_NE(text.find("# [m] minimum point range"), std::string::npos) << text;
   EXPECT_NE(text.find("backend: ieskf"), std::string::npos);
@@ -181,9 +181,9 @@ TEST(ConfigDump, NonFiniteNumbersRoundTrip) {
 // random options (200 seeds each for the odometry and the toy struct).
 TEST(ConfigDump, RoundTripRestoresRandomOptionsExactly) {
   for (uint32_t seed = 1; seed <= 200; ++seed) {
-    const OdometryOptions original = RandomOptions<OdometryOptions>(seed);
+    const Configuration original = RandomOptions<Configuration>(seed);
     const std::string text = DumpYaml(original);
-    OdometryOptions back;
+    Configuration back;
     Status s = ApplyYamlText(back, text, "dump");
     ASSERT_TRUE(s.ok()) << "seed " << seed << ": " << s.message() << "\n" << text;
     ASSERT_EQ(ToJson(back), ToJson(original)) << "seed " << seed << "\n" << text;
@@ -218,12 +218,12 @@ TEST(ConfigDump, SimOptionsRoundTripAndLoad) {
 
 TEST(ConfigDump, RoundTripThroughAFileOfTheResolvedConfig) {
   TempDir dir;
-  StatusOr<OdometryOptions> r =
+  StatusOr<Configuration> r =
       LoadConfig({std::string(RVLIO_SOURCE_DIR) + "/config/paper_sim.yaml"},
                  {"extrinsics.imu_T_lidar.translation=[0.1,0,0.05]", "lidar.topic=/a b:#c"});
   ASSERT_TRUE(r.ok()) << r.status().message();
   const std::string path = dir.Write("resolved.yaml", DumpYaml(*r));
-  StatusOr<OdometryOptions> back = LoadConfig({path}, {});
+  StatusOr<Configuration> back = LoadConfig({path}, {});
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(ToJson(*back), ToJson(*r));
   EXPECT_EQ(back->lidar.topic, "/a b:#c");

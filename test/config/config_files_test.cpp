@@ -18,7 +18,7 @@ const std::string kConfigDir = std::string(RVLIO_SOURCE_DIR) + "/config";
 
 TEST(ConfigFiles, DefaultYamlListsEveryKnownKey) {
   const std::string path = kConfigDir + "/default.yaml";
-  OdometryOptions options;
+  Configuration options;
   ConfigSources sources;
   ASSERT_TRUE(ApplyYamlFile(options, path, &sources).ok());
   const std::vector<std::string> keys = ListKeys(options);
@@ -32,9 +32,9 @@ TEST(ConfigFiles, DefaultYamlListsEveryKnownKey) {
 }
 
 TEST(ConfigFiles, DefaultYamlValuesEqualTheBuiltInDefaults) {
-  StatusOr<OdometryOptions> loaded = LoadConfig({kConfigDir + "/default.yaml"}, {});
+  StatusOr<Configuration> loaded = LoadConfig({kConfigDir + "/default.yaml"}, {});
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
-  const OdometryOptions builtin;
+  const Configuration builtin;
   const nlohmann::json a = ToJson(*loaded), b = ToJson(builtin);
   for (const auto& key : ListKeys(builtin)) {
     std::string p = "/" + key;
@@ -44,12 +44,12 @@ TEST(ConfigFiles, DefaultYamlValuesEqualTheBuiltInDefaults) {
   }
   EXPECT_EQ(a, b);
   // And the built-in defaults themselves pass validation.
-  OdometryOptions copy = builtin;
+  Configuration copy = builtin;
   EXPECT_TRUE(copy.Validate().ok()) << copy.Validate().message();
 }
 
 TEST(ConfigFiles, PaperSimPresetHoldsThePaperValues) {
-  StatusOr<OdometryOptions> r = LoadConfig({kConfigDir + "/paper_sim.yaml"}, {});
+  StatusOr<Configuration> r = LoadConfig({kConfigDir + "/paper_sim.yaml"}, {});
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->rv.eps0, 0.510303);
   EXPECT_EQ(r->rv.eps1, 0.11303);
@@ -58,7 +58,7 @@ TEST(ConfigFiles, PaperSimPresetHoldsThePaperValues) {
 }
 
 TEST(ConfigFiles, PaperRealPresetHoldsThePaperValues) {
-  StatusOr<OdometryOptions> r = LoadConfig({kConfigDir + "/paper_real.yaml"}, {});
+  StatusOr<Configuration> r = LoadConfig({kConfigDir + "/paper_real.yaml"}, {});
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->rv.eps0, 0.290713);
   EXPECT_EQ(r->rv.eps1, 0.29071);
@@ -68,12 +68,12 @@ TEST(ConfigFiles, PaperRealPresetHoldsThePaperValues) {
 
 TEST(ConfigFiles, PresetsOverrideOnlyTheRvSection) {
   // A preset after a sensor file keeps the sensor's keys.
-  StatusOr<OdometryOptions> r =
+  StatusOr<Configuration> r =
       LoadConfig({kConfigDir + "/sensors/os0_32.yaml", kConfigDir + "/paper_real.yaml"}, {});
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->lidar.type, "ouster");
   EXPECT_EQ(r->rv.eps0, 0.290713);
-  nlohmann::json diff = nlohmann::json::diff(ToJson(OdometryOptions{}), ToJson(*r));
+  nlohmann::json diff = nlohmann::json::diff(ToJson(Configuration{}), ToJson(*r));
   for (const auto& op : diff) {
     const std::string path = op["path"];
     EXPECT_TRUE(path.rfind("/rv/", 0) == 0 || path.rfind("/lidar/", 0) == 0 ||
@@ -89,14 +89,14 @@ TEST(ConfigFiles, EveryShippedFileLoadsAndValidates) {
       if (e.path().extension() == ".yaml") files.push_back(e.path().string());
   ASSERT_GE(files.size(), 5u);  // default, two presets, at least two sensors
   for (const auto& f : files) {
-    StatusOr<OdometryOptions> r = LoadConfig({f}, {});
+    StatusOr<Configuration> r = LoadConfig({f}, {});
     EXPECT_TRUE(r.ok()) << f << ": " << r.status().message();
   }
 }
 
 TEST(ConfigFiles, SensorExamplesDescribeOusterSensors) {
   for (const char* name : {"os1_32.yaml", "os0_32.yaml"}) {
-    StatusOr<OdometryOptions> r = LoadConfig({kConfigDir + "/sensors/" + name}, {});
+    StatusOr<Configuration> r = LoadConfig({kConfigDir + "/sensors/" + name}, {});
     ASSERT_TRUE(r.ok()) << name << ": " << r.status().message();
     EXPECT_EQ(r->lidar.type, "ouster") << name;
     EXPECT_EQ(r->lidar.topic, "/os_cloud_node/points") << name;

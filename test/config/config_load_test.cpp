@@ -19,9 +19,9 @@ using test::ToyOptions;
 // Precedence and merging.
 
 TEST(ConfigLoad, NoFilesGivesBuiltInDefaults) {
-  StatusOr<OdometryOptions> r = LoadConfig({}, {});
+  StatusOr<Configuration> r = LoadConfig({}, {});
   ASSERT_TRUE(r.ok()) << r.status().message();
-  EXPECT_EQ(ToJson(*r), ToJson(OdometryOptions{}));
+  EXPECT_EQ(ToJson(*r), ToJson(Configuration{}));
 }
 
 TEST(ConfigLoad, LaterFileWinsAndPartialSectionsKeepOtherKeys) {
@@ -30,12 +30,12 @@ TEST(ConfigLoad, LaterFileWinsAndPartialSectionsKeepOtherKeys) {
       dir.Write("a.yaml", "rv:\n  eps0: 0.3\n  k0: 2.0\nlidar:\n  max_range: 50\n");
   const std::string b = dir.Write("b.yaml", "rv:\n  eps0: 0.4\n");
   ConfigSources sources;
-  StatusOr<OdometryOptions> r = LoadOptions<OdometryOptions>({a, b}, {}, &sources);
+  StatusOr<Configuration> r = LoadOptions<Configuration>({a, b}, {}, &sources);
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->rv.eps0, 0.4);  // b wins
   EXPECT_EQ(r->rv.k0, 2.0);    // only in a
   EXPECT_EQ(r->lidar.max_range, 50.0);
-  const OdometryOptions d;
+  const Configuration d;
   EXPECT_EQ(r->rv.eps1, d.rv.eps1);  // untouched keys keep defaults
   EXPECT_EQ(r->lidar.min_range, d.lidar.min_range);
   EXPECT_EQ(r->lidar.topic, d.lidar.topic);
@@ -44,7 +44,7 @@ TEST(ConfigLoad, LaterFileWinsAndPartialSectionsKeepOtherKeys) {
   EXPECT_EQ(sources.count("rv.eps1"), 0u);
 
   // The other order gives the other value.
-  StatusOr<OdometryOptions> r2 = LoadConfig({b, a}, {});
+  StatusOr<Configuration> r2 = LoadConfig({b, a}, {});
   ASSERT_TRUE(r2.ok());
   EXPECT_EQ(r2->rv.eps0, 0.3);
 }
@@ -53,7 +53,7 @@ TEST(ConfigLoad, SetWinsOverFilesAndLastSetWins) {
   TempDir dir;
   const std::string a = dir.Write("a.yaml", "rv: {eps0: 0.3, enabled: true}\nbackend: ieskf\n");
   ConfigSources sources;
-  StatusOr<OdometryOptions> r = LoadOptions<OdometryOptions>(
+  StatusOr<Configuration> r = LoadOptions<Configuration>(
       {a}, {"rv.eps0=0.45", "rv.enabled=false", "backend=smoother", "rv.eps0=0.6"}, &sources);
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->rv.eps0, 0.6);
@@ -73,7 +73,7 @@ TEST(ConfigLoad, NestedKeysAndArrays) {
                                   "      - 0\n"
                                   "      - 0.7071067811865476\n"
                                   "      - 0.7071067811865476\n");
-  StatusOr<OdometryOptions> r =
+  StatusOr<Configuration> r =
       LoadConfig({a}, {"extrinsics.imu_T_lidar.translation=[0.1,0,0.05]"});
   ASSERT_TRUE(r.ok()) << r.status().message();
   const auto& e = r->extrinsics.imu_T_lidar;
@@ -82,7 +82,7 @@ TEST(ConfigLoad, NestedKeysAndArrays) {
 }
 
 TEST(ConfigLoad, SetAcceptsAFlowMappingForASection) {
-  StatusOr<OdometryOptions> r = LoadConfig({}, {"rv={eps0: 0.35, k0: 3}"});
+  StatusOr<Configuration> r = LoadConfig({}, {"rv={eps0: 0.35, k0: 3}"});
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->rv.eps0, 0.35);
   EXPECT_EQ(r->rv.k0, 3.0);
@@ -93,27 +93,27 @@ TEST(ConfigLoad, EmptyFilesCommentsAndEmptySectionsChangeNothing) {
   const std::string empty = dir.Write("empty.yaml", "");
   const std::string comments = dir.Write("comments.yaml", "# nothing here\n\n");
   const std::string bare = dir.Write("bare.yaml", "rv:\nlidar:\n");
-  StatusOr<OdometryOptions> r = LoadConfig({empty, comments, bare}, {});
+  StatusOr<Configuration> r = LoadConfig({empty, comments, bare}, {});
   ASSERT_TRUE(r.ok()) << r.status().message();
-  EXPECT_EQ(ToJson(*r), ToJson(OdometryOptions{}));
+  EXPECT_EQ(ToJson(*r), ToJson(Configuration{}));
 }
 
 TEST(ConfigLoad, StringsKeepTheirTextAndQuotedValues) {
   TempDir dir;
   const std::string a =
       dir.Write("a.yaml", "lidar:\n  topic: \"/a b: c # d\"\nimu:\n  topic: 123\n");
-  StatusOr<OdometryOptions> r = LoadConfig({a}, {});
+  StatusOr<Configuration> r = LoadConfig({a}, {});
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->lidar.topic, "/a b: c # d");
   EXPECT_EQ(r->imu.topic, "123");  // a string key takes any scalar as text
-  StatusOr<OdometryOptions> s = LoadConfig({}, {"lidar.topic='x: y'", "imu.topic=/imu"});
+  StatusOr<Configuration> s = LoadConfig({}, {"lidar.topic='x: y'", "imu.topic=/imu"});
   ASSERT_TRUE(s.ok()) << s.status().message();
   EXPECT_EQ(s->lidar.topic, "x: y");
   EXPECT_EQ(s->imu.topic, "/imu");
 }
 
 TEST(ConfigLoad, NumbersInYamlSpellings) {
-  OdometryOptions o;
+  Configuration o;
   struct Case {
     const char* text;
     double value;
@@ -131,11 +131,11 @@ TEST(ConfigLoad, FailedApplyLeavesOptionsUntouched) {
   TempDir dir;
   // The first key is valid, the second is not: nothing may be applied.
   const std::string bad = dir.Write("bad.yaml", "rv:\n  eps0: 0.2\n  k0: abc\n");
-  OdometryOptions o;
+  Configuration o;
   EXPECT_FALSE(ApplyYamlFile(o, bad).ok());
-  EXPECT_EQ(ToJson(o), ToJson(OdometryOptions{}));
+  EXPECT_EQ(ToJson(o), ToJson(Configuration{}));
   EXPECT_FALSE(ApplyOverride(o, "rv={eps0: 0.2, nope: 1}").ok());
-  EXPECT_EQ(o.rv.eps0, OdometryOptions{}.rv.eps0);
+  EXPECT_EQ(o.rv.eps0, Configuration{}.rv.eps0);
 }
 
 // ---------------------------------------------------------------------------
@@ -228,7 +228,7 @@ TEST(ConfigErrors, IntegersRejectFractionsAndOtherText) {
   // Beyond the range of int: a type error, not a silent wrap-around.
   EXPECT_TRUE(IsConfigError(LoadConfig({}, {"rv.max_iterations=4294967297"}).status(),
                             {"rv.max_iterations in --set: expected an integer in [-2147483648"}));
-  StatusOr<OdometryOptions> r = LoadConfig({}, {"rv.max_iterations=+7"});
+  StatusOr<Configuration> r = LoadConfig({}, {"rv.max_iterations=+7"});
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->rv.max_iterations, 7);
 }
@@ -240,7 +240,7 @@ TEST(ConfigErrors, BoolsAcceptOnlyTrueAndFalse) {
         << bad;
   }
   for (const char* t : {"true", "True", "TRUE"}) {
-    StatusOr<OdometryOptions> r =
+    StatusOr<Configuration> r =
         LoadConfig({}, {"rv.repair=false", std::string("rv.repair=") + t});
     ASSERT_TRUE(r.ok()) << t;
     EXPECT_TRUE(r->rv.repair);

@@ -81,7 +81,7 @@ TEST_F(ControlCli, RunThenRefineWithMarksOrWallTargetsDeliversInTheSurveyFrame) 
   const testing_cli::ToolRun f =
       RunTool("refine --bag " + data_ + "/sg.bag --config " + data_ + "/sg.yaml --init " + run +
                   "/trajectory.tum --control " + data_ + "/sg_control.csv --out " + out +
-                  " --set smoother.refine_rounds=2",
+                  " --set refine.rounds=2",
               dir_);
   ASSERT_EQ(f.exit_code, 0) << f.err;
   EXPECT_NE(f.out.find("control points: 3"), std::string::npos) << f.out;
@@ -152,7 +152,7 @@ TEST_F(ControlCli, RunThenRefineWithMarksOrWallTargetsDeliversInTheSurveyFrame) 
   const testing_cli::ToolRun t =
       RunTool("refine --bag " + data_ + "/sg.bag --config " + data_ + "/sg.yaml --init " + run +
                   "/trajectory.tum --control " + dir_ + "/targets.csv --out " + tied +
-                  " --set smoother.refine_rounds=1",
+                  " --set refine.rounds=1",
               dir_);
   ASSERT_EQ(t.exit_code, 0) << t.err;
   EXPECT_LT(testing_cli::AteNoAlign(data_ + "/sg_gt_survey.tum", tied + "/trajectory.tum", dir_),
@@ -183,7 +183,7 @@ TEST_F(ControlCli, RunThenRefineWithMarksOrWallTargetsDeliversInTheSurveyFrame) 
         RunTool("refine --bag " + data_ + "/sg.bag --config " + data_ + "/sg.yaml --init " + run +
                     "/trajectory.tum --control " +
                     (frame == "utm" ? data_ + "/sg_control.csv" : dir_ + "/local.csv") + " --out " +
-                    dir_ + "/" + frame + " --set smoother.refine_rounds=1",
+                    dir_ + "/" + frame + " --set refine.rounds=1",
                 dir_);
     ASSERT_EQ(l.exit_code, 0) << l.err;
   }
@@ -288,7 +288,7 @@ TEST(ControlGnssCli, GnssAtBothPortalsWithAndWithoutControlPointsInside) {
     const std::string out = dir + (marks ? "/both" : "/gnss");
     const testing_cli::ToolRun f =
         RunTool("refine " + common + " --init " + dir + "/run/trajectory.tum --out " + out +
-                    " --set smoother.refine_rounds=1" +
+                    " --set refine.rounds=1" +
                     (marks ? " --control " + data + "/po_control.csv" : std::string()),
                 dir);
     ASSERT_EQ(f.exit_code, 0) << f.err;

@@ -42,7 +42,7 @@ std::string AliasExpansionYaml(int levels) {
 // fuzz/corpus/config/recursive_alias: the alias refers to the sequence that
 // contains it; converting the document recursed until the stack overflowed.
 TEST(ConfigFuzzRegress, RecursiveAliasIsAnErrorNotAStackOverflow) {
-  OdometryOptions options;
+  Configuration options;
   const Status s = ApplyYamlText(options, "a: &x [*x]\n", "loop.yaml");
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
@@ -50,7 +50,7 @@ TEST(ConfigFuzzRegress, RecursiveAliasIsAnErrorNotAStackOverflow) {
 }
 
 TEST(ConfigFuzzRegress, RecursiveAliasInSetOverrideIsAnError) {
-  OdometryOptions options;
+  Configuration options;
   const Status s = ApplyOverride(options, "rv.eps0=&x [*x]");
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
@@ -60,7 +60,7 @@ TEST(ConfigFuzzRegress, RecursiveAliasInSetOverrideIsAnError) {
 // fuzz/corpus/config/alias_expansion: exponentially expanding aliases made the
 // loader build 10^9 values (minutes of CPU, then out of memory).
 TEST(ConfigFuzzRegress, ExponentialAliasExpansionIsBounded) {
-  OdometryOptions options;
+  Configuration options;
   const Status s = ApplyYamlText(options, AliasExpansionYaml(9), "laughs.yaml");
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
@@ -72,7 +72,7 @@ TEST(ConfigFuzzRegress, ExponentialAliasExpansionIsBounded) {
 
 // The bounds leave ordinary anchors and aliases working.
 TEST(ConfigFuzzRegress, OrdinaryAliasesStillLoad) {
-  OdometryOptions options;
+  Configuration options;
   const Status s = ApplyYamlText(options,
                                  "lidar:\n  voxel_size: &v 0.7\nmap:\n  voxel_size: *v\n"
                                  "extrinsics:\n  imu_T_lidar:\n    translation: &t [0.1, 0.0, 0.05]\n",

@@ -49,7 +49,7 @@ TEST(MapLasCli, RunRefineAndMergeWriteMapLasWhenAsked) {
   ExpectLasMatchesPcd(dir + "/run", true);
 
   r = RunTool("refine " + input + " --init " + dir + "/run/trajectory.tum --chunk 1 --of 1 --out " +
-                  dir + "/chunk1 --set smoother.refine_rounds=1 --set output.las=true",
+                  dir + "/chunk1 --set refine.rounds=1 --set output.las=true",
               dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ExpectLasMatchesPcd(dir + "/chunk1", false);

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 using Stream = testing_ouster::Decoded;
 
-Stream ReadAll(const std::string& path, const OdometryOptions& o) {
+Stream ReadAll(const std::string& path, const Configuration& o) {
   return testing_ouster::ReadAll(path, o.lidar, o.imu);
 }
 
@@ -51,7 +51,7 @@ TEST(OusterSimTest, CaptureDecodesExactlyToTheBagOfTheSameSimulation) {
   ASSERT_TRUE(fs::exists(dir / "sim.json"));
   ASSERT_TRUE(fs::exists(dir / "sim.bag"));
   std::vector<std::string> warnings;
-  StatusOr<OdometryOptions> options = LoadConfig({(dir / "sim.yaml").string()}, {}, &warnings);
+  StatusOr<Configuration> options = LoadConfig({(dir / "sim.yaml").string()}, {}, &warnings);
   ASSERT_TRUE(options.ok()) << options.status().message();
 
   const Stream pcap = ReadAll((dir / "sim.pcap").string(), *options);

@@ -92,8 +92,8 @@ inline RefineConfig Config() {
   c.imu.gravity = 9.81;  // the closed-form motion's gravity; its start is not static
   c.rv.enabled = false;
   c.constraints.lidar_noise = 0.02;
-  c.smoother.refine_rounds = 6;
-  c.smoother.refine_threads = 2;
+  c.refine.rounds = 6;
+  c.refine.threads = 2;
   return c;
 }
 

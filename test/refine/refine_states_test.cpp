@@ -32,23 +32,6 @@ RefineState TrueState(TimeNs t, const Vector3d& bg, const Vector3d& ba) {
   return s;
 }
 
-TEST(RefineStates, InterpolatePoseIsExactAtStampsAndSlerpsBetween) {
-  Trajectory traj;
-  traj.push_back({1000, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity()});
-  traj.push_back({3000, Vector3d(2, -4, 6),
-                  Eigen::Quaterniond(Eigen::AngleAxisd(0.8, Vector3d(1, 2, 3).normalized()))});
-  Pose3 T;
-  ASSERT_TRUE(InterpolatePose(traj, 3000, &T));
-  EXPECT_LT((T.t - Vector3d(2, -4, 6)).norm(), 1e-12);
-  ASSERT_TRUE(InterpolatePose(traj, 1500, &T));
-  EXPECT_LT((T.t - Vector3d(0.5, -1, 1.5)).norm(), 1e-12);
-  const Vector3d w = so3::Log(T.R);
-  EXPECT_NEAR(w.norm(), 0.2, 1e-9);
-  EXPECT_LT((w.normalized() - Vector3d(1, 2, 3).normalized()).norm(), 1e-9);
-  EXPECT_FALSE(InterpolatePose(traj, 999, &T));
-  EXPECT_FALSE(InterpolatePose(traj, 3001, &T));
-}
-
 TEST(RefineStates, FiniteDifferenceVelocityFollowsTheMotion) {
   const TimeNs t0 = 1000000000, t1 = 5000000000;
   const Trajectory traj = SampleTruth(t0, t1, 10000000);  // 100 Hz

@@ -464,10 +464,10 @@ TEST(RefineProblem, VelocityAndBiasSolveRecoversTheVelocities) {
 
 TEST(RefineSteps, RefineIsBitIdenticalOnOneAndTwoThreads) {
   RefineConfig one = Config(), two = Config();
-  one.smoother.refine_rounds = two.smoother.refine_rounds = 2;
-  one.smoother.refine_chunk_scans = two.smoother.refine_chunk_scans = 10;
-  one.smoother.refine_threads = 1;
-  two.smoother.refine_threads = 2;
+  one.refine.rounds = two.refine.rounds = 2;
+  one.refine.chunk_scans = two.refine.chunk_scans = 10;
+  one.refine.threads = 1;
+  two.refine.threads = 2;
   StatusOr<RefineResult> a = Refine(one, MakeScene(16, 7).input);
   StatusOr<RefineResult> b = Refine(two, MakeScene(16, 7).input);
   ASSERT_TRUE(a.ok() && b.ok());

@@ -81,7 +81,7 @@ TEST(Refine, ChunksOfTenScansAlsoRecoverTheTruth) {
   Scene scene = MakeScene(30, 9, 0.3);
   const Errors before = Compare(scene.input.init, scene.truth);
   RefineConfig c = Config();
-  c.smoother.refine_chunk_scans = 10;
+  c.refine.chunk_scans = 10;
   StatusOr<RefineResult> r = Refine(c, std::move(scene.input));
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(r->rounds.front().chunks, 4);  // [0,10) [8,18) [16,26) [24,30)
@@ -96,7 +96,7 @@ TEST(Refine, ChunksOfTenScansAlsoRecoverTheTruth) {
 // the same rounds leave a clearly larger error on the drifting start.
 TEST(Refine, PlanesMovingWithTheirScansConvergeFasterThanAWorldFixedMap) {
   RefineConfig fixed_map = Config();
-  fixed_map.smoother.refine_plane_window = 0;
+  fixed_map.refine.plane_window = 0;
   Scene a = MakeScene(30, 5), b = MakeScene(30, 5);
   StatusOr<RefineResult> ra = Refine(fixed_map, std::move(a.input));
   StatusOr<RefineResult> rb = Refine(Config(), std::move(b.input));
@@ -106,15 +106,15 @@ TEST(Refine, PlanesMovingWithTheirScansConvergeFasterThanAWorldFixedMap) {
   EXPECT_LT(e_joint, 0.25 * e_fixed) << "fixed map " << e_fixed << ", joint " << e_joint;
 }
 
-// Summarized pair and world-plane factors (smoother.refine_summarize_pairs,
+// Summarized pair and world-plane factors (refine.summarize_pairs,
 // refine_pair_factor.h) have the exact factors' cost, gradient and
 // Gauss-Newton Hessian: the refined trajectories agree to rounding, far
 // below the error left.
 TEST(Refine, SummarizedFactorsAgreeWithExactFactors) {
   RefineConfig exact = Config(), summarized = Config();
-  exact.smoother.refine_summarize_pairs = false;
-  summarized.smoother.refine_summarize_pairs = true;
-  summarized.smoother.refine_chunk_scans = exact.smoother.refine_chunk_scans = 12;  // fixed planes too
+  exact.refine.summarize_pairs = false;
+  summarized.refine.summarize_pairs = true;
+  summarized.refine.chunk_scans = exact.refine.chunk_scans = 12;  // fixed planes too
   Scene a = MakeScene(30, 5), b = MakeScene(30, 5);
   StatusOr<RefineResult> ra = Refine(exact, std::move(a.input));
   StatusOr<RefineResult> rb = Refine(summarized, std::move(b.input));
@@ -168,7 +168,7 @@ TEST(Refine, BadInputIsInvalidInputWithAClearMessage) {
 // ends with the last completed round's result (what that many rounds give).
 TEST(Refine, ResumedFromARoundStateEqualsTheUninterruptedResult) {
   RefineConfig config = Config();
-  config.smoother.refine_rounds = 3;
+  config.refine.rounds = 3;
   std::vector<RefineRoundState> states;
   RefineHooks record;
   record.on_state = [&](const RefineRoundState& s) {
@@ -215,7 +215,7 @@ TEST(Refine, ResumedFromARoundStateEqualsTheUninterruptedResult) {
   ASSERT_TRUE(stopped.ok());
   EXPECT_TRUE(stopped->stopped);
   EXPECT_EQ(stopped->rounds.size(), 1u);
-  config.smoother.refine_rounds = 1;
+  config.refine.rounds = 1;
   StatusOr<RefineResult> one = Refine(config, MakeScene(12, 7).input);
   ASSERT_TRUE(one.ok());
   EXPECT_FALSE(one->stopped);

@@ -43,7 +43,7 @@ class RefineSignalsTest : public ::testing::Test {
   static std::string Sensors() { return dir_ + "/data/tunnel.yaml"; }
   static std::vector<std::string> ArgList(const std::string& out, int rounds) {
     return {"refine", "--bag", Bag(), "--init", dir_ + "/run/trajectory.tum", "--config",
-            Sensors(), "--set", "smoother.refine_rounds=" + std::to_string(rounds), "--out", out};
+            Sensors(), "--set", "refine.rounds=" + std::to_string(rounds), "--out", out};
   }
   static ToolRun Refine(const std::string& out, int rounds, const std::string& extra = "") {
     std::string args;

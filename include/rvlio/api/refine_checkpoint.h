@@ -4,7 +4,7 @@
 // with every double bit for bit, written atomically. A checkpoint carries the
 // fingerprint of what the refinement depends on (the input read from the bag,
 // the initial trajectory, the --map file's content and the configuration
-// except smoother.refine_rounds,
+// except refine.rounds,
 // so a resumed run may also go on for more rounds); resuming with another
 // input is refused.
 #include <cstdint>
@@ -21,17 +21,17 @@ namespace rvlio {
 constexpr const char* kCheckpointFile = "refine.checkpoint";
 
 // reference_hash: FileContentHash of the --map file (0 without one).
-uint64_t RefineFingerprint(const OdometryOptions& options, const RefineInput& input,
+uint64_t RefineFingerprint(const Configuration& options, const RefineInput& input,
                            uint64_t reference_hash);
 // FNV-1a 64 over a file's bytes and its size: the --map file's identity in a
 // checkpoint and in chunk.json (the content, so a map rewritten in place, or
 // another map at the same path, is another map). InvalidInput naming the file.
 StatusOr<uint64_t> FileContentHash(const std::string& path);
 // The same hash (FNV-1a 64) over the configuration alone (its JSON, except
-// smoother.refine_threads: refine's result is bit-identical on any thread
+// refine.threads: refine's result is bit-identical on any thread
 // count) and over a trajectory's stamps and poses: what chunk.json records so
 // that `rvlio merge` only merges chunks of one refinement (refine_jobs.h).
-uint64_t RefineOptionsHash(const OdometryOptions& options);
+uint64_t RefineOptionsHash(const Configuration& options);
 uint64_t TrajectoryHash(const Trajectory& trajectory);
 // A hash as chunk.json writes it: 16 lower-case hex digits.
 std::string HashText(uint64_t hash);

@@ -31,7 +31,7 @@
 #include "rvlio/imu/rest.h"
 #include "rvlio/math/local_origin.h"
 #include "rvlio/math/pose.h"
-#include "rvlio/odometry/options.h"
+#include "rvlio/config/configuration.h"
 #include "rvlio/refine/control.h"
 
 namespace rvlio {
@@ -50,7 +50,7 @@ class SurveyTies {
   // init_origin: of the local frame the --init trajectory is read into
   // (targets' map_x, map_y, map_z are in the --init frame).
   SurveyTies(std::string control_path, std::vector<ControlRow> rows, std::vector<SurveyFix> fixes,
-             const OdometryOptions& options, const LocalOrigin& init_origin = LocalOrigin());
+             const Configuration& options, const LocalOrigin& init_origin = LocalOrigin());
 
   bool active() const { return !rows_.empty() || !fixes_.empty(); }
   // The raw IMU samples and scans of the recording as they are read (scans
@@ -122,11 +122,11 @@ class SurveyTies {
 // is given. InvalidInput naming the file, line, topic or key.
 StatusOr<std::unique_ptr<SurveyTies>> OpenSurveyTies(const std::string& control_path,
                                                      const std::string& bag,
-                                                     const OdometryOptions& options,
+                                                     const Configuration& options,
                                                      const LocalOrigin& init_origin);
 // The recording's NavSatFix fixes (gnss.topic) in survey.crs.
 StatusOr<std::vector<SurveyFix>> ReadSurveyFixes(const std::string& bag,
-                                                 const OdometryOptions& options,
+                                                 const Configuration& options,
                                                  NavSatFixStats* stats);
 
 // summary.json "control": per role count, rms_m, rms_xyz_m, max_m, max_name.

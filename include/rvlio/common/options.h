@@ -119,6 +119,10 @@ template <class T, class = void>
 struct HasDeprecatedNames : std::false_type {};
 template <class T>
 struct HasDeprecatedNames<T, std::void_t<decltype(T::kDeprecatedNames)>> : std::true_type {};
+template <class T, class = void>
+struct HasMovedKeys : std::false_type {};
+template <class T>
+struct HasMovedKeys<T, std::void_t<decltype(T::kMovedKeys)>> : std::true_type {};
 
 }  // namespace options_detail
 
@@ -128,6 +132,17 @@ std::vector<DeprecatedName> DeprecatedNamesOf() {
   if constexpr (options_detail::HasDeprecatedNames<T>::value) {
     return std::vector<DeprecatedName>(std::begin(T::kDeprecatedNames),
                                        std::end(T::kDeprecatedNames));
+  } else {
+    return {};
+  }
+}
+
+// The keys of a root Options struct that moved to another section, as dotted
+// paths {"refine.rounds", "refine.rounds"} (kMovedKeys; empty for most).
+template <class T>
+std::vector<DeprecatedName> MovedKeysOf() {
+  if constexpr (options_detail::HasMovedKeys<T>::value) {
+    return std::vector<DeprecatedName>(std::begin(T::kMovedKeys), std::end(T::kMovedKeys));
   } else {
     return {};
   }

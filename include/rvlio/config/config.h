@@ -21,7 +21,7 @@
 
 #include "rvlio/common/options.h"
 #include "rvlio/common/status.h"
-#include "rvlio/odometry/options.h"
+#include "rvlio/config/configuration.h"
 
 namespace rvlio {
 
@@ -76,6 +76,12 @@ Status NotASection(const Node& n, const std::string& key, const std::string& whe
 // "WHERE: KEY = 'VALUE' is not one of A|B" (the message of a bad choice).
 Status NotOneOf(const std::string& key, const std::string& where, const std::string& value,
                 const std::vector<std::string>& choices);
+// Moves every key of `moved` that `root` gives under its former dotted name
+// ({"refine.rounds", "refine.rounds"}) to its new one, creating the
+// sections on the way; one DeprecationWarning each into *deprecations (may be
+// null). BothNames when the mapping gives both names.
+Status RelocateMovedKeys(Node* root, const std::vector<DeprecatedName>& moved,
+                         const std::string& source, std::vector<std::string>* deprecations);
 // A mapping that gives a key under both its deprecated and its new name.
 Status BothNames(const std::string& old_key, const std::string& new_key, const std::string& where);
 // "WHERE: OLD is deprecated, use NEW (the old name goes in the next release)".
@@ -322,8 +328,15 @@ Status ApplyNode(Opts& options, const Node& root, const std::string& source,
   Opts copy = options;
   ConfigSources new_sources;
   std::vector<std::string> new_deprecations;
-  ApplyVisitor v(root, "", source, known, &new_sources, DeprecatedNamesOf<Opts>(),
-                 &new_deprecations);
+  const std::vector<DeprecatedName> moved = MovedKeysOf<Opts>();
+  Node relocated;
+  if (!moved.empty()) {
+    relocated = root;
+    if (Status s = RelocateMovedKeys(&relocated, moved, source, &new_deprecations); !s.ok())
+      return s;
+  }
+  ApplyVisitor v(moved.empty() ? root : relocated, "", source, known, &new_sources,
+                 DeprecatedNamesOf<Opts>(), &new_deprecations);
   copy.Visit(v);
   Status s = v.Finish();
   if (!s.ok()) return s;
@@ -427,7 +440,7 @@ StatusOr<Opts> LoadOptions(const std::vector<std::string>& config_files,
 
 // The odometry configuration of `rvlio run`, `refine`, `compare`, `ablate`.
 // warnings (may be null): one line per deprecated key name used.
-StatusOr<OdometryOptions> LoadConfig(const std::vector<std::string>& config_files,
+StatusOr<Configuration> LoadConfig(const std::vector<std::string>& config_files,
                                      const std::vector<std::string>& set_overrides,
                                      std::vector<std::string>* warnings = nullptr);
 

@@ -1,7 +1,7 @@
 #pragma once
 // The robust kernel on point-to-plane residuals, shared by the sliding
 // window (smoother.sliding_window_huber_delta) and batch refinement
-// (smoother.refine_huber_delta).
+// (refine.huber_delta).
 //
 // Iteratively reweighted Huber: the gradient of the Huber cost of a residual
 // r equals that of the weighted square w r^2 / 2 with w = min(1, delta / |r|),

@@ -21,7 +21,7 @@ enum class LiveMiddleware { kRos1, kRos2 };
 
 struct LiveArgs {
   LiveMiddleware middleware = LiveMiddleware::kRos1;
-  OdometryOptions options;  // e.g. LoadConfig(files, overrides)
+  Configuration options;  // e.g. LoadConfig(files, overrides)
   std::string out_dir;      // as RunArgs::out_dir
   std::string map, initial_pose, initial_pose_tum;  // as RunArgs
   std::string node_name = "rvlio";  // ROS 1 node name (made unique)

@@ -1,6 +1,8 @@
 #pragma once
-// The whole configuration of a run: one section per module. This is what
-// `--config` files and `--set key=value` fill (config/config.h).
+// The options of the online odometry (rvlio::Odometry): one section per
+// module. The whole configuration that `--config` files and `--set
+// key=value` fill adds the sections the other layers read
+// (config/configuration.h).
 #include <string>
 #include <utility>
 
@@ -9,15 +11,11 @@
 #include "rvlio/degeneracy/options.h"
 #include "rvlio/ieskf/options.h"
 #include "rvlio/imu/options.h"
-#include "rvlio/formats/live_options.h"
-#include "rvlio/formats/reader_options.h"
 #include "rvlio/lidar/extrinsics.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/options.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/reference.h"
-#include "rvlio/outputs/output_options.h"
-#include "rvlio/refine/control_options.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/window/options.h"
 
@@ -45,12 +43,6 @@ struct OdometryOptions {
   SmootherOptions smoother;
   DivergenceOptions divergence;
   LocalizationOptions localization;  // used only with a reference map (`run --map`)
-  ReaderOptions io;
-  LiveOptions live;  // `rvlio live` only (docs/live.md)
-  OutputOptions output;  // optional output files (map.las)
-  SurveyOptions survey;  // the map frame's coordinate reference system
-  ControlOptions control;  // control and check points (`refine --control`, docs/control.md)
-  GnssOptions gnss;        // GNSS fixes of the recording (refine, docs/control.md)
 
   template <class V>
   void Visit(V& v) {
@@ -66,12 +58,6 @@ struct OdometryOptions {
     v.Section("smoother", smoother);
     v.Section("divergence", divergence);
     v.Section("localization", localization);
-    v.Section("io", io);
-    v.Section("live", live);
-    v.Section("output", output);
-    v.Section("survey", survey);
-    v.Section("control", control);
-    v.Section("gnss", gnss);
   }
 
   // Ranges and choices of every key, then the cross-field rules of each module.
@@ -80,8 +66,7 @@ struct OdometryOptions {
     if (!s.ok()) return s;
     for (Status m : {lidar.Validate(), imu.Validate(), extrinsics.Validate(), map.Validate(),
                      constraints.Validate(), rv.Validate(), degeneracy.Validate(), ieskf.Validate(), smoother.Validate(),
-                     divergence.Validate(), localization.Validate(), io.Validate(), live.Validate(),
-                     output.Validate(), survey.Validate(), control.Validate(), gnss.Validate()})
+                     divergence.Validate(), localization.Validate()})
       if (!m.ok()) return m;
     if (backend == Backend::kSmoother && lidar.estimate_time_offset && smoother.estimate_extrinsics)
       return Status::InvalidInput(

@@ -2,7 +2,7 @@
 // What a run writes besides its fixed outputs (config section `output`) and the
 // coordinate reference system of its map frame (config section `survey`):
 // map.las beside map.pcd in `run`, `refine` and `merge` (docs/outputs.md "map.las").
-// Plain option structs: the core holds them in OdometryOptions; the CRS is
+// Plain option structs of the Configuration (config/configuration.h); the CRS is
 // resolved (PROJ, formats/crs.h) in the I/O layer only.
 #include <string>
 

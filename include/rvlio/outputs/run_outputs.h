@@ -39,7 +39,7 @@ StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
 // A stamp in seconds with all nine decimals (the t column of the CSV files).
 std::string FormatSeconds(TimeNs t_ns);
 
-// scans.csv: one row per scan, the columns of odometry/scan_columns.h
+// scans.csv: one row per scan, the columns of outputs/scan_columns.h
 // (ScanColumnsOf(results)); `rss_mb[i]` is the process's resident memory (MB)
 // when scan i was done (nan where rss_mb has no entry).
 Status WriteScansCsv(const std::string& path, const std::vector<ScanResult>& results,

@@ -21,14 +21,14 @@
 // frame must be gravity-aligned, z up (docs/design.md "Conventions", which is what
 // `rvlio run` writes), and g_world = (0, 0, -imu.gravity).
 //
-// Each outer round (smoother.refine_rounds):
+// Each outer round (refine.rounds):
 //   Deskew   every scan with the current estimate (IMU integrated backwards
 //            from the scan-end state: refine_states.h);
 //   Map      one leave-one-out map of all scans' world points at the current
 //            estimates (refine_map.h): a scan never matches its own points;
 //   Associate every scan against the others' points (threads over scans);
 //   RV       per scan when rv.enabled (rv/rv.h: 1/K on SCVs, normal repair),
-//            then Huber IRLS weights (smoother.refine_huber_delta) folded into the
+//            then Huber IRLS weights (refine.huber_delta) folded into the
 //            constraint weights;
 //   Degeneracy per scan with degeneracy.method remap, localizability or
 //            regularized: the weak directions of its constraints at the
@@ -40,7 +40,7 @@
 //            current biases), and the scan's point-to-plane constraints: a
 //            plane fitted mostly to scan j's points moves with scan j
 //            (ScanPairPlaneFactor, refine_pair_factor.h) when j is in the
-//            chunk and |k - j| <= smoother.refine_plane_window, otherwise it
+//            chunk and |k - j| <= refine.plane_window, otherwise it
 //            is world-fixed (one PlaneFactor per scan, at the current estimate
 //            of its source scan). Attached planes make each round a joint
 //            optimization over the associations: with world-fixed planes only
@@ -50,10 +50,10 @@
 //            solver SPARSE_NORMAL_CHOLESKY with SuiteSparse CHOLMOD (Eigen's
 //            sparse Cholesky if Ceres lacks SuiteSparse;
 //            RefineResult::linear_solver says which);
-//            smoother.refine_solver_iterations LM iterations.
+//            refine.solver_iterations LM iterations.
 // Rounds stop early when no pose moved more than 0.5 mm / 0.005 deg.
 //
-// Long sequences: chunks of smoother.refine_chunk_scans scans overlapping by
+// Long sequences: chunks of refine.chunk_scans scans overlapping by
 // 10% (at least 2 scans); each chunk after the first holds its first pose at
 // the previous chunk's result. The map always spans the whole sequence.
 //
@@ -83,8 +83,8 @@
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/options.h"
-#include "rvlio/window/options.h"
 #include "rvlio/refine/control.h"
+#include "rvlio/refine/options.h"
 #include "rvlio/refine/refine_states.h"
 
 namespace rvlio {
@@ -99,7 +99,7 @@ struct RefineConfig {
   // round, a prior at the scan's initial (--init) pose along the weak
   // directions of its constraints (docs/degeneracy.md "Backends").
   DegeneracyOptions degeneracy;
-  SmootherOptions smoother;
+  RefineOptions refine;
   // A fixed reference map (`refine --map`, docs/survey.md), or null. Each
   // scan is then also associated with it every round (the same association
   // and Huber weights), its planes world-fixed, so the result is held to the

@@ -66,7 +66,7 @@ void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundM
 // The plane factors of one scan: world-fixed planes (PlaneFactor, or
 // PlaneSummaryFactor), and planes attached to their source scans
 // (refine_pair_factor.h: ScanPairPlaneFactor, or ScanPairSummaryFactor), one
-// factor per source. With smoother.refine_summarize_pairs a group of at
+// factor per source. With refine.summarize_pairs a group of at
 // least kRefineSummaryMinConstraints constraints becomes a summary: below,
 // the summary's fixed size (~3 KB with Ceres' Jacobian) exceeds the ~190 B
 // per constraint of the exact factor.

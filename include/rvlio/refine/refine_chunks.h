@@ -9,7 +9,7 @@
 
 namespace rvlio {
 
-// Overlap of consecutive chunks as a fraction of smoother.refine_chunk_scans
+// Overlap of consecutive chunks as a fraction of refine.chunk_scans
 // (at least kRefineMinChunkOverlap scans): enough shared scans for the next
 // chunk's held first pose to sit inside well-constrained states.
 constexpr double kRefineChunkOverlap = 0.1;

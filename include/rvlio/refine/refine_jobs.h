@@ -43,7 +43,7 @@ struct RefineJobSpan {
   bool Contains(TimeNs t_ns) const { return t_ns >= begin_ns && t_ns <= end_ns; }
 };
 
-// InvalidInput (naming --chunk / --of / smoother.refine_job_overlap_s) when
+// InvalidInput (naming --chunk / --of / refine.job_overlap_s) when
 // count < 1, chunk outside 1..count, t1 <= t0, overlap_s < 0, or a core
 // shorter than the overlap (the shared intervals of a chunk would overlap
 // each other).

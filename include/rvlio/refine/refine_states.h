@@ -25,11 +25,6 @@ struct RefineState {
   SpeedBiasBlock SpeedBias() const { return SpeedBiasBlock::FromArray(speed_bias.data()); }
 };
 
-// The pose of `trajectory` (sorted by time, non-empty) at t_ns: positions
-// linear and rotations slerped between the two poses around t_ns. False when
-// t_ns is outside [front, back].
-bool InterpolatePose(const Trajectory& trajectory, TimeNs t_ns, Pose3* T_world_imu);
-
 // Central difference of the trajectory's positions over [t - h, t + h],
 // clamped to the trajectory's span (m/s). Zero for a single pose.
 Eigen::Vector3d FiniteDifferenceVelocity(const Trajectory& trajectory, TimeNs t_ns,

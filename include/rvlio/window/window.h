@@ -114,7 +114,7 @@ class PlaneSummaryFactor;
 class PlaneTimeOffsetFactor;
 
 // The window's configuration: the option sections it reads, with the names
-// and types they have in the whole configuration (OdometryOptions), listed in
+// and types they have in the odometry's options (OdometryOptions), listed in
 // Visit so that the odometry fills them through the options reflection
 // (CopySections, common/options.h) and validation names their keys; plus the
 // gravity of the static initialization, which is not configuration.

@@ -1,4 +1,4 @@
-#include "rvlio/odometry/scan_columns.h"
+#include "rvlio/outputs/scan_columns.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// The per-scan column table (odometry/scan_columns.h): scans.csv and the
+// The per-scan column table (outputs/scan_columns.h): scans.csv and the
 // Python per-scan table are generated from it.
 #include <cmath>
 #include <set>
@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/odometry/scan_columns.h"
+#include "rvlio/outputs/scan_columns.h"
 
 namespace rvlio {
 namespace {
