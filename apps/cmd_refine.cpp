@@ -101,6 +101,7 @@ int CmdRefine(int argc, char** argv) {
                      "for `rvlio merge`"},
                     {"of", "N", "the number of chunks (with --chunk)"},
                     {"map", "REF", "reference map (PCD or PLY, metres) in the --init trajectory's frame: every scan is also held to it (docs/survey.md)"},
+                    {"control", "FILE", "control file (CSV: name,x,y,z[,role,sigma_m,t_start,t_end,map_x,map_y,map_z]): the trajectory is brought into the survey frame and tied to the control points; control.csv reports every row's residual (docs/control.md)"},
                     AllowDivergenceOption(),
                     StartOption(),
                     DurationOption()}};
@@ -114,6 +115,7 @@ int CmdRefine(int argc, char** argv) {
   req.args.init_path = args.Get("init");
   req.args.out_dir = args.Get("out");
   req.args.map = args.Get("map");
+  req.args.control = args.Get("control");
   req.config_files = args.GetAll("config");
   req.overrides = OverridesOf(args);
   req.allow_divergence = args.Has("allow-divergence");
@@ -122,6 +124,34 @@ int CmdRefine(int argc, char** argv) {
   RefineOutcome outcome;
   return RefineOnBag(std::move(req), &outcome);
 }
+
+namespace {
+
+// "control points: 3, RMS 0.004 m; check points: 2, RMS 0.011 m, largest 0.015 m (M4)".
+void PrintControl(std::FILE* out, const nlohmann::json& summary) {
+  if (!summary.contains("control")) return;
+  std::string line;
+  for (const char* role : {"control", "check"}) {
+    const nlohmann::json& j = summary["control"][role];
+    if (j.value("count", 0) == 0) continue;
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), "%s%s points: %d, RMS %.4f m, largest %.4f m (%s)",
+                  line.empty() ? "" : "; ", role, j["count"].get<int>(), j["rms_m"].get<double>(),
+                  j["max_m"].get<double>(), j["max_name"].get<std::string>().c_str());
+    line += buf;
+  }
+  const nlohmann::json& survey = summary["survey"];
+  if (survey.value("gnss_fixes", 0) > 0) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "%sGNSS fixes: %d (%d outliers left out)",
+                  line.empty() ? "" : "; ", survey["gnss_fixes"].get<int>(),
+                  survey["gnss_outliers"].get<int>());
+    line += buf;
+  }
+  if (!line.empty()) std::fprintf(out, "rvlio refine: %s\n", line.c_str());
+}
+
+}  // namespace
 
 int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
   const auto t0 = Clock::now();
@@ -177,6 +207,7 @@ int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
                refined.trajectory.size(), refined.rounds.size(),
                refined.converged ? " (converged)" : "", refined.linear_solver.c_str(),
                SecondsSince(t0), PeakMemoryMb(), req.out_dir.c_str());
+  PrintControl(out, result->summary);
   std::fflush(out);
   if (result->divergence.detected)
     return FinishDiverged("refine", result->divergence, req.out_dir, request.allow_divergence);

@@ -1,5 +1,7 @@
 #include <cstdio>
 
+#include "rvlio/formats/control_file.h"
+
 #include "commands.h"
 #include "common_options.h"
 #include "interrupt.h"
@@ -24,6 +26,7 @@ int CmdRun(int argc, char** argv) {
                     {"map", "REF", "reference map (PCD or PLY, metres): localize in it; outputs in its frame (docs/survey.md)"},
                     {"initial-pose", "X,Y,Z,R,P,Y", "with --map: IMU pose in the map's frame at the first scan (m, deg; R = Rz Ry Rx)"},
                     {"initial-pose-tum", "FILE", "with --map: initial pose from a TUM file (one line, or interpolated at the first scan)"},
+                    {"control", "FILE", "control file: checked, then left to `rvlio refine --control FILE` (the online backends do not use it; docs/control.md)"},
                     {"quiet", "", "no progress line"},
                     AllowDivergenceOption()}};
   Args args;
@@ -34,6 +37,18 @@ int CmdRun(int argc, char** argv) {
                  ReadWindow(),        args.Get("map"),
                  args.Get("initial-pose"), args.Get("initial-pose-tum")};
   if (std::string err = ParseWindow(args, &req.window); !err.empty()) return Fail("run", err);
+  if (args.Has("control")) {
+    // The online backends do not take control points (docs/control.md "Online
+    // backends"): the file is checked now, so that a bad one is found before
+    // the flight is processed, and refine ties the trajectory to it.
+    StatusOr<std::vector<ControlRow>> rows = ReadControlFile(args.Get("control"));
+    if (!rows.ok()) return Fail("run", rows.status());
+    std::fprintf(stderr,
+                 "rvlio run: note: --control is used by refine: this run's outputs stay in its own "
+                 "frame; tie them to the %zu control file rows with `rvlio refine --init "
+                 "OUT/trajectory.tum --control %s`\n",
+                 rows->size(), args.Get("control").c_str());
+  }
   RunOutcome outcome;
   InterruptScope interrupt_scope;  // SIGINT/SIGTERM: write what is done, exit 130/143
   const int rc = RunOdometryOnBag(req, &outcome);

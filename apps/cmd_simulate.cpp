@@ -10,6 +10,7 @@
 //                    (docs/degeneracy_truth.md; localizability.* keys)
 // Argument parsing and the summary line only: SimulateRecording (rvlio/api.h)
 // does the work.
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -60,6 +61,11 @@ CommandSpec SimulateSpec() {
            {"lidar-msg", "TYPE",
             "pointcloud2 (Ouster layout, default) or livox (livox_ros_driver/CustomMsg on "
             "/livox/lidar unless sim lidar.topic is --set)", false, false},
+           {"survey-frame", "E,N,h,YAW",
+            "the world frame in a survey frame (m, m, m, deg): marks.survey_frame; with "
+            "--set marks.enabled=true writes NAME_control.csv and NAME_gt_survey.tum "
+            "(docs/control.md)",
+            false, false},
            SetOption(),
            {"out", "DIR", "output directory (created if missing)", true, false},
            {"name", "NAME", "output file stem (default: the preset name)", false, false},
@@ -112,7 +118,13 @@ std::string ReadSimulateArgs(const Args& args, SimulateArgs* sim) {
   sim->reference_map = args.Has("reference-map");
   sim->reference_map_only = args.Has("reference-map-only");
   if (std::string err = ReadDurationOption(args, &sim->duration_s); !err.empty()) return err;
-  sim->overrides = args.GetAll("set");
+  if (args.Has("survey-frame")) {  // before --set: a --set of marks.survey_frame wins
+    const std::string f = args.Get("survey-frame");
+    if (std::count(f.begin(), f.end(), ',') != 3)
+      return "--survey-frame '" + f + "' is not E,N,h,yaw_deg";
+    sim->overrides.push_back("marks.survey_frame=[" + f + "]");
+  }
+  for (const std::string& set : args.GetAll("set")) sim->overrides.push_back(set);
   sim->out_dir = args.Get("out");
   sim->name = args.Get("name", sim->preset);
   sim->format = args.Get("format", "bag");
@@ -162,6 +174,9 @@ int SimulateOnDisk(SimulateArgs sim) {
       sim.name.c_str(), static_cast<long long>(r->scans), r->rows, r->cols,
       static_cast<long long>(r->imu_samples), r->duration_s, r->bag_path.c_str(), mb, r->wall_s,
       r->cpu_s);
+  if (!r->control_path.empty())
+    std::printf("rvlio simulate: stop-and-go marks -> %s; ground truth in the survey frame -> %s\n",
+                r->control_path.c_str(), r->gt_survey_path.c_str());
   if (!r->localizability_path.empty())
     std::printf("rvlio simulate: true localizability: %lld of %lld scans degenerate -> %s\n",
                 static_cast<long long>(r->degenerate_scans), static_cast<long long>(r->scans),

@@ -22,6 +22,7 @@ int CmdCalibrateTime(int argc, char** argv);
 int CmdDemo(int argc, char** argv);
 int CmdReport(int argc, char** argv);
 int CmdExport(int argc, char** argv);
+int CmdLive(int argc, char** argv);
 
 // `rvlio simulate`'s options (cmd_simulate.cpp), for demo too: --NAME (seed or
 // flight-seed) and --duration as written; "" or the error message (nothing set).

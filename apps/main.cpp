@@ -18,6 +18,8 @@ struct Subcommand {
 
 constexpr Subcommand kSubcommands[] = {
     {"run", "run the odometry (IESKF or smoother) on a ROS1 or ROS 2 bag", rvlio::cli::CmdRun},
+    {"live", "run the odometry on a ROS 1 or ROS 2 network and publish it (docs/live.md)",
+     rvlio::cli::CmdLive},
     {"refine", "offline batch refinement of a whole sequence from an initial trajectory",
      rvlio::cli::CmdRefine},
     {"merge", "merge the chunk jobs of `refine --chunk K --of N` into one trajectory and map",
@@ -52,7 +54,8 @@ void PrintHelp() {
   }
   std::cout << "\nexit status: 0 success, 2 bad input or configuration, 3 divergence detected\n"
                "(run, refine; outputs written), 1 internal failure, 130 / 143 stopped by\n"
-               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate, export)\n";
+               "SIGINT / SIGTERM (run, refine, compare, ablate, simulate, export; `live` ends\n"
+               "by them: outputs written, exit 0)\n";
 }
 
 }  // namespace

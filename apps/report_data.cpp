@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/formats/control_file.h"
 #include "rvlio/math/local_origin.h"
 #include "rvlio/version.h"
 
@@ -76,6 +78,44 @@ struct PageFrame {
 
 PageFrame FrameOf(const Trajectory& t) {
   return {NsToSeconds(t.front().t_ns), ChooseLocalOrigin(t)};
+}
+
+// control.csv of `refine --control` (docs/control.md): its table, numbers as
+// numbers, and the given positions (x, y relative to the page's origin) for
+// the top view. Null when it cannot be read (a note says so).
+json ControlJson(const std::string& path, const LocalOrigin& origin,
+                 std::vector<std::string>* notes) {
+  std::ifstream in(path, std::ios::binary);
+  StatusOr<std::vector<ControlResidual>> rows =
+      ParseControlCsv(std::string(std::istreambuf_iterator<char>(in), {}), path);
+  if (!rows.ok()) {
+    notes->push_back("control points not shown: " + rows.status().message());
+    return nullptr;
+  }
+  json table = {{"columns", {"name", "role", "kind", "dx_m", "dy_m", "dz_m", "d3d_m", "sigma_m",
+                             "x", "y", "z"}},
+                {"rows", json::array()}};
+  std::vector<float> xy;
+  json names = json::array(), roles = json::array();
+  for (const ControlResidual& r : *rows) {
+    const Eigen::Vector3d d = r.Residual();
+    json row = {r.row.name, ControlRoleName(r.row.role), r.kind};
+    for (int a = 0; a < 3; ++a) row.push_back(r.estimated ? json(d[a]) : json(nullptr));
+    row.push_back(r.estimated ? json(d.norm()) : json(nullptr));
+    row.push_back(r.sigma_m);
+    for (int a = 0; a < 3; ++a) row.push_back(r.row.p_survey[a]);
+    table["rows"].push_back(row);
+    const Eigen::Vector3d p = origin.ToLocal(r.row.p_survey);
+    xy.push_back(ToFloat(p.x()));
+    xy.push_back(ToFloat(p.y()));
+    names.push_back(r.row.name);
+    roles.push_back(ControlRoleName(r.row.role));
+  }
+  table["marks"] = {{"xy", ReportArray(xy)}, {"names", names}, {"roles", roles}};
+  table["caption"] = "From " + path +
+                     ": estimated minus given survey coordinates [m]; a check point's residual "
+                     "is the delivered accuracy (it never entered the solve).";
+  return table;
 }
 
 // ---------------------------------------------------------------------------
@@ -497,6 +537,9 @@ StatusOr<json> BuildReportModel(const std::string& dir, const ReportOptions& opt
   for (const RunEntry& r : c->runs)
     if (r.name == c->map_run && IsFile(r.dir + "/map.pcd"))
       model["cloud"] = CloudJson(r.name, r.dir + "/map.pcd", shown.origin, options, &c->notes);
+  for (const RunEntry& r : c->runs)
+    if (r.name == c->map_run && IsFile(r.dir + "/control.csv"))
+      model["control"] = ControlJson(r.dir + "/control.csv", shown.origin, &c->notes);
   model["notes"] = c->notes;
   return model;
 }

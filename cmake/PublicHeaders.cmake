@@ -31,6 +31,7 @@ set(rvlio_public_headers
   rvlio/eval/options.h
   rvlio/eval/stats.h
   rvlio/factors/parameter_blocks.h
+  rvlio/formats/live_options.h
   rvlio/formats/reader_options.h
   rvlio/formats/sensor_bag.h
   rvlio/formats/sensor_stream.h

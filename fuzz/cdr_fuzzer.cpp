@@ -5,10 +5,12 @@
 // DecodePointCloud2 with lidar.type auto as the reader does; 1
 // sensor_msgs/msg/Imu; 2 livox_ros_driver2/msg/CustomMsg, then
 // DecodeLivoxCustomMsg; 3
-// std_msgs/msg/String), the rest is the CDR payload (encapsulation header
-// first). Seeds (fuzz/corpus/cdr/) are real payloads: the first cloud and IMU
+// std_msgs/msg/String; 4 nav_msgs/msg/Odometry and 5 tf2_msgs/msg/TFMessage,
+// what `rvlio live` publishes), the rest is the CDR payload (encapsulation
+// header first). Seeds (fuzz/corpus/cdr/) are real payloads: the first cloud and IMU
 // message of a small `rvlio simulate --format db3` sequence, big-endian
-// re-encodings of them, a talker String of test/data/ros2_bags and a CustomMsg.
+// re-encodings of them, a talker String of test/data/ros2_bags, a CustomMsg,
+// and an Odometry and a TFMessage as `rvlio live` publishes them.
 //
 // Invariants: a failure is InvalidInput with a message; a decoded message
 // re-encodes (little endian) to a payload that decodes to the same values;
@@ -103,6 +105,29 @@ void FuzzString(const uint8_t* data, size_t size) {
   Require(back.ok() && *back == *text, "String round trip differs");
 }
 
+void FuzzOdometry(const uint8_t* data, size_t size) {
+  const auto odo = rvlio::cdr::DecodeOdometry(data, size, "/f");
+  if (!CheckError(odo)) return;
+  const std::vector<uint8_t> again = rvlio::cdr::EncodeOdometry(*odo);
+  const auto back = rvlio::cdr::DecodeOdometry(again.data(), again.size(), "/f");
+  Require(back.ok() && back->stamp_ns == odo->stamp_ns && back->frame_id == odo->frame_id &&
+              back->child_frame_id == odo->child_frame_id &&
+              std::memcmp(back->pose_covariance.data(), odo->pose_covariance.data(), 36 * 8) == 0,
+          "Odometry round trip differs");
+}
+
+void FuzzTf(const uint8_t* data, size_t size) {
+  const auto tf = rvlio::cdr::DecodeTfMessage(data, size, "/f");
+  if (!CheckError(tf)) return;
+  const std::vector<uint8_t> again = rvlio::cdr::EncodeTfMessage(*tf);
+  const auto back = rvlio::cdr::DecodeTfMessage(again.data(), again.size(), "/f");
+  Require(back.ok() && back->size() == tf->size(), "TFMessage round trip differs");
+  for (size_t i = 0; i < tf->size(); ++i)
+    Require((*back)[i].child_frame_id == (*tf)[i].child_frame_id &&
+                (*back)[i].stamp_ns == (*tf)[i].stamp_ns,
+            "TFMessage transform round trip differs");
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -110,11 +135,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // An exact-size copy, so that ASan sees any read past the payload.
   const std::vector<uint8_t> payload(data + 1, data + size);
   const uint8_t* p = payload.empty() ? nullptr : payload.data();
-  switch (data[0] % 4) {
+  switch (data[0] % 6) {
     case 0: FuzzCloud(p, payload.size()); break;
     case 1: FuzzImu(p, payload.size()); break;
     case 2: FuzzLivox(p, payload.size()); break;
-    default: FuzzString(p, payload.size()); break;
+    case 3: FuzzString(p, payload.size()); break;
+    case 4: FuzzOdometry(p, payload.size()); break;
+    default: FuzzTf(p, payload.size()); break;
   }
   return 0;
 }

@@ -15,6 +15,8 @@ packages=(
   python3-rosbag python3-matplotlib python3-yaml
   libtbb-dev pybind11-dev python3-dev python3-numpy
   libjs-three
+  libroscpp-dev libtopic-tools-dev libnav-msgs-dev libtf2-msgs-dev libdiagnostic-msgs-dev
+  cyclonedds-dev
 )
 # Extra packages the test command needs (Snakemake workflow test; clang with
 # the libFuzzer/ASan runtimes and llvm-symbolizer for scripts/fuzz.sh — gcc's
@@ -23,10 +25,12 @@ packages=(
 # GNU time for the peak memory of scripts/refine_scaling.sh; scipy for the
 # independent check of the map metrics in python/tests/test_evaluate_map.py;
 # chromium for the headless browser test of report.html; lld, the faster
-# linker the build uses when it is installed).
+# linker the build uses when it is installed; rosmaster for test/live).
 if [[ "${1:-}" == "--with-test-tools" ]]; then
   packages+=(python3-pytest python3-scipy snakemake clang-14 libclang-rt-14-dev llvm-14 munge slurmctld slurmd slurm-client)
   packages+=(time chromium lld)
+  # rosmaster for the live tests (test/live: `rvlio live --ros1` against a real master).
+  packages+=(python3-rosmaster)
 fi
 
 missing=()

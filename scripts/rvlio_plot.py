@@ -9,6 +9,8 @@ Usage:
                              [--yscale auto|linear|log]
   rvlio_plot.py compare-bars --table CSV --out PREFIX [--metric NAME ...]
   rvlio_plot.py deviation    --run DIR --out PREFIX [--title TEXT]
+  rvlio_plot.py control      --gt GT_SURVEY.tum [--run LABEL=DIR ...] [--run-origin LABEL=DIR ...]
+                             [--control CSV] --out PREFIX
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
 
 Inputs follow the run-directory contract of `rvlio run` (docs/design.md, "The command-line contract"):
@@ -826,6 +828,65 @@ def CmdDeviation(args):
   SaveFigure(fig, args.out, "deviation")
 
 
+def ReadControlCsv(path):
+  """control.csv of `refine --control` (or a control file): rows with name, role, x, y, z."""
+  header, rows = ReadCsvTable(path)
+  missing = [c for c in ("name", "x", "y", "z") if c not in header]
+  if missing:
+    raise PlotError("%s: missing column(s) %s" % (path, ", ".join(missing)))
+  return rows
+
+
+def CmdControl(args):
+  """Along-axis and height error against the survey-frame ground truth, over the
+  chainage, for runs in the survey frame (--run, no alignment) and runs in their
+  own frame (--run-origin, placed at the ground truth's first pose), with the marks."""
+  if not args.run and not args.run_origin:
+    raise PlotError("control: give at least one --run or --run-origin LABEL=DIR")
+  gt = ReadTum(args.gt)
+  axis = TunnelAxis(gt[1])
+  runs = []
+  for specs, align in ((args.run, "none"), (args.run_origin, "origin")):
+    for spec in specs:
+      label, path = ParseRunSpec(spec)
+      run = RunErrors(label, ReadTum(RunTrajectoryPath(path)), gt, align, args.max_dt, axis)
+      i_est, i_gt = Associate(run.t, gt[0], args.max_dt)
+      run.chainage = (gt[1][i_gt] - gt[1][0]) @ axis
+      run.height_error = run.p[i_est][:, 2] - gt[1][i_gt][:, 2]
+      runs.append(run)
+  for run in runs:
+    print(run.Describe() + ", at the far end %.4f m (height %.4f m)" %
+          (run.axis_error[-1], run.height_error[-1]))
+  marks = ReadControlCsv(args.control) if args.control else []
+  colors = [ColorCycle()[i % len(ColorCycle())] for i in range(len(runs))]
+  plt = Pyplot()
+  fig, (ax, ax_z) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+  cm = 100.0
+  for i, (run, color) in enumerate(zip(runs, colors)):
+    ax.plot(run.chainage, cm * run.axis_error, color=color, lw=RunWidth(i),
+            label="%s (far end %.1f cm)" % (run.label, cm * run.axis_error[-1]))
+    ax_z.plot(run.chainage, cm * run.height_error, color=color, lw=RunWidth(i), label=run.label)
+  origin = gt[1][0]
+  for k, m in enumerate(marks):
+    c = (np.array([ToFloat(m["x"]), ToFloat(m["y"]), ToFloat(m["z"])]) - origin) @ axis
+    check = m.get("role") == "check"
+    for a in (ax, ax_z):
+      a.axvline(c, color="0.5", lw=0.8, ls="--" if check else "-",
+                label=None if a is ax_z or k > 1 else None)
+    ax.annotate(m["name"] + (" (check)" if check else ""), (c, 1.0), xycoords=("data", "axes fraction"),
+                fontsize=7, ha="center", va="bottom")
+  for a, what in ((ax, "along-axis error [cm]"), (ax_z, "height error [cm]")):
+    a.axhline(0.0, color="black", lw=0.8)
+    a.set_ylabel(what)
+    a.grid(True, alpha=0.3)
+  ax.legend(loc="best", fontsize=8)
+  ax_z.set_xlabel("chainage along the tunnel axis [m] (marks: solid control, dashed check)")
+  fig.suptitle(args.title or "error in the survey frame against %s" % os.path.basename(args.gt),
+               fontsize=10)
+  fig.tight_layout()
+  SaveFigure(fig, args.out, "control")
+
+
 # --------------------------------------------------------------------------
 # Command line
 # --------------------------------------------------------------------------
@@ -879,6 +940,17 @@ def BuildParser():
   p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
   p.add_argument("--title", help="figure title (default: from summary.json)")
   p.set_defaults(func=CmdDeviation)
+  p = sub.add_parser("control", help="error in the survey frame over the chainage, with marks")
+  p.add_argument("--gt", required=True, help="ground truth in the survey frame (NAME_gt_survey.tum)")
+  p.add_argument("--run", action="append", default=[],
+                 help="LABEL=DIR in the survey frame (no alignment; repeatable)")
+  p.add_argument("--run-origin", action="append", default=[],
+                 help="LABEL=DIR in its own frame, placed at the ground truth's first pose")
+  p.add_argument("--control", help="control.csv (or the control file): the marks")
+  p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
+  p.add_argument("--max-dt", type=PositiveFloat, default=0.01, help="association [s]")
+  p.add_argument("--title", help="figure title")
+  p.set_defaults(func=CmdControl)
   p = sub.add_parser("check", help="exit 0 when matplotlib is usable")
   p.set_defaults(func=None)
   return parser

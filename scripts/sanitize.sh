@@ -64,10 +64,18 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # checked here by LasWriter.*); the LAS memory bounds measure a Release
 # build's peak, as the refine one does; MapLasCli runs run, refine and merge
 # end to end for the one call each makes to the LAS writer, which runs here in
-# LasExport.* and LasWriter.*. The
+# LasExport.* and LasWriter.*. The survey ties' end-to-end cases (ControlCli:
+# a 50 s stop-and-go flight run and refined twice; a 40 s flight through both
+# portals refined twice) run refine for a minute or more under ASan; their
+# math runs here in PositionFactor, FitYawTranslation, RestPeriods,
+# SurveyTies and ControlFile, and the bad control files in ControlCli's
+# bad-input case. The
 # survey-coordinates suite (SurveyCoordinates) runs a flight twice, a refine
 # and eval --map of a 590 k point survey; the local frame it checks runs here
-# in LocalOrigin, VoxelMap, ReferenceMap, MapMetrics and ReferenceMapFileTest.
+# in LocalOrigin, VoxelMap, ReferenceMap, MapMetrics and ReferenceMapFileTest. Live runs `rvlio live` against rosmaster,
+# rosbag and DDS in real time (about a minute of wall time whatever the
+# build); its queues, ordering and errors run here in LiveSensorSource.*,
+# the propagator in ImuPropagator.*, the output messages in CdrTest.*.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -117,6 +125,9 @@ ex=(
   Refine.SummarizedFactorsAgreeWithExactFactors
   'LasReaders\..*' LasWriter.MemoryStaysBoundedWhileMillionsOfPointsAreWritten
   LasExport.AMapOfMillionsOfPointsIsExportedInBoundedMemory MapLasCli.RunRefineAndMergeWriteMapLasWhenAsked
+  Live
+  ControlCli.RunThenRefineWithMarksOrWallTargetsDeliversInTheSurveyFrame
+  ControlCli.GnssAtBothPortalsWithAndWithoutControlPointsInside
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

@@ -80,6 +80,16 @@ var RvlioReport = (function () {
     }
     ctx.save(); ctx.beginPath(); ctx.rect(L, T, pw, ph); ctx.clip();
     series.forEach(function (s) {
+      if (s.markers) {  // points: a square (control) or a ring (check) each, with its label
+        for (var m = 0; m < s.x.length; m++) {
+          var mx = X(s.x[m]), my = Y(s.y[m]);
+          ctx.strokeStyle = s.color; ctx.fillStyle = s.color; ctx.lineWidth = 1.5; ctx.setLineDash([]);
+          if (s.hollow && s.hollow[m]) { ctx.beginPath(); ctx.arc(mx, my, 4.5, 0, 2 * Math.PI); ctx.stroke(); }
+          else ctx.fillRect(mx - 4, my - 4, 8, 8);
+          if (s.labels) { ctx.textAlign = "left"; ctx.fillText(s.labels[m], mx + 6, my - 6); }
+        }
+        return;
+      }
       ctx.strokeStyle = s.color; ctx.lineWidth = s.width || 1.5; ctx.setLineDash(s.dash || []);
       ctx.beginPath();
       var pen = false, lastY = 0;
@@ -167,8 +177,33 @@ var RvlioReport = (function () {
     document.getElementById("trajectory-caption").textContent = model.gt
       ? "Estimates aligned to the ground truth (" + model.gt.file + ") as rvlio eval aligns them. The top view scales its axes separately, so sideways error shows in a long tunnel."
       : "No ground truth: estimates in their own world frame; no along-axis error.";
+    if (model.control && model.control.marks) {
+      var xy = decode(model.control.marks.xy);
+      top.push({markers: true, color: "#c0392b", labels: model.control.marks.names,
+                hollow: model.control.marks.roles.map(function (r) { return r === "check"; }),
+                x: xy.filter(function (_, i) { return i % 2 === 0; }), y: xy.filter(function (_, i) { return i % 2 === 1; })});
+      var sc = el("span"); sc.appendChild(el("i", {style: "background:#c0392b"}));
+      sc.appendChild(document.createTextNode("control points (filled), check points (rings)"));
+      legend.appendChild(sc);
+    }
     linePlot(document.getElementById("topview"), top, {xlabel: "x [m]", ylabel: "y [m]"});
     linePlot(document.getElementById("axiserror"), axis, {xlabel: "t [s]", ylabel: "along-axis error [m]"});
+  }
+
+  // control.csv of a refine --control: one row per control or check point.
+  function drawControl(model) {
+    var section = document.getElementById("control-section");
+    if (!model.control) { section.style.display = "none"; return; }
+    document.getElementById("control-caption").textContent = model.control.caption;
+    var t = document.getElementById("control"), head = el("tr");
+    model.control.columns.forEach(function (c) { head.appendChild(el("th", {}, c)); });
+    t.appendChild(head);
+    var role = model.control.columns.indexOf("role");
+    model.control.rows.forEach(function (row) {
+      var tr = el("tr", {"class": String(row[role])});
+      row.forEach(function (v, i) { tr.appendChild(valueCell(v, model.control.columns[i])); });
+      t.appendChild(tr);
+    });
   }
 
   function drawScans(model) {
@@ -296,6 +331,7 @@ var RvlioReport = (function () {
     (model.notes || []).forEach(function (n) { notes.appendChild(el("li", {}, n)); });
     drawTable(model.table);
     drawTrajectories(model);
+    drawControl(model);
     drawScans(model);
     drawCloud(model);
     document.body.setAttribute("data-rvlio-ready", "1");

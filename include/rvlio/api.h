@@ -30,6 +30,7 @@
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/config/config.h"
+#include "rvlio/formats/control_file.h"
 #include "rvlio/formats/sensor_stream.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/odometry.h"
@@ -76,6 +77,16 @@ struct RunArgs {
   StopFn stop;
   // Called after every message read and once after the end of the input.
   std::function<void(const RunProgress&)> progress;
+  // A source to read instead of the recording `bag` (not owned), e.g. the
+  // network messages of `rvlio live` (formats/live_source.h): read as it
+  // is (`window` must be the default; no extrinsic from the recording);
+  // `bag` then only names it in summary.json.
+  SensorBagReader* source = nullptr;
+  // Called on the calling thread with each scan result as it is estimated
+  // (in order, once each), with the odometry that made it.
+  std::function<void(const ScanResult&, const Odometry&)> on_result;
+  // Called with summary.json before it is written (e.g. `live` adds its figures).
+  std::function<void(nlohmann::json* summary)> annotate_summary;
 };
 
 struct RunResult {
@@ -137,6 +148,11 @@ struct RefineArgs {
   // A reference map (PCD or PLY, metres) in the initial trajectory's frame:
   // every scan is also held to it (`refine --map`, docs/survey.md).
   std::string map;
+  // A control file (`refine --control`, docs/control.md): the initial
+  // trajectory is brought into the survey frame and refined with the control
+  // points as factors; outputs in the survey frame, out_dir also receives
+  // control.csv. GNSS fixes (options.gnss.topic) are ties as well.
+  std::string control;
 };
 
 struct RefineRunResult {
@@ -149,6 +165,9 @@ struct RefineRunResult {
   bool written = false;
   std::optional<RefineJobSpan> job;  // a chunk job's span (chunk.json; none otherwise)
   nlohmann::json chunk;         // chunk.json of a chunk job (null otherwise)
+  // With a control file: control.csv's text (the residual of every row) and
+  // its rows; empty otherwise.
+  std::string control_csv;
 };
 
 // Errors: unreadable inputs, a checkpoint that is missing or belongs to other
@@ -189,6 +208,10 @@ struct MergeResult {
   std::vector<MergedChunk> chunks;          // in order 1..N
   nlohmann::json summary;                   // summary.json
   std::vector<std::string> warnings;        // the chunks' warnings, each once
+  // Chunks refined with --control: the merged control.csv (each row from the
+  // chunk that owns its tie time, in the merged frame); empty otherwise.
+  std::string control_csv;
+  std::vector<ControlResidual> control;
   bool written = false;
 };
 
@@ -240,6 +263,10 @@ struct SimulateResult {
   // localizability.csv (the true per-scan localizability, sim/localizability.h)
   // when localizability.enabled, else ""; its scans flagged degenerate.
   std::string localizability_path;
+  // NAME_control.csv (marks.enabled: the stop-and-go marks in the survey
+  // frame) and NAME_gt_survey.tum (marks or gnss: the ground truth in the
+  // survey frame), else "".
+  std::string control_path, gt_survey_path;
   int64_t degenerate_scans = 0;
   double reference_map_s = 0.0;  // wall time of the survey
   int64_t scans = 0, imu_samples = 0;

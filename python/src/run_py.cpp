@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
+#include <string>
 
 #include "config_py.h"
 #include "odometry_py.h"
@@ -176,7 +178,32 @@ struct RefineOutput {
   bool converged = false;
   std::vector<std::string> warnings;
   bool written = false;
+  py::object control;  // control.csv as {column: list} (None without a control file)
 };
+
+// control.csv's text as a table {column: list}: name, role and kind as
+// strings, every other column as floats (NaN where empty).
+py::object ControlTable(const std::string& csv) {
+  if (csv.empty()) return py::none();
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  for (std::istringstream h(line); std::getline(h, line, ',');) names.push_back(line);
+  std::vector<py::list> columns(names.size());
+  for (std::string row; std::getline(in, row);) {
+    std::istringstream cells(row);
+    std::string cell;
+    for (size_t c = 0; c < names.size(); ++c) {
+      if (!std::getline(cells, cell, ',')) cell.clear();
+      if (c < 3) columns[c].append(cell);
+      else columns[c].append(cell.empty() ? std::nan("") : std::stod(cell));
+    }
+  }
+  py::dict table;
+  for (size_t c = 0; c < names.size(); ++c) table[py::str(names[c])] = columns[c];
+  return table;
+}
 
 // `chunk`/`of` of a chunk job (both None: the whole refine).
 void SetChunk(const py::handle& chunk, const py::handle& of, RefineArgs* args) {
@@ -192,7 +219,7 @@ void SetChunk(const py::handle& chunk, const py::handle& of, RefineArgs* args) {
 
 RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py::handle& config,
                     const py::handle& out, double start, double duration, const py::handle& chunk,
-                    const py::handle& of, const py::handle& map) {
+                    const py::handle& of, const py::handle& map, const py::handle& control) {
   const std::string bag = PathText(bag_obj);
   RequireExisting(bag, "recording");
   Config defaults;
@@ -203,6 +230,10 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   args.window = Window(start, duration);
   SetChunk(chunk, of, &args);
   if (!map.is_none()) args.map = PathText(map);
+  if (!control.is_none()) {
+    args.control = PathText(control);
+    RequireExisting(args.control, "control file");
+  }
   if (py::isinstance<RunOutput>(init)) {
     args.init = init.cast<const RunOutput&>().poses;
   } else if (py::isinstance<py::str>(init) || py::hasattr(init, "__fspath__")) {
@@ -223,6 +254,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   o.converged = r.refine.converged;
   o.warnings = r.refine.warnings;
   o.written = r.written;
+  o.control = ControlTable(r.control_csv);
   return o;
 }
 
@@ -311,7 +343,10 @@ void BindRun(py::module_& m) {
       .def_readonly("rounds", &RefineOutput::rounds, "one dict per round")
       .def_readonly("converged", &RefineOutput::converged)
       .def_readonly("warnings", &RefineOutput::warnings)
-      .def_readonly("written", &RefineOutput::written);
+      .def_readonly("written", &RefineOutput::written)
+      .def_readonly("control", &RefineOutput::control,
+                    "with control=: the quality report (control.csv) as {column: list}, "
+                    "e.g. pandas.DataFrame(result.control); None otherwise");
 
   py::class_<MergeOutput>(m, "MergeResult", "What rvlio.merge returns.")
       .def_readonly("trajectory", &MergeOutput::trajectory,
@@ -337,10 +372,12 @@ void BindRun(py::module_& m) {
   m.def("refine", &Refine, py::arg("bag"), py::arg("init"), py::arg("config") = py::none(),
         py::arg("out") = py::none(), py::kw_only(), py::arg("start") = 0.0,
         py::arg("duration") = 0.0, py::arg("chunk") = py::none(), py::arg("of") = py::none(),
-        py::arg("map") = py::none(),
+        py::arg("map") = py::none(), py::arg("control") = py::none(),
         "`rvlio refine`: offline batch refinement from `init` (a TUM path or an rvlio.run "
         "result). With `out`, writes trajectory.tum, map.pcd and summary.json there. "
         "map: a reference map (PCD/PLY) every scan is also held to (`refine --map`). "
+        "control: a control file (`refine --control`): outputs in the survey frame, "
+        "result.control the quality report. "
         "chunk=K, of=N: the chunk job `rvlio refine --chunk K --of N` (also writes chunk.json; "
         "join the N output folders with rvlio.merge).");
   m.def("merge", &Merge, py::arg("chunks"), py::arg("out") = py::none(), py::kw_only(),

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "rvlio/api.h"
+#include "rvlio/api/survey_ties.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/config/config.h"
 #include "rvlio/outputs/deviation_outputs.h"
@@ -38,6 +39,7 @@ struct ChunkFolder {
   RefineJobTrajectory job;
   std::vector<std::string> warnings;  // its summary.json "warnings"
   json config;                        // its summary.json "config" (the refinement's options)
+  std::string control_csv;            // its control.csv (refine --control), "" without
 };
 
 // The whole file ("" when it cannot be read: the JSON parse then says so).
@@ -121,6 +123,7 @@ StatusOr<ChunkFolder> ReadChunkFolder(const std::string& dir) {
     for (const json& w : summary["warnings"])
       if (w.is_string()) c.warnings.push_back(w.get<std::string>());
   if (summary.is_object() && summary.contains("config")) c.config = summary["config"];
+  c.control_csv = ReadFileText(FilePath(dir, "control.csv"));
   return c;
 }
 
@@ -226,6 +229,9 @@ Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), r.trajectory); !s.ok())
     return stage.Explain(s);
+  if (!r.control_csv.empty())
+    if (Status s = WriteFileAtomically(stage.Path("control.csv"), r.control_csv); !s.ok())
+      return stage.Explain(s);
   if (Status s = WriteMapOutputs(&stage, r.map_points, deviation, las); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
@@ -270,6 +276,32 @@ StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkF
 }
 
 }  // namespace
+
+// control.csv of chunks refined with --control (all or none of them): every
+// row's estimate from the chunk that owns its tie time, in the merged frame.
+Status MergeControl(const std::vector<ChunkFolder>& chunks, const RefineJobMerge& merge,
+                    const LocalOrigin& origin, MergeResult* r) {
+  const size_t with = std::count_if(chunks.begin(), chunks.end(),
+                                    [](const ChunkFolder& c) { return !c.control_csv.empty(); });
+  if (with == 0) return Status::Ok();
+  std::vector<ChunkControl> controls;
+  for (size_t k = 0; k < chunks.size(); ++k) {
+    const ChunkFolder& c = chunks[k];
+    const std::string path = FilePath(c.dir, "control.csv");
+    if (c.control_csv.empty())
+      return Status::InvalidInput(path + " is missing, but " + std::to_string(with) +
+                                  " chunk(s) were refined with --control: refine every chunk "
+                                  "with the same control file");
+    StatusOr<std::vector<ControlResidual>> rows = ParseControlCsv(c.control_csv, path);
+    if (!rows.ok()) return rows.status();
+    const Pose3 to_user(Eigen::Matrix3d::Identity(), origin.t_user_local);
+    controls.push_back({std::move(*rows), c.job.span.core_begin_ns, c.job.span.core_end_ns,
+                        to_user * merge.alignments[k].T_merged_chunk * to_user.Inverse()});
+  }
+  r->control = MergeChunkControl(controls);
+  r->control_csv = ControlCsvText(r->control);
+  return Status::Ok();
+}
 
 json MergedChunkJson(const MergedChunk& c) {
   return {{"chunk", c.chunk},
@@ -333,8 +365,10 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
                                     reference->options);
   origin.ToUser(&r.trajectory);
   origin.ToUser(&r.map_points);
+  if (Status s = MergeControl(chunks, *merge, origin, &r); !s.ok()) return s;
   r.summary = Summary(chunks, r);
   r.summary["local_origin"] = LocalOriginJson(origin);
+  if (!r.control_csv.empty()) r.summary["control"] = ControlSummaryJson(r.control);
   if (deviation) {
     r.summary["map"] = args.map;
     r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);

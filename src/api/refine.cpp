@@ -19,6 +19,7 @@
 #include "rvlio/outputs/deviation_outputs.h"
 #include "rvlio/formats/reference_map_file.h"
 #include "rvlio/api/refine_checkpoint.h"
+#include "rvlio/api/survey_ties.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/outputs/summary_json.h"
@@ -35,10 +36,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-RefineConfig ToRefineConfig(const Configuration& o,
-                            std::shared_ptr<const VoxelMap> reference) {
+RefineConfig ToRefineConfig(const Configuration& o, std::shared_ptr<const VoxelMap> reference,
+                            SurveyFactors survey) {
   RefineConfig c;
   c.reference = std::move(reference);
+  c.survey = std::move(survey);
   c.imu = o.imu;
   c.T_imu_lidar = ImuTLidar(o.extrinsics);
   c.map = o.map;
@@ -92,7 +94,7 @@ void CountScan(const Scan& scan, const Trajectory& init, ScansSeen* seen) {
 // Stops early (Ok, *stop_reason set) when `stop` says so.
 Status ReadBag(const RefineArgs& args, const RefineJobSpan* job, SensorBagReader* reader,
                RefineInput* input, int64_t* raw_points, ScansSeen* seen,
-               std::string* stop_reason) {
+               std::string* stop_reason, SurveyTies* survey) {
   ScanPreprocessor preprocessor(args.options.lidar);
   ImuSample imu;
   Scan scan;
@@ -103,6 +105,7 @@ Status ReadBag(const RefineArgs& args, const RefineJobSpan* job, SensorBagReader
     if (*m == SensorMessage::kEnd) return Status::Ok();
     if (*m == SensorMessage::kImu) {
       if (input->imu.empty()) static_end_ns = imu.t_ns + SecondsToNs(args.options.imu.init_duration);
+      if (survey != nullptr) survey->ObserveImu(imu);
       if (KeepImu(job, static_end_ns, imu.t_ns)) input->imu.push_back(imu);
       continue;
     }
@@ -114,6 +117,7 @@ Status ReadBag(const RefineArgs& args, const RefineJobSpan* job, SensorBagReader
       preprocessor.Downsample(scan, &small);
       if (static_cast<int>(small.points.size()) >= kMinScanPoints) seen->first_in_init = small;
     }
+    if (survey != nullptr && survey->NeedsScans()) survey->ObserveScan(scan, input->init);
     if (job != nullptr && !job->Contains(scan.t_end_ns)) continue;
     if (seen->chunk_first < 0) seen->chunk_first = seen->scans - 1;
     seen->chunk_last = seen->scans - 1;
@@ -270,6 +274,9 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
   if (!r.chunk.is_null())
     if (Status s = WriteFileAtomically(stage.Path("chunk.json"), JsonText(r.chunk) + "\n"); !s.ok())
       return stage.Explain(s);
+  if (!r.control_csv.empty())
+    if (Status s = WriteFileAtomically(stage.Path("control.csv"), r.control_csv); !s.ok())
+      return stage.Explain(s);
   if (Status s = WriteTum(stage.Path("trajectory.tum"), r.refine.trajectory); !s.ok())
     return stage.Explain(s);
   if (Status s = WriteMapOutputs(&stage, r.refine.map_points, deviation, las); !s.ok()) return s;
@@ -338,15 +345,17 @@ Status CheckMapFits(const RefineArgs& args, const Trajectory& init, const ScansS
 // The refinement with its hooks: rounds, checkpoints, the stop flag.
 // *checkpoint_s: wall time of the fingerprint and the checkpoint writes.
 // map_hash: FileContentHash of --map (0 without one).
+// inputs_hash: of --map and --control / the fixes (0 without them).
 StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input,
-                                       std::shared_ptr<const VoxelMap> reference, uint64_t map_hash,
+                                       std::shared_ptr<const VoxelMap> reference,
+                                       uint64_t inputs_hash, SurveyFactors survey,
                                        std::string* stop_reason, double* checkpoint_s) {
   RefineHooks hooks;
   hooks.on_round = args.on_round;
   hooks.stop = [&args, stop_reason] { return !(*stop_reason = StopReason(args)).empty(); };
   const bool checkpoints = !args.checkpoint_dir.empty();
   const auto t0 = Clock::now();
-  const uint64_t fingerprint = checkpoints ? RefineFingerprint(args.options, input, map_hash) : 0;
+  const uint64_t fingerprint = checkpoints ? RefineFingerprint(args.options, input, inputs_hash) : 0;
   *checkpoint_s = checkpoints ? SecondsSince(t0) : 0.0;
   if (checkpoints)
     hooks.on_state = [&args, fingerprint, checkpoint_s](const RefineRoundState& state) {
@@ -356,12 +365,14 @@ StatusOr<RefineResult> RefineWithHooks(const RefineArgs& args, RefineInput input
       return s;
     };
   if (!args.resume)
-    return Refine(ToRefineConfig(args.options, std::move(reference)), std::move(input), hooks);
+    return Refine(ToRefineConfig(args.options, std::move(reference), std::move(survey)),
+                  std::move(input), hooks);
   StatusOr<RefineRoundState> resume = ReadRefineCheckpoint(args.checkpoint_dir, fingerprint);
   if (!resume.ok()) return resume.status();
   hooks.resume = &*resume;
   if (args.on_resume) args.on_resume(resume->rounds_done);
-  return Refine(ToRefineConfig(args.options, std::move(reference)), std::move(input), hooks);
+  return Refine(ToRefineConfig(args.options, std::move(reference), std::move(survey)),
+                std::move(input), hooks);
 }
 
 // The checkpoint folder: one to resume from must hold a checkpoint; a new
@@ -424,6 +435,10 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     if (!hash.ok()) return Status::InvalidInput("--map " + hash.status().message());
     map_hash = *hash;
   }
+  StatusOr<std::unique_ptr<SurveyTies>> survey = OpenSurveyTies(args.control, args.bag, args.options, origin);
+  if (!survey.ok()) return survey.status();  // before anything is written
+  const uint64_t inputs_hash =  // the control file and the fixes are inputs of a checkpoint
+      *survey == nullptr ? map_hash : (map_hash * 1099511628211ULL) ^ (*survey)->ContentHash();
   if (Status s = PrepareCheckpointDir(args); !s.ok()) return s;
   StatusOr<std::unique_ptr<SensorBagReader>> reader = OpenSensorStream(
       args.bag, args.options.lidar, args.options.imu, args.window, args.options.io);
@@ -437,7 +452,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   int64_t raw_points = 0;
   ScansSeen seen;
   if (Status s = ReadBag(args, job ? &*job : nullptr, reader->get(), &input, &raw_points, &seen,
-                         &r.stop_reason);
+                         &r.stop_reason, survey->get());
       !s.ok())
     return s;
   if (!r.stop_reason.empty()) {  // stopped while reading: nothing refined or written
@@ -451,9 +466,13 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     if (Status s = CheckMapFits(args, input.init, seen, *reference, origin); !s.ok()) return s;
   Times times;
   times.read_s = SecondsSince(t0);
+  SurveyFactors ties;  // in the local survey frame, where refine then runs
+  if (*survey != nullptr)
+    if (Status s = (*survey)->Prepare(reference != nullptr, &origin, &input.init, &ties); !s.ok())
+      return s;
   StatusOr<RefineResult> refined =
-      RefineWithHooks(args, std::move(input), std::move(reference), map_hash, &r.stop_reason,
-                      &times.checkpoint_s);
+      RefineWithHooks(args, std::move(input), std::move(reference), inputs_hash, std::move(ties),
+                      &r.stop_reason, &times.checkpoint_s);
   if (!refined.ok()) {
     const std::string what =
         refined.status().message() + " (bag " + args.bag + ", init " + args.init_path + ")";
@@ -472,11 +491,13 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (surface != nullptr && !r.refine.trajectory.empty())
     deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
                                     args.options.localization.deviation);
+  if (*survey != nullptr) DeliverInSurveyFrame(survey->get(), &r);  // residuals, local frame
   origin.ToUser(&r.refine.trajectory);
   origin.ToUser(&r.refine.map_points);
   times.wall_s = SecondsSince(t0);
   r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
   r.summary["local_origin"] = LocalOriginJson(origin);
+  if (*survey != nullptr) AddSurveySummary(**survey, args.options.survey.crs, &r.summary);
   r.summary["truncated"] = (*reader)->truncated();
   r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
   if (job) r.summary["chunk"] = r.chunk;

@@ -211,11 +211,14 @@ std::string NoScanMessage(const std::string& bag, const OdometryOptions& o,
 
 // Appends the poses of the results not streamed yet to trajectory.partial.tum,
 // in the user's frame (the estimation's local frame plus `origin`, as
-// trajectory.tum); a write error stops the streaming with one warning (the
-// run goes on).
+// trajectory.tum), and hands them to `on_result` (in the local frame, as the
+// odometry it also hands over); a write error stops the streaming with one
+// warning (the run goes on).
 void StreamNewPoses(const std::vector<ScanResult>& results, const LocalOrigin& origin,
+                    const RunArgs& args, const Odometry& odo,
                     size_t* streamed, TumStream* stream, std::vector<std::string>* warnings) {
   for (; *streamed < results.size(); ++*streamed) {
+    if (args.on_result) args.on_result(results[*streamed], odo);
     if (!stream->is_open()) continue;
     StampedPose pose;
     pose.t_ns = results[*streamed].t_ns;
@@ -231,7 +234,7 @@ void StreamNewPoses(const std::vector<ScanResult>& results, const LocalOrigin& o
 class ProgressReporter {
  public:
   ProgressReporter(const RunArgs& args, Clock::time_point t0) : fn_(args.progress), t0_(t0) {
-    if (!fn_) return;
+    if (!fn_ || args.source != nullptr) return;  // a live source has no known span
     StatusOr<BagInfo> info = ReadBagSpan(args.bag);
     if (!info.ok()) return;
     const WindowSpan span = SpanOfWindow(info->start_s, info->end_s, args.window);
@@ -281,7 +284,7 @@ void Process(const RunArgs& args, const LocalOrigin& origin, SensorBagReader* re
     else odo->AddScan(std::move(scan));
     odo->Poll(&result->scans);
     if (!odo->status().ok()) return;  // the reference map did not fit: nothing is written
-    StreamNewPoses(result->scans, origin, &streamed, partial, stream_warnings);
+    StreamNewPoses(result->scans, origin, args, *odo, &streamed, partial, stream_warnings);
     (void)partial->SyncIfDue();  // a failure surfaces at the next Append
     if (result->rss_mb.size() < result->scans.size())
       result->rss_mb.resize(result->scans.size(), CurrentMemoryMb());
@@ -289,9 +292,20 @@ void Process(const RunArgs& args, const LocalOrigin& origin, SensorBagReader* re
   }
   if (!result->stopped) {
     odo->Finish(&result->scans);
+    StreamNewPoses(result->scans, args, *odo, &streamed, partial, stream_warnings);
     progress.Report(static_cast<int>(result->scans.size()), t, odo->divergence());
   }
   result->rss_mb.resize(result->scans.size(), CurrentMemoryMb());
+}
+
+// The recording `bag` (null when args.source is given: it is read instead).
+StatusOr<std::unique_ptr<SensorBagReader>> OpenReader(const RunArgs& args) {
+  if (args.source == nullptr)
+    return OpenSensorStream(args.bag, args.options.lidar, args.options.imu, args.window,
+                            args.options.io);
+  if (args.window.start_s != 0.0 || args.window.duration_s != 0.0)
+    return Status::InvalidInput("a time window (--start, --duration) needs a recording");
+  return std::unique_ptr<SensorBagReader>();
 }
 
 }  // namespace
@@ -299,10 +313,11 @@ void Process(const RunArgs& args, const LocalOrigin& origin, SensorBagReader* re
 StatusOr<RunResult> RunRecording(const RunArgs& in) {
   RunArgs args = in;  // an Ouster recording may supply the default extrinsic
   std::vector<std::string> notes;
-  if (Status s = ApplyRecordingExtrinsics(args.bag, args.options.lidar, &args.options.extrinsics,
-                                          &notes);
-      !s.ok())
-    return s;
+  if (args.source == nullptr)
+    if (Status s = ApplyRecordingExtrinsics(args.bag, args.options.lidar,
+                                            &args.options.extrinsics, &notes);
+        !s.ok())
+      return s;
   StatusOr<MapLasRequest> las = MapLasRequestOf(args.options.output, args.options.survey);
   if (!las.ok()) return las.status();  // an unknown survey.crs, before anything is read
   Localization localization;
@@ -322,10 +337,9 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   const LocalOrigin origin = localization.origin;
   StatusOr<std::unique_ptr<Odometry>> odo = Odometry::Create(args.options, std::move(localization));
   if (!odo.ok()) return odo.status();
-  StatusOr<std::unique_ptr<SensorBagReader>> reader =
-      OpenSensorStream(args.bag, args.options.lidar, args.options.imu, args.window,
-                       args.options.io);
-  if (!reader.ok()) return reader.status();
+  StatusOr<std::unique_ptr<SensorBagReader>> opened = OpenReader(args);
+  if (!opened.ok()) return opened.status();
+  SensorBagReader* reader = args.source != nullptr ? args.source : opened->get();
   const bool write = !args.out_dir.empty();
   OutputFolder out_folder(args.out_dir);  // removed again when nothing gets written
   if (write)
@@ -341,9 +355,9 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
         !s.ok())
       stream_warnings.push_back(s.message() + "; the partial trajectory is not written");
   const auto t0 = Clock::now();
-  Process(args, origin, reader->get(), odo->get(), &partial, &stream_warnings, &data, &result);
+  Process(args, origin, reader, odo->get(), &partial, &stream_warnings, &data, &result);
   data.wall_s = SecondsSince(t0);
-  data.truncated = (*reader)->truncated();
+  data.truncated = reader->truncated();
   if (!(*odo)->status().ok()) {  // nothing new in the output folder
     if (write) partial.Remove();
     std::string text = "--map " + args.map + ": " + (*odo)->status().message();
@@ -351,15 +365,15 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
     return Status::InvalidInput(text);
   }
 
-  const SensorReaderStats& reader_stats = (*reader)->stats();
+  const SensorReaderStats& reader_stats = reader->stats();
   result.warnings = notes;
   for (const auto& w : ReaderWarnings(reader_stats, args.options.lidar, args.options.imu))
     result.warnings.push_back(w);
   for (const auto& w : (*odo)->warnings()) result.warnings.push_back(w);
-  for (const auto& w : (*reader)->warnings()) result.warnings.push_back(w);
+  for (const auto& w : reader->warnings()) result.warnings.push_back(w);
   for (const auto& w : stream_warnings) result.warnings.push_back(w);
   result.divergence = (*odo)->divergence();
-  result.lidar_layout = (*reader)->lidar_layout();
+  result.lidar_layout = reader->lidar_layout();
   if (result.scans.empty()) {  // nothing to write: nothing new in the output folder
     if (write) partial.Remove();
     if (result.stopped) return result;
@@ -380,6 +394,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   result.summary = Summary(args, **odo, reader_stats, data, result);
   result.summary["local_origin"] = LocalOriginJson(origin);
   if (deviation) result.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  if (args.annotate_summary) args.annotate_summary(&result.summary);
   if (!write) return result;
   const Status written =
       WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr, *las);

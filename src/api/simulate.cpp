@@ -31,7 +31,10 @@
 #include "rvlio/formats/pcap.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/formats/crs.h"
+#include "rvlio/formats/navsatfix.h"
 #include "rvlio/sim/localizability.h"
+#include "rvlio/sim/marks.h"
 #include "rvlio/sim/presets.h"
 #include "rvlio/sim/simulator.h"
 
@@ -130,6 +133,14 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
     << FormatG(t[2], 10) << "]\n"
     << "    rotation_xyzw: [" << FormatG(q[0], 10) << ", " << FormatG(q[1], 10) << ", "
     << FormatG(q[2], 10) << ", " << FormatG(q[3], 10) << "]\n";
+  if (o.marks.enabled)  // the IMU stands world.start_height above a mark (sim/marks.h)
+    y << "control:\n  lever_arm: [0, 0, " << FormatG(o.world.start_height, 10) << "]\n";
+  if (o.gnss.enabled) {
+    const auto& l = o.gnss.lever_arm;
+    y << "gnss:\n  topic: " << o.gnss.topic << "\n  lever_arm: [" << FormatG(l[0], 10) << ", "
+      << FormatG(l[1], 10) << ", " << FormatG(l[2], 10) << "]\n"
+      << "survey:\n  crs: " << o.gnss.crs << "\n";
+  }
   // The resolved simulator options, as comments, so the sequence can be
   // reproduced (rvlio simulate --set KEY=VALUE for any of them).
   y << "\n# Simulator options of this sequence:\n";
@@ -142,17 +153,24 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
 // Streams the simulation into the bag; the first write error stops the run,
 // and so does `stop` (*stop_reason set). Either leaves no bag: the writer's
 // temporary file (path + ".tmp") is removed when the writer goes.
+// fixes: NavSatFix messages (gnss.enabled), each written before the first
+// IMU sample that is not older, so the recording stays in time order.
 Status WriteBag(const sim::Simulator& simulator, const std::string& path, bool livox,
                 const BagWriterOptions& format, const sim::Simulator::TruthCallback& on_truth,
-                const StopFn& stop, std::string* stop_reason) {
+                const std::vector<NavSatFix>& fixes, const StopFn& stop,
+                std::string* stop_reason) {
   StatusOr<std::unique_ptr<SensorBagWriter>> writer = SensorBagWriter::Create(path, format);
   if (!writer.ok()) return writer.status();
   const SimOptions& o = simulator.options();
   Status error;
   auto go_on = [&] { return error.ok() && (!stop || (*stop_reason = stop()).empty()); };
+  size_t next_fix = 0;
   simulator.Run(
       [&](const ImuSample& m) {
-        error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
+        for (; error.ok() && next_fix < fixes.size() && fixes[next_fix].header_stamp_ns <= m.t_ns;
+             ++next_fix)
+          error = (*writer)->WriteNavSatFix(o.gnss.topic, fixes[next_fix]);
+        if (error.ok()) error = (*writer)->WriteImu(o.imu.topic, o.imu.frame_id, m);
         return go_on();
       },
       [&](const Scan& scan, int rows, int cols) {
@@ -230,6 +248,68 @@ Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pc
   if (Status s = (*bag)->Close(); !s.ok()) return s;
   if (Status s = WriteFileAtomically(json_path, json); !s.ok()) return s;
   return pcap.Close();
+}
+
+// The fixes of gnss.enabled as NavSatFix messages: survey coordinates to
+// latitude, longitude and ellipsoidal height through PROJ (gnss.crs); the
+// covariance is the simulated noise's (diagonal known).
+StatusOr<std::vector<NavSatFix>> GnssMessages(const sim::Simulator& simulator) {
+  const SimGnssOptions& g = simulator.options().gnss;
+  std::vector<NavSatFix> out;
+  if (!g.enabled) return out;
+  StatusOr<GeodeticToCrs> crs = GeodeticToCrs::Create(g.crs);
+  if (!crs.ok()) return Status::InvalidInput("gnss.crs: " + crs.status().message());
+  for (const sim::SimFix& f : sim::SimulateFixes(simulator)) {
+    StatusOr<Eigen::Vector3d> llh = crs->Inverse(f.p_survey);
+    if (!llh.ok()) return Status::InvalidInput("gnss.crs '" + g.crs + "': " + llh.status().message());
+    NavSatFix m;
+    m.header_stamp_ns = f.t_ns;
+    m.frame_id = g.frame_id;
+    m.status = 2;  // GBAS (RTK)
+    m.latitude_deg = (*llh)[0];
+    m.longitude_deg = (*llh)[1];
+    m.altitude_m = (*llh)[2];
+    m.position_covariance = {};
+    m.position_covariance[0] = m.position_covariance[4] = std::pow(std::max(g.noise_m, 1e-4), 2);
+    m.position_covariance[8] = std::pow(std::max(g.noise_vertical_m, 1e-4), 2);
+    m.covariance_type = 2;  // diagonal known
+    out.push_back(m);
+  }
+  return out;
+}
+
+// NAME_control.csv (marks.enabled) and NAME_gt_survey.tum (marks or gnss).
+Status WriteSurveyFiles(const sim::Simulator& simulator, const std::string& name,
+                        OutputStage& stage, SimulateResult* r) {
+  const SimOptions& o = simulator.options();
+  if (o.marks.enabled) {
+    std::string csv = o.marks.times ? "name,x,y,z,role,t_start,t_end\n" : "name,x,y,z,role\n";
+    for (const sim::SimMark& m : sim::SimulateMarks(simulator)) {
+      csv += m.name + "," + FormatFixed(m.p_survey.x(), 4) + "," + FormatFixed(m.p_survey.y(), 4) +
+             "," + FormatFixed(m.p_survey.z(), 4) + "," + (m.check ? "check" : "control");
+      if (o.marks.times)
+        csv += "," + FormatFixed(NsToSeconds(m.t_start_ns), 3) + "," +
+               FormatFixed(NsToSeconds(m.t_end_ns), 3);
+      csv += "\n";
+    }
+    r->control_path = (std::filesystem::path(r->bag_path).parent_path() / (name + "_control.csv")).string();
+    if (Status s = WriteFileAtomically(stage.Path(name + "_control.csv"), csv); !s.ok())
+      return stage.Explain(s);
+  }
+  if (!o.marks.enabled && !o.gnss.enabled) return Status::Ok();
+  Trajectory gt = simulator.GroundTruth(kGroundTruthRate);
+  const Pose3 T_survey_world = sim::SurveyFromWorld(o.marks);
+  for (StampedPose& p : gt) {
+    const Pose3 T = T_survey_world * Pose3(p.q_world_imu, p.p_world_imu);
+    p.p_world_imu = T.t;
+    p.q_world_imu = T.quaternion();
+  }
+  r->gt_survey_path = (std::filesystem::path(r->bag_path).parent_path() / (name + "_gt_survey.tum")).string();
+  if (Status s = WriteTum(stage.Path(name + "_gt_survey.tum"), gt,
+                          "ground truth of '" + name + "' in the survey frame (marks.survey_frame)");
+      !s.ok())
+    return stage.Explain(s);
+  return Status::Ok();
 }
 
 std::string GroundTruthHeader(const SimOptions& o, const std::string& name) {
@@ -360,6 +440,10 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   r.bag_path = (dir / recording).string();
   const std::string staged_recording = stage.Path(recording);
   if (args.staged) args.staged(staged_recording);
+  StatusOr<std::vector<NavSatFix>> fixes = GnssMessages(**simulator);
+  if (!fixes.ok()) return fixes.status();
+  if (!fixes->empty() && args.format == "ouster-pcap")
+    return Status::InvalidInput("gnss.enabled: format ouster-pcap holds no NavSatFix messages");
   sim::LocalizabilityTruth truth(options.localizability, options.lidar);
   std::vector<sim::ScanLocalizability> localizability;
   sim::Simulator::TruthCallback on_truth;
@@ -371,7 +455,7 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
       args.format == "ouster-pcap"
           ? WriteOusterCapture(**simulator, staged_recording, stage.Path(name + ".json"),
                                stage.Path(name + ".bag"), on_truth, args.stop, &r.stop_reason)
-          : WriteBag(**simulator, staged_recording, livox, format, on_truth, args.stop,
+          : WriteBag(**simulator, staged_recording, livox, format, on_truth, *fixes, args.stop,
                      &r.stop_reason);
   if (!written.ok()) return stage.Explain(written);
   if ((r.stopped = !r.stop_reason.empty())) return r;
@@ -383,6 +467,7 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   if (Status s = WriteTum(stage.Path(name + "_gt.tum"), gt, GroundTruthHeader(options, name));
       !s.ok())
     return stage.Explain(s);
+  if (Status s = WriteSurveyFiles(**simulator, name, stage, &r); !s.ok()) return s;
   r.config_path = (dir / (name + ".yaml")).string();
   if (Status s = WriteFileAtomically(stage.Path(name + ".yaml"), yaml); !s.ok())
     return stage.Explain(s);

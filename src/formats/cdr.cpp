@@ -84,6 +84,19 @@ const std::string& ImuDefinition() {
   return def;
 }
 
+const std::string& NavSatFixDefinition() {
+  static const std::string def = WithDependencies(
+      "std_msgs/Header header\n"
+      "NavSatStatus status\n"
+      "float64 latitude\n"
+      "float64 longitude\n"
+      "float64 altitude\n"
+      "float64[9] position_covariance\n"
+      "uint8 position_covariance_type",
+      {kHeaderDef, kTimeDef, "MSG: sensor_msgs/NavSatStatus\nint8 status\nuint16 service"});
+  return def;
+}
+
 const std::string& LivoxCustomMsgDefinition() {
   static const std::string def = WithDependencies(
       "std_msgs/Header header\n"
@@ -427,6 +440,113 @@ std::vector<uint8_t> EncodeString(const std::string& text) {
   Writer w;
   w.String(text);
   return w.Take();
+}
+
+
+// ---------------------------------------------------------------------------
+// What `rvlio live` publishes (nav_messages.h), field by field as in the
+// public definitions of nav_msgs, geometry_msgs, tf2_msgs and diagnostic_msgs.
+// ---------------------------------------------------------------------------
+
+namespace {
+
+void WritePose(Writer* w, const PoseMessage& p) {
+  for (double v : p.position) w->F64(v);
+  for (double v : p.orientation_xyzw) w->F64(v);
+}
+
+Status ReadPose(Reader* r, PoseMessage* p) {
+  if (Status s = ReadDoubles(r, &p->position, "pose.position"); !s.ok()) return s;
+  return ReadDoubles(r, &p->orientation_xyzw, "pose.orientation");
+}
+
+void WriteTransform(Writer* w, const TransformMessage& t) {
+  w->Header(t.stamp_ns, t.frame_id);
+  w->String(t.child_frame_id);
+  for (double v : t.translation) w->F64(v);
+  for (double v : t.rotation_xyzw) w->F64(v);
+}
+
+}  // namespace
+
+std::vector<uint8_t> EncodeOdometry(const OdometryMessage& m) {
+  Writer w;
+  w.Header(m.stamp_ns, m.frame_id);
+  w.String(m.child_frame_id);
+  WritePose(&w, m.pose);
+  for (double v : m.pose_covariance) w.F64(v);
+  for (double v : m.linear_velocity) w.F64(v);
+  for (double v : m.angular_velocity) w.F64(v);
+  for (double v : m.twist_covariance) w.F64(v);
+  return w.Take();
+}
+
+std::vector<uint8_t> EncodeTfMessage(const std::vector<TransformMessage>& transforms) {
+  Writer w;
+  w.U32(static_cast<uint32_t>(transforms.size()));
+  for (const TransformMessage& t : transforms) WriteTransform(&w, t);
+  return w.Take();
+}
+
+std::vector<uint8_t> EncodePath(const PathMessage& m) {
+  Writer w;
+  w.Header(m.stamp_ns, m.frame_id);
+  w.U32(static_cast<uint32_t>(m.poses.size()));
+  for (const auto& [t_ns, pose] : m.poses) {
+    w.Header(t_ns, m.frame_id);
+    WritePose(&w, pose);
+  }
+  return w.Take();
+}
+
+std::vector<uint8_t> EncodeDiagnosticArray(const DiagnosticMessage& m) {
+  Writer w;
+  w.Header(m.stamp_ns, "");
+  w.U32(1);  // one DiagnosticStatus
+  w.U8(m.level);
+  w.String(m.name);
+  w.String(m.message);
+  w.String(m.hardware_id);
+  w.U32(static_cast<uint32_t>(m.values.size()));
+  for (const auto& [key, value] : m.values) {
+    w.String(key);
+    w.String(value);
+  }
+  return w.Take();
+}
+
+StatusOr<OdometryMessage> DecodeOdometry(const uint8_t* data, size_t size,
+                                         const std::string& topic) {
+  Reader r(data, size, Where(kOdometryType, topic));
+  OdometryMessage m;
+  Status s = r.Begin();
+  if (s.ok()) s = r.Header(&m.stamp_ns, &m.frame_id);
+  if (s.ok()) s = r.String(&m.child_frame_id, "child_frame_id");
+  if (s.ok()) s = ReadPose(&r, &m.pose);
+  if (s.ok()) s = ReadDoubles(&r, &m.pose_covariance, "pose.covariance");
+  if (s.ok()) s = ReadDoubles(&r, &m.linear_velocity, "twist.linear");
+  if (s.ok()) s = ReadDoubles(&r, &m.angular_velocity, "twist.angular");
+  if (s.ok()) s = ReadDoubles(&r, &m.twist_covariance, "twist.covariance");
+  if (!s.ok()) return s;
+  return m;
+}
+
+StatusOr<std::vector<TransformMessage>> DecodeTfMessage(const uint8_t* data, size_t size,
+                                                        const std::string& topic) {
+  Reader r(data, size, Where(kTfMessageType, topic));
+  uint32_t count = 0;
+  Status s = r.Begin();
+  // The smallest TransformStamped: stamp, empty frame and child, 7 doubles.
+  if (s.ok()) s = r.SequenceCount(&count, 8 + 5 + 5 + 7 * 8, "transforms");
+  std::vector<TransformMessage> out(s.ok() ? count : 0);
+  for (TransformMessage& t : out) {
+    if (s.ok()) s = r.Header(&t.stamp_ns, &t.frame_id);
+    if (s.ok()) s = r.String(&t.child_frame_id, "child_frame_id");
+    if (s.ok()) s = ReadDoubles(&r, &t.translation, "transform.translation");
+    if (s.ok()) s = ReadDoubles(&r, &t.rotation_xyzw, "transform.rotation");
+  }
+  if (!s.ok()) return s;
+  return out;
 }
 
 }  // namespace rvlio::cdr

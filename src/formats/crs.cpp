@@ -125,4 +125,16 @@ StatusOr<Eigen::Vector3d> GeodeticToCrs::Transform(double latitude_deg, double l
   return p;
 }
 
+StatusOr<Eigen::Vector3d> GeodeticToCrs::Inverse(const Eigen::Vector3d& p_crs) const {
+  const PJ_COORD in = proj_coord(p_crs.x(), p_crs.y(), p_crs.z(), HUGE_VAL);
+  proj_errno_reset(impl_->transform.get());
+  const PJ_COORD out = proj_trans(impl_->transform.get(), PJ_INV, in);
+  const Eigen::Vector3d lat_lon_h(out.xyz.y, out.xyz.x, out.xyz.z);
+  if (proj_errno(impl_->transform.get()) != 0 || !lat_lon_h.allFinite())
+    return Status::InvalidInput("cannot transform (" + std::to_string(p_crs.x()) + ", " +
+                                std::to_string(p_crs.y()) + ") to latitude, longitude (" +
+                                Reason(impl_->ctx.get(), "outside the CRS's area") + ")");
+  return lat_lon_h;
+}
+
 }  // namespace rvlio

@@ -12,6 +12,10 @@
 
 namespace rvlio::bag_detail {
 
+// The ROS1 names of the two types.
+inline constexpr const char* kPointCloud2Type = "sensor_msgs/PointCloud2";
+inline constexpr const char* kImuType = "sensor_msgs/Imu";
+
 // The md5 sums ROS1 bags carry for the two types (the connection header's
 // md5sum): a message under another md5 has another layout.
 inline constexpr const char* kPointCloud2Md5 = "1158d486dd51d683ce2f1be655c3c181";

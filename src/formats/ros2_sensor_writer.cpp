@@ -253,6 +253,13 @@ class Ros2SensorWriter final : public SensorBagWriter {
     return Write(topic, cdr::kImuType, cdr::ImuDefinition(), sample.t_ns, cdr::EncodeImu(msg));
   }
 
+  Status WriteNavSatFix(const std::string& topic, const NavSatFix& fix) override {
+    if (!storage_) return Closed();
+    if (Status s = CheckRos2Stamp(fix.header_stamp_ns, "NavSatFix stamp"); !s.ok()) return s;
+    return Write(topic, kNavSatFixRos2Type, cdr::NavSatFixDefinition(), fix.header_stamp_ns,
+                 EncodeNavSatFixCdr(fix));
+  }
+
   Status Close() override {
     if (!storage_) return Closed();
     Status s = storage_->Close();

@@ -13,12 +13,10 @@
 #include "rvlio/common/status.h"
 #include "rvlio/common/time.h"
 #include "rvlio/formats/pointcloud2.h"
+#include "ros1_messages.h"  // kPointCloud2Type, kImuType
 #include "sensor_reader_common.h"
 
 namespace rvlio::bag_detail {
-
-inline constexpr const char* kPointCloud2Type = "sensor_msgs/PointCloud2";
-inline constexpr const char* kImuType = "sensor_msgs/Imu";
 
 // Opens `path` for reading; InvalidInput naming the path when it is missing,
 // not a bag, or truncated.

@@ -10,6 +10,7 @@
 
 #include <rosbag/bag.h>
 #include <sensor_msgs/Imu.h>
+#include <sensor_msgs/NavSatFix.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/PointField.h>
 
@@ -123,6 +124,22 @@ class RosbagSensorWriter final : public SensorBagWriter {
     msg.linear_acceleration.y = sample.acc_imu.y();
     msg.linear_acceleration.z = sample.acc_imu.z();
     return Write(topic, bag_detail::RecordTime(sample.t_ns), msg);
+  }
+
+  Status WriteNavSatFix(const std::string& topic, const NavSatFix& fix) override {
+    if (!open_) return Status::Internal("bag '" + path_ + "' is already closed");
+    if (Status s = CheckRosStamp(fix.header_stamp_ns, "NavSatFix stamp"); !s.ok()) return s;
+    sensor_msgs::NavSatFix msg;
+    msg.header.stamp.fromNSec(static_cast<uint64_t>(fix.header_stamp_ns));
+    msg.header.frame_id = fix.frame_id;
+    msg.status.status = fix.status;
+    msg.status.service = fix.service;
+    msg.latitude = fix.latitude_deg;
+    msg.longitude = fix.longitude_deg;
+    msg.altitude = fix.altitude_m;
+    for (int i = 0; i < 9; ++i) msg.position_covariance[i] = fix.position_covariance[i];
+    msg.position_covariance_type = fix.covariance_type;
+    return Write(topic, bag_detail::RecordTime(fix.header_stamp_ns), msg);
   }
 
   Status Close() override {

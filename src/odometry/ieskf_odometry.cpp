@@ -26,6 +26,21 @@ DivergenceOptions MonitorOptions(const OdometryOptions& options) {
   return divergence;
 }
 
+// Biases, gravity and the pose covariance for the IMU-rate output. The
+// filter's rotation error is a right perturbation (R = R_hat Exp(d)); about
+// the world axes it is R_hat d, so the covariance's rotation rows turn by R_hat.
+void SetPropagationState(const Ieskf& filter, ScanResult* r) {
+  const FilterState& x = filter.state();
+  r->bg_imu = x.bg;
+  r->ba_imu = x.ba;
+  r->g_world = x.g_world;
+  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+  J.block<3, 3>(0, FilterState::kPos) = Eigen::Matrix3d::Identity();
+  J.block<3, 3>(3, FilterState::kRot) = x.R_world_imu;
+  const Eigen::Matrix<double, 6, 6> P = filter.covariance().topLeftCorner<6, 6>();
+  r->pose_covariance_world = J * P * J.transpose();
+}
+
 }  // namespace
 
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization localization)
@@ -251,6 +266,7 @@ void IeskfPipeline::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.t_ns = scan.t_end_ns;
   r.T_world_imu = filter_.state().T_world_imu();
   r.v_world_imu = filter_.state().v_world_imu;
+  SetPropagationState(filter_, &r);
   r.ms = WorkCpuMs() - start_ms;
   r.health.divergence_mask = monitor_.Check(HealthSampleOf(r));
   ++stats_.scans_processed;

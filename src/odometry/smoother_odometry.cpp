@@ -160,6 +160,9 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
   r.t_ns = scan.t_end_ns;
   r.T_world_imu = Pose3(newest_.R_world_imu, newest_.p_world_imu);
   r.v_world_imu = newest_.v_world_imu;
+  r.bg_imu = bg_;
+  r.ba_imu = ba_;
+  r.g_world = window_options_.g_world;
   r.ms = WorkCpuMs() - start_ms;
   r.health.divergence_mask = monitor_.Check(HealthSampleOf(r));
   ++stats_.scans_processed;

@@ -100,10 +100,16 @@ void BatchRefiner::SolveChunk(const ScanRange& chunk, int next_begin, RefineRoun
 
   t0 = Clock::now();
   ceres::Problem problem(RefineProblemOptions());
-  const bool hold_first_pose = chunk.begin > 0 || config_.reference == nullptr;
+  const bool gauge_fixed =
+      config_.reference != nullptr || RangeHoldsTie(config_.survey.ties, chunk, states_);
+  const bool hold_first_pose = chunk.begin > 0 || !gauge_fixed;
   BuildRefineChunkProblem(sequence_, noise_, result_.g_world, chunk, hold_first_pose, &a.factors,
                           &pose_manifold_, &states_, &problem);
   AddRefineDegeneracyPriors(chunk, a.factors, anchors_, &states_, &problem);
+  AddRefinePositionTies(config_.survey.ties, chunk, &states_, &problem);
+  if (config_.survey.rest_sigma_v > 0.0)
+    AddRefineRestFactors(config_.survey.rests, config_.survey.rest_sigma_v, chunk, &states_,
+                         &problem);
   const RefineSolveReport r = SolveRefineProblem(
       &problem, solver_.Options(config_.refine.solver_iterations), chunk, stop_, &states_);
   if (!r.accepted) {

@@ -48,7 +48,9 @@ ImuSample ImuSimulator::Next() {
   const double sqrt_rate = std::sqrt(options_.rate);
   m.gyro_imu += bg_ + NormalVector(rng_, options_.gyro_noise_density * sqrt_rate);
   m.acc_imu += ba_ + NormalVector(rng_, options_.accel_noise_density * sqrt_rate);
-  if (options_.vibration_accel > 0.0 || options_.vibration_gyro > 0.0) {
+  // Stop-and-go flights: the motors stand still while landed.
+  const bool still = trajectory_.stop_and_go() && trajectory_.Landed(NsToSeconds(m.t_ns - trajectory_.t0_ns()));
+  if ((options_.vibration_accel > 0.0 || options_.vibration_gyro > 0.0) && !still) {
     const double arg =
         2.0 * M_PI * options_.vibration_frequency * NsToSeconds(m.t_ns - trajectory_.t0_ns());
     for (int i = 0; i < 3; ++i) {

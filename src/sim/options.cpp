@@ -26,9 +26,12 @@ Status CheckWaypoints(const SimOptions& o) {
         "(the world origin is the start pose), got " +
         Fmt(wps->front()));
   const sim::WorldLayout L = sim::MakeLayout(o.world);
+  // Out of an open end, the flight may leave the tunnel (GNSS at the portals).
   const double far_x = o.world.end_wall ? L.x_end : L.x_end + 1e4;
+  const bool open_front = o.world.layout == "tunnel" && o.world.open_entrance;
+  const double near_x = open_front ? L.x_entrance - 1e4 : L.x_entrance;
   for (const Eigen::Vector3d& p : *wps) {
-    const bool inside = p.x() > L.x_entrance + 0.3 && p.x() < far_x - 0.3 &&
+    const bool inside = p.x() > near_x + 0.3 && p.x() < far_x - 0.3 &&
                         std::abs(p.y() - L.y_center) < L.half_width - 0.3 &&
                         p.z() >= L.z_floor + 0.05 && p.z() < L.z_ceiling - 0.3;
     if (!inside)
@@ -61,6 +64,11 @@ Status SimOptions::Validate() {
     return Status::InvalidInput("survey.max_range must be greater than survey.min_range");
   if (world.start_height >= world.height - 0.3)
     return Status::InvalidInput("world.start_height must be below world.height - 0.3");
+  if (trajectory.landing_time > 0.0 &&
+      (trajectory.yaw_amplitude != 0.0 || trajectory.sway_amplitude != 0.0))
+    return Status::InvalidInput(
+        "trajectory.landing_time (stop-and-go) needs trajectory.yaw_amplitude 0 and "
+        "trajectory.sway_amplitude 0: a landed device holds still");
   return CheckWaypoints(*this);
 }
 

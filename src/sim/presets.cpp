@@ -1,5 +1,7 @@
 #include "rvlio/sim/presets.h"
 
+#include "rvlio/common/text.h"
+
 namespace rvlio::sim {
 
 namespace {
@@ -78,10 +80,53 @@ SimOptions Featureless() {
   return o;
 }
 
+// Stop-and-go over 200 m (docs/control.md): landings on floor marks every
+// 50 m, a UTM-sized survey frame, the rotors' vibration in flight (what tells
+// a landing from a cruise to the IMU).
+SimOptions StopGo() {
+  SimOptions o = Tunnel();
+  o.world.length = 215.0;
+  o.trajectory.waypoints = StopGoWaypoints(50.0, 4, 1.5);
+  o.trajectory.yaw_amplitude = 0.0;
+  o.trajectory.hover_time = 0.5;
+  o.trajectory.landing_time = 4.0;
+  o.imu.vibration_accel = 0.3;
+  o.imu.vibration_gyro = 0.02;
+  o.marks.enabled = true;
+  o.marks.survey_frame = {500000.0, 5400000.0, 250.0, 30.0};
+  o.marks.check_every = 2;
+  o.duration = 184.0;  // ~180.4 s of motion, then the last landing
+  return o;
+}
+
+// A tunnel open at both ends, flown from outside the entrance to beyond the
+// far portal: GNSS fixes at both portals (docs/control.md "GNSS").
+SimOptions Portals() {
+  SimOptions o = Tunnel();
+  o.world.length = 60.0;
+  o.world.start_depth = 0.5;
+  o.world.end_wall = false;
+  o.trajectory.waypoints = "0,0,0; 0,0,1.5; -12,0,1.5; 72,0,1.5";
+  o.marks.survey_frame = {500000.0, 5400000.0, 250.0, 30.0};
+  o.gnss.enabled = true;
+  o.duration = 72.0;
+  return o;
+}
+
 }  // namespace
 
+std::string StopGoWaypoints(double spacing_m, int legs, double height_m) {
+  std::string w = "0,0,0";
+  const std::string h = FormatG(height_m, 10);
+  for (int i = 0; i < legs; ++i) {
+    const std::string x0 = FormatG(i * spacing_m, 10), x1 = FormatG((i + 1) * spacing_m, 10);
+    w += "; " + x0 + ",0," + h + "; " + x1 + ",0," + h + "; " + x1 + ",0,0";
+  }
+  return w;
+}
+
 std::vector<std::string> PresetNames() {
-  return {"tunnel", "corridor", "loopback", "hall", "featureless"};
+  return {"tunnel", "corridor", "loopback", "hall", "featureless", "stopgo", "portals"};
 }
 
 StatusOr<SimOptions> PresetOptions(const std::string& name) {
@@ -90,6 +135,8 @@ StatusOr<SimOptions> PresetOptions(const std::string& name) {
   if (name == "loopback") return Loopback();
   if (name == "hall") return Hall();
   if (name == "featureless") return Featureless();
+  if (name == "stopgo") return StopGo();
+  if (name == "portals") return Portals();
   std::string list;
   for (const auto& n : PresetNames()) list += (list.empty() ? "" : ", ") + n;
   return Status::InvalidInput("unknown preset '" + name + "' (presets: " + list + ")");

@@ -72,6 +72,7 @@ FlightTrajectory::FlightTrajectory(std::vector<Eigen::Vector3d> waypoints,
   RVLIO_CHECK(!waypoints_.empty());
   double t = options.static_duration;
   arrival_s_.push_back(0.0);
+  landed_s_.push_back({0.0, options.static_duration});
   for (size_t i = 0; i + 1 < waypoints_.size(); ++i) {
     Segment s;
     const Eigen::Vector3d delta = waypoints_[i + 1] - waypoints_[i];
@@ -89,7 +90,11 @@ FlightTrajectory::FlightTrajectory(std::vector<Eigen::Vector3d> waypoints,
     s.cruise = std::max(0.0, s.cruise);
     segments_.push_back(s);
     arrival_s_.push_back(s.t_end());
-    t = s.t_end() + options.hover_time;
+    const bool landing = options.landing_time > 0.0 && waypoints_[i + 1].z() <= 0.0;
+    const double rest = landing ? options.landing_time : options.hover_time;
+    const bool last = i + 2 == waypoints_.size();
+    if (landing) landed_s_.push_back({s.t_end(), last ? 1e300 : s.t_end() + rest});
+    t = s.t_end() + rest;
   }
   Rng rng = Rng::Stream(seed, 7);
   for (double& phase : yaw_phase_) phase = rng.Uniform(0.0, 2.0 * M_PI);
@@ -220,6 +225,12 @@ TruthState FlightTrajectory::At(TimeNs t_ns) const {
     s.w_imu = R_sway.transpose() * s.w_imu + so3::Jr(phi) * phi_rate;
   }
   return s;
+}
+
+bool FlightTrajectory::Landed(double tau) const {
+  for (const auto& [begin, end] : landed_s_)
+    if (tau >= begin && tau <= end) return true;
+  return false;
 }
 
 std::vector<Eigen::Vector3d> FlightTrajectory::SamplePath(double step) const {

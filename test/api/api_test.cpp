@@ -134,6 +134,41 @@ TEST_F(ApiTest, RunWithAndWithoutOutputFolderGivesTheSameTrajectory) {
   EXPECT_NEAR(j["ape"]["rmse"].get<double>(), from_files->ape_m.rmse, 1e-9);
 }
 
+// An opened source instead of the recording (as `rvlio live` hands over its
+// network input): the same scans; on_result sees each once, in order;
+// annotate_summary edits summary.json before it is written.
+TEST_F(ApiTest, AnOpenedSourceGivesTheRecordingsRunAndEveryResultOnce) {
+  StatusOr<RunResult> bag = RunRecording(Run(""));
+  ASSERT_TRUE(bag.ok()) << bag.status().message();
+  RunArgs args = Run(dir_ + "/source");
+  StatusOr<std::unique_ptr<SensorBagReader>> source = OpenSensorStream(
+      args.bag, args.options.lidar, args.options.imu, ReadWindow(), args.options.io);
+  ASSERT_TRUE(source.ok()) << source.status().message();
+  args.bag = "network";
+  args.source = source->get();
+  std::vector<TimeNs> seen;
+  args.on_result = [&](const ScanResult& r, const Odometry& odo) {
+    seen.push_back(r.t_ns);
+    EXPECT_EQ(odo.stats().scans_processed, static_cast<int64_t>(seen.size()));
+  };
+  args.annotate_summary = [](nlohmann::json* j) { (*j)["extra"] = 7; };
+  StatusOr<RunResult> run = RunRecording(args);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  ASSERT_EQ(run->trajectory.size(), bag->trajectory.size());
+  ASSERT_EQ(seen.size(), run->scans.size());
+  for (size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i], bag->trajectory[i].t_ns);
+    EXPECT_EQ(run->trajectory[i].p_world_imu, bag->trajectory[i].p_world_imu) << i;
+  }
+  const nlohmann::json summary =
+      nlohmann::json::parse(ReadFile(dir_ + "/source/summary.json"), nullptr, false);
+  EXPECT_EQ(summary["extra"], 7);
+  EXPECT_EQ(summary["bag"], "network");
+  // A window needs a recording.
+  args.window.start_s = 1.0;
+  EXPECT_FALSE(RunRecording(args).ok());
+}
+
 TEST_F(ApiTest, StopEndsTheRunAndRecordsTheReason) {
   const std::string out = dir_ + "/stopped";
   RunArgs args = Run(out);

@@ -254,6 +254,35 @@ TEST_F(ReportDataTest, PositionsFarFromZeroAreDrawnRelativeToALocalOrigin) {
             notes.end());
 }
 
+// A run folder of `refine --control` in a UTM-sized frame: the residual table
+// and the marks, drawn relative to the page's origin.
+TEST_F(ReportDataTest, ControlPointsOfARefineAreTabledAndDrawnAsMarks) {
+  const Eigen::Vector3d utm(500000.0, 5400000.0, 0.0);
+  Trajectory est = Straight(0.0);
+  for (StampedPose& p : est) p.p_world_imu += utm;
+  WriteRun("run", est, 0, false);
+  Write("run/control.csv",
+        "name,role,kind,x,y,z,x_est,y_est,z_est,dx,dy,dz,d3d,sigma_m,t_s,scans\n"
+        "M1,control,mark,500000.0000,5400000.0000,0.7000,500000.0030,5400000.0000,0.7000,"
+        "0.0030,0.0000,0.0000,0.0030,0.005,1.000,0\n"
+        "M2,check,mark,500010.0000,5400000.0000,0.7000,500010.0000,5400000.0120,0.7000,"
+        "0.0000,0.0120,0.0000,0.0120,0.005,6.000,0\n");
+  StatusOr<json> m = BuildReportModel(Path("run"), ReportOptions());
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  const json& c = (*m)["control"];
+  ASSERT_TRUE(c.is_object()) << m->dump();
+  ASSERT_EQ(c["rows"].size(), 2u);
+  EXPECT_EQ(c["rows"][1][0], "M2");
+  EXPECT_EQ(c["rows"][1][1], "check");
+  EXPECT_NEAR(c["rows"][1][6].get<double>(), 0.012, 1e-9);  // d3d_m
+  EXPECT_EQ(DecodeArray(c["marks"]["xy"]), (std::vector<float>{0.0f, 0.0f, 10.0f, 0.0f}));
+  // A control.csv that is not one: a note, no table.
+  Write("run/control.csv", "name,x\nA,1\n");
+  m = BuildReportModel(Path("run"), ReportOptions());
+  ASSERT_TRUE(m.ok());
+  EXPECT_TRUE((*m)["control"].is_null());
+}
+
 // A compare folder as `rvlio compare` writes it, run from another directory
 // (paths in compare.json relative to that one), with a map column compare
 // does not have today.

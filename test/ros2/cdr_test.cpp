@@ -1,6 +1,7 @@
 // CDR codec: little-endian round trips through the encoders, big-endian
 // payloads built byte by byte (with their alignment padding), and corrupt
 // payloads that must fail with a message naming the field.
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -270,6 +271,61 @@ TEST(CdrTest, BadEncapsulationAndTruncationAreErrors) {
   const Bytes imu = cdr::EncodeImu(m);
   for (size_t n = 0; n < imu.size(); ++n)
     EXPECT_FALSE(cdr::DecodeImu(imu.data(), n, "/imu").ok()) << n;
+}
+
+// The outputs of `rvlio live` (nav_messages.h): byte layout of a TFMessage
+// (sequence count, then per transform a header whose strings realign the
+// doubles to 8) and round trips of Odometry and TFMessage.
+TEST(CdrTest, TfMessageLayoutAlignsDoublesAfterStrings) {
+  TransformMessage t;
+  t.stamp_ns = 1500000000;  // 1 s + 0.5 s
+  t.frame_id = "odom";
+  t.child_frame_id = "base";
+  t.translation = {1.0, 2.0, 3.0};
+  const std::vector<uint8_t> b = cdr::EncodeTfMessage({t});
+  // encapsulation 4 | count 4 | sec 4, nanosec 4 | "odom" + NUL: length 4 + 5, pad 3 |
+  // "base" + NUL: 4 + 5, pad to 8: 7 | 7 doubles 56
+  ASSERT_EQ(b.size(), 4u + 4 + 8 + 12 + 16 + 56);
+  EXPECT_EQ(b[4], 1);  // one transform
+  EXPECT_EQ(b[8], 1);  // sec = 1
+  EXPECT_EQ(b[16], 5);  // strlen("odom") + 1
+  double x = 0.0;
+  std::memcpy(&x, b.data() + 4 + 4 + 8 + 12 + 16, 8);
+  EXPECT_EQ(x, 1.0);
+  StatusOr<std::vector<TransformMessage>> back = cdr::DecodeTfMessage(b.data(), b.size(), "/tf");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_EQ(back->size(), 1u);
+  EXPECT_EQ((*back)[0].child_frame_id, "base");
+  EXPECT_EQ((*back)[0].stamp_ns, t.stamp_ns);
+  EXPECT_EQ((*back)[0].translation, t.translation);
+  for (size_t n = 0; n < b.size(); ++n)
+    EXPECT_FALSE(cdr::DecodeTfMessage(b.data(), n, "/tf").ok()) << n;
+}
+
+TEST(CdrTest, OdometryRoundTrip) {
+  OdometryMessage m;
+  m.stamp_ns = 1234567890123;
+  m.frame_id = "odom";
+  m.child_frame_id = "base_link";
+  m.pose.position = {1.0, -2.0, 0.5};
+  m.pose.orientation_xyzw = {0.0, 0.0, std::sqrt(0.5), std::sqrt(0.5)};
+  for (int i = 0; i < 36; ++i) m.pose_covariance[i] = 0.01 * i;
+  m.linear_velocity = {1.5, 0.0, 0.0};
+  m.angular_velocity = {0.0, 0.0, 0.2};
+  const std::vector<uint8_t> b = cdr::EncodeOdometry(m);
+  StatusOr<OdometryMessage> back = cdr::DecodeOdometry(b.data(), b.size(), "/odometry");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->stamp_ns, m.stamp_ns);
+  EXPECT_EQ(back->frame_id, m.frame_id);
+  EXPECT_EQ(back->child_frame_id, m.child_frame_id);
+  EXPECT_EQ(back->pose.position, m.pose.position);
+  EXPECT_EQ(back->pose.orientation_xyzw, m.pose.orientation_xyzw);
+  EXPECT_EQ(back->pose_covariance, m.pose_covariance);
+  EXPECT_EQ(back->linear_velocity, m.linear_velocity);
+  EXPECT_EQ(back->angular_velocity, m.angular_velocity);
+  // 4 + header (8 + 4 + 5 -> 17, pad 3) + child (4 + 10 -> 34, pad to 40) + 85 doubles.
+  EXPECT_EQ(b.size(), 4u + 40 + 8 * (7 + 36 + 6 + 36));
+  EXPECT_FALSE(cdr::DecodeOdometry(b.data(), b.size() - 1, "/odometry").ok());
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "../cli/cli_util.h"
@@ -20,13 +21,14 @@ namespace rvlio::signals_test {
 
 using testing_cli::ReadFile;
 
-// `rvlio ARGS...` with stdout and stderr into files.
-inline pid_t Spawn(const std::vector<std::string>& args, const std::string& out_path,
-                   const std::string& err_path) {
-  std::vector<std::string> argv_s = {RVLIO_BIN};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
+// `PROGRAM ARGS...` (argv_s[0]: a path, or a name looked up in PATH) with
+// stdout and stderr into files; with own_group, in a process group of its
+// own (pid = group id), so that kill(-pid, ...) reaches the children it starts.
+inline pid_t SpawnProgram(std::vector<std::string> argv_s, const std::string& out_path,
+                          const std::string& err_path, bool own_group = false) {
   const pid_t pid = ::fork();
   if (pid != 0) return pid;
+  if (own_group) ::setpgid(0, 0);
   const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (out < 0 || err < 0) ::_exit(97);
@@ -35,8 +37,16 @@ inline pid_t Spawn(const std::vector<std::string>& args, const std::string& out_
   std::vector<char*> argv;
   for (auto& a : argv_s) argv.push_back(a.data());
   argv.push_back(nullptr);
-  ::execv(argv[0], argv.data());
+  ::execvp(argv[0], argv.data());
   ::_exit(98);
+}
+
+// `rvlio ARGS...` with stdout and stderr into files.
+inline pid_t Spawn(const std::vector<std::string>& args, const std::string& out_path,
+                   const std::string& err_path) {
+  std::vector<std::string> argv_s = {RVLIO_BIN};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  return SpawnProgram(std::move(argv_s), out_path, err_path);
 }
 
 // The exit status of a child: its exit code, or 128 + the signal that killed it.

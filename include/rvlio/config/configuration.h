@@ -7,9 +7,11 @@
 // recording, optional outputs and the survey frame. A Configuration is an
 // OdometryOptions, so it is handed to Odometry::Create as it is.
 #include "rvlio/common/options.h"
+#include "rvlio/formats/live_options.h"
 #include "rvlio/formats/reader_options.h"
 #include "rvlio/odometry/options.h"
 #include "rvlio/outputs/output_options.h"
+#include "rvlio/refine/control_options.h"
 #include "rvlio/refine/options.h"
 
 namespace rvlio {
@@ -19,6 +21,9 @@ struct Configuration : OdometryOptions {
   ReaderOptions io;
   OutputOptions output;  // optional output files (map.las)
   SurveyOptions survey;  // the map frame's coordinate reference system
+  LiveOptions live;        // `rvlio live` only (docs/live.md)
+  ControlOptions control;  // control and check points (`refine --control`, docs/control.md)
+  GnssOptions gnss;        // GNSS fixes of the recording (refine, docs/control.md)
 
   // Keys that moved to another section, read under their former dotted name
   // with a warning until the next release (config/config.h).
@@ -40,12 +45,16 @@ struct Configuration : OdometryOptions {
     v.Section("io", io);
     v.Section("output", output);
     v.Section("survey", survey);
+    v.Section("live", live);
+    v.Section("control", control);
+    v.Section("gnss", gnss);
   }
 
   Status Validate() {
     if (Status s = OdometryOptions::Validate(); !s.ok()) return s;
     if (Status s = ValidateFields(*this); !s.ok()) return s;
-    for (Status m : {refine.Validate(), io.Validate(), output.Validate(), survey.Validate()})
+    for (Status m : {refine.Validate(), io.Validate(), output.Validate(), survey.Validate(),
+                     live.Validate(), control.Validate(), gnss.Validate()})
       if (!m.ok()) return m;
     return Status::Ok();
   }

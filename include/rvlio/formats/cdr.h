@@ -20,6 +20,7 @@
 #include "rvlio/common/status.h"
 #include "rvlio/common/time.h"
 #include "rvlio/formats/livox.h"
+#include "rvlio/formats/nav_messages.h"
 #include "rvlio/formats/pointcloud2.h"
 
 namespace rvlio::cdr {
@@ -29,6 +30,11 @@ inline constexpr const char* kPointCloud2Type = "sensor_msgs/msg/PointCloud2";
 inline constexpr const char* kImuType = "sensor_msgs/msg/Imu";
 inline constexpr const char* kStringType = "std_msgs/msg/String";
 // livox_ros_driver2/msg/CustomMsg: kLivoxRos2Type (formats/livox.h).
+// What `rvlio live` publishes (nav_messages.h).
+inline constexpr const char* kOdometryType = "nav_msgs/msg/Odometry";
+inline constexpr const char* kTfMessageType = "tf2_msgs/msg/TFMessage";
+inline constexpr const char* kPathType = "nav_msgs/msg/Path";
+inline constexpr const char* kDiagnosticArrayType = "diagnostic_msgs/msg/DiagnosticArray";
 
 // The message definitions (ros2msg text, dependencies appended after
 // "=====" separator lines as rosbag2 stores them), for MCAP schemas and the
@@ -36,6 +42,7 @@ inline constexpr const char* kStringType = "std_msgs/msg/String";
 const std::string& PointCloud2Definition();
 const std::string& ImuDefinition();
 const std::string& LivoxCustomMsgDefinition();
+const std::string& NavSatFixDefinition();  // sensor_msgs/msg/NavSatFix (formats/navsatfix.h)
 
 // Bounds-checked sequential reader of one CDR payload.
 class Reader {
@@ -125,5 +132,13 @@ std::vector<uint8_t> EncodePointCloud2(const PointCloud2View& cloud, const std::
 std::vector<uint8_t> EncodeImu(const ImuMessage& msg);
 std::vector<uint8_t> EncodeLivoxCustomMsg(const LivoxCustomMsg& msg);
 std::vector<uint8_t> EncodeString(const std::string& text);
+std::vector<uint8_t> EncodeOdometry(const OdometryMessage& msg);
+std::vector<uint8_t> EncodeTfMessage(const std::vector<TransformMessage>& transforms);
+std::vector<uint8_t> EncodePath(const PathMessage& msg);
+std::vector<uint8_t> EncodeDiagnosticArray(const DiagnosticMessage& msg);
+// nav_msgs/msg/Odometry and tf2_msgs/msg/TFMessage, for subscribers (and tests).
+StatusOr<OdometryMessage> DecodeOdometry(const uint8_t* data, size_t size, const std::string& topic);
+StatusOr<std::vector<TransformMessage>> DecodeTfMessage(const uint8_t* data, size_t size,
+                                                        const std::string& topic);
 
 }  // namespace rvlio::cdr

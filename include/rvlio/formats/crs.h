@@ -48,6 +48,9 @@ class GeodeticToCrs {
   // of use, non-finite input).
   StatusOr<Eigen::Vector3d> Transform(double latitude_deg, double longitude_deg,
                                       double height_m) const;
+  // The inverse: CRS coordinates to (latitude_deg, longitude_deg, height_m)
+  // (the simulator's GNSS fixes).
+  StatusOr<Eigen::Vector3d> Inverse(const Eigen::Vector3d& p_crs) const;
 
  private:
   struct Impl;

@@ -12,6 +12,7 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/formats/navsatfix.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/lidar/extrinsics.h"
 #include "rvlio/lidar/options.h"
@@ -111,6 +112,9 @@ class SensorBagWriter {
                                 const Scan& scan) = 0;
   virtual Status WriteImu(const std::string& topic, const std::string& frame_id,
                           const ImuSample& sample) = 0;
+  // sensor_msgs/NavSatFix (ROS1) / sensor_msgs/msg/NavSatFix, received at its
+  // header stamp (formats/navsatfix.h).
+  virtual Status WriteNavSatFix(const std::string& topic, const NavSatFix& fix) = 0;
   virtual Status Close() = 0;
 };
 

@@ -20,6 +20,7 @@ struct LidarOptions {
   // a scan against the scan period, median over the first scans.
   double point_time_span_stop = 0.01;  // below this fraction reading stops (0: never)
   double point_time_span_warn = 0.5;   // below this fraction a warning
+  double wait_timeout = 10.0;         // s: rvlio live waits this long for the first message of each topic
   std::string ouster_metadata;        // Ouster metadata JSON of a packet recording ("" = find it)
   // Online estimation of time_offset (docs/time_offset.md): an augmented state
   // of the IESKF, one parameter of the smoother's window.
@@ -68,6 +69,10 @@ struct LidarOptions {
             Spec().Range(0.0, 1.0).Help(
                 "a warning when the point times of a scan span less than this fraction of the "
                 "scan period (median of the first scans)"));
+    v.Field("wait_timeout", wait_timeout,
+            Spec().Unit("s").Range(0.1, 3600.0).Help(
+                "rvlio live: the first message on lidar.topic and on imu.topic must arrive "
+                "within this (else exit 2 naming the topic)"));
     v.Field("ouster_metadata", ouster_metadata,
             Spec().Help("Ouster sensor metadata JSON for a packet recording (pcap capture or "
                         "packet bag); empty: NAME.json / NAME_0.json next to a capture, the "

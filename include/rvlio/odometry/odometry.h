@@ -59,6 +59,16 @@ struct ScanResult {
   // the reference (else to the working map: out of the reference).
   std::optional<double> map_overlap;
   bool localized = false;
+  // The rest of the state at t_ns, for propagating the pose at IMU rate
+  // between scans (imu/propagator.h, `rvlio live`): gyro and accelerometer
+  // biases (IMU frame) and gravity (world frame).
+  Eigen::Vector3d bg_imu = Eigen::Vector3d::Zero();  // rad/s
+  Eigen::Vector3d ba_imu = Eigen::Vector3d::Zero();  // m/s^2
+  Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);  // m/s^2
+  // Covariance of the pose at t_ns: [p_world_imu (m^2), rotation about the
+  // world axes (rad^2)] (the order of ROS' nav_msgs/Odometry). Set by the
+  // IESKF (its posterior); the smoother has none.
+  std::optional<Eigen::Matrix<double, 6, 6>> pose_covariance_world;
 };
 
 // The monitor's view of a scan result (odometry/divergence.h).

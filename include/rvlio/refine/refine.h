@@ -83,6 +83,7 @@
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/rv/options.h"
+#include "rvlio/refine/control.h"
 #include "rvlio/refine/options.h"
 #include "rvlio/refine/refine_states.h"
 
@@ -105,6 +106,14 @@ struct RefineConfig {
   // reference's frame; the first scan's pose is then not held (no gauge
   // freedom is left).
   std::shared_ptr<const VoxelMap> reference;
+  // Survey ties (`refine --control`, GNSS; refine/control.h, docs/control.md),
+  // survey.ties:
+  // a PositionFactor each in every chunk that holds its state(s), in the
+  // frame of the initial trajectory; a chunk holding one does not hold its
+  // first pose (the ties fix the gauge), as with a reference.
+  // With rest_sigma_v > 0, every state inside one of the rests of the
+  // stop-and-go marks gets a ZeroVelocityFactor (control.rest_sigma_v).
+  SurveyFactors survey;
 };
 
 struct RefineInput {

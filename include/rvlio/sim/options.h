@@ -221,6 +221,11 @@ struct SimTrajectoryOptions {
   // for roll, pitch, yaw, faded in with the yaw motion. 0: off (the presets).
   double sway_amplitude = 0.0;   // rad per axis
   double sway_frequency = 0.8;   // Hz of the roll component
+  // Stop-and-go: a waypoint after the first at z = 0 (the take-off height:
+  // standing on the floor) is a landing, where the flight rests landing_time
+  // instead of hover_time. 0: off. While landed (the static phase, each
+  // landing, a final landing) the motors stand still: no IMU vibration.
+  double landing_time = 0.0;     // s
 
   template <class V>
   void Visit(V& v) {
@@ -239,6 +244,11 @@ struct SimTrajectoryOptions {
     v.Field("sway_frequency", sway_frequency,
             Spec().Unit("Hz").Range(0.01, 20.0).Help("sway frequency of the roll axis; "
                                                      "pitch x1.37, yaw x0.71"));
+    v.Field("landing_time", landing_time,
+            Spec().Unit("s").Range(0.0, 3600.0).Help(
+                "stop-and-go: rest at each waypoint at z = 0 after the first (a landing) for this "
+                "long, motors still (no IMU vibration); 0: off. Needs yaw_amplitude and "
+                "sway_amplitude 0"));
   }
 };
 
@@ -306,6 +316,76 @@ struct SimLocalizabilityOptions {
   }
 };
 
+// The survey frame and the stop-and-go marks (docs/simulator.md "Survey
+// frame, marks, GNSS"): p_survey = Rz(yaw) p_world + (E, N, h). The marks are
+// the floor points under the IMU where the flight rests on the floor (the
+// start and every landing, trajectory.landing_time), written to
+// NAME_control.csv in the survey frame with Gaussian noise; the ground truth
+// is also written in the survey frame (NAME_gt_survey.tum).
+struct SimMarksOptions {
+  bool enabled = false;  // write NAME_control.csv
+  // E, N, h (m) and yaw (deg) of the world frame in the survey frame.
+  std::array<double, 4> survey_frame = {0.0, 0.0, 0.0, 0.0};
+  double noise_m = 0.002;  // m, std per axis of the marks' coordinates
+  int check_every = 0;     // every k-th mark (1-based index % k == 0) is a check point; 0: none
+  bool times = false;      // write t_start,t_end (else refine finds the rests from the IMU)
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("enabled", enabled,
+            Spec().Help("write NAME_control.csv: the stop-and-go marks in the survey frame"));
+    v.Field("survey_frame", survey_frame,
+            Spec().Range(-1e7, 1e7).Help(
+                "easting, northing, height (m) and yaw (deg) of the world frame in the survey "
+                "frame (rvlio simulate --survey-frame E,N,h,yaw_deg)"));
+    v.Field("noise_m", noise_m,
+            Spec().Unit("m").Range(0.0, 1.0).Help("std per axis of the marks' coordinates"));
+    v.Field("check_every", check_every,
+            Spec().Range(0, 1000).Help("every k-th mark is a check point (0: none)"));
+    v.Field("times", times,
+            Spec().Help("write t_start,t_end of each rest (default: refine finds them)"));
+  }
+};
+
+// GNSS fixes (sensor_msgs/NavSatFix) where the flight is outside the tunnel:
+// beyond the entrance (x < x_entrance - portal_margin) or beyond an open far
+// end; none inside. Noise, dropouts and multipath outliers.
+struct SimGnssOptions {
+  bool enabled = false;
+  std::string topic = "/gnss/fix";
+  std::string frame_id = "gnss";
+  std::string crs = "EPSG:25832";  // the projected CRS of marks.survey_frame
+  double rate = 5.0;               // Hz
+  std::array<double, 3> lever_arm = {0.0, 0.0, 0.1};  // m, antenna in the IMU frame
+  double noise_m = 0.015;          // m, horizontal std per axis
+  double noise_vertical_m = 0.03;  // m
+  double dropout = 0.05;           // probability of a missing fix
+  double outlier_rate = 0.02;      // probability of a multipath outlier
+  double outlier_m = 3.0;          // m, horizontal offset of an outlier
+  double portal_margin_m = 3.0;    // m beyond the portal before the sky is open
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("enabled", enabled, Spec().Help("write NavSatFix messages outside the portals"));
+    v.Field("topic", topic, Spec().Help("NavSatFix topic written"));
+    v.Field("frame_id", frame_id, Spec().Help("header frame of the fixes"));
+    v.Field("crs", crs,
+            Spec().Help("projected CRS of the survey frame (latitude, longitude through PROJ)"));
+    v.Field("rate", rate, Spec().Unit("Hz").Range(0.1, 100.0));
+    v.Field("lever_arm", lever_arm,
+            Spec().Unit("m").Range(-10.0, 10.0).Help("antenna position in the IMU frame"));
+    v.Field("noise_m", noise_m, Spec().Unit("m").Range(0.0, 10.0).Help("horizontal std per axis"));
+    v.Field("noise_vertical_m", noise_vertical_m, Spec().Unit("m").Range(0.0, 10.0));
+    v.Field("dropout", dropout, Spec().Range(0.0, 1.0).Help("probability of a missing fix"));
+    v.Field("outlier_rate", outlier_rate,
+            Spec().Range(0.0, 1.0).Help("probability of a multipath outlier"));
+    v.Field("outlier_m", outlier_m,
+            Spec().Unit("m").Range(0.0, 1000.0).Help("horizontal offset of an outlier"));
+    v.Field("portal_margin_m", portal_margin_m,
+            Spec().Unit("m").Range(0.0, 1000.0).Help("open sky this far beyond a portal"));
+  }
+};
+
 struct SimOptions {
   int64_t seed = 1;           // world seed: every random choice of the world derives from it
   // The flight's seed (trajectory yaw/sway phases, IMU noise and bias walk,
@@ -321,6 +401,8 @@ struct SimOptions {
   ExtrinsicsSection extrinsics = DefaultExtrinsics();  // LiDAR pose in the IMU frame
   SimSurveyOptions survey;
   SimLocalizabilityOptions localizability;
+  SimMarksOptions marks;
+  SimGnssOptions gnss;
 
   template <class V>
   void Visit(V& v) {
@@ -338,6 +420,8 @@ struct SimOptions {
     v.Section("extrinsics", extrinsics);
     v.Section("survey", survey);
     v.Section("localizability", localizability);
+    v.Section("marks", marks);
+    v.Section("gnss", gnss);
   }
 
   // The seed of the flight: flight_seed, or seed when flight_seed is -1.

@@ -7,6 +7,10 @@
 //   feature-rich room with pillars, boxes, stairs and doorways (nothing degenerate) featureless a
 //   long smooth tunnel without any feature and with both ends
 //               beyond the LiDAR range: the axial position is unobservable (paper Remark 3)
+//   stopgo      stop-and-go over 200 m of the tunnel: landings on floor marks every 50 m,
+//               NAME_control.csv in a UTM-sized survey frame (docs/control.md)
+//   portals     a 60 m tunnel open at both ends, flown from outside one portal to beyond the
+//               other: GNSS fixes outside (docs/control.md "GNSS")
 #include <string>
 #include <vector>
 
@@ -18,5 +22,9 @@ namespace rvlio::sim {
 std::vector<std::string> PresetNames();
 // InvalidInput listing the presets for an unknown name.
 StatusOr<SimOptions> PresetOptions(const std::string& name);
+// trajectory.waypoints of a stop-and-go flight along x: from the start (a
+// mark), `legs` times up to height_m, spacing_m along, and down onto the
+// next mark (z = 0: a landing with trajectory.landing_time).
+std::string StopGoWaypoints(double spacing_m, int legs, double height_m);
 
 }  // namespace rvlio::sim

@@ -11,6 +11,7 @@
 // is C^4, acceleration C^2 and the angular rate (which depends on the jerk)
 // C^1: the IMU signal is continuous and numerically integrable.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -53,6 +54,11 @@ class FlightTrajectory {
   // Seconds after t0 at which waypoint i is reached (0 for the first).
   double ArrivalTime(size_t i) const { return arrival_s_[i]; }
   double MotionEnd() const { return arrival_s_.back(); }
+  // The rests on the floor, s after t0: the static phase and, with
+  // trajectory.landing_time, each landing (the last one open-ended).
+  const std::vector<std::pair<double, double>>& landed() const { return landed_s_; }
+  bool Landed(double tau) const;
+  bool stop_and_go() const { return options_.landing_time > 0.0; }
   TimeNs t0_ns() const { return t0_ns_; }
   double gravity() const { return gravity_; }
   // Points along the path every `step` m (for feature clearance).
@@ -74,6 +80,7 @@ class FlightTrajectory {
   std::vector<Eigen::Vector3d> waypoints_;
   std::vector<Segment> segments_;
   std::vector<double> arrival_s_;
+  std::vector<std::pair<double, double>> landed_s_;
   SimTrajectoryOptions options_;
   double gravity_;
   TimeNs t0_ns_;
