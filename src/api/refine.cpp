@@ -28,6 +28,7 @@
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/math/so3.h"
 #include "rvlio/odometry/reference.h"
+#include "rvlio/refine/refine_divergence.h"
 #include "rvlio/refine/refine_states.h"
 #include "rvlio/refine/refine_jobs.h"
 

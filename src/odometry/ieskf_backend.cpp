@@ -53,6 +53,21 @@ Prediction IeskfBackend::Predict(std::deque<ImuSample>* imu_buffer, TimeNs t_end
   return p;
 }
 
+// The filter's rotation error is a right perturbation (R = R_hat Exp(d));
+// about the world axes it is R_hat d, so the covariance's rotation rows turn
+// by R_hat.
+void IeskfBackend::ReportPropagationState(ScanResult* r) const {
+  const FilterState& x = filter_.state();
+  r->bg_imu = x.bg;
+  r->ba_imu = x.ba;
+  r->g_world = x.g_world;
+  Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+  J.block<3, 3>(0, FilterState::kPos) = Eigen::Matrix3d::Identity();
+  J.block<3, 3>(3, FilterState::kRot) = x.R_world_imu;
+  const Eigen::Matrix<double, 6, 6> P = filter_.covariance().topLeftCorner<6, 6>();
+  r->pose_covariance_world = J * P * J.transpose();
+}
+
 void IeskfBackend::ChangeWorldFrame(const Pose3& T_ref_world, Prediction* prediction) {
   filter_.ChangeWorldFrame(T_ref_world);
   const FilterState& x = filter_.state();

@@ -1,7 +1,8 @@
 #include "rvlio/odometry/odometry.h"
 
 #include "rvlio/odometry/ieskf_odometry.h"
-#include "rvlio/odometry/smoother_odometry.h"
+#include "rvlio/odometry/pipeline.h"
+#include "rvlio/odometry/smoother_backend.h"
 
 #include <cstdio>
 #include <utility>
@@ -135,7 +136,8 @@ StatusOr<std::unique_ptr<Odometry>> Odometry::Create(const OdometryOptions& opti
     case Backend::kIeskf:
       return std::unique_ptr<Odometry>(new IeskfOdometry(options, std::move(localization)));
     case Backend::kSmoother:
-      return std::unique_ptr<Odometry>(new SmootherOdometry(options, std::move(localization)));
+      return std::unique_ptr<Odometry>(
+          new PipelineOdometry<SmootherBackend>(options, std::move(localization)));
   }
   return Status::InvalidInput("backend " + std::to_string(static_cast<int>(options.backend)) +
                               " is not a backend");

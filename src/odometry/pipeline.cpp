@@ -169,6 +169,7 @@ void ScanPipeline<Backend>::Report(TimeNs t_ns, const Prediction& prediction, do
   r->t_ns = t_ns;
   r->T_world_imu = backend_.T_world_imu();
   r->v_world_imu = backend_.v_world_imu();
+  backend_.ReportPropagationState(r);
   r->ms = WorkCpuMs() - start_ms;
   r->health.divergence_mask = monitor_.Check(HealthSampleOf(*r));
   ++stats_.scans_processed;

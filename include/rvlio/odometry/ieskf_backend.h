@@ -41,6 +41,8 @@ class IeskfBackend {
   double time_offset_s() const { return filter_.time_offset_s(); }
   double time_offset_std_s() const { return filter_.time_offset_std_s(); }
   bool time_offset_at_bound() const { return filter_.time_offset_at_bound(); }
+  // Biases, gravity and the posterior's pose covariance (world axes).
+  void ReportPropagationState(ScanResult* r) const;
   bool estimates_extrinsics() const { return options_.ieskf.estimate_extrinsics; }
   void CountExcitationScan() { filter_.CountExcitationScan(); }
   const ExtrinsicExcitation& extrinsic_excitation() const { return filter_.extrinsic_excitation(); }

@@ -14,8 +14,8 @@
 #include "rvlio/lidar/extrinsics.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/options.h"
-#include "rvlio/odometry/divergence.h"
-#include "rvlio/odometry/reference.h"
+#include "rvlio/odometry/divergence_options.h"
+#include "rvlio/odometry/localization_options.h"
 #include "rvlio/rv/options.h"
 #include "rvlio/window/options.h"
 

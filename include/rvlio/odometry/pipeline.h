@@ -28,7 +28,9 @@
 //   void Finish(ScanContext&);
 //       end of input: what the backend still holds into the output map
 //   the state after the scan: time_ns(), T_world_imu(), v_world_imu(),
-//       T_imu_lidar(), time_offset_s(), time_offset_std_s(), time_offset_at_bound()
+//       T_imu_lidar(), time_offset_s(), time_offset_std_s(), time_offset_at_bound();
+//       void ReportPropagationState(ScanResult*) const: biases, gravity and
+//       the pose covariance if any (the IMU-rate output of `rvlio live`)
 //   online extrinsic: estimates_extrinsics(), CountExcitationScan(), extrinsic_excitation()
 //   void AddReports(OdometryStats*) const; std::vector<std::string> Warnings(const OdometryStats&) const;
 // A new backend is one such class and one line in Odometry::Create and at

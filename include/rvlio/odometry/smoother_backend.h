@@ -64,6 +64,8 @@ class SmootherBackend {
   double time_offset_s() const;
   double time_offset_std_s() const { return window_ ? window_->time_offset_std_s() : 0.0; }
   bool time_offset_at_bound() const { return window_ && window_->time_offset_at_bound(); }
+  // Biases and gravity (no pose covariance: the window keeps none).
+  void ReportPropagationState(ScanResult* r) const;
   bool estimates_extrinsics() const { return options_.smoother.estimate_extrinsics; }
   void CountExcitationScan() { window_->CountExcitationScan(); }
   const ExtrinsicExcitation& extrinsic_excitation() const { return window_->extrinsic_excitation(); }
@@ -90,7 +92,7 @@ class SmootherBackend {
   Eigen::Vector3d bg_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d ba_ = Eigen::Vector3d::Zero();
   bool window_filled_ = false;  // a state has been marginalized
-  // The current scan's prediction: its IMU samples and poses.
+  // The current scan's prediction: its IMU samples (ImuCovering) and poses.
   std::vector<ImuSample> samples_;
   ImuPoseHistory history_;
   std::vector<Eigen::Vector3d> p_world_;  // workspace
