@@ -53,8 +53,10 @@ set(rvlio_public_headers
   rvlio/math/time_offset_excitation.h
   rvlio/odometry/deviation.h
   rvlio/odometry/divergence.h
+  rvlio/odometry/divergence_options.h
   rvlio/odometry/odometry.h
   rvlio/odometry/options.h
+  rvlio/odometry/localization_options.h
   rvlio/odometry/reference.h
   rvlio/outputs/output_options.h
   rvlio/outputs/run_outputs.h

@@ -1,6 +1,6 @@
 #pragma once
-// Pieces of the odometry pipeline shared by its backends (ieskf_odometry.h,
-// smoother_odometry.h): the extrinsics, static initialization and the working
+// Pieces of the odometry's backbone (odometry/pipeline.h) shared by its
+// backends: the extrinsics, static initialization and the working
 // map with its periodic trim (the IMU poses for deskew: imu/pose_history.h).
 #include <algorithm>
 #include <deque>
