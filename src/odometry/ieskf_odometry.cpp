@@ -8,19 +8,19 @@
 namespace rvlio {
 
 IeskfOdometry::IeskfOdometry(const OdometryOptions& options, Localization localization)
-    : options_(options), live_(options, std::move(localization)) {
+    : PipelineOdometry<IeskfBackend>(options, std::move(localization)), options_(options) {
   if (options.lidar.estimate_time_offset && options.lidar.time_offset_replay > 0.0)
     phase_ = ReplayPhase::kWaitingForMotion;
 }
 
 void IeskfOdometry::AddImu(const ImuSample& imu) {
-  live_.AddImu(imu);
+  pipeline_.AddImu(imu);
   if (snapshot_) snapshot_->AddImu(imu);
 }
 
 void IeskfOdometry::AddScan(Scan scan) {
   if (snapshot_) snapshot_->AddScan(scan);
-  live_.AddScan(std::move(scan));
+  pipeline_.AddScan(std::move(scan));
 }
 
 void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
@@ -31,34 +31,34 @@ void IeskfOdometry::Poll(std::vector<ScanResult>* out) {
 // At the end of input a hold ends with the results there are: the held ones
 // when the offset has not converged by then.
 void IeskfOdometry::Finish(std::vector<ScanResult>* out) {
-  live_.StartFinishing();
+  pipeline_.StartFinishing();
   if (snapshot_) snapshot_->StartFinishing();
   while (Step(true, out)) {
   }
   if (phase_ == ReplayPhase::kHolding) GiveUpReplay(out);
-  live_.Finish();
+  pipeline_.Finish();
 }
 
 bool IeskfOdometry::NextScanShowsTimeOffset(bool finishing) const {
-  const ScanQueue& scans = live_.scans();
-  if (!live_.status().ok() || scans.empty() || live_.map().Empty()) return false;
-  const TimeNs shift_ns = live_.ScanTimeShiftNs();
-  if (!finishing && !scans.FrontReady(live_.imu_buffer(), shift_ns)) return false;
-  return live_.backend().filter().TimeOffsetObservableAt(live_.imu_buffer(),
-                                                         scans.front().t_end_ns + shift_ns);
+  const ScanQueue& scans = pipeline_.scans();
+  if (!pipeline_.status().ok() || scans.empty() || pipeline_.map().Empty()) return false;
+  const TimeNs shift_ns = pipeline_.ScanTimeShiftNs();
+  if (!finishing && !scans.FrontReady(pipeline_.imu_buffer(), shift_ns)) return false;
+  return pipeline_.backend().filter().TimeOffsetObservableAt(pipeline_.imu_buffer(),
+                                                             scans.front().t_end_ns + shift_ns);
 }
 
 // One scan of the live pipeline; the snapshot is taken before the first scan
 // that shows the offset, the results of the hold go to held_.
 bool IeskfOdometry::Step(bool finishing, std::vector<ScanResult>* out) {
   if (phase_ == ReplayPhase::kWaitingForMotion && NextScanShowsTimeOffset(finishing)) {
-    snapshot_ = live_;
-    hold_start_ns_ = live_.backend().time_ns();
+    snapshot_ = pipeline_;
+    hold_start_ns_ = pipeline_.backend().time_ns();
     phase_ = ReplayPhase::kHolding;
   }
   const bool holding = phase_ == ReplayPhase::kHolding;
   const size_t first_new = out->size();
-  if (!live_.ProcessNext(finishing, holding ? &held_ : out)) return false;
+  if (!pipeline_.ProcessNext(finishing, holding ? &held_ : out)) return false;
   if (holding)
     EndHoldIfDue(out);
   else if (!held_cost_ms_.empty())
@@ -67,8 +67,8 @@ bool IeskfOdometry::Step(bool finishing, std::vector<ScanResult>* out) {
 }
 
 void IeskfOdometry::EndHoldIfDue(std::vector<ScanResult>* out) {
-  if (!live_.status().ok()) return GiveUpReplay(out);
-  const IeskfBackend& backend = live_.backend();
+  if (!pipeline_.status().ok()) return GiveUpReplay(out);
+  const IeskfBackend& backend = pipeline_.backend();
   if (backend.time_offset_std_s() < options_.lidar.time_offset_replay_std) return Replay();
   if (NsToSeconds(backend.time_ns() - hold_start_ns_) >= options_.lidar.time_offset_replay)
     GiveUpReplay(out);
@@ -78,19 +78,19 @@ void IeskfOdometry::EndHoldIfDue(std::vector<ScanResult>* out) {
 // (uncorrelated with the state at the snapshot, which the scans at rest
 // did not tie to it); the following Steps re-process the kept input.
 void IeskfOdometry::Replay() {
-  const IeskfBackend& converged = live_.backend();
+  const IeskfBackend& converged = pipeline_.backend();
   snapshot_->backend().filter().SetTimeOffset(converged.time_offset_s(),
                                               converged.time_offset_std_s());
   snapshot_->DropScansBeforeState();
   // The snapshot queues the scans the hold processed (less those the new
   // shift dropped) and those the live pipeline still queues: the difference
   // is the scans processed again.
-  const size_t queued_in_both = live_.scans().size();
+  const size_t queued_in_both = pipeline_.scans().size();
   const size_t queued_in_snapshot = snapshot_->scans().size();
   const size_t replayed = queued_in_snapshot > queued_in_both ? queued_in_snapshot - queued_in_both : 0;
   snapshot_->SetReplayedScans(static_cast<int64_t>(replayed));
   CarryHeldCost(replayed);
-  live_ = std::move(*snapshot_);
+  pipeline_ = std::move(*snapshot_);
   snapshot_.reset();
   held_.clear();
   phase_ = ReplayPhase::kOver;

@@ -24,7 +24,7 @@ namespace rvlio {
 // and the next scan that shows the offset starts a new hold (at most three
 // holds). One replay per run.
 // Each scan's result is emitted once, in order.
-class IeskfOdometry : public Odometry {
+class IeskfOdometry : public PipelineOdometry<IeskfBackend> {
  public:
   IeskfOdometry(const OdometryOptions& options, Localization localization = {});
 
@@ -33,16 +33,10 @@ class IeskfOdometry : public Odometry {
   void Poll(std::vector<ScanResult>* out) override;
   void Finish(std::vector<ScanResult>* out) override;
 
-  const OdometryStats& stats() const override { return live_.stats(); }
-  std::vector<std::string> warnings() const override { return live_.warnings(); }
-  const DivergenceReport& divergence() const override { return live_.divergence(); }
-  std::vector<Eigen::Vector3d> MapPoints() const override { return live_.MapPoints(); }
-  const Status& status() const override { return live_.status(); }
-
  private:
   using Pipeline = ScanPipeline<IeskfBackend>;
   enum class ReplayPhase { kWaitingForMotion, kHolding, kOver };
-  // True when the live pipeline's next ProcessNext would process a scan
+  // True when the live pipeline's (pipeline_) next ProcessNext would process a scan
   // whose update estimates the offset (the motion shows it,
   // Ieskf::TimeOffsetObservableAt).
   bool NextScanShowsTimeOffset(bool finishing) const;
@@ -54,7 +48,6 @@ class IeskfOdometry : public Odometry {
   void AddHeldCost(size_t first_new, std::vector<ScanResult>* out);
 
   OdometryOptions options_;
-  Pipeline live_;
   ReplayPhase phase_ = ReplayPhase::kOver;
   std::optional<Pipeline> snapshot_;  // kHolding: before the first moving scan, with the input since
   TimeNs hold_start_ns_ = 0;          // kHolding: the state's time at the snapshot

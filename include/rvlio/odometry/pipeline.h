@@ -155,7 +155,7 @@ class ScanPipeline {
 };
 
 // An Odometry that is its pipeline (the smoother; the IESKF adds its replay:
-// odometry/ieskf_odometry.h).
+// IeskfOdometry, odometry/ieskf_odometry.h, over the pipeline_ held here).
 template <class Backend>
 class PipelineOdometry : public Odometry {
  public:
@@ -181,8 +181,8 @@ class PipelineOdometry : public Odometry {
   std::vector<Eigen::Vector3d> MapPoints() const override { return pipeline_.MapPoints(); }
   const Status& status() const override { return pipeline_.status(); }
 
- private:
-  ScanPipeline<Backend> pipeline_;
+ protected:
+  ScanPipeline<Backend> pipeline_;  // the live one
 };
 
 }  // namespace rvlio
