@@ -18,6 +18,7 @@
 #include "rvlio/math/pose.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/options.h"
+#include "rvlio/odometry/reference.h"  // Localization
 #include "rvlio/degeneracy/degeneracy.h"
 #include "rvlio/rv/rv.h"
 
