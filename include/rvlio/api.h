@@ -31,6 +31,7 @@
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/config/config.h"
 #include "rvlio/formats/control_file.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/formats/sensor_stream.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/odometry.h"
@@ -83,8 +84,10 @@ struct RunArgs {
   // `bag` then only names it in summary.json.
   SensorBagReader* source = nullptr;
   // Called on the calling thread with each scan result as it is estimated
-  // (in order, once each), with the odometry that made it.
-  std::function<void(const ScanResult&, const Odometry&)> on_result;
+  // (in order, once each), in the user's frame (as trajectory.tum), with the
+  // odometry that made it and the odometry's local frame (where its
+  // MapPoints are) relative to the user's frame (math/local_origin.h).
+  std::function<void(const ScanResult&, const Odometry&, const LocalOrigin&)> on_result;
   // Called with summary.json before it is written (e.g. `live` adds its figures).
   std::function<void(nlohmann::json* summary)> annotate_summary;
 };

@@ -209,16 +209,19 @@ std::string NoScanMessage(const std::string& bag, const OdometryOptions& o,
   return text;
 }
 
-// Appends the poses of the results not streamed yet to trajectory.partial.tum,
-// in the user's frame (the estimation's local frame plus `origin`, as
-// trajectory.tum), and hands them to `on_result` (in the local frame, as the
-// odometry it also hands over); a write error stops the streaming with one
-// warning (the run goes on).
+// Appends the poses of the results not streamed yet to trajectory.partial.tum
+// and hands the results to `on_result`, both in the user's frame (the
+// estimation's local frame plus `origin`, as trajectory.tum); a write error
+// stops the streaming with one warning (the run goes on).
 void StreamNewPoses(const std::vector<ScanResult>& results, const LocalOrigin& origin,
                     const RunArgs& args, const Odometry& odo,
                     size_t* streamed, TumStream* stream, std::vector<std::string>* warnings) {
   for (; *streamed < results.size(); ++*streamed) {
-    if (args.on_result) args.on_result(results[*streamed], odo);
+    if (args.on_result) {
+      ScanResult user = results[*streamed];
+      user.T_world_imu.t = origin.ToUser(user.T_world_imu.t);
+      args.on_result(user, odo, origin);
+    }
     if (!stream->is_open()) continue;
     StampedPose pose;
     pose.t_ns = results[*streamed].t_ns;

@@ -114,7 +114,9 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   // recording, so the outputs hold every scan received, as `run` on a
   // recording of the same messages.
   run.progress = args.progress;
-  run.on_result = [&publisher](const ScanResult& r, const Odometry& odo) { publisher.OnResult(r, odo); };
+  run.on_result = [&publisher](const ScanResult& r, const Odometry& odo, const LocalOrigin& origin) {
+    publisher.OnResult(r, odo, origin);
+  };
   LiveFigures figures;
   figures.middleware = args.middleware == LiveMiddleware::kRos1 ? "ros1" : "ros2";
   figures.origin = net.origin();

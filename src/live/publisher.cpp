@@ -86,7 +86,8 @@ void LivePublisher::OnImu(const ImuSample& sample) {
   last_output_ = now;
 }
 
-void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometry) {
+void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometry,
+                             const LocalOrigin& origin) {
   ImuKinematics state;
   state.t_ns = r.t_ns;
   state.R_world_imu = r.T_world_imu.R;
@@ -133,7 +134,7 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
     transport_->Publish(path_);
   }
   PublishStatus(r);
-  PublishMap(r.t_ns, odometry);
+  PublishMap(r.t_ns, odometry, origin);
 }
 
 // The scan deskewed to its end by the IMU motion around the estimate (the
@@ -158,11 +159,13 @@ void LivePublisher::PublishRegisteredScan(const ScanResult& r, const Scan& scan,
   transport_->Publish(CloudTopic::kRegisteredScan, cloud.view, options_.live.odom_frame);
 }
 
-void LivePublisher::PublishMap(TimeNs t_ns, const rvlio::Odometry& odometry) {
+void LivePublisher::PublishMap(TimeNs t_ns, const rvlio::Odometry& odometry,
+                               const LocalOrigin& origin) {
   const double period_s = options_.live.map_period;
   if (period_s <= 0.0 || (last_map_ns_ >= 0 && t_ns - last_map_ns_ < SecondsToNs(period_s))) return;
   last_map_ns_ = t_ns;
-  const std::vector<Eigen::Vector3d> p_world = odometry.MapPoints();
+  std::vector<Eigen::Vector3d> p_world = odometry.MapPoints();
+  origin.ToUser(&p_world);
   XyziCloud cloud(t_ns, p_world.size());
   for (size_t i = 0; i < p_world.size(); ++i) cloud.Set(i, p_world[i], 0.0f);
   transport_->Publish(CloudTopic::kMap, cloud.view, options_.live.odom_frame);
