@@ -224,7 +224,8 @@ StatusOr<OusterMetadata> SimulatedMetadata(const sim::Simulator& simulator, std:
 // `--format ouster-bag` (packet_bag): the same packets, received at the same
 // times, in the ROS1 bag NAME.bag as the ROS driver records them
 // (ouster_ros/PacketMsg on /ouster/lidar_packets and /ouster/imu_packets,
-// the metadata JSON on /ouster/metadata before them), and NAME.json.
+// the metadata JSON on /ouster/metadata before them), and NAME.json;
+// cloud_bag_path is then unused.
 Status WriteOusterCapture(const sim::Simulator& simulator, bool packet_bag,
                           const std::string& recording_path, const std::string& json_path,
                           const std::string& cloud_bag_path,
@@ -491,8 +492,9 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   const Status written =
       OusterFormat(args.format)
           ? WriteOusterCapture(**simulator, args.format == "ouster-bag", staged_recording,
-                               stage.Path(name + ".json"), stage.Path(name + ".bag"), on_truth,
-                               args.stop, &r.stop_reason)
+                               stage.Path(name + ".json"),
+                               args.format == "ouster-pcap" ? stage.Path(name + ".bag") : "",
+                               on_truth, args.stop, &r.stop_reason)
           : WriteBag(**simulator, staged_recording, livox, format, on_truth, *fixes, args.stop,
                      &r.stop_reason);
   if (!written.ok()) return stage.Explain(written);

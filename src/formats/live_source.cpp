@@ -122,10 +122,13 @@ class LiveSensorSource::Decoder {
   }
 
  private:
+  // "... carries T, expected A, B or C".
   static Status WrongType(const std::string& where, const std::string& type,
                           const std::vector<std::string>& expected) {
-    return Status::InvalidInput(where + " carries " + type + ", expected " +
-                                Join(expected, " or "));
+    std::vector<std::string> head(expected.begin(), expected.end() - 1);
+    const std::string list =
+        head.empty() ? expected.back() : Join(head, ", ") + " or " + expected.back();
+    return Status::InvalidInput(where + " carries " + type + ", expected " + list);
   }
   Status InOrigin(const Status& s) const {
     return Status::InvalidInput(s.message() + " (" + origin_ + ")");
