@@ -26,6 +26,20 @@ int LidarDepth(const std::optional<OusterMetadata>& ouster) {
   return kLidarDepth * ((ouster->WindowColumns() + per_packet - 1) / per_packet);
 }
 
+// The sensor of Ouster packet topics (lidar.ouster_metadata, when given),
+// read before connecting; it gives the default extrinsic as it does to
+// `run` on a packet recording (*notes says so).
+Status LoadOusterSensor(Configuration* options, std::optional<OusterMetadata>* ouster,
+                        std::vector<std::string>* notes) {
+  const std::string& path = options->lidar.ouster_metadata;
+  if (path.empty()) return Status::Ok();
+  StatusOr<OusterMetadata> meta = ReadOusterMetadataFile(path);
+  if (!meta.ok()) return meta.status();
+  *ouster = std::move(meta).value();
+  ApplyOusterExtrinsics(**ouster, path, &options->extrinsics, notes);
+  return Status::Ok();
+}
+
 nlohmann::json LiveJson(const LiveFigures& f) {
   return {{"middleware", f.middleware},
           {"origin", f.origin},
@@ -58,16 +72,9 @@ StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args,
 StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   Configuration options = args.options;
   if (Status s = options.Validate(); !s.ok()) return s;
-  // The sensor of Ouster packet topics, read before connecting; it gives the
-  // default extrinsic as it does to `run` on a packet recording.
   std::optional<OusterMetadata> ouster;
   std::vector<std::string> notes;
-  if (!options.lidar.ouster_metadata.empty()) {
-    StatusOr<OusterMetadata> meta = ReadOusterMetadataFile(options.lidar.ouster_metadata);
-    if (!meta.ok()) return meta.status();
-    ouster = std::move(meta).value();
-    ApplyOusterExtrinsics(*ouster, options.lidar.ouster_metadata, &options.extrinsics, &notes);
-  }
+  if (Status s = LoadOusterSensor(&options, &ouster, &notes); !s.ok()) return s;
   if (!args.out_dir.empty()) {  // an unusable output folder is refused before connecting
     OutputFolder check(args.out_dir);  // removes again what it created
     if (Status s = check.Prepare(); !s.ok()) return s;
