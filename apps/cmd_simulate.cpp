@@ -69,7 +69,7 @@ CommandSpec SimulateSpec() {
            SetOption(),
            {"out", "DIR", "output directory (created if missing)", true, false},
            {"name", "NAME", "output file stem (default: the preset name)", false, false},
-           {"format", "FMT", "bag (ROS1, default), mcap or db3 (ROS 2), ouster-pcap (NAME.pcap + NAME.json Ouster packets, and NAME.bag with the same quantized data)", false, false},
+           {"format", "FMT", "bag (ROS1, default), mcap or db3 (ROS 2), ouster-pcap (NAME.pcap + NAME.json Ouster packets, and NAME.bag with the same quantized data), ouster-bag (NAME.bag: the packets as the ROS1 driver records them, + NAME.json)", false, false},
            {"mcap-compression", "C",
             "MCAP chunks: zstd (default), lz4, none, or unchunked", false, false}}};
 }

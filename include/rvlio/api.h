@@ -241,7 +241,7 @@ struct SimulateArgs {
   std::string lidar_msg = "pointcloud2"; // or "livox"
   std::string out_dir;                   // created if missing (required)
   std::string name;                      // file stem (default: the preset)
-  std::string format = "bag";            // bag (ROS1) | mcap | db3
+  std::string format = "bag";            // bag (ROS1) | mcap | db3 | ouster-pcap | ouster-bag
   std::string mcap_compression = "zstd"; // zstd | lz4 | none | unchunked (mcap only)
   StopFn stop;                           // a stop leaves no recording
   // Called with the path the recording is written to before it is moved
