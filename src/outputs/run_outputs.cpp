@@ -10,6 +10,7 @@
 #include "rvlio/common/text.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/formats/trajectory_io.h"
 #include "rvlio/math/local_origin.h"
 #include "rvlio/outputs/scan_columns.h"
 
@@ -183,6 +184,28 @@ Trajectory ToTrajectory(const std::vector<ScanResult>& results) {
     t.push_back(p);
   }
   return t;
+}
+
+Status WriteTrajectoryOutputs(OutputStage* stage, const Trajectory& trajectory,
+                              const Trajectory& imu_trajectory) {
+  if (Status s = WriteTum(stage->Path("trajectory.tum"), trajectory); !s.ok())
+    return stage->Explain(s);
+  if (imu_trajectory.empty()) return Status::Ok();
+  if (Status s = WriteTum(stage->Path(kImuTrajectoryFile), imu_trajectory); !s.ok())
+    return stage->Explain(s);
+  return Status::Ok();
+}
+
+ImuEstimate ImuEstimateOf(const ScanResult& r) {
+  ImuEstimate e;
+  e.state.t_ns = r.t_ns;
+  e.state.R_world_imu = r.T_world_imu.R;
+  e.state.p_world_imu = r.T_world_imu.t;
+  e.state.v_world_imu = r.v_world_imu;
+  e.bg_imu = r.bg_imu;
+  e.ba_imu = r.ba_imu;
+  e.g_world = r.g_world;
+  return e;
 }
 
 TimingStats ComputeTimingStats(const std::vector<ScanResult>& results) {
