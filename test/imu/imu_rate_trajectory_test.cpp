@@ -81,7 +81,9 @@ TEST(ImuRateTrajectory, FollowsAConstantAccelerationAndRotationAndHitsEveryState
     ASSERT_EQ(poses.size(), 211u);
     size_t k = 0;
     for (size_t i = 0; i < poses.size(); ++i) {
-      if (i > 0) ASSERT_GT(poses[i].t_ns, poses[i - 1].t_ns);
+      if (i > 0) {
+        ASSERT_GT(poses[i].t_ns, poses[i - 1].t_ns);
+      }
       const ImuKinematics want = Truth(poses[i].t_ns);
       EXPECT_LT(PositionError(poses[i], want), 1e-9) << i;
       EXPECT_LT(RotationError(poses[i], want.R_world_imu), 1e-9) << i;
