@@ -19,7 +19,7 @@
 #include "rvlio/math/so3.h"
 
 namespace rvlio {
-namespace {
+namespace imu_trajectory_cli {  // named: the test folder compiles as one unit (unity build)
 
 using testing_cli::ReadFile;
 using testing_cli::RunTool;
@@ -156,5 +156,5 @@ TEST_F(ImuTrajectoryCli, RunRefineAndMergeWriteTheImuRateTrajectoryOnlyWhenAsked
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/broken"));
 }
 
-}  // namespace
+}  // namespace imu_trajectory_cli
 }  // namespace rvlio

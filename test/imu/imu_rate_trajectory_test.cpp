@@ -13,7 +13,7 @@
 #include "rvlio/math/so3.h"
 
 namespace rvlio {
-namespace {
+namespace imu_rate_test {  // named: the test folder compiles as one unit (unity build)
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
@@ -208,5 +208,5 @@ TEST(ImuRateTrajectory, StreamingEqualsTheWholeAndIgnoresStraySamplesAndStates) 
   }
 }
 
-}  // namespace
+}  // namespace imu_rate_test
 }  // namespace rvlio
