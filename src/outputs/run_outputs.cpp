@@ -196,18 +196,6 @@ Status WriteTrajectoryOutputs(OutputStage* stage, const Trajectory& trajectory,
   return Status::Ok();
 }
 
-ImuEstimate ImuEstimateOf(const ScanResult& r) {
-  ImuEstimate e;
-  e.state.t_ns = r.t_ns;
-  e.state.R_world_imu = r.T_world_imu.R;
-  e.state.p_world_imu = r.T_world_imu.t;
-  e.state.v_world_imu = r.v_world_imu;
-  e.bg_imu = r.bg_imu;
-  e.ba_imu = r.ba_imu;
-  e.g_world = r.g_world;
-  return e;
-}
-
 TimingStats ComputeTimingStats(const std::vector<ScanResult>& results) {
   TimingStats s;
   if (results.empty()) return s;

@@ -8,7 +8,6 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
-#include "rvlio/imu/propagator.h"
 #include "rvlio/odometry/deviation.h"
 #include "rvlio/odometry/odometry.h"
 #include "rvlio/outputs/output_stage.h"
@@ -68,10 +67,6 @@ inline constexpr const char* kImuTrajectoryFile = "trajectory_imu.tum";
 // is not empty (run, refine, merge). The error is the stage's explanation.
 Status WriteTrajectoryOutputs(OutputStage* stage, const Trajectory& trajectory,
                               const Trajectory& imu_trajectory);
-
-// The state of a scan result for propagating the pose at IMU rate from it
-// (imu/propagator.h, imu/imu_rate_trajectory.h).
-ImuEstimate ImuEstimateOf(const ScanResult& result);
 
 // Median, 95th percentile and maximum of the per-scan processing times, ms.
 struct TimingStats {
