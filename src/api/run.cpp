@@ -376,7 +376,8 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
             partial.Open((std::filesystem::path(args.out_dir) / kPartialTrajectory).string());
         !s.ok())
       streams.warnings.push_back(s.message() + "; the partial trajectory is not written");
-  if (args.options.output.imu_trajectory) streams.imu_rate.emplace(ImuRateJoinOf(args.options.backend));
+  if (args.options.output.imu_trajectory)
+    streams.imu_rate.emplace(ImuRateJoinOf(args.options.backend));
   const auto t0 = Clock::now();
   Process(args, origin, reader, odo->get(), &streams, &data, &result);
   data.wall_s = SecondsSince(t0);

@@ -32,8 +32,7 @@ void SpreadEndMismatch(TimeNs t0_ns, const ImuKinematics& end, std::vector<ImuKi
 }  // namespace
 
 std::vector<ImuKinematics> ImuRateBetween(const ImuEstimate& a, const ImuEstimate& b,
-                                          const std::vector<ImuSample>& samples,
-                                          ImuRateJoin join) {
+                                          const std::vector<ImuSample>& samples, ImuRateJoin join) {
   RVLIO_CHECK(b.state.t_ns > a.state.t_ns);
   if (samples.empty()) return {b.state};
   std::vector<ImuKinematics> states =

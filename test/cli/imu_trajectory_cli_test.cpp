@@ -44,8 +44,7 @@ double Ate(const Trajectory& truth, const Trajectory& est) {
 // one pose per IMU sample over the span plus the scan ends, the scan ends'
 // poses those of trajectory.tum, the error against the truth close to
 // trajectory.tum's (`slack_m`).
-void CheckImuTrajectory(const std::string& dir, const Trajectory& truth,
-                                             double slack_m) {
+void CheckImuTrajectory(const std::string& dir, const Trajectory& truth, double slack_m) {
   SCOPED_TRACE(dir);
   const Trajectory scans = Read(dir + "/trajectory.tum");
   const Trajectory imu = Read(dir + "/trajectory_imu.tum");
@@ -126,9 +125,9 @@ TEST_F(ImuTrajectoryCli, RunRefineAndMergeWriteTheImuRateTrajectoryOnlyWhenAsked
   ASSERT_EQ((r = RefineChunk(2, kImuTrajectory)).exit_code, 0) << r.err;
   CheckImuTrajectory(dir_ + "/chunk1", truth_, 0.002);
   CheckImuTrajectory(dir_ + "/chunk2", truth_, 0.002);
-  r = RunTool("merge --chunks " + dir_ + "/chunk1 --chunks " + dir_ + "/chunk2 --out " + dir_ +
-                  "/merged",
-              dir_);
+  r = RunTool(
+      "merge --chunks " + dir_ + "/chunk1 --chunks " + dir_ + "/chunk2 --out " + dir_ + "/merged",
+      dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   CheckImuTrajectory(dir_ + "/merged", truth_, 0.002);
 
@@ -148,9 +147,9 @@ TEST_F(ImuTrajectoryCli, RunRefineAndMergeWriteTheImuRateTrajectoryOnlyWhenAsked
             std::string::npos);
   // Its trajectory_imu.tum missing while its summary asks for it: exit 2 naming the file.
   std::filesystem::remove(dir_ + "/chunk2/trajectory_imu.tum");
-  r = RunTool("merge --chunks " + dir_ + "/chunk1 --chunks " + dir_ + "/chunk2 --out " + dir_ +
-                  "/broken",
-              dir_);
+  r = RunTool(
+      "merge --chunks " + dir_ + "/chunk1 --chunks " + dir_ + "/chunk2 --out " + dir_ + "/broken",
+      dir_);
   testing_cli::ExpectOneErrorLine(r, "merge", "chunk2/trajectory_imu.tum");
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/broken"));
 }

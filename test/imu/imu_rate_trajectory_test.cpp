@@ -21,10 +21,10 @@ using Eigen::Vector3d;
 constexpr TimeNs kImuNs = 5000000;     // 200 Hz
 constexpr TimeNs kScanNs = 100000000;  // 10 Hz
 const Vector3d kGravity(0.0, 0.0, -9.81);
-const Vector3d kAccWorld(0.8, -0.3, 0.2);    // m/s^2
-const Vector3d kRateImu(0.05, -0.1, 0.4);    // rad/s
-const Vector3d kV0(2.0, 0.5, -0.1);          // m/s
-const Vector3d kP0(10.0, -4.0, 1.5);         // m
+const Vector3d kAccWorld(0.8, -0.3, 0.2);  // m/s^2
+const Vector3d kRateImu(0.05, -0.1, 0.4);  // rad/s
+const Vector3d kV0(2.0, 0.5, -0.1);        // m/s
+const Vector3d kP0(10.0, -4.0, 1.5);       // m
 const Matrix3d kR0 = so3::Exp(Vector3d(0.1, -0.2, 0.7));
 
 // The true state at t_ns: R0 Exp(w t), p0 + v0 t + a t^2 / 2.
@@ -105,7 +105,8 @@ TEST(ImuRateTrajectory, StatesOnSampleStampsAreNotRepeated) {
   const Trajectory poses =
       ImuRatePoses(ScanStates(3), Samples(0, 3 * kScanNs), ImuRateJoin::kPropagate);
   ASSERT_EQ(poses.size(), 41u);  // 0 .. 200 ms at 5 ms
-  for (size_t i = 0; i < poses.size(); ++i) EXPECT_EQ(poses[i].t_ns, static_cast<TimeNs>(i) * kImuNs);
+  for (size_t i = 0; i < poses.size(); ++i)
+    EXPECT_EQ(poses[i].t_ns, static_cast<TimeNs>(i) * kImuNs);
 }
 
 // A later state off the forward integration (here 3 cm and 0.5 deg): the
@@ -139,10 +140,12 @@ TEST(ImuRateTrajectory, TheJoinsPropagateOrSpreadTheEndMismatch) {
   }
   // The last step: the whole mismatch for the propagated poses, 1/20 of it spread.
   EXPECT_NEAR((propagated[19].p_world_imu - propagated[18].p_world_imu -
-               (Truth(kScanNs).p_world_imu - Truth(19 * kImuNs).p_world_imu)).norm(),
+               (Truth(kScanNs).p_world_imu - Truth(19 * kImuNs).p_world_imu))
+                  .norm(),
               dp.norm(), 1e-9);
   EXPECT_NEAR((spread[19].p_world_imu - spread[18].p_world_imu -
-               (Truth(kScanNs).p_world_imu - Truth(19 * kImuNs).p_world_imu)).norm(),
+               (Truth(kScanNs).p_world_imu - Truth(19 * kImuNs).p_world_imu))
+                  .norm(),
               dp.norm() / 20.0, 1e-9);
 }
 

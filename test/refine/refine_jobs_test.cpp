@@ -141,10 +141,11 @@ TEST(MergeAlignedTrajectories, MergesDenserTrajectoriesAsTheScanPoses) {
   const double noise_m = 0.002;
   const std::vector<RefineJobTrajectory> dense = ChunksOfTruth(3, 4.0, noise_m, kPeriod / 5);
   std::vector<RefineJobTrajectory> scans = dense;
+  const auto between_scans = [](const StampedPose& p) { return (p.t_ns - kJobsT0) % kPeriod != 0; };
   for (RefineJobTrajectory& c : scans)
-    c.trajectory.erase(std::remove_if(c.trajectory.begin(), c.trajectory.end(),
-                                      [](const StampedPose& p) { return (p.t_ns - kJobsT0) % kPeriod != 0; }),
-                       c.trajectory.end());
+    c.trajectory.erase(
+        std::remove_if(c.trajectory.begin(), c.trajectory.end(), between_scans),
+        c.trajectory.end());
   const StatusOr<RefineJobMerge> merged = MergeRefineJobs(scans);
   ASSERT_TRUE(merged.ok()) << merged.status().message();
   const StatusOr<Trajectory> merged_dense = MergeAlignedTrajectories(dense, merged->alignments);
@@ -155,14 +156,15 @@ TEST(MergeAlignedTrajectories, MergesDenserTrajectoriesAsTheScanPoses) {
   size_t at_scans = 0;
   for (const StampedPose& p : *merged_dense) {
     EXPECT_LT((p.p_world_imu - T1 * TruthAt(p.t_ns).p_world_imu).norm(), 5.0 * noise_m);
-    if ((p.t_ns - kJobsT0) % kPeriod != 0) continue;
+    if (between_scans(p)) continue;
     const StampedPose& s = merged->trajectory[at_scans++];
     ASSERT_EQ(s.t_ns, p.t_ns);
     EXPECT_EQ(s.p_world_imu, p.p_world_imu);
     EXPECT_EQ(s.q_world_imu.coeffs(), p.q_world_imu.coeffs());
   }
   EXPECT_EQ(at_scans, merged->trajectory.size());
-  const std::vector<RefineJobAlignment> two(merged->alignments.begin(), merged->alignments.begin() + 2);
+  const std::vector<RefineJobAlignment> two(merged->alignments.begin(),
+                                            merged->alignments.begin() + 2);
   EXPECT_EQ(MergeAlignedTrajectories(dense, two).status().code(), StatusCode::kInvalidInput);
 }
 

@@ -42,8 +42,7 @@ enum class ImuRateJoin {
 // them, as the integrator does); may be empty (then b's state only).
 // b.state.t_ns must be later than a.state.t_ns.
 std::vector<ImuKinematics> ImuRateBetween(const ImuEstimate& a, const ImuEstimate& b,
-                                          const std::vector<ImuSample>& samples,
-                                          ImuRateJoin join);
+                                          const std::vector<ImuSample>& samples, ImuRateJoin join);
 
 // Builds the trajectory as samples and states arrive (a run's results come
 // after the IMU samples covering them): the poses up to each state are
