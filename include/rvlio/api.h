@@ -96,6 +96,10 @@ struct RunResult {
   std::vector<ScanResult> scans;  // one per processed scan (the rows of scans.csv)
   std::vector<double> rss_mb;     // process resident memory when each scan was done, MB
   Trajectory trajectory;          // T_world_imu at each scan end (trajectory.tum)
+  // With output.imu_trajectory: T_world_imu at every IMU sample from the
+  // first scan end to the last and at every scan end (trajectory_imu.tum,
+  // imu/imu_rate_trajectory.h); empty otherwise.
+  Trajectory imu_trajectory;
   // The figures summary.json writes under the same names, typed: read these,
   // not the JSON.
   double sequence_duration_s = 0.0;  // first to last message read
@@ -160,6 +164,9 @@ struct RefineArgs {
 
 struct RefineRunResult {
   RefineResult refine;          // trajectory, map points, rounds, stats, warnings
+  // With output.imu_trajectory: the refined trajectory at IMU rate
+  // (trajectory_imu.tum, as RunResult::imu_trajectory); empty otherwise.
+  Trajectory imu_trajectory;
   DivergenceReport divergence;  // the checks of the refined result
   nlohmann::json summary;       // summary.json
   bool stopped = false;         // `stop` ended it (after a round, or while reading)
@@ -207,6 +214,9 @@ nlohmann::json MergedChunkJson(const MergedChunk& chunk);
 
 struct MergeResult {
   Trajectory trajectory;                    // T_world_imu, the merged frame is chunk 1's
+  // The chunks' trajectory_imu.tum merged as `trajectory` (when every chunk
+  // wrote one: output.imu_trajectory); empty otherwise.
+  Trajectory imu_trajectory;
   std::vector<Eigen::Vector3d> map_points;  // the chunks' maps carried into that frame, re-voxelized
   std::vector<MergedChunk> chunks;          // in order 1..N
   nlohmann::json summary;                   // summary.json

@@ -88,18 +88,14 @@ void LivePublisher::OnImu(const ImuSample& sample) {
 
 void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometry,
                              const LocalOrigin& origin) {
-  ImuKinematics state;
-  state.t_ns = r.t_ns;
-  state.R_world_imu = r.T_world_imu.R;
-  state.p_world_imu = r.T_world_imu.t;
-  state.v_world_imu = r.v_world_imu;
+  const ImuEstimate estimate = ImuEstimateOf(r);
   std::optional<LiveScanArrival> arrival = source_->TakeArrival(r.t_ns);
   std::vector<ImuSample> imu;
   Eigen::Vector3d gyro_imu = Eigen::Vector3d::Zero();
   OdometryMessage message;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    propagator_.SetEstimate(ImuEstimate{state, r.bg_imu, r.ba_imu, r.g_world});
+    propagator_.SetEstimate(estimate);
     bg_imu_ = r.bg_imu;
     pose_covariance_.fill(0.0);
     if (r.pose_covariance_world)
@@ -107,7 +103,7 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
           *r.pose_covariance_world;
     if (arrival) imu = propagator_.Covering(arrival->scan.t_start_ns, r.t_ns);
     if (!imu.empty()) gyro_imu = InterpolateImu(imu, r.t_ns).gyro_imu - r.bg_imu;
-    message = Odometry(r.t_ns, state, gyro_imu);
+    message = Odometry(r.t_ns, estimate.state, gyro_imu);
   }
   transport_->Publish(OdometryTopic::kScanRate, message);
   if (options_.live.publish_tf) {
@@ -142,13 +138,9 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
 // the IMU samples), in the world frame at the estimated pose.
 void LivePublisher::PublishRegisteredScan(const ScanResult& r, const Scan& scan,
                                           const std::vector<ImuSample>& imu) {
-  ImuKinematics end;
-  end.t_ns = r.t_ns;
-  end.R_world_imu = r.T_world_imu.R;
-  end.p_world_imu = r.T_world_imu.t;
-  end.v_world_imu = r.v_world_imu;
-  const ImuPoseHistory history =
-      ImuPoseHistory::Integrate(end, imu, scan.t_start_ns, r.bg_imu, r.ba_imu, r.g_world);
+  const ImuPoseHistory history = ImuPoseHistory::Integrate(ImuEstimateOf(r).state, imu,
+                                                           scan.t_start_ns, r.bg_imu, r.ba_imu,
+                                                           r.g_world);
   const Pose3 T_imu_lidar = r.T_imu_lidar.value_or(T_imu_lidar_config_);
   std::vector<Eigen::Vector3d> p_lidar_end;
   DeskewToScanEnd(history.samples(), T_imu_lidar, scan.points, r.t_ns, &p_lidar_end);
