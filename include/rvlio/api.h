@@ -204,7 +204,9 @@ nlohmann::json MergedChunkJson(const MergedChunk& chunk);
 
 struct MergeResult {
   Trajectory trajectory;                    // T_world_imu, the merged frame is chunk 1's
-  std::vector<Eigen::Vector3d> map_points;  // the chunks' maps carried into that frame, re-voxelized
+  // The chunks' maps carried into that frame, re-voxelized, with the
+  // attributes they have (scan_index: rows of `trajectory`).
+  MapCloud map;
   std::vector<MergedChunk> chunks;          // in order 1..N
   nlohmann::json summary;                   // summary.json
   std::vector<std::string> warnings;        // the chunks' warnings, each once

@@ -153,14 +153,14 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   return j;
 }
 
-Status WriteOutputs(const std::string& out_dir, const std::vector<Eigen::Vector3d>& p_map,
+Status WriteOutputs(const std::string& out_dir, const MapCloud& map,
                     const RunResult& result, const MapDeviation* deviation,
                     const MapLasRequest& las) {
   OutputStage stage(out_dir);
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTum(stage.Path("trajectory.tum"), result.trajectory); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteMapOutputs(&stage, p_map, deviation, las); !s.ok()) return s;
+  if (Status s = WriteMapOutputs(&stage, map, deviation, las); !s.ok()) return s;
   if (Status s = WriteScansCsv(stage.Path("scans.csv"), result.scans, result.rss_mb); !s.ok())
     return stage.Explain(s);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(result.summary) + "\n");
@@ -382,14 +382,14 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
         NoScanMessage(args.bag, args.options, reader_stats, (*odo)->stats()));
   }
   SetFigures(data, &result);
-  std::vector<Eigen::Vector3d> p_map;  // the output map, when written or compared
-  if (write || reference != nullptr) p_map = (*odo)->MapPoints();
+  MapCloud map;  // the output map, when written or compared
+  if (write || reference != nullptr) map = (*odo)->MapWithAttributes();
   std::optional<MapDeviation> deviation;  // in the local frame, as the reference
   if (reference != nullptr)
-    deviation = ComputeMapDeviation(p_map, *reference, ToTrajectory(result.scans),
+    deviation = ComputeMapDeviation(map.p, *reference, ToTrajectory(result.scans),
                                     args.options.localization.deviation);
   MoveToUserFrame(origin, &result.scans);
-  origin.ToUser(&p_map);
+  origin.ToUser(&map.p);
   result.trajectory = ToTrajectory(result.scans);
   result.summary = Summary(args, **odo, reader_stats, data, result);
   result.summary["local_origin"] = LocalOriginJson(origin);
@@ -397,7 +397,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   if (args.annotate_summary) args.annotate_summary(&result.summary);
   if (!write) return result;
   const Status written =
-      WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr, *las);
+      WriteOutputs(args.out_dir, map, result, deviation ? &*deviation : nullptr, *las);
   partial.Remove();  // the complete outputs (or the folder as it was) replace it
   if (!written.ok()) return written;  // out_folder removes a folder it created
   out_folder.Keep();

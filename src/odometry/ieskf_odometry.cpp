@@ -425,7 +425,9 @@ void IeskfPipeline::InsertIntoMap(TimeNs t_ns, bool provisional) {
       options_.lidar.estimate_time_offset ? filter_.ScanTimeImuPose() : x.T_world_imu();
   const std::vector<Eigen::Vector3d>& p_world =
       map_.InsertScan(t_ns, T_world_imu, x.T_imu_lidar(), p_lidar_end_);
-  if (!provisional) output_map_.Insert(p_world);
+  // This scan's result is the next one out: its index is the count so far.
+  if (!provisional)
+    output_map_.InsertScan(p_world, downsampled_, static_cast<uint32_t>(stats_.scans_processed));
 }
 
 }  // namespace rvlio

@@ -4,6 +4,7 @@
 
 #include <utility>
 
+#include "rvlio/common/check.h"
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/common/parallel.h"
 #include "rvlio/constraints/plane_association.h"
@@ -111,7 +112,7 @@ void SmootherOdometry::Finish(std::vector<ScanResult>* out) {
   for (int k = 0; k < window_->size(); ++k) {
     TransformPoints(window_->ScanTimeImuPose(k) * CurrentTImuLidar(), window_->points(k),
                     &p_world_);
-    output_map_.Insert(p_world_);
+    InsertIntoOutputMap(window_->state(k).t_ns, p_world_);
   }
 }
 
@@ -152,6 +153,7 @@ void SmootherOdometry::ProcessFrontScan(std::vector<ScanResult>* out) {
     r.map_overlap = localizer_.start_overlap();
     r.localized = true;
   }
+  pending_.push_back({scan.t_end_ns, static_cast<uint32_t>(stats_.scans_processed), downsampled_});
   SetNewestFromWindow();
   MarginalizeIfFull();
   ReportExtrinsic(&r);
@@ -294,13 +296,23 @@ void SmootherOdometry::MarginalizeIfFull() {
   stats_.marginalization_ms += ThreadCpuMs() - start_ms;
   window_filled_ = true;
   if (options_.smoother.map_update == "marginalized") {
-    output_map_.Insert(
-        map_.InsertScan(m->state.t_ns, m->scan_T_world_imu, CurrentTImuLidar(), m->p_lidar));
+    InsertIntoOutputMap(m->state.t_ns, map_.InsertScan(m->state.t_ns, m->scan_T_world_imu,
+                                                       CurrentTImuLidar(), m->p_lidar));
   } else {
     TransformPoints(m->scan_T_world_imu * CurrentTImuLidar(), m->p_lidar, &p_world_);
-    output_map_.Insert(p_world_);
+    InsertIntoOutputMap(m->state.t_ns, p_world_);
   }
   stats_.marginalization_failures = window_->stats().marginalization_failures;
+}
+
+// Entries of states older than this one left the window unmarginalized: dropped.
+void SmootherOdometry::InsertIntoOutputMap(TimeNs state_t_ns,
+                                           const std::vector<Eigen::Vector3d>& p_world) {
+  while (!pending_.empty() && pending_.front().t_ns < state_t_ns) pending_.pop_front();
+  RVLIO_CHECK_MSG(!pending_.empty() && pending_.front().t_ns == state_t_ns,
+                  "smoother: a window state without its scan's returns");
+  output_map_.InsertScan(p_world, pending_.front().returns, pending_.front().scan_index);
+  pending_.pop_front();
 }
 
 Pose3 SmootherOdometry::CurrentTImuLidar() const {

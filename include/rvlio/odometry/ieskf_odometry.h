@@ -40,6 +40,7 @@ class IeskfPipeline {
   std::vector<std::string> warnings() const;
   const DivergenceReport& divergence() const { return monitor_.report(); }
   std::vector<Eigen::Vector3d> MapPoints() const { return output_map_.Points(); }
+  MapCloud MapWithAttributes() const { return output_map_.Cloud(); }
   const Status& status() const { return status_; }
   const Ieskf& filter() const { return filter_; }
 
@@ -117,6 +118,7 @@ class IeskfOdometry : public Odometry {
   std::vector<std::string> warnings() const override { return live_.warnings(); }
   const DivergenceReport& divergence() const override { return live_.divergence(); }
   std::vector<Eigen::Vector3d> MapPoints() const override { return live_.MapPoints(); }
+  MapCloud MapWithAttributes() const override { return live_.MapWithAttributes(); }
   const Status& status() const override { return live_.status(); }
 
   const FilterState& state() const { return live_.filter().state(); }

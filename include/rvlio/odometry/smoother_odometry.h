@@ -53,6 +53,7 @@ class SmootherOdometry : public Odometry {
   const DivergenceReport& divergence() const override { return monitor_.report(); }
   std::vector<std::string> warnings() const override;
   std::vector<Eigen::Vector3d> MapPoints() const override { return output_map_.Points(); }
+  MapCloud MapWithAttributes() const override { return output_map_.Cloud(); }
   const Status& status() const override { return status_; }
 
   // Null before static initialization.
@@ -76,6 +77,9 @@ class SmootherOdometry : public Odometry {
   // State k's scan at its IMU pose of the scan time (SlidingWindow::ScanTimeImuPose).
   void InsertIntoWorkingMap(int k, const std::vector<Eigen::Vector3d>& p_lidar);
   void MarginalizeIfFull();
+  // State k's (or the marginalized state's) points into the output map at
+  // T_world_lidar, with the attributes of its scan (pending_).
+  void InsertIntoOutputMap(TimeNs state_t_ns, const std::vector<Eigen::Vector3d>& p_world);
   void SetNewestFromWindow();
   Pose3 CurrentTImuLidar() const;  // the window's extrinsic (estimate or configured)
   void ReportExtrinsic(ScanResult* r);  // smoother.estimate_extrinsics: stats_.extrinsic, r->T_imu_lidar
@@ -108,6 +112,15 @@ class SmootherOdometry : public Odometry {
   Eigen::Vector3d ba_ = Eigen::Vector3d::Zero();
   bool window_filled_ = false;  // a state has been marginalized
   bool flushed_ = false;        // window states written to the output map
+  // The downsampled returns of the scans whose states are in the window (the
+  // attributes of their points for the output map) and their results'
+  // indices, oldest first; a state's entry leaves when it enters the output map.
+  struct PendingScan {
+    TimeNs t_ns;  // the state's time
+    uint32_t scan_index;
+    Scan returns;
+  };
+  std::deque<PendingScan> pending_;
   // Per-scan workspaces, reused.
   Scan downsampled_;
   std::vector<Eigen::Vector3d> p_lidar_end_;

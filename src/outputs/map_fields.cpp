@@ -1,0 +1,52 @@
+#include "rvlio/outputs/map_fields.h"
+
+namespace rvlio {
+namespace {
+
+constexpr MapFieldSpec kSpecs[] = {
+    {MapField::kIntensity, "intensity", 'F', 4},
+    {MapField::kTime, "time", 'F', 8},
+    {MapField::kRing, "ring", 'U', 2},
+    {MapField::kScanIndex, "scan_index", 'U', 4},
+    {MapField::kDeviation, "deviation_m", 'F', 4},
+};
+
+bool Has(const MapCloud& map, MapField f, bool with_deviation) {
+  switch (f) {
+    case MapField::kIntensity: return map.has_intensity;
+    case MapField::kTime: return map.has_time;
+    case MapField::kRing: return map.has_ring;
+    case MapField::kScanIndex: return map.has_scan_index;
+    case MapField::kDeviation: return with_deviation;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<MapFieldSpec> MapAttributeFields(const MapCloud& map, bool with_deviation) {
+  std::vector<MapFieldSpec> out;
+  for (const MapFieldSpec& s : kSpecs)
+    if (Has(map, s.field, with_deviation)) out.push_back(s);
+  return out;
+}
+
+const MapFieldSpec* MapFieldByName(const std::string& name) {
+  for (const MapFieldSpec& s : kSpecs)
+    if (name == s.name) return &s;
+  return nullptr;
+}
+
+double MapFieldValue(MapField f, const MapCloud& map, const std::vector<double>* deviation_m,
+                     size_t i) {
+  switch (f) {
+    case MapField::kIntensity: return map.intensity[i];
+    case MapField::kTime: return NsToSeconds(map.t_ns[i]);
+    case MapField::kRing: return map.ring[i];
+    case MapField::kScanIndex: return map.scan_index[i];
+    case MapField::kDeviation: return (*deviation_m)[i];
+  }
+  return 0.0;
+}
+
+}  // namespace rvlio
