@@ -9,6 +9,7 @@ Usage:
                              [--yscale auto|linear|log]
   rvlio_plot.py compare-bars --table CSV --out PREFIX [--metric NAME ...]
   rvlio_plot.py deviation    --run DIR --out PREFIX [--title TEXT]
+  rvlio_plot.py map          --run DIR --out PREFIX [--field intensity|z|NAME] [--title TEXT]
   rvlio_plot.py control      --gt GT_SURVEY.tum [--run LABEL=DIR ...] [--run-origin LABEL=DIR ...]
                              [--control CSV] --out PREFIX
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
@@ -898,6 +899,73 @@ class Parser(argparse.ArgumentParser):
     Fail(message, EXIT_BAD_INPUT)
 
 
+PCD_TYPES = {("F", 4): "<f4", ("F", 8): "<f8", ("U", 1): "u1", ("U", 2): "<u2", ("U", 4): "<u4",
+             ("U", 8): "<u8", ("I", 1): "i1", ("I", 2): "<i2", ("I", 4): "<i4", ("I", 8): "<i8"}
+
+
+def ReadMapPcd(path):
+  """The fields of a binary PCD as rvlio writes map.pcd (COUNT 1 each):
+  {name: array}."""
+  try:
+    with open(path, "rb") as f:
+      raw = f.read()
+  except OSError as e:
+    raise PlotError("%s: %s" % (path, e.strerror))
+  header, sep, body = raw.partition(b"DATA binary\n")
+  if not sep:
+    raise PlotError("%s: not a binary PCD (DATA binary)" % path)
+  words = {}
+  for line in header.decode("ascii", "replace").splitlines():
+    parts = line.split()
+    if parts and not parts[0].startswith("#"):
+      words[parts[0]] = parts[1:]
+  try:
+    dtype = np.dtype([(n, PCD_TYPES[(t, int(z))]) for n, t, z in
+                      zip(words["FIELDS"], words["TYPE"], words["SIZE"])])
+    count = int(words["POINTS"][0])
+  except (KeyError, ValueError, IndexError):
+    raise PlotError("%s: malformed PCD header" % path)
+  if len(body) < count * dtype.itemsize:
+    raise PlotError("%s: truncated: %d points declared" % (path, count))
+  cloud = np.frombuffer(body[:count * dtype.itemsize], dtype=dtype)
+  return {n: cloud[n].astype(np.float64) for n in dtype.names}
+
+
+def CmdMap(args):
+  """DIR/map.pcd coloured by a field: a top view of the points below the
+  map's mid height (the ceiling would hide the rest) and an elevation of the
+  +y side (the points with y in its top 10 %), in grey for intensity."""
+  path = os.path.join(args.run, "map.pcd")
+  m = ReadMapPcd(path)
+  if args.field not in m:
+    raise PlotError("%s has no field %s (fields: %s)" % (path, args.field, " ".join(m)))
+  x, y, z, v = m["x"], m["y"], m["z"], m[args.field]
+  if len(x) == 0:
+    raise PlotError("%s has no points" % path)
+  grey = args.field == "intensity"
+  lo, hi = np.nanpercentile(v, 2), np.nanpercentile(v, 98)
+  plt = Pyplot()
+  fig, (top, side) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True)
+  below = z < np.median(z)
+  wall = y >= np.percentile(y, 90)
+  style = dict(c=None, s=1.0, cmap="gray" if grey else "viridis", vmin=lo, vmax=hi,
+               linewidths=0, rasterized=True)
+  for ax, keep, vertical in ((top, below, y), (side, wall, z)):
+    order = np.argsort(v[keep])  # bright points drawn last
+    style["c"] = v[keep][order]
+    im = ax.scatter(x[keep][order], vertical[keep][order], **style)
+    ax.set_aspect("equal")
+    ax.set_facecolor("0.85" if grey else "white")
+  top.set_ylabel("y [m]")
+  top.set_title(args.title or "%s of %s, coloured by %s" %
+                ("map.pcd", os.path.basename(os.path.normpath(args.run)), args.field))
+  side.set_ylabel("z [m] (the +y wall)")
+  side.set_xlabel("x [m]")
+  fig.colorbar(im, ax=(top, side), label=args.field, shrink=0.8)
+  print("%d points, %s %.4g to %.4g (2nd to 98th percentile)" % (len(x), args.field, lo, hi))
+  SaveFigure(fig, args.out, "map_" + args.field)
+
+
 def PositiveFloat(text):
   v = ToFloat(text)
   if not (math.isfinite(v) and v > 0):
@@ -940,6 +1008,12 @@ def BuildParser():
   p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
   p.add_argument("--title", help="figure title (default: from summary.json)")
   p.set_defaults(func=CmdDeviation)
+  p = sub.add_parser("map", help="map.pcd coloured by a field: top view and the +y wall")
+  p.add_argument("--run", required=True, help="run, refine or merge output folder")
+  p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
+  p.add_argument("--field", default="intensity", help="field to colour by (default intensity)")
+  p.add_argument("--title", help="figure title")
+  p.set_defaults(func=CmdMap)
   p = sub.add_parser("control", help="error in the survey frame over the chainage, with marks")
   p.add_argument("--gt", required=True, help="ground truth in the survey frame (NAME_gt_survey.tum)")
   p.add_argument("--run", action="append", default=[],

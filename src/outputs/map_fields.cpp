@@ -11,7 +11,7 @@ constexpr MapFieldSpec kSpecs[] = {
     {MapField::kDeviation, "deviation_m", 'F', 4},
 };
 
-bool Has(const MapCloud& map, MapField f, bool with_deviation) {
+bool MapHasField(const MapCloud& map, MapField f, bool with_deviation) {
   switch (f) {
     case MapField::kIntensity: return map.has_intensity;
     case MapField::kTime: return map.has_time;
@@ -27,7 +27,7 @@ bool Has(const MapCloud& map, MapField f, bool with_deviation) {
 std::vector<MapFieldSpec> MapAttributeFields(const MapCloud& map, bool with_deviation) {
   std::vector<MapFieldSpec> out;
   for (const MapFieldSpec& s : kSpecs)
-    if (Has(map, s.field, with_deviation)) out.push_back(s);
+    if (MapHasField(map, s.field, with_deviation)) out.push_back(s);
   return out;
 }
 
