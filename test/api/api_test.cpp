@@ -159,7 +159,9 @@ TEST_F(ApiTest, MapPointsKeepTheirReturnsAttributesInBothBackends) {
       ++per_scan[k];
       // The map stores UNIX seconds in a double: 0.24 us of rounding.
       EXPECT_LE(map.t_ns[i], run->trajectory[k].t_ns + 1000) << i;
-      if (k > 0) EXPECT_GT(map.t_ns[i], run->trajectory[k - 1].t_ns - 1000) << i;
+      if (k > 0) {
+        EXPECT_GT(map.t_ns[i], run->trajectory[k - 1].t_ns - 1000) << i;
+      }
       EXPECT_LT(map.ring[i], 32) << "the simulated OS1-32's beams";
       bright += map.intensity[i] > 0.0f;
     }

@@ -217,7 +217,9 @@ void CompareCopc(const Expected& e, const json& c) {
       if (std::isnan(e.deviation[i])) EXPECT_TRUE(std::isnan(dev)) << i;
       else EXPECT_EQ(dev, static_cast<float>(e.deviation[i])) << i;
     }
-    if (!e.scan_index.empty()) EXPECT_EQ(Num(pts["scan_index"][i]), e.scan_index[i]);
+    if (!e.scan_index.empty()) {
+      EXPECT_EQ(Num(pts["scan_index"][i]), e.scan_index[i]);
+    }
   }
 }
 
@@ -253,7 +255,9 @@ BandCounts CheckAgainstTrajectory(const std::string& folder, const json& c) {
     const double end_s = NsToSeconds((*tum)[k].t_ns);
     EXPECT_LE(t_s, end_s + 1e-6) << folder << " point " << i << " after its scan's end";
     EXPECT_GE(t_s, end_s - 0.1 - 1e-6) << folder << " point " << i << " before its scan";
-    if (k > 0) EXPECT_GT(t_s, NsToSeconds((*tum)[k - 1].t_ns)) << folder << " point " << i;
+    if (k > 0) {
+      EXPECT_GT(t_s, NsToSeconds((*tum)[k - 1].t_ns)) << folder << " point " << i;
+    }
     ++rings[static_cast<size_t>(Num(pts["UserData"][i]))];
     const Eigen::Vector3d p(Num(pts["X"][i]), Num(pts["Y"][i]), Num(pts["Z"][i]));
     if (std::abs(p.y() - kLeftWallY) > 0.08) continue;  // not the left wall
