@@ -961,7 +961,7 @@ def CmdMap(args):
                 ("map.pcd", os.path.basename(os.path.normpath(args.run)), args.field))
   side.set_ylabel("z [m] (the +y wall)")
   side.set_xlabel("x [m]")
-  fig.colorbar(im, ax=(top, side), label=args.field, shrink=0.8)
+  fig.colorbar(im, ax=[top, side], label=args.field, shrink=0.8)
   print("%d points, %s %.4g to %.4g (2nd to 98th percentile)" % (len(x), args.field, lo, hi))
   SaveFigure(fig, args.out, "map_" + args.field)
 
