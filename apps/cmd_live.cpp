@@ -61,7 +61,7 @@ int CmdLive(int argc, char** argv) {
     overrides.push_back("live.ros2_domain_id=" + std::to_string(id));
   }
   std::vector<std::string> warnings;
-  StatusOr<OdometryOptions> options = LoadConfig(args.GetAll("config"), overrides, &warnings);
+  StatusOr<Configuration> options = LoadConfig(args.GetAll("config"), overrides, &warnings);
   if (!options.ok()) return Fail("live", options.status());
   for (const auto& w : warnings) std::fprintf(stderr, "rvlio live: warning: %s\n", w.c_str());
 

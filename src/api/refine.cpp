@@ -11,6 +11,7 @@
 #include <optional>
 #include <utility>
 
+#include "rvlio/math/pose_interpolation.h"
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/api.h"
 #include "rvlio/formats/atomic_file.h"

@@ -292,7 +292,7 @@ void Process(const RunArgs& args, const LocalOrigin& origin, SensorBagReader* re
   }
   if (!result->stopped) {
     odo->Finish(&result->scans);
-    StreamNewPoses(result->scans, args, *odo, &streamed, partial, stream_warnings);
+    StreamNewPoses(result->scans, origin, args, *odo, &streamed, partial, stream_warnings);
     progress.Report(static_cast<int>(result->scans.size()), t, odo->divergence());
   }
   result->rss_mb.resize(result->scans.size(), CurrentMemoryMb());

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "rvlio/math/pose_interpolation.h"
 #include "rvlio/common/check.h"
 #include "rvlio/common/fnv1a.h"
 #include "rvlio/common/text.h"

@@ -108,7 +108,7 @@ StatusOr<Pose3> ReferenceLocalizer::Start(TimeNs t_ns, const std::vector<Eigen::
   StatusOr<ReferenceAlignment> a =
       FindStartInReference(p_lidar, T_imu_lidar, *localization_.reference,
                            guess ? &*guess : nullptr, T_world_imu.R, constraints_, options_,
-                           "--initial-pose");
+                           "--initial-pose", localization_.origin);
   if (!a.ok()) return a.status();
   started_ = true;
   start_overlap_ = a->overlap;

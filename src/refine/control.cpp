@@ -13,6 +13,7 @@
 #include "rvlio/common/check.h"
 #include "rvlio/common/text.h"
 #include "rvlio/factors/position_factor.h"
+#include "rvlio/math/pose_interpolation.h"
 #include "rvlio/math/so3.h"
 #include "rvlio/refine/refine_chunks.h"
 

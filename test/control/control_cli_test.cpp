@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_util.h"
+#include "rvlio/math/pose_interpolation.h"
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/refine/refine_states.h"
