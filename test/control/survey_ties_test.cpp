@@ -40,7 +40,7 @@ TEST(SurveyTies, GnssAlignmentShrugsOffMultipathOutliers) {
     f.sqrt_information = IsotropicSqrtInformation(0.015);
     fixes.push_back(f);
   }
-  OdometryOptions options;
+  Configuration options;
   SurveyTies ties("", {}, fixes, options);
   Trajectory init = flight;
   SurveyFactors out;
@@ -72,7 +72,7 @@ TEST(SurveyTies, ResidualsOfMarksAtTheRefinedTrajectory) {
   }
   rows[1].role = ControlRole::kCheck;
   rows[1].p_survey.x() += 0.004;  // the check point's given coordinates are 4 mm off
-  OdometryOptions options;
+  Configuration options;
   options.control.lever_arm = {0.0, 0.0, 0.3};
   SurveyTies ties("marks.csv", rows, {}, options);
   Trajectory init = flight;
