@@ -9,7 +9,8 @@ Usage:
                              [--yscale auto|linear|log]
   rvlio_plot.py compare-bars --table CSV --out PREFIX [--metric NAME ...]
   rvlio_plot.py deviation    --run DIR --out PREFIX [--title TEXT]
-  rvlio_plot.py map          --run DIR --out PREFIX [--field intensity|z|NAME] [--title TEXT]
+  rvlio_plot.py map          --run DIR --out PREFIX [--field intensity|z|NAME]
+                             [--box XMIN,XMAX,YMIN,YMAX] [--title TEXT]
   rvlio_plot.py control      --gt GT_SURVEY.tum [--run LABEL=DIR ...] [--run-origin LABEL=DIR ...]
                              [--control CSV] --out PREFIX
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
@@ -932,38 +933,53 @@ def ReadMapPcd(path):
 
 
 def CmdMap(args):
-  """DIR/map.pcd coloured by a field: a top view of the points below the
-  map's mid height (the ceiling would hide the rest) and an elevation of the
-  +y side (the points with y in its top 10 %), in grey for intensity."""
+  """DIR/map.pcd coloured by a field (grey for intensity): a top view of the
+  points below their median height (the ceiling would hide the rest) and an
+  elevation of the +y side (the points within 0.5 m of the 99th percentile
+  of y), both of the points inside --box when given."""
   path = os.path.join(args.run, "map.pcd")
   m = ReadMapPcd(path)
   if args.field not in m:
     raise PlotError("%s has no field %s (fields: %s)" % (path, args.field, " ".join(m)))
-  x, y, z, v = m["x"], m["y"], m["z"], m[args.field]
+  keep = np.ones(len(m["x"]), dtype=bool)
+  if args.box:
+    x0, x1, y0, y1 = args.box
+    keep = (m["x"] >= x0) & (m["x"] <= x1) & (m["y"] >= y0) & (m["y"] <= y1)
+  x, y, z, v = m["x"][keep], m["y"][keep], m["z"][keep], m[args.field][keep]
   if len(x) == 0:
-    raise PlotError("%s has no points" % path)
+    raise PlotError("%s has no points%s" % (path, " in the box" if args.box else ""))
   grey = args.field == "intensity"
   lo, hi = np.nanpercentile(v, 2), np.nanpercentile(v, 98)
   plt = Pyplot()
-  fig, (top, side) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True)
+  fig, (top, side) = plt.subplots(2, 1, figsize=(12, 5.5), sharex=True)
   below = z < np.median(z)
-  wall = y >= np.percentile(y, 90)
-  style = dict(c=None, s=1.0, cmap="gray" if grey else "viridis", vmin=lo, vmax=hi,
-               linewidths=0, rasterized=True)
-  for ax, keep, vertical in ((top, below, y), (side, wall, z)):
-    order = np.argsort(v[keep])  # bright points drawn last
-    style["c"] = v[keep][order]
-    im = ax.scatter(x[keep][order], vertical[keep][order], **style)
-    ax.set_aspect("equal")
-    ax.set_facecolor("0.85" if grey else "white")
-  top.set_ylabel("y [m]")
-  top.set_title(args.title or "%s of %s, coloured by %s" %
-                ("map.pcd", os.path.basename(os.path.normpath(args.run)), args.field))
-  side.set_ylabel("z [m] (the +y wall)")
+  wall = y >= np.percentile(y, 99) - 0.5
+  im = None
+  for ax, shown, vertical in ((top, below, y), (side, wall, z)):
+    order = np.argsort(v[shown])  # bright points drawn last
+    im = ax.scatter(x[shown][order], vertical[shown][order], c=v[shown][order], s=1.5,
+                    cmap="gray" if grey else "viridis", vmin=lo, vmax=hi, linewidths=0,
+                    rasterized=True)
+    ax.set_facecolor("0.82" if grey else "white")
+  top.set_ylabel("y [m] (top view)")
+  top.set_title(args.title or "map.pcd of %s, coloured by %s" %
+                (os.path.basename(os.path.normpath(args.run)), args.field))
+  side.set_ylabel("z [m] (the +y side)")
   side.set_xlabel("x [m]")
-  fig.colorbar(im, ax=[top, side], label=args.field, shrink=0.8)
+  fig.colorbar(im, ax=[top, side], label=args.field, shrink=0.9)
   print("%d points, %s %.4g to %.4g (2nd to 98th percentile)" % (len(x), args.field, lo, hi))
   SaveFigure(fig, args.out, "map_" + args.field)
+
+
+def Box(text):
+  try:
+    box = [float(t) for t in text.split(",")]
+  except ValueError:
+    box = []
+  if len(box) != 4 or not all(math.isfinite(b) for b in box) or box[0] >= box[1] or box[2] >= box[3]:
+    raise argparse.ArgumentTypeError("expected XMIN,XMAX,YMIN,YMAX with XMIN < XMAX, YMIN < YMAX, "
+                                     "got '%s'" % text)
+  return box
 
 
 def PositiveFloat(text):
@@ -1012,6 +1028,7 @@ def BuildParser():
   p.add_argument("--run", required=True, help="run, refine or merge output folder")
   p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
   p.add_argument("--field", default="intensity", help="field to colour by (default intensity)")
+  p.add_argument("--box", type=Box, help="XMIN,XMAX,YMIN,YMAX: only the points inside [m]")
   p.add_argument("--title", help="figure title")
   p.set_defaults(func=CmdMap)
   p = sub.add_parser("control", help="error in the survey frame over the chainage, with marks")
