@@ -1,5 +1,7 @@
 #include "rvlio/outputs/map_fields.h"
 
+#include <cmath>
+
 namespace rvlio {
 namespace {
 
@@ -24,6 +26,18 @@ bool MapHasField(const MapCloud& map, MapField f, bool with_deviation) {
 
 }  // namespace
 
+double MapTimeSeconds(TimeNs t_ns) {
+  TimeNs whole_s = t_ns / kNsPerSecond, fraction_ns = t_ns % kNsPerSecond;
+  if (fraction_ns < 0) --whole_s, fraction_ns += kNsPerSecond;
+  return static_cast<double>(whole_s) + static_cast<double>(fraction_ns) * 1e-9;
+}
+
+TimeNs MapTimeNs(double t_s) {
+  const double whole_s = std::floor(t_s);
+  return static_cast<TimeNs>(whole_s) * kNsPerSecond +
+         static_cast<TimeNs>(std::llround((t_s - whole_s) * 1e9));
+}
+
 std::vector<MapFieldSpec> MapAttributeFields(const MapCloud& map, bool with_deviation) {
   std::vector<MapFieldSpec> out;
   for (const MapFieldSpec& s : kSpecs)
@@ -41,7 +55,7 @@ double MapFieldValue(MapField f, const MapCloud& map, const std::vector<double>*
                      size_t i) {
   switch (f) {
     case MapField::kIntensity: return map.intensity[i];
-    case MapField::kTime: return NsToSeconds(map.t_ns[i]);
+    case MapField::kTime: return MapTimeSeconds(map.t_ns[i]);
     case MapField::kRing: return map.ring[i];
     case MapField::kScanIndex: return map.scan_index[i];
     case MapField::kDeviation: return (*deviation_m)[i];

@@ -59,7 +59,7 @@ void AppendPcdRecord(const MapCloud& map, const std::vector<double>* deviation_m
   for (const MapFieldSpec& f : attributes) {
     switch (f.field) {
       case MapField::kIntensity: AppendValue<float>(map.intensity[i], block); break;
-      case MapField::kTime: AppendValue<double>(NsToSeconds(map.t_ns[i]), block); break;
+      case MapField::kTime: AppendValue<double>(MapTimeSeconds(map.t_ns[i]), block); break;
       case MapField::kRing: AppendValue<uint16_t>(map.ring[i], block); break;
       case MapField::kScanIndex: AppendValue<uint32_t>(map.scan_index[i], block); break;
       case MapField::kDeviation:
@@ -73,7 +73,7 @@ void AppendPcdRecord(const MapCloud& map, const std::vector<double>* deviation_m
 void StoreMapField(MapField f, double v, MapCloud* map, std::vector<double>* deviation_m) {
   switch (f) {
     case MapField::kIntensity: map->intensity.push_back(static_cast<float>(v)); break;
-    case MapField::kTime: map->t_ns.push_back(SecondsToNs(v)); break;
+    case MapField::kTime: map->t_ns.push_back(MapTimeNs(v)); break;
     case MapField::kRing: map->ring.push_back(static_cast<uint16_t>(v)); break;
     case MapField::kScanIndex: map->scan_index.push_back(static_cast<uint32_t>(v)); break;
     case MapField::kDeviation: deviation_m->push_back(v); break;

@@ -20,6 +20,7 @@
 #include "las_test_util.h"
 #include "rvlio/formats/crs.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/outputs/map_fields.h"
 #include "rvlio/outputs/map_las.h"
 #include "rvlio/outputs/run_outputs.h"
 
@@ -126,7 +127,7 @@ Expected OutputFolderFile(const std::string& folder) {
   const double scale = 65536.0 / IntensityRange(largest);
   for (size_t i = 0; i < m.size(); ++i) {
     e.intensity_las.push_back(std::min(65535.0, std::nearbyint(m.intensity[i] * scale)));
-    e.gps_time.push_back(NsToSeconds(m.t_ns[i]) + kGpsMinusUnix_s);
+    e.gps_time.push_back(MapTimeSeconds(m.t_ns[i]) + kGpsMinusUnix_s);
     e.ring.push_back(std::min<int>(m.ring[i], 255));
     e.scan_index.push_back(m.scan_index[i]);
   }

@@ -480,6 +480,7 @@ TEST_F(PlotScriptTest, MapColouredByIntensity) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("1000 points, intensity 1.98 to 98"), std::string::npos) << r.out;
   ExpectFigures("map_intensity");
+  for (const auto& entry : fs::directory_iterator(dir_ + "/out")) fs::remove(entry.path());
   ExpectBadInput("map --run " + run + " --field deviation_m " + Out(),
                  "has no field deviation_m (fields: x y z intensity time ring scan_index)");
 }

@@ -28,7 +28,13 @@ std::vector<MapFieldSpec> MapAttributeFields(const MapCloud& map, bool with_devi
 // map attribute.
 const MapFieldSpec* MapFieldByName(const std::string& name);
 
-// Field f of point i as a double (time: UNIX seconds); deviation_m may be
+// A map time as UNIX seconds in a double and back, the whole seconds apart
+// from the fraction: a round trip keeps the time to 0.12 us (half the
+// double's step at today's times), where t * 1e-9 loses up to 0.37 us.
+double MapTimeSeconds(TimeNs t_ns);
+TimeNs MapTimeNs(double t_s);  // t_s finite
+
+// Field f of point i as a double (time: MapTimeSeconds); deviation_m may be
 // null when f is not kDeviation.
 double MapFieldValue(MapField f, const MapCloud& map, const std::vector<double>* deviation_m,
                      size_t i);
