@@ -9,6 +9,7 @@
 #include "rvlio/formats/crs.h"
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/outputs/map_fields.h"
+#include "rvlio/outputs/run_outputs.h"
 
 namespace rvlio {
 namespace {
@@ -212,8 +213,10 @@ StatusOr<MapLasRequest> MapLasRequestOf(const OutputOptions& output, const Surve
 Status WriteMapLas(const std::string& path, const MapCloud& map,
                    const std::vector<double>* deviation_m, const std::string& crs_wkt,
                    size_t chunk_points) {
-  // The fields as map.pcd has them, so that `rvlio export` of that file
+  // The coordinates and fields as map.pcd has them (x y z in float32 below
+  // 8192 m: a step of 1 mm at most), so that `rvlio export` of that file
   // writes the same bytes.
+  const bool float32_xyz = !MapNeedsFloat64(map.p);
   std::vector<PointCloudStreamField> fields;
   const std::vector<MapFieldSpec> specs = MapAttributeFields(map, deviation_m != nullptr);
   for (const MapFieldSpec& f : specs) fields.push_back({f.name, f.type, f.size});
@@ -232,6 +235,8 @@ Status WriteMapLas(const std::string& path, const MapCloud& map,
   for (size_t first = 0; first < map.size(); first += chunk_points) {
     const size_t n = std::min(chunk_points, map.size() - first);
     chunk.points.assign(map.p.begin() + first, map.p.begin() + first + n);
+    if (float32_xyz)
+      for (Eigen::Vector3d& p : chunk.points) p = p.cast<float>().cast<double>();
     for (size_t k = 0; k < specs.size(); ++k) {
       chunk.fields[k].resize(n);
       for (size_t i = 0; i < n; ++i)

@@ -169,7 +169,8 @@ TEST(LasExport, RunsMapPcdExportsToTheSameFileAsRunsMapLas) {
   map.has_intensity = map.has_time = map.has_ring = map.has_scan_index = true;
   std::vector<double> deviation;
   for (int i = 0; i < 2000; ++i) {
-    map.p.emplace_back(0.01 * i - 3.0, std::sin(0.01 * i), 1.5);
+    // Half millimetres: a float32 and a double often round to different mm.
+    map.p.emplace_back(0.0010001 * i + 0.0005 - 3.0, std::sin(0.01 * i), 12.3455 + 0.001 * i);
     map.intensity.push_back(static_cast<float>((i * 37) % 200) + 0.25f);
     map.t_ns.push_back(1'700'000'000'123'456'789 + 123'457LL * i);
     map.ring.push_back(static_cast<uint16_t>(i % 128));

@@ -32,8 +32,10 @@ StatusOr<MapLasRequest> MapLasRequestOf(const OutputOptions& output, const Surve
 
 // map.las of the output map (the map.pcd frame) with its attributes and
 // deviation_m (one per point, NaN allowed) when it is not null, atomically:
-// every field where `rvlio export` of the map.pcd of the same map puts it
-// (the same bytes), the intensity range from the largest intensity. Built
+// the coordinates as map.pcd stores them (float32 below 8192 m,
+// MapNeedsFloat64) and every field where `rvlio export` of the map.pcd of
+// the same map puts it (the same bytes), the intensity range from the
+// largest intensity. Built
 // chunk_points at a time (the memory beyond the map's).
 Status WriteMapLas(const std::string& path, const MapCloud& map,
                    const std::vector<double>* deviation_m, const std::string& crs_wkt,
