@@ -229,6 +229,47 @@ TEST(Deformation, MovesTheSurfaceByTheAmplitudeAtItsCentreAndNotOutside) {
   }
 }
 
+// world.band: a ray that hits the painted surface within [x_min, x_max]
+// returns the band's reflectivity, elsewhere the surface's own; the other
+// surfaces and the geometry are as without it.
+TEST(Band, PaintsItsSurfaceBetweenItsXAndNothingElse) {
+  struct Case {
+    const char* surface;
+    Eigen::Vector3d dir;  // from the centre line towards the surface
+    float own;            // the surface's reflectivity
+  };
+  const Case cases[] = {{"left", Eigen::Vector3d::UnitY(), 80.0f},
+                        {"right", -Eigen::Vector3d::UnitY(), 80.0f},
+                        {"ceiling", Eigen::Vector3d::UnitZ(), 60.0f},
+                        {"floor", -Eigen::Vector3d::UnitZ(), 40.0f}};
+  for (const Case& c : cases) {
+    SimOptions o = Bare();
+    o.world.band.surface = c.surface;
+    o.world.band.x_min = 16.0;
+    o.world.band.x_max = 19.0;
+    o.world.band.reflectivity = 250.0;
+    SimOptions plain_options = o;
+    plain_options.world.band.reflectivity = 0.0;
+    const auto painted = Make(o), plain = Make(plain_options);
+    ASSERT_TRUE(painted && plain);
+    const WorldLayout& L = plain->layout();
+    const Eigen::Vector3d centre(0.0, L.y_center, 0.5 * (L.z_floor + L.z_ceiling));
+    for (double x : {15.9, 16.1, 17.5, 18.9, 19.1, 40.0}) {
+      for (const Case& target : cases) {
+        RayHit a, b;
+        const Eigen::Vector3d origin = centre + Eigen::Vector3d(x, 0.0, 0.0);
+        ASSERT_TRUE(painted->world().Raycast(origin, target.dir, 100.0, &a));
+        ASSERT_TRUE(plain->world().Raycast(origin, target.dir, 100.0, &b));
+        EXPECT_EQ(a.range, b.range) << c.surface << " x " << x;  // paint, not geometry
+        EXPECT_EQ(b.reflectivity, target.own);
+        const bool on_band = &target == &c && x > 16.0 && x < 19.0;
+        EXPECT_EQ(a.reflectivity, on_band ? 250.0f : target.own)
+            << c.surface << " band, ray to " << target.surface << " at x " << x;
+      }
+    }
+  }
+}
+
 TEST(Deformation, ABulgeIsLimitedAcrossTheWall) {
   SimOptions o = Bare();
   o.world.deformation.surface = "left";
