@@ -12,6 +12,7 @@
 #include <pcl/point_types.h>
 #include <pcl/register_point_struct.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -45,6 +46,11 @@ namespace rvlio {
 namespace {
 
 namespace fs = std::filesystem;
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
 
 class PointCloudFileTest : public MapioTestDir {
  protected:
@@ -131,11 +137,7 @@ TEST_F(PointCloudFileTest, MapPcdIsWhatPclWritesAndReads) {
     cloud.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
                                   static_cast<float>(p.z())));
   ASSERT_EQ(pcl::PCDWriter().writeBinary(Path("pcl.pcd"), cloud), 0);
-  auto bytes = [](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  EXPECT_EQ(bytes(Path("ours.pcd")), bytes(Path("pcl.pcd")));
+  EXPECT_EQ(FileBytes(Path("ours.pcd")), FileBytes(Path("pcl.pcd")));
 
   const std::vector<double> deviation_m = {0.012, std::numeric_limits<double>::quiet_NaN(), -0.03};
   ASSERT_TRUE(WriteMapPcd(Path("deviation.pcd"), points, &deviation_m).ok());
@@ -160,6 +162,45 @@ TEST_F(PointCloudFileTest, MapPcdIsWhatPclWritesAndReads) {
   EXPECT_FLOAT_EQ(xyz[1].x, -4.5f);
 }
 
+struct BlobField {
+  const char* name;
+  uint32_t offset;
+  uint8_t type;
+};
+
+// An unorganized PCLPointCloud2 of n points of `point_step` bytes with these
+// fields, its data zeroed (the test fills it).
+pcl::PCLPointCloud2 Blob(const std::vector<BlobField>& fields, uint32_t point_step, size_t n) {
+  pcl::PCLPointCloud2 blob;
+  for (const BlobField& f : fields) {
+    pcl::PCLPointField field;
+    field.name = f.name;
+    field.offset = f.offset;
+    field.datatype = f.type;
+    field.count = 1;
+    blob.fields.push_back(field);
+  }
+  blob.point_step = point_step;
+  blob.width = static_cast<uint32_t>(n);
+  blob.height = 1;
+  blob.row_step = blob.point_step * blob.width;
+  blob.data.resize(blob.row_step);
+  return blob;
+}
+
+// `ours` is byte for byte what PCL's writer makes of `blob` (which pads its
+// file with zeros to a page); returns our file's bytes.
+std::string ExpectPclWritesTheSame(const std::string& ours, const pcl::PCLPointCloud2& blob,
+                                   const std::string& pcl_path) {
+  EXPECT_EQ(pcl::PCDWriter().writeBinary(pcl_path, blob), 0);
+  const std::string ours_bytes = FileBytes(ours), pcl_bytes = FileBytes(pcl_path);
+  EXPECT_GE(pcl_bytes.size(), ours_bytes.size());
+  EXPECT_EQ(pcl_bytes.substr(0, ours_bytes.size()), ours_bytes);
+  EXPECT_EQ(pcl_bytes.find_first_not_of('\0', std::min(ours_bytes.size(), pcl_bytes.size())),
+            std::string::npos);
+  return ours_bytes;
+}
+
 // A map in a national grid (UTM: easting 5e5 m, northing 5.4e6 m, where a
 // float32 keeps only decimetres) is written with x y z as float64: the header
 // and the bytes are PCL's for such a cloud, PCL reads the doubles back, and so
@@ -174,36 +215,18 @@ TEST_F(PointCloudFileTest, FarMapPcdIsFloat64AndWhatPclWrites) {
   EXPECT_TRUE(MapNeedsFloat64({{0.0, -8192.0, 0.0}}));
   ASSERT_TRUE(WriteMapPcd(Path("ours.pcd"), points, &deviation_m).ok());
 
-  pcl::PCLPointCloud2 blob;  // the same cloud through PCL's writer
-  const char* names[] = {"x", "y", "z", "deviation_m"};
-  for (int f = 0; f < 4; ++f) {
-    pcl::PCLPointField field;
-    field.name = names[f];
-    field.offset = 8 * f;
-    field.datatype = f < 3 ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32;
-    field.count = 1;
-    blob.fields.push_back(field);
-  }
-  blob.point_step = 28;
-  blob.width = static_cast<uint32_t>(points.size());
-  blob.height = 1;
-  blob.row_step = blob.point_step * blob.width;
-  blob.data.resize(blob.row_step);
+  // The same cloud through PCL's writer.
+  pcl::PCLPointCloud2 blob = Blob({{"x", 0, pcl::PCLPointField::FLOAT64},
+                                   {"y", 8, pcl::PCLPointField::FLOAT64},
+                                   {"z", 16, pcl::PCLPointField::FLOAT64},
+                                   {"deviation_m", 24, pcl::PCLPointField::FLOAT32}},
+                                  28, points.size());
   for (size_t i = 0; i < points.size(); ++i) {
     std::memcpy(&blob.data[i * 28], points[i].data(), 24);
     const float d = static_cast<float>(deviation_m[i]);
     std::memcpy(&blob.data[i * 28 + 24], &d, 4);
   }
-  ASSERT_EQ(pcl::PCDWriter().writeBinary(Path("pcl.pcd"), blob), 0);
-  auto bytes = [](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  // PCL's writer of a PCLPointCloud2 pads its file with zeros to a page.
-  const std::string ours_bytes = bytes(Path("ours.pcd")), pcl_bytes = bytes(Path("pcl.pcd"));
-  ASSERT_GE(pcl_bytes.size(), ours_bytes.size());
-  EXPECT_EQ(pcl_bytes.substr(0, ours_bytes.size()), ours_bytes);
-  EXPECT_EQ(pcl_bytes.find_first_not_of('\0', ours_bytes.size()), std::string::npos);
+  const std::string ours_bytes = ExpectPclWritesTheSame(Path("ours.pcd"), blob, Path("pcl.pcd"));
   EXPECT_NE(ours_bytes.find("SIZE 8 8 8 4\nTYPE F F F F\n"), std::string::npos);
 
   pcl::PCLPointCloud2 read;
@@ -224,7 +247,7 @@ TEST_F(PointCloudFileTest, FarMapPcdIsFloat64AndWhatPclWrites) {
 
   // Near the origin map.pcd stays float32, byte for byte PCL's PointXYZ file.
   ASSERT_TRUE(WriteMapPcd(Path("near.pcd"), {{8191.5, 0.0, 0.0}}).ok());
-  EXPECT_NE(bytes(Path("near.pcd")).find("SIZE 4 4 4\n"), std::string::npos);
+  EXPECT_NE(FileBytes(Path("near.pcd")).find("SIZE 4 4 4\n"), std::string::npos);
 }
 
 TEST_F(PointCloudFileTest, MapPcdWithAttributesIsWhatPclWritesAndReads) {
@@ -241,25 +264,13 @@ TEST_F(PointCloudFileTest, MapPcdWithAttributesIsWhatPclWritesAndReads) {
   }
   ASSERT_TRUE(WriteMapPcd(Path("ours.pcd"), map, &deviation_m).ok());
 
-  pcl::PCLPointCloud2 blob;  // the same cloud through PCL's writer
-  const struct { const char* name; uint32_t offset; uint8_t type; } fields[] = {
-      {"x", 0, pcl::PCLPointField::FLOAT32},          {"y", 4, pcl::PCLPointField::FLOAT32},
-      {"z", 8, pcl::PCLPointField::FLOAT32},          {"intensity", 12, pcl::PCLPointField::FLOAT32},
-      {"time", 16, pcl::PCLPointField::FLOAT64},      {"ring", 24, pcl::PCLPointField::UINT16},
-      {"scan_index", 26, pcl::PCLPointField::UINT32}, {"deviation_m", 30, pcl::PCLPointField::FLOAT32}};
-  for (const auto& f : fields) {
-    pcl::PCLPointField field;
-    field.name = f.name;
-    field.offset = f.offset;
-    field.datatype = f.type;
-    field.count = 1;
-    blob.fields.push_back(field);
-  }
-  blob.point_step = 34;
-  blob.width = static_cast<uint32_t>(map.size());
-  blob.height = 1;
-  blob.row_step = blob.point_step * blob.width;
-  blob.data.resize(blob.row_step);
+  // The same cloud through PCL's writer.
+  pcl::PCLPointCloud2 blob = Blob(
+      {{"x", 0, pcl::PCLPointField::FLOAT32},          {"y", 4, pcl::PCLPointField::FLOAT32},
+       {"z", 8, pcl::PCLPointField::FLOAT32},          {"intensity", 12, pcl::PCLPointField::FLOAT32},
+       {"time", 16, pcl::PCLPointField::FLOAT64},      {"ring", 24, pcl::PCLPointField::UINT16},
+       {"scan_index", 26, pcl::PCLPointField::UINT32}, {"deviation_m", 30, pcl::PCLPointField::FLOAT32}},
+      34, map.size());
   for (size_t i = 0; i < map.size(); ++i) {
     uint8_t* d = &blob.data[i * 34];
     const float xyz[3] = {static_cast<float>(map.p[i].x()), static_cast<float>(map.p[i].y()),
@@ -273,14 +284,7 @@ TEST_F(PointCloudFileTest, MapPcdWithAttributesIsWhatPclWritesAndReads) {
     std::memcpy(d + 26, &map.scan_index[i], 4);
     std::memcpy(d + 30, &dev, 4);
   }
-  ASSERT_EQ(pcl::PCDWriter().writeBinary(Path("pcl.pcd"), blob), 0);
-  auto bytes = [](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  const std::string ours_bytes = bytes(Path("ours.pcd")), pcl_bytes = bytes(Path("pcl.pcd"));
-  ASSERT_GE(pcl_bytes.size(), ours_bytes.size());
-  EXPECT_EQ(pcl_bytes.substr(0, ours_bytes.size()), ours_bytes);  // PCL pads to a page
+  const std::string ours_bytes = ExpectPclWritesTheSame(Path("ours.pcd"), blob, Path("pcl.pcd"));
   EXPECT_NE(ours_bytes.find("FIELDS x y z intensity time ring scan_index deviation_m\n"
                             "SIZE 4 4 4 4 8 2 4 4\nTYPE F F F F F U U F\n"),
             std::string::npos);
