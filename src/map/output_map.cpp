@@ -60,7 +60,8 @@ void OutputMap::NoteAttributes(const MapAttributeSet& given) {
   attributes_.scan_index = attributes_.scan_index && given.scan_index;
 }
 
-// The point nearest the voxel's centre stays; an equal one does not replace it.
+// Every point moves the centroid; the attributes are the return's nearest the
+// voxel's centre (an equal one does not replace it).
 void OutputMap::InsertPoint(const Eigen::Vector3d& p_world, const MapPointAttributes& a,
                             const MapAttributeSet& given) {
   NoteAttributes(given);
@@ -70,8 +71,9 @@ void OutputMap::InsertPoint(const Eigen::Vector3d& p_world, const MapPointAttrib
   const float d2 = static_cast<float>((p_world - centre).squaredNorm());
   bool created = false;
   Cell& cell = cells_[FindOrAddCell(key, &created)];
+  cell.sum += p_world;
+  ++cell.count;
   if (!created && !(d2 < cell.d2)) return;
-  cell.p = p_world;
   cell.d2 = d2;
   cell.intensity = a.intensity;
   cell.t_ns = a.t_ns;
@@ -115,7 +117,7 @@ void OutputMap::InsertCloud(const MapCloud& cloud) {
 std::vector<Eigen::Vector3d> OutputMap::Points() const {
   std::vector<Eigen::Vector3d> out;
   out.reserve(cells_.size());
-  for (const Cell& c : cells_) out.push_back(c.p);
+  for (const Cell& c : cells_) out.push_back(c.sum / static_cast<double>(c.count));
   return out;
 }
 

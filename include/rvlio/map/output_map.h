@@ -1,17 +1,19 @@
 #pragma once
 // The coarse full map written to map.pcd and map.las: every inserted point
 // falls into a voxel of edge MapOptions::output_resolution, and each occupied
-// voxel keeps one point, the one nearest the voxel's centre (the first of
-// equals): a real LiDAR return with its own coordinates and attributes
-// (intensity, acquisition time, ring, scan index; map/map_cloud.h), never an
-// average of unrelated points. Unbounded and insert-only (nothing is ever
-// removed); output order is the order in which voxels were first touched, so
-// it is deterministic. Voxels are found through an open-addressing table
-// (linear probing, power-of-two capacity, load <= 1/2) of indices into the
-// cell array. Only the output map holds attributes: the working map that
-// scans are associated with (voxel_map.h) holds positions only.
+// voxel contributes one point: at the centroid of what fell into it (the
+// surface with the range noise averaged out, as a reference map for a later
+// flight needs it), with the attributes of one return, the one nearest the
+// voxel's centre (the first of equals): its intensity, acquisition time, ring
+// and scan index together (map/map_cloud.h), never averages of unrelated
+// returns. Unbounded and insert-only (nothing is ever removed); output order
+// is the order in which voxels were first touched, so it is deterministic.
+// Voxels are found through an open-addressing table (linear probing,
+// power-of-two capacity, load <= 1/2) of indices into the cell array. Only
+// the output map holds attributes: the working map that scans are associated
+// with (voxel_map.h) holds positions only.
 //
-// Memory: 48 bytes a voxel's point, 12 its key, 8 to 16 the table.
+// Memory: 56 bytes a voxel's cell, 12 its key, 8 to 16 the table.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -59,15 +61,16 @@ class OutputMap {
   // The attributes every insertion gave (none before the first).
   const MapAttributeSet& attributes() const { return attributes_; }
 
-  // One point per occupied voxel (world, m).
+  // One point per occupied voxel: its centroid (world, m).
   std::vector<Eigen::Vector3d> Points() const;
   // The same points with the attributes every insertion gave.
   MapCloud Cloud() const;
 
  private:
   struct Cell {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();  // the kept point
-    float d2 = 0.0f;                              // its squared distance to the voxel centre, m^2
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // of the points that fell in
+    uint32_t count = 0;
+    float d2 = 0.0f;  // the kept return's squared distance to the voxel centre, m^2
     float intensity = 0.0f;
     TimeNs t_ns = 0;
     uint32_t scan_index = 0;
