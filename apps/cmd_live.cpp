@@ -34,7 +34,7 @@ int ReportEnd(const std::string& out_dir, const LiveResult& r) {
 int CmdLive(int argc, char** argv) {
   CommandSpec spec{"live",
                    "Runs the odometry on a ROS 1 or ROS 2 network: subscribes to lidar.topic and "
-                   "imu.topic, publishes odometry (scan and IMU rate), TF, the registered scan, "
+                   "imu.topic (point clouds, Livox CustomMsg or Ouster packets), publishes odometry (scan and IMU rate), TF, the registered scan, "
                    "path, map and status under live.topic_namespace (docs/live.md). SIGINT/SIGTERM "
                    "end it: the outputs of `run` are written to the output folder, exit 0.",
                    {{"ros1", "", "ROS 1: roscpp, the master of ROS_MASTER_URI"},
@@ -43,6 +43,10 @@ int CmdLive(int argc, char** argv) {
                     ConfigOption(),
                     SetOption(),
                     {"out", "DIR", "output folder", true},
+                    {"ouster-metadata", "FILE",
+                     "Ouster sensor metadata JSON, needed when lidar.topic carries Ouster packets "
+                     "(ouster_ros/PacketMsg, ouster_sensor_msgs/msg/PacketMsg); same as --set "
+                     "lidar.ouster_metadata=FILE"},
                     {"map", "REF", "reference map (PCD or PLY, metres): localize in it (docs/survey.md)"},
                     {"initial-pose", "X,Y,Z,R,P,Y", "with --map: IMU pose in the map's frame at the first scan (m, deg)"},
                     {"initial-pose-tum", "FILE", "with --map: initial pose from a TUM file"},

@@ -69,7 +69,7 @@ CommandSpec SimulateSpec() {
            SetOption(),
            {"out", "DIR", "output directory (created if missing)", true, false},
            {"name", "NAME", "output file stem (default: the preset name)", false, false},
-           {"format", "FMT", "bag (ROS1, default), mcap or db3 (ROS 2), ouster-pcap (NAME.pcap + NAME.json Ouster packets, and NAME.bag with the same quantized data)", false, false},
+           {"format", "FMT", "bag (ROS1, default), mcap or db3 (ROS 2), ouster-pcap (NAME.pcap + NAME.json Ouster packets, and NAME.bag with the same quantized data), ouster-bag (NAME.bag: the packets as the ROS1 driver records them, + NAME.json)", false, false},
            {"mcap-compression", "C",
             "MCAP chunks: zstd (default), lz4, none, or unchunked", false, false}}};
 }
@@ -146,10 +146,15 @@ int CmdSimulate(int argc, char** argv) {
 
 int SimulateOnDisk(SimulateArgs sim) {
   sim.stop = [] { return InterruptSignalName(); };
-  // A second signal aborts at once: the writer's temporary file goes with it
-  // (the staging folder around it is removed by the next command that stages
-  // in this folder).
-  sim.staged = [](const std::string& staged) { SetAbortRemovePath(staged + ".tmp"); };
+  // A second signal aborts at once: the writer's temporary file goes with it,
+  // and the staging folder around it, and --out when this command made it.
+  std::error_code exists_ec;
+  const bool out_existed = std::filesystem::exists(sim.out_dir, exists_ec);
+  sim.staged = [out_existed, out = sim.out_dir](const std::string& staged) {
+    std::vector<std::string> made = {std::filesystem::path(staged).parent_path().string()};
+    if (!out_existed) made.push_back(out);
+    SetAbortRemovePath(staged + ".tmp", made);
+  };
   StatusOr<SimulateResult> r = SimulateRecording(sim);
   SetAbortRemovePath("");
   if (!r.ok()) return Fail(kSimulate, r.status());

@@ -29,13 +29,25 @@ void Forward(int sig) {
   }
 }
 
+// The published abort list: a file, then folders, each ended by '\0', the
+// list by an empty entry (unlink and rmdir are async-signal-safe; rmdir
+// removes only an empty folder).
+void RemoveAbortPaths(const char* list) {
+  ::unlink(list);
+  for (const char* p = list; *p != '\0';) {
+    while (*p != '\0') ++p;
+    ++p;  // the next entry
+    if (*p != '\0') ::rmdir(p);
+  }
+}
+
 extern "C" void OnSignal(int sig) {
   const int saved_errno = errno;
   Forward(sig);
   int none = 0;
   if (!g_signal.compare_exchange_strong(none, sig)) {  // the second signal: abort now
     const int slot = g_abort_slot.load();
-    if (slot >= 0) ::unlink(g_abort_path[slot]);
+    if (slot >= 0) RemoveAbortPaths(g_abort_path[slot]);
     ::_exit(128 + sig);
   }
   errno = saved_errno;
@@ -97,13 +109,17 @@ void RemoveForwardPid(pid_t pid) {
   }
 }
 
-void SetAbortRemovePath(const std::string& path) {
-  if (path.empty() || path.size() >= kMaxPath) {
+void SetAbortRemovePath(const std::string& path, const std::vector<std::string>& empty_folders) {
+  std::string list = path + '\0';
+  for (const std::string& folder : empty_folders)
+    if (!folder.empty()) list += folder + '\0';
+  list += '\0';
+  if (path.empty() || list.size() > kMaxPath) {
     g_abort_slot.store(-1);
     return;
   }
   const int slot = g_abort_slot.load() == 0 ? 1 : 0;  // never the one the handler may read
-  std::memcpy(g_abort_path[slot], path.c_str(), path.size() + 1);
+  std::memcpy(g_abort_path[slot], list.data(), list.size());
   g_abort_slot.store(slot);
 }
 

@@ -12,6 +12,7 @@
 #include <sys/types.h>
 
 #include <string>
+#include <vector>
 
 namespace rvlio::cli {
 
@@ -35,7 +36,9 @@ bool AddForwardPid(pid_t pid);
 void RemoveForwardPid(pid_t pid);
 
 // A file that an abort by the second signal removes (one at a time), e.g. the
-// temporary file of a bag being written; "" clears it.
-void SetAbortRemovePath(const std::string& path);
+// temporary file of a bag being written, then the folders around it that the
+// command created, in order, each only when empty; "" clears it.
+void SetAbortRemovePath(const std::string& path,
+                        const std::vector<std::string>& empty_folders = {});
 
 }  // namespace rvlio::cli

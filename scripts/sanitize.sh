@@ -76,6 +76,9 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # rosbag and DDS in real time (about a minute of wall time whatever the
 # build); its queues, ordering and errors run here in LiveSensorSource.*,
 # the propagator in ImuPropagator.*, the output messages in CdrTest.*.
+# ImuTrajectoryCli runs both backends, two refine chunks and three merges on
+# a 6 s flight for trajectory_imu.tum (9 s in Release); its interpolation
+# runs here in ImuRateTrajectory.*, the chunk blend in RefineJobs.*.
 # RVLIO_SANITIZE_EXCLUDE='^$' runs everything.
 ex=(
   RvCliTest.TunnelRvOnBeatsRvOffOnAteAndAlongAxisError
@@ -128,6 +131,7 @@ ex=(
   Live
   ControlCli.RunThenRefineWithMarksOrWallTargetsDeliversInTheSurveyFrame
   ControlCli.GnssAtBothPortalsWithAndWithoutControlPointsInside
+  ImuTrajectoryCli.RunRefineAndMergeWriteTheImuRateTrajectoryOnlyWhenAsked
 )
 default_exclude="^($(IFS='|'; echo "${ex[*]}"))\$"
 exclude=${RVLIO_SANITIZE_EXCLUDE:-$default_exclude}

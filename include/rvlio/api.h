@@ -31,6 +31,7 @@
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/config/config.h"
 #include "rvlio/formats/control_file.h"
+#include "rvlio/math/local_origin.h"
 #include "rvlio/formats/sensor_stream.h"
 #include "rvlio/odometry/divergence.h"
 #include "rvlio/odometry/odometry.h"
@@ -83,8 +84,10 @@ struct RunArgs {
   // `bag` then only names it in summary.json.
   SensorBagReader* source = nullptr;
   // Called on the calling thread with each scan result as it is estimated
-  // (in order, once each), with the odometry that made it.
-  std::function<void(const ScanResult&, const Odometry&)> on_result;
+  // (in order, once each), in the user's frame (as trajectory.tum), with the
+  // odometry that made it and the odometry's local frame (where its
+  // MapPoints are) relative to the user's frame (math/local_origin.h).
+  std::function<void(const ScanResult&, const Odometry&, const LocalOrigin&)> on_result;
   // Called with summary.json before it is written (e.g. `live` adds its figures).
   std::function<void(nlohmann::json* summary)> annotate_summary;
 };
@@ -93,6 +96,10 @@ struct RunResult {
   std::vector<ScanResult> scans;  // one per processed scan (the rows of scans.csv)
   std::vector<double> rss_mb;     // process resident memory when each scan was done, MB
   Trajectory trajectory;          // T_world_imu at each scan end (trajectory.tum)
+  // With output.imu_trajectory: T_world_imu at every IMU sample from the
+  // first scan end to the last and at every scan end (trajectory_imu.tum,
+  // imu/imu_rate_trajectory.h); empty otherwise.
+  Trajectory imu_trajectory;
   // The figures summary.json writes under the same names, typed: read these,
   // not the JSON.
   double sequence_duration_s = 0.0;  // first to last message read
@@ -157,6 +164,9 @@ struct RefineArgs {
 
 struct RefineRunResult {
   RefineResult refine;          // trajectory, map points, rounds, stats, warnings
+  // With output.imu_trajectory: the refined trajectory at IMU rate
+  // (trajectory_imu.tum, as RunResult::imu_trajectory); empty otherwise.
+  Trajectory imu_trajectory;
   DivergenceReport divergence;  // the checks of the refined result
   nlohmann::json summary;       // summary.json
   bool stopped = false;         // `stop` ended it (after a round, or while reading)
@@ -204,6 +214,9 @@ nlohmann::json MergedChunkJson(const MergedChunk& chunk);
 
 struct MergeResult {
   Trajectory trajectory;                    // T_world_imu, the merged frame is chunk 1's
+  // The chunks' trajectory_imu.tum merged as `trajectory` (when every chunk
+  // wrote one: output.imu_trajectory); empty otherwise.
+  Trajectory imu_trajectory;
   // The chunks' maps carried into that frame, re-voxelized, with the
   // attributes they have (scan_index: rows of `trajectory`).
   MapCloud map;
@@ -240,7 +253,7 @@ struct SimulateArgs {
   std::string lidar_msg = "pointcloud2"; // or "livox"
   std::string out_dir;                   // created if missing (required)
   std::string name;                      // file stem (default: the preset)
-  std::string format = "bag";            // bag (ROS1) | mcap | db3
+  std::string format = "bag";            // bag (ROS1) | mcap | db3 | ouster-pcap | ouster-bag
   std::string mcap_compression = "zstd"; // zstd | lz4 | none | unchunked (mcap only)
   StopFn stop;                           // a stop leaves no recording
   // Called with the path the recording is written to before it is moved

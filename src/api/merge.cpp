@@ -40,6 +40,8 @@ struct ChunkFolder {
   std::vector<std::string> warnings;  // its summary.json "warnings"
   json config;                        // its summary.json "config" (the refinement's options)
   std::string control_csv;            // its control.csv (refine --control), "" without
+  // Its trajectory_imu.tum, when it was refined with output.imu_trajectory.
+  std::optional<Trajectory> imu_trajectory;
 };
 
 // The whole file ("" when it cannot be read: the JSON parse then says so).
@@ -104,6 +106,28 @@ Status CheckTrajectoryAgainstManifest(const std::string& path, const json& m,
   return Status::Ok();
 }
 
+// trajectory_imu.tum of a chunk refined with output.imu_trajectory (its
+// summary's config says so): it must span the chunk's trajectory.tum.
+Status ReadChunkImuTrajectory(ChunkFolder* c) {
+  const json& config = c->config;
+  if (!config.is_object() || !config.contains("output") || !config["output"].is_object() ||
+      !config["output"].value("imu_trajectory", false))
+    return Status::Ok();
+  const std::string path = FilePath(c->dir, kImuTrajectoryFile);
+  StatusOr<Trajectory> imu = ReadTum(path);
+  if (!imu.ok())
+    return imu.status().WithMessage(imu.status().message() + " (the chunk was refined with "
+                                    "output.imu_trajectory=true)");
+  const Trajectory& scans = c->job.trajectory;
+  if (imu->front().t_ns != scans.front().t_ns || imu->back().t_ns != scans.back().t_ns)
+    return Status::InvalidInput(path + " spans " + std::to_string(imu->front().t_ns) + " .. " +
+                                std::to_string(imu->back().t_ns) + " ns, its trajectory.tum " +
+                                std::to_string(scans.front().t_ns) + " .. " +
+                                std::to_string(scans.back().t_ns) + ": not this chunk's");
+  c->imu_trajectory = std::move(*imu);
+  return Status::Ok();
+}
+
 StatusOr<ChunkFolder> ReadChunkFolder(const std::string& dir) {
   ChunkFolder c;
   c.dir = dir;
@@ -124,6 +148,7 @@ StatusOr<ChunkFolder> ReadChunkFolder(const std::string& dir) {
       if (w.is_string()) c.warnings.push_back(w.get<std::string>());
   if (summary.is_object() && summary.contains("config")) c.config = summary["config"];
   c.control_csv = ReadFileText(FilePath(dir, "control.csv"));
+  if (Status s = ReadChunkImuTrajectory(&c); !s.ok()) return s;
   return c;
 }
 
@@ -253,8 +278,8 @@ Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
                     const MapDeviation* deviation, const MapLasRequest& las) {
   OutputStage stage(out_dir);  // all outputs or none
   if (Status s = stage.Open(); !s.ok()) return s;
-  if (Status s = WriteTum(stage.Path("trajectory.tum"), r.trajectory); !s.ok())
-    return stage.Explain(s);
+  if (Status s = WriteTrajectoryOutputs(&stage, r.trajectory, r.imu_trajectory); !s.ok())
+    return s;
   if (!r.control_csv.empty())
     if (Status s = WriteFileAtomically(stage.Path("control.csv"), r.control_csv); !s.ok())
       return stage.Explain(s);
@@ -299,6 +324,34 @@ StatusOr<MergeReference> LoadMergeReference(const std::string& map, const ChunkF
   if (!surface.ok()) return surface.status();
   ref.surface = std::move(*surface);
   return ref;
+}
+
+// trajectory_imu.tum of the merge, in the local frame of `origin`: the
+// chunks' merged as their trajectory.tum were (MergeAlignedTrajectories),
+// when every chunk has one; a warning naming those without one when only
+// some have.
+Status MergeImuTrajectories(const std::vector<ChunkFolder>& chunks, const RefineJobMerge& merge,
+                            const LocalOrigin& origin, MergeResult* r) {
+  std::vector<RefineJobTrajectory> jobs;
+  std::string without;
+  for (const ChunkFolder& c : chunks) {
+    if (!c.imu_trajectory) {
+      without += (without.empty() ? "" : ", ") + std::to_string(c.job.span.chunk);
+      continue;
+    }
+    jobs.push_back({c.job.span, *c.imu_trajectory});
+    origin.ToLocal(&jobs.back().trajectory);
+  }
+  if (jobs.empty()) return Status::Ok();
+  if (!without.empty()) {
+    r->warnings.push_back("no trajectory_imu.tum is merged: chunk(s) " + without +
+                          " were refined without output.imu_trajectory=true");
+    return Status::Ok();
+  }
+  StatusOr<Trajectory> merged = MergeAlignedTrajectories(jobs, merge.alignments);
+  if (!merged.ok()) return merged.status();
+  r->imu_trajectory = std::move(*merged);
+  return Status::Ok();
 }
 
 }  // namespace
@@ -389,7 +442,9 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   if (reference->surface != nullptr)
     deviation = ComputeMapDeviation(r.map.p, *reference->surface, r.trajectory,
                                     reference->options);
+  if (Status s = MergeImuTrajectories(chunks, *merge, origin, &r); !s.ok()) return s;
   origin.ToUser(&r.trajectory);
+  origin.ToUser(&r.imu_trajectory);
   origin.ToUser(&r.map.p);
   if (Status s = MergeControl(chunks, *merge, origin, &r); !s.ok()) return s;
   r.summary = Summary(chunks, r);

@@ -25,6 +25,7 @@
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/outputs/summary_json.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/imu/imu_rate_trajectory.h"
 #include "rvlio/lidar/deskew.h"
 #include "rvlio/lidar/preprocess.h"
 #include "rvlio/math/so3.h"
@@ -278,13 +279,29 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
   if (!r.control_csv.empty())
     if (Status s = WriteFileAtomically(stage.Path("control.csv"), r.control_csv); !s.ok())
       return stage.Explain(s);
-  if (Status s = WriteTum(stage.Path("trajectory.tum"), r.refine.trajectory); !s.ok())
-    return stage.Explain(s);
+  if (Status s = WriteTrajectoryOutputs(&stage, r.refine.trajectory, r.imu_trajectory); !s.ok())
+    return s;
   if (Status s = WriteMapOutputs(&stage, r.refine.map, deviation, las); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
     return stage.Explain(s);
   return stage.Commit();
+}
+
+// The refined states (local frame), as the IMU-rate trajectory starts from them.
+std::vector<ImuEstimate> RefinedStates(const RefineResult& res) {
+  std::vector<ImuEstimate> states(res.trajectory.size());
+  for (size_t i = 0; i < states.size(); ++i) {
+    ImuEstimate& e = states[i];
+    e.state.t_ns = res.trajectory[i].t_ns;
+    e.state.R_world_imu = res.trajectory[i].q_world_imu.normalized().toRotationMatrix();
+    e.state.p_world_imu = res.trajectory[i].p_world_imu;
+    e.state.v_world_imu = res.v_world_imu[i];
+    e.bg_imu = res.gyro_bias[i];
+    e.ba_imu = res.accel_bias[i];
+    e.g_world = res.g_world;
+  }
+  return states;
 }
 
 // The IMU poses over [t0_ns, t1_ns] from the initial trajectory: its poses
@@ -467,6 +484,8 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     if (Status s = CheckMapFits(args, input.init, seen, *reference, origin); !s.ok()) return s;
   Times times;
   times.read_s = SecondsSince(t0);
+  std::vector<ImuSample> imu_for_output;  // output.imu_trajectory: Refine consumes the input
+  if (args.options.output.imu_trajectory) imu_for_output = input.imu;
   SurveyFactors ties;  // in the local survey frame, where refine then runs
   if (*survey != nullptr)
     if (Status s = (*survey)->Prepare(reference != nullptr, &origin, &input.init, &ties); !s.ok())
@@ -493,6 +512,10 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     deviation = ComputeMapDeviation(r.refine.map.p, *surface, r.refine.trajectory,
                                     args.options.localization.deviation);
   if (*survey != nullptr) DeliverInSurveyFrame(survey->get(), &r);  // residuals, local frame
+  if (args.options.output.imu_trajectory) {  // between the refined states, as their IMU factors
+    r.imu_trajectory = ImuRatePoses(RefinedStates(r.refine), imu_for_output, ImuRateJoin::kSpread);
+    origin.ToUser(&r.imu_trajectory);
+  }
   origin.ToUser(&r.refine.trajectory);
   origin.ToUser(&r.refine.map.p);
   times.wall_s = SecondsSince(t0);

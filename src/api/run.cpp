@@ -21,6 +21,7 @@
 #include "rvlio/outputs/summary_json.h"
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/formats/tum_stream.h"
+#include "rvlio/imu/imu_rate_trajectory.h"
 
 namespace rvlio {
 namespace {
@@ -158,8 +159,8 @@ Status WriteOutputs(const std::string& out_dir, const MapCloud& map,
                     const MapLasRequest& las) {
   OutputStage stage(out_dir);
   if (Status s = stage.Open(); !s.ok()) return s;
-  if (Status s = WriteTum(stage.Path("trajectory.tum"), result.trajectory); !s.ok())
-    return stage.Explain(s);
+  if (Status s = WriteTrajectoryOutputs(&stage, result.trajectory, result.imu_trajectory); !s.ok())
+    return s;
   if (Status s = WriteMapOutputs(&stage, map, deviation, las); !s.ok()) return s;
   if (Status s = WriteScansCsv(stage.Path("scans.csv"), result.scans, result.rss_mb); !s.ok())
     return stage.Explain(s);
@@ -209,23 +210,46 @@ std::string NoScanMessage(const std::string& bag, const OdometryOptions& o,
   return text;
 }
 
-// Appends the poses of the results not streamed yet to trajectory.partial.tum,
-// in the user's frame (the estimation's local frame plus `origin`, as
-// trajectory.tum), and hands them to `on_result` (in the local frame, as the
-// odometry it also hands over); a write error stops the streaming with one
-// warning (the run goes on).
+// Where the results go as they are estimated.
+struct ResultStreams {
+  size_t streamed = 0;  // results handed on so far
+  TumStream partial;    // trajectory.partial.tum: what a killed run leaves (tum_stream.h)
+  std::vector<std::string> warnings;
+  // output.imu_trajectory: the IMU-rate trajectory, local frame; fed the IMU
+  // samples as read and the results as estimated.
+  std::optional<ImuRateTrajectory> imu_rate;
+};
+
+// How the IMU-rate poses meet the backend's states (imu/imu_rate_trajectory.h):
+// the IESKF's are the filter's own propagation from each update; the
+// smoother's states are estimated jointly with the IMU between them.
+ImuRateJoin ImuRateJoinOf(Backend backend) {
+  return backend == Backend::kIeskf ? ImuRateJoin::kPropagate : ImuRateJoin::kSpread;
+}
+
+// Appends the poses of the results not streamed yet to trajectory.partial.tum
+// and hands the results to `on_result`, both in the user's frame (the
+// estimation's local frame plus `origin`, as trajectory.tum), and to the
+// IMU-rate trajectory (local frame); a write error
+// stops the streaming with one warning (the run goes on).
 void StreamNewPoses(const std::vector<ScanResult>& results, const LocalOrigin& origin,
-                    const RunArgs& args, const Odometry& odo,
-                    size_t* streamed, TumStream* stream, std::vector<std::string>* warnings) {
+                    const RunArgs& args, const Odometry& odo, ResultStreams* streams) {
+  size_t* streamed = &streams->streamed;
+  TumStream* stream = &streams->partial;
   for (; *streamed < results.size(); ++*streamed) {
-    if (args.on_result) args.on_result(results[*streamed], odo);
+    if (args.on_result) {
+      ScanResult user = results[*streamed];
+      user.T_world_imu.t = origin.ToUser(user.T_world_imu.t);
+      args.on_result(user, odo, origin);
+    }
+    if (streams->imu_rate) streams->imu_rate->AddEstimate(ImuEstimateOf(results[*streamed]));
     if (!stream->is_open()) continue;
     StampedPose pose;
     pose.t_ns = results[*streamed].t_ns;
     pose.p_world_imu = origin.ToUser(results[*streamed].T_world_imu.t);
     pose.q_world_imu = results[*streamed].T_world_imu.quaternion();
     if (Status s = stream->Append(pose); !s.ok())
-      warnings->push_back(s.message() + "; the partial trajectory is no longer written");
+      streams->warnings.push_back(s.message() + "; the partial trajectory is no longer written");
   }
 }
 
@@ -259,10 +283,8 @@ class ProgressReporter {
 
 // Feeds the recording to the odometry until its end, a read error or a stop.
 void Process(const RunArgs& args, const LocalOrigin& origin, SensorBagReader* reader,
-             Odometry* odo, TumStream* partial, std::vector<std::string>* stream_warnings,
-             RunData* data, RunResult* result) {
+             Odometry* odo, ResultStreams* streams, RunData* data, RunResult* result) {
   const ProgressReporter progress(args, Clock::now());
-  size_t streamed = 0;
   ImuSample imu;
   Scan scan;
   TimeNs t = 0;
@@ -280,19 +302,23 @@ void Process(const RunArgs& args, const LocalOrigin& origin, SensorBagReader* re
     t = *m == SensorMessage::kImu ? imu.t_ns : scan.t_end_ns;
     if (data->first_ns < 0) data->first_ns = t;
     data->last_ns = std::max(data->last_ns, t);
-    if (*m == SensorMessage::kImu) odo->AddImu(imu);
-    else odo->AddScan(std::move(scan));
+    if (*m == SensorMessage::kImu) {
+      odo->AddImu(imu);
+      if (streams->imu_rate) streams->imu_rate->AddImu(imu);
+    } else {
+      odo->AddScan(std::move(scan));
+    }
     odo->Poll(&result->scans);
     if (!odo->status().ok()) return;  // the reference map did not fit: nothing is written
-    StreamNewPoses(result->scans, origin, args, *odo, &streamed, partial, stream_warnings);
-    (void)partial->SyncIfDue();  // a failure surfaces at the next Append
+    StreamNewPoses(result->scans, origin, args, *odo, streams);
+    (void)streams->partial.SyncIfDue();  // a failure surfaces at the next Append
     if (result->rss_mb.size() < result->scans.size())
       result->rss_mb.resize(result->scans.size(), CurrentMemoryMb());
     progress.Report(static_cast<int>(result->scans.size()), t, odo->divergence());
   }
   if (!result->stopped) {
     odo->Finish(&result->scans);
-    StreamNewPoses(result->scans, origin, args, *odo, &streamed, partial, stream_warnings);
+    StreamNewPoses(result->scans, origin, args, *odo, streams);
     progress.Report(static_cast<int>(result->scans.size()), t, odo->divergence());
   }
   result->rss_mb.resize(result->scans.size(), CurrentMemoryMb());
@@ -347,15 +373,17 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
 
   RunResult result;
   RunData data;
-  std::vector<std::string> stream_warnings;
-  TumStream partial;  // trajectory.partial.tum: what a killed run leaves (tum_stream.h)
+  ResultStreams streams;
+  TumStream& partial = streams.partial;
   if (write)
     if (Status s =
             partial.Open((std::filesystem::path(args.out_dir) / kPartialTrajectory).string());
         !s.ok())
-      stream_warnings.push_back(s.message() + "; the partial trajectory is not written");
+      streams.warnings.push_back(s.message() + "; the partial trajectory is not written");
+  if (args.options.output.imu_trajectory)
+    streams.imu_rate.emplace(ImuRateJoinOf(args.options.backend));
   const auto t0 = Clock::now();
-  Process(args, origin, reader, odo->get(), &partial, &stream_warnings, &data, &result);
+  Process(args, origin, reader, odo->get(), &streams, &data, &result);
   data.wall_s = SecondsSince(t0);
   data.truncated = reader->truncated();
   if (!(*odo)->status().ok()) {  // nothing new in the output folder
@@ -371,7 +399,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
     result.warnings.push_back(w);
   for (const auto& w : (*odo)->warnings()) result.warnings.push_back(w);
   for (const auto& w : reader->warnings()) result.warnings.push_back(w);
-  for (const auto& w : stream_warnings) result.warnings.push_back(w);
+  for (const auto& w : streams.warnings) result.warnings.push_back(w);
   result.divergence = (*odo)->divergence();
   result.lidar_layout = reader->lidar_layout();
   if (result.scans.empty()) {  // nothing to write: nothing new in the output folder
@@ -391,6 +419,10 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   MoveToUserFrame(origin, &result.scans);
   origin.ToUser(&map.p);
   result.trajectory = ToTrajectory(result.scans);
+  if (streams.imu_rate) {
+    result.imu_trajectory = streams.imu_rate->TakePoses();
+    origin.ToUser(&result.imu_trajectory);
+  }
   result.summary = Summary(args, **odo, reader_stats, data, result);
   result.summary["local_origin"] = LocalOriginJson(origin);
   if (deviation) result.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);

@@ -3,7 +3,9 @@
 //   DIR/NAME.bag     ROS1 bag: Ouster-layout PointCloud2 + sensor_msgs/Imu
 //                    (format mcap: DIR/NAME.mcap, db3: DIR/NAME.db3, ROS 2 CDR;
 //                    ouster-pcap: DIR/NAME.pcap + NAME.json, Ouster packets, and
-//                    DIR/NAME.bag with the same quantized data)
+//                    DIR/NAME.bag with the same quantized data; ouster-bag:
+//                    DIR/NAME.bag, the packets as the ROS1 driver records
+//                    them, + NAME.json)
 //   DIR/NAME_gt.tum  true IMU pose in the world frame at 100 Hz
 //   DIR/NAME.yaml    sensor configuration for `rvlio run --config`
 //   DIR/localizability.csv  with localizability.enabled (default): the true
@@ -81,13 +83,26 @@ Status ResolveOptions(const SimulateArgs& args, SimOptions* options) {
   return options->Validate();
 }
 
+// The Ouster ROS driver's topics (its default namespace), for --format ouster-bag.
+constexpr const char* kLidarPacketTopic = "/ouster/lidar_packets";
+constexpr const char* kImuPacketTopic = "/ouster/imu_packets";
+constexpr const char* kMetadataTopic = "/ouster/metadata";
+
+bool OusterFormat(const std::string& format) { return format == "ouster-pcap" || format == "ouster-bag"; }
+
+std::string RecordingExtension(const std::string& format) {
+  if (format == "ouster-pcap") return ".pcap";
+  return format == "ouster-bag" ? ".bag" : "." + format;
+}
+
 // The format and MCAP compression -> writer options and the file extension.
 Status ResolveFormat(const SimulateArgs& args, BagWriterOptions* format, std::string* extension) {
   const std::string& name = args.format;
-  if (name != "bag" && name != "mcap" && name != "db3" && name != "ouster-pcap")
-    return Status::InvalidInput("format '" + name + "' is not one of bag, mcap, db3, ouster-pcap");
-  format->format = name == "bag" || name == "ouster-pcap" ? "ros1" : name;
-  *extension = name == "ouster-pcap" ? ".pcap" : "." + name;
+  if (name != "bag" && name != "mcap" && name != "db3" && !OusterFormat(name))
+    return Status::InvalidInput("format '" + name +
+                                "' is not one of bag, mcap, db3, ouster-pcap, ouster-bag");
+  format->format = name == "bag" || OusterFormat(name) ? "ros1" : name;
+  *extension = RecordingExtension(name);
   format->mcap_compression = args.mcap_compression;
   const std::string& c = format->mcap_compression;
   if (c != "zstd" && c != "lz4" && c != "none" && c != "unchunked")
@@ -106,8 +121,9 @@ std::string FlightSeedNote(const SimOptions& o) {
 
 // The estimator's sensor keys (odometry/options.h) as simulated. The noise
 // densities must be positive there; a noise-free simulation gets a tiny value.
+// packet_topics: lidar.topic and imu.topic are the Ouster packet topics.
 std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
-                       const std::string& bag_file) {
+                       const std::string& bag_file, bool packet_topics) {
   auto density = [](double v) { return FormatG(std::max(v, 1e-9), 10); };
   const auto& t = o.extrinsics.imu_T_lidar.translation;
   const auto& q = o.extrinsics.imu_T_lidar.rotation_xyzw;
@@ -116,12 +132,12 @@ std::string SensorYaml(const SimOptions& o, const std::string& name, bool livox,
     << o.seed << FlightSeedNote(o) << ").\n# Use: rvlio run --bag " << bag_file << " --config "
     << name << ".yaml --out DIR\n"
     << "lidar:\n"
-    << "  topic: " << o.lidar.topic << "\n"
+    << "  topic: " << (packet_topics ? kLidarPacketTopic : o.lidar.topic) << "\n"
     << (livox ? "  type: livox\n" : "  type: ouster\n  header_stamp: start\n")
     << "  min_range: " << FormatG(o.lidar.min_range, 10) << "\n"
     << "  max_range: " << FormatG(o.lidar.max_range, 10) << "\n"
     << "imu:\n"
-    << "  topic: " << o.imu.topic << "\n"
+    << "  topic: " << (packet_topics ? kImuPacketTopic : o.imu.topic) << "\n"
     << "  gyro_noise_density: " << density(o.imu.gyro_noise_density) << "\n"
     << "  accel_noise_density: " << density(o.imu.accel_noise_density) << "\n"
     << "  gyro_bias_random_walk: " << density(o.imu.gyro_bias_random_walk) << "\n"
@@ -205,17 +221,35 @@ StatusOr<OusterMetadata> SimulatedMetadata(const sim::Simulator& simulator, std:
 // 7502, IMU packets on 7503, IPv4-fragmented at a 1500-byte MTU), NAME.json
 // (the metadata) and NAME.bag, the same quantized data as PointCloud2 and
 // Imu messages (what the capture must decode to, bit for bit).
-Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pcap_path,
-                          const std::string& json_path, const std::string& bag_path,
+// `--format ouster-bag` (packet_bag): the same packets, received at the same
+// times, in the ROS1 bag NAME.bag as the ROS driver records them
+// (ouster_ros/PacketMsg on /ouster/lidar_packets and /ouster/imu_packets,
+// the metadata JSON on /ouster/metadata before them), and NAME.json;
+// cloud_bag_path is then unused.
+Status WriteOusterCapture(const sim::Simulator& simulator, bool packet_bag,
+                          const std::string& recording_path, const std::string& json_path,
+                          const std::string& cloud_bag_path,
                           const sim::Simulator::TruthCallback& on_truth, const StopFn& stop,
                           std::string* stop_reason) {
   std::string json;
   StatusOr<OusterMetadata> meta = SimulatedMetadata(simulator, &json);
   if (!meta.ok()) return meta.status();
   PcapWriter pcap;
-  if (Status s = pcap.Open(pcap_path); !s.ok()) return s;
-  StatusOr<std::unique_ptr<SensorBagWriter>> bag = SensorBagWriter::Create(bag_path);
+  if (!packet_bag)
+    if (Status s = pcap.Open(recording_path); !s.ok()) return s;
+  StatusOr<std::unique_ptr<SensorBagWriter>> bag =
+      SensorBagWriter::Create(packet_bag ? recording_path : cloud_bag_path);
   if (!bag.ok()) return bag.status();
+  bool metadata_written = false;
+  auto write_packet = [&](bool lidar, TimeNs receive_ns, const std::vector<uint8_t>& bytes) {
+    const uint16_t port = lidar ? 7502 : 7503;
+    if (!packet_bag) return pcap.Write({receive_ns, "", port, port, bytes});
+    if (!metadata_written) {  // the driver latches it before the packets
+      metadata_written = true;
+      if (Status s = (*bag)->WriteString(kMetadataTopic, receive_ns, json); !s.ok()) return s;
+    }
+    return (*bag)->WriteOusterPacket(lidar ? kLidarPacketTopic : kImuPacketTopic, receive_ns, bytes);
+  };
   LidarOptions every_return;
   every_return.min_range = 0.0;
   every_return.max_range = 1e9;
@@ -227,8 +261,9 @@ Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pc
   simulator.Run(
       [&](const ImuSample& m) {
         const OusterImuPacket packet = OusterImuPacketOf(m);
-        error = pcap.Write({m.t_ns, "", 7503, 7503, EncodeOusterImuPacket(packet)});
-        if (error.ok()) error = (*bag)->WriteImu(o.imu.topic, o.imu.frame_id, OusterImuToSample(packet));
+        error = write_packet(false, m.t_ns, EncodeOusterImuPacket(packet));
+        if (error.ok() && !packet_bag)
+          error = (*bag)->WriteImu(o.imu.topic, o.imu.frame_id, OusterImuToSample(packet));
         return go_on();
       },
       [&](const Scan& scan, int rows, int cols) {
@@ -236,18 +271,19 @@ Status WriteOusterCapture(const sim::Simulator& simulator, const std::string& pc
         DecodeStats decode;
         for (const OusterLidarPacket& p : OusterPacketsOfScan(*meta, scan, frame_id)) {
           if (!error.ok()) break;
-          error = pcap.Write({p.columns.back().t_ns, "", 7502, 7502, EncodeOusterLidarPacket(*meta, p)});
+          error = write_packet(true, p.columns.back().t_ns, EncodeOusterLidarPacket(*meta, p));
           assembler.Add(p, &decoded, &decode);
         }
         ++frame_id;
-        if (error.ok()) error = (*bag)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, decoded, rows, cols);
+        if (error.ok() && !packet_bag)
+          error = (*bag)->WriteOusterScan(o.lidar.topic, o.lidar.frame_id, decoded, rows, cols);
         return go_on();
       },
       on_truth);
   if (!error.ok() || !stop_reason->empty()) return error;
   if (Status s = (*bag)->Close(); !s.ok()) return s;
   if (Status s = WriteFileAtomically(json_path, json); !s.ok()) return s;
-  return pcap.Close();
+  return packet_bag ? Status::Ok() : pcap.Close();
 }
 
 // The fixes of gnss.enabled as NavSatFix messages: survey coordinates to
@@ -387,7 +423,7 @@ StatusOr<nlohmann::json> SimulationIdentity(const SimulateArgs& args, const SimO
 
 std::string SimulatedRecordingPath(const SimulateArgs& args) {
   const std::string name = args.name.empty() ? args.preset : args.name;
-  return (std::filesystem::path(args.out_dir) / (name + "." + args.format)).string();
+  return (std::filesystem::path(args.out_dir) / (name + RecordingExtension(args.format))).string();
 }
 
 StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
@@ -405,7 +441,8 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   if (Status s = ResolveFormat(args, &format, &extension); !s.ok()) return s;
   // The sensor configuration must be one that `rvlio run` accepts.
   const bool livox = args.lidar_msg == "livox";
-  const std::string yaml = SensorYaml(options, name, livox, name + extension);
+  const std::string yaml =
+      SensorYaml(options, name, livox, name + extension, args.format == "ouster-bag");
   Configuration check;
   if (Status s = ApplyYamlText(check, yaml, name + ".yaml");
       !s.ok() || !(s = check.Validate()).ok())
@@ -442,8 +479,9 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
   if (args.staged) args.staged(staged_recording);
   StatusOr<std::vector<NavSatFix>> fixes = GnssMessages(**simulator);
   if (!fixes.ok()) return fixes.status();
-  if (!fixes->empty() && args.format == "ouster-pcap")
-    return Status::InvalidInput("gnss.enabled: format ouster-pcap holds no NavSatFix messages");
+  if (!fixes->empty() && OusterFormat(args.format))
+    return Status::InvalidInput("gnss.enabled: format " + args.format +
+                                " holds no NavSatFix messages");
   sim::LocalizabilityTruth truth(options.localizability, options.lidar);
   std::vector<sim::ScanLocalizability> localizability;
   sim::Simulator::TruthCallback on_truth;
@@ -452,9 +490,11 @@ StatusOr<SimulateResult> SimulateRecording(const SimulateArgs& args) {
       localizability.push_back(truth.Compute((*simulator)->world(), scan, hits));
     };
   const Status written =
-      args.format == "ouster-pcap"
-          ? WriteOusterCapture(**simulator, staged_recording, stage.Path(name + ".json"),
-                               stage.Path(name + ".bag"), on_truth, args.stop, &r.stop_reason)
+      OusterFormat(args.format)
+          ? WriteOusterCapture(**simulator, args.format == "ouster-bag", staged_recording,
+                               stage.Path(name + ".json"),
+                               args.format == "ouster-pcap" ? stage.Path(name + ".bag") : "",
+                               on_truth, args.stop, &r.stop_reason)
           : WriteBag(**simulator, staged_recording, livox, format, on_truth, *fixes, args.stop,
                      &r.stop_reason);
   if (!written.ok()) return stage.Explain(written);

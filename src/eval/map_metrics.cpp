@@ -108,8 +108,8 @@ double MaxChainage(const std::vector<Eigen::Vector3d>& points, const ChainageAxi
   return max_chainage;
 }
 
-// The profile's bin count, refused beyond kMaxProfileBins (before any work:
-// a tiny step would allocate bins by the billion).
+// The profile's bin count, refused beyond kMaxProfileBins (before the bins
+// are allocated: a tiny step would allocate them by the billion).
 StatusOr<size_t> ProfileBins(double max_chainage_m, double step_m) {
   const double bins = std::floor(max_chainage_m / step_m) + 1.0;  // double: no overflow
   if (!(bins <= static_cast<double>(kMaxProfileBins))) {
@@ -189,8 +189,6 @@ StatusOr<MapEvalResult> EvaluateLocal(const std::vector<Eigen::Vector3d>& map_po
     return Status::InvalidInput(text);
   }
   const ChainageAxis axis = PrincipalAxis(ref_points);
-  StatusOr<size_t> bins = ProfileBins(MaxChainage(ref_points, axis), options.profile_step);
-  if (!bins.ok()) return bins.status();
   SearchProgress progress(progress_fn, map_points.size() + ref_points.size());
   const double D = options.max_distance;
   MapEvalResult r;
@@ -203,10 +201,16 @@ StatusOr<MapEvalResult> EvaluateLocal(const std::vector<Eigen::Vector3d>& map_po
   const std::vector<uint32_t> ref_order = VoxelOrder(ref_points, options.search.voxel_size);
   const std::vector<uint32_t> map_order = VoxelOrder(map_points, options.search.voxel_size);
   MapPointDistances d;
+  size_t bins = 0;
   {
     const ReferenceMap ref(ref_points, ref_order, options.search);
     if (Status s = CheckReach(ref.voxels(), ref_points); !s.ok())
       return Status::InvalidInput("the reference: " + s.message());
+    // After the reach (a stray point far away is named as such), before the
+    // search and the profile's bins are allocated.
+    StatusOr<size_t> profile_bins = ProfileBins(MaxChainage(ref_points, axis), options.profile_step);
+    if (!profile_bins.ok()) return profile_bins.status();
+    bins = *profile_bins;
     d = MapToReference(map_points, map_order, ref, options, &progress);
   }  // the reference's search structure is freed before the map's is built
   std::vector<double> plane, nearest;
@@ -244,7 +248,7 @@ StatusOr<MapEvalResult> EvaluateLocal(const std::vector<Eigen::Vector3d>& map_po
 
   r.axis_origin = axis.origin;
   r.axis_direction = axis.direction;
-  r.profile = Profile(map_points, ref_points, d, ref_nearest, axis, *bins, options);
+  r.profile = Profile(map_points, ref_points, d, ref_nearest, axis, bins, options);
   return r;
 }
 

@@ -11,7 +11,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
-#include "livox_ros1.h"
+#include "ros1_raw_message.h"
 #include "ouster_source.h"
 #include "rvlio/formats/pcap.h"
 #include "ros1_messages.h"

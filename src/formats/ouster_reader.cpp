@@ -8,20 +8,92 @@
 #include "sensor_reader_common.h"
 
 namespace rvlio::bag_detail {
-namespace {
 
-// The gate receives SI accelerations: the packet's g are converted here.
-ImuOptions SiImu(ImuOptions imu) {
-  imu.accel_unit = "mps2";
-  return imu;
+OusterPacketDecoder::OusterPacketDecoder(OusterMetadata meta, std::string metadata_origin,
+                                         const LidarOptions& lidar)
+    : meta_(std::move(meta)), metadata_origin_(std::move(metadata_origin)), assembler_(meta_, lidar) {}
+
+StatusOr<OusterLidarPacket> OusterPacketDecoder::DecodeLidar(const std::vector<uint8_t>& bytes,
+                                                             const std::string& where) {
+  if (!meta_.lidar_profile_decoded)
+    return Status::InvalidInput(where + ": lidar packets of profile " + meta_.lidar_profile_name +
+                                " (metadata " + metadata_origin_ + "), which rvlio does not decode");
+  StatusOr<OusterLidarPacket> packet = DecodeOusterLidarPacket(
+      meta_, bytes.data(), bytes.size(), where + " (metadata " + metadata_origin_ + ")");
+  if (!packet.ok()) return packet;
+  if (packet->init_id >= 0 && meta_.initialization_id >= 0 && packet->init_id != meta_.initialization_id)
+    return Status::InvalidInput(where + ": lidar packets of initialization id " +
+                                std::to_string(packet->init_id) + ", metadata " + metadata_origin_ +
+                                " of " + std::to_string(meta_.initialization_id) +
+                                " (metadata of another sensor or session)");
+  if (!first_decoded_) {
+    first_decoded_ = true;
+    crc_checked_ = packet->crc_present;
+  }
+  return packet;
 }
+
+StatusOr<bool> OusterPacketDecoder::AddLidar(const std::vector<uint8_t>& bytes, const std::string& where,
+                                             Scan* scan, DecodeStats* decode) {
+  StatusOr<OusterLidarPacket> packet = DecodeLidar(bytes, where);
+  if (!packet.ok()) return packet.status();
+  if (crc_checked_ && !packet->crc_present) {
+    ++assembler_.mutable_stats().crc_errors;
+    return false;
+  }
+  return assembler_.Add(*packet, scan, decode);
+}
+
+bool OusterPacketDecoder::FlushLidar(Scan* scan, DecodeStats* decode) {
+  return assembler_.Flush(scan, decode);
+}
+
+StatusOr<std::vector<ImuSample>> OusterPacketDecoder::DecodeImu(const std::vector<uint8_t>& bytes,
+                                                                const std::string& where) {
+  bool crc_ok = true;
+  StatusOr<std::vector<ImuSample>> samples =
+      DecodeOusterImuSamples(meta_, bytes.data(), bytes.size(), where, &crc_ok);
+  if (!samples.ok()) return samples;
+  ++imu_packets_;
+  if (crc_ok) return samples;
+  ++imu_crc_errors_;
+  return std::vector<ImuSample>();
+}
+
+OusterFrameStats OusterPacketDecoder::stats() const {
+  OusterFrameStats s = assembler_.stats();
+  s.imu_packets = imu_packets_;
+  s.imu_crc_errors = imu_crc_errors_;
+  return s;
+}
+
+std::vector<std::string> OusterPacketDecoder::Warnings(const std::string& source) const {
+  const OusterFrameStats s = stats();
+  std::vector<std::string> out;
+  if (s.incomplete_frames > 0)
+    out.push_back(source + ": " + std::to_string(s.incomplete_frames) +
+                  " frames with missing columns (" + std::to_string(s.missing_columns) +
+                  " columns absent: dropped packets), used with what they have");
+  if (s.late_packets > 0)
+    out.push_back(source + ": " + std::to_string(s.late_packets) +
+                  " lidar packets of an already completed frame dropped");
+  if (s.imu_crc_errors > 0)
+    out.push_back(source + ": " + std::to_string(s.imu_crc_errors) +
+                  " IMU packets with a wrong CRC-64 dropped");
+  if (s.crc_errors > 0)
+    out.push_back(source + ": " + std::to_string(s.crc_errors) +
+                  " lidar packets with a wrong CRC-64 dropped");
+  return out;
+}
+
+namespace {
 
 class OusterSensorReader final : public SensorBagReader {
  public:
   OusterSensorReader(std::unique_ptr<OusterPacketSource> source, const LidarOptions& lidar,
                      const ImuOptions& imu)
-      : source_(std::move(source)), gate_(SiImu(imu), lidar, source_->path()),
-        assembler_(source_->metadata(), lidar) {}
+      : source_(std::move(source)), gate_(imu, lidar, source_->path()),
+        packets_(source_->metadata(), source_->metadata_origin(), lidar) {}
 
   // Reads ahead to the first lidar packet and decodes it, so that metadata
   // of another mode or profile fails at Open.
@@ -33,8 +105,7 @@ class OusterSensorReader final : public SensorBagReader {
       if (!*got) return Status::Ok();
       peeked_.push_back(std::move(p));
       if (peeked_.back().kind != OusterPacketKind::kLidar) continue;
-      StatusOr<OusterLidarPacket> first = Decode(peeked_.back());
-      return first.ok() ? Status::Ok() : first.status();
+      return packets_.DecodeLidar(peeked_.back().bytes, Where(peeked_.back())).status();
     }
   }
 
@@ -47,28 +118,14 @@ class OusterSensorReader final : public SensorBagReader {
   }
 
   const SensorReaderStats& stats() const override { return gate_.stats(); }
-  const OusterFrameStats& frame_stats() const { return assembler_.stats(); }
+  OusterFrameStats frame_stats() const { return packets_.stats(); }
   const OusterPacketSource& source() const { return *source_; }
-  bool crc_checked() const { return crc_checked_; }
+  bool crc_checked() const { return packets_.crc_checked(); }
   std::string lidar_layout() const override { return "ouster_packets"; }
   std::vector<std::string> warnings() const override {
-    const OusterFrameStats& s = assembler_.stats();
-    std::vector<std::string> out;
-    if (s.incomplete_frames > 0)
-      out.push_back("'" + source_->path() + "': " + std::to_string(s.incomplete_frames) +
-                    " frames with missing columns (" + std::to_string(s.missing_columns) +
-                    " columns absent: dropped packets), used with what they have");
-    if (s.late_packets > 0)
-      out.push_back("'" + source_->path() + "': " + std::to_string(s.late_packets) +
-                    " lidar packets of an already completed frame dropped");
-    if (s.imu_crc_errors > 0)
-      out.push_back("'" + source_->path() + "': " + std::to_string(s.imu_crc_errors) +
-                    " IMU packets with a wrong CRC-64 dropped");
-    if (s.lidar_packets == 0)
+    std::vector<std::string> out = packets_.Warnings("'" + source_->path() + "'");
+    if (packets_.stats().lidar_packets == 0)
       out.push_back("'" + source_->path() + "': no lidar packets (IMU samples only)");
-    if (s.crc_errors > 0)
-      out.push_back("'" + source_->path() + "': " + std::to_string(s.crc_errors) +
-                    " lidar packets with a wrong CRC-64 dropped");
     return out;
   }
 
@@ -78,7 +135,7 @@ class OusterSensorReader final : public SensorBagReader {
       while (!pending_imu_.empty()) {
         const ImuSample s = pending_imu_.front();
         pending_imu_.pop_front();
-        if (gate_.AcceptImu(s.t_ns, s.acc_imu, s.gyro_imu, imu)) return SensorMessage::kImu;
+        if (gate_.AcceptSiImu(s.t_ns, s.acc_imu, s.gyro_imu, imu)) return SensorMessage::kImu;
       }
       OusterRawPacket p;
       StatusOr<bool> got = NextPacket(&p);
@@ -86,7 +143,7 @@ class OusterSensorReader final : public SensorBagReader {
       if (!*got) {
         DecodeStats decode;
         Scan last;
-        while (assembler_.Flush(&last, &decode)) {
+        while (packets_.FlushLidar(&last, &decode)) {
           StatusOr<bool> accepted = gate_.AcceptScan(decode, std::move(last), scan);
           if (!accepted.ok()) return accepted.status();
           if (*accepted) return SensorMessage::kScan;
@@ -94,39 +151,20 @@ class OusterSensorReader final : public SensorBagReader {
         return SensorMessage::kEnd;
       }
       if (p.kind == OusterPacketKind::kImu) {
-        if (Status s = DecodeImu(p); !s.ok()) return s;
-        continue;
-      }
-      StatusOr<OusterLidarPacket> packet = Decode(p);
-      if (!packet.ok()) return packet.status();
-      if (crc_checked_ && !packet->crc_present) {
-        ++assembler_.mutable_stats().crc_errors;
+        StatusOr<std::vector<ImuSample>> samples = packets_.DecodeImu(p.bytes, Where(p));
+        if (!samples.ok()) return samples.status();
+        pending_imu_.insert(pending_imu_.end(), samples->begin(), samples->end());
         continue;
       }
       DecodeStats decode;
       Scan done;
-      if (!assembler_.Add(*packet, &done, &decode)) continue;
+      StatusOr<bool> completed = packets_.AddLidar(p.bytes, Where(p), &done, &decode);
+      if (!completed.ok()) return completed.status();
+      if (!*completed) continue;
       StatusOr<bool> accepted = gate_.AcceptScan(decode, std::move(done), scan);
       if (!accepted.ok()) return accepted.status();
       if (*accepted) return SensorMessage::kScan;
     }
-  }
-
-  // Queues the packet's samples (one LEGACY, several ACCEL32_GYRO32_NMEA);
-  // a packet with a wrong CRC-64 is dropped and counted.
-  Status DecodeImu(const OusterRawPacket& p) {
-    bool crc_ok = true;
-    StatusOr<std::vector<ImuSample>> samples =
-        DecodeOusterImuSamples(source_->metadata(), p.bytes.data(), p.bytes.size(), Where(p), &crc_ok);
-    if (!samples.ok()) return samples.status();
-    OusterFrameStats& stats = assembler_.mutable_stats();
-    ++stats.imu_packets;
-    if (!crc_ok) {
-      ++stats.imu_crc_errors;
-      return Status::Ok();
-    }
-    pending_imu_.insert(pending_imu_.end(), samples->begin(), samples->end());
-    return Status::Ok();
   }
 
   StatusOr<bool> NextPacket(OusterRawPacket* out) {
@@ -141,37 +179,11 @@ class OusterSensorReader final : public SensorBagReader {
            (p.kind == OusterPacketKind::kLidar ? source_->lidar_origin() : source_->imu_origin());
   }
 
-  // Decodes and checks the packet against the metadata's sensor: the
-  // initialization id, when both carry one, and the CRC-64 once the first
-  // packet showed that the firmware writes it.
-  StatusOr<OusterLidarPacket> Decode(const OusterRawPacket& p) {
-    const OusterMetadata& meta = source_->metadata();
-    if (!meta.lidar_profile_decoded)
-      return Status::InvalidInput(Where(p) + ": lidar packets of profile " + meta.lidar_profile_name +
-                                  " (metadata " + source_->metadata_origin() +
-                                  "), which rvlio does not decode");
-    StatusOr<OusterLidarPacket> packet = DecodeOusterLidarPacket(
-        meta, p.bytes.data(), p.bytes.size(), Where(p) + " (metadata " + source_->metadata_origin() + ")");
-    if (!packet.ok()) return packet;
-    if (packet->init_id >= 0 && meta.initialization_id >= 0 && packet->init_id != meta.initialization_id)
-      return Status::InvalidInput(Where(p) + ": lidar packets of initialization id " +
-                                  std::to_string(packet->init_id) + ", metadata " +
-                                  source_->metadata_origin() + " of " +
-                                  std::to_string(meta.initialization_id) +
-                                  " (metadata of another sensor or session)");
-    if (!first_decoded_) {
-      first_decoded_ = true;
-      crc_checked_ = packet->crc_present;
-    }
-    return packet;
-  }
-
   std::unique_ptr<OusterPacketSource> source_;
   SensorGate gate_;
-  OusterScanAssembler assembler_;
+  OusterPacketDecoder packets_;
   std::deque<OusterRawPacket> peeked_;
   std::deque<ImuSample> pending_imu_;
-  bool first_decoded_ = false, crc_checked_ = false;
   Status error_;
 };
 
@@ -211,7 +223,7 @@ StatusOr<OusterRecordingInfo> ReadOusterRecordingInfo(const std::string& path, R
     }
   }
   const OusterMetadata& meta = reader.source().metadata();
-  const OusterFrameStats& f = reader.frame_stats();
+  const OusterFrameStats f = reader.frame_stats();
   OusterRecordingInfo info;
   info.metadata = reader.source().metadata_origin();
   info.prod_line = meta.prod_line;
@@ -243,10 +255,28 @@ StatusOr<OusterRecordingInfo> ReadOusterRecordingInfo(const std::string& path, R
 
 namespace rvlio {
 
+void ApplyOusterExtrinsics(const OusterMetadata& meta, const std::string& origin,
+                           ExtrinsicsSection* extrinsics, std::vector<std::string>* notes) {
+  const ExtrinsicsOptions defaults;
+  ExtrinsicsOptions& e = extrinsics->imu_T_lidar;
+  if (e.translation != defaults.translation || e.rotation_xyzw != defaults.rotation_xyzw) return;
+  const Eigen::Isometry3d imu_T_lidar = OusterImuTLidar(meta);
+  const Eigen::Quaterniond q(imu_T_lidar.linear());
+  const Eigen::Vector3d t = imu_T_lidar.translation();
+  e.translation = {t.x(), t.y(), t.z()};
+  e.rotation_xyzw = {q.x(), q.y(), q.z(), q.w()};
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "extrinsics.imu_T_lidar from the Ouster metadata %s (imu_to_sensor_transform): "
+                "translation [%.6f, %.6f, %.6f] m, rotation_xyzw [%.6f, %.6f, %.6f, %.6f]",
+                origin.c_str(), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  notes->push_back(line);
+}
+
 Status ApplyRecordingExtrinsics(const std::string& path, const LidarOptions& lidar,
                                 ExtrinsicsSection* extrinsics, std::vector<std::string>* notes) {
   const ExtrinsicsOptions defaults;
-  ExtrinsicsOptions& e = extrinsics->imu_T_lidar;
+  const ExtrinsicsOptions& e = extrinsics->imu_T_lidar;
   if (e.translation != defaults.translation || e.rotation_xyzw != defaults.rotation_xyzw)
     return Status::Ok();
   StatusOr<RecordingKind> kind = DetectRecording(path);
@@ -258,17 +288,7 @@ Status ApplyRecordingExtrinsics(const std::string& path, const LidarOptions& lid
           ? bag_detail::OpenOusterPcapSource(path, lidar.ouster_metadata, std::nullopt)
           : bag_detail::OpenOusterBagSource(path, *kind, lidar.ouster_metadata, std::nullopt);
   if (!source.ok()) return source.status();
-  const Eigen::Isometry3d imu_T_lidar = OusterImuTLidar((*source)->metadata());
-  const Eigen::Quaterniond q(imu_T_lidar.linear());
-  const Eigen::Vector3d t = imu_T_lidar.translation();
-  e.translation = {t.x(), t.y(), t.z()};
-  e.rotation_xyzw = {q.x(), q.y(), q.z(), q.w()};
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "extrinsics.imu_T_lidar from the Ouster metadata %s (imu_to_sensor_transform): "
-                "translation [%.6f, %.6f, %.6f] m, rotation_xyzw [%.6f, %.6f, %.6f, %.6f]",
-                (*source)->metadata_origin().c_str(), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-  notes->push_back(line);
+  ApplyOusterExtrinsics((*source)->metadata(), (*source)->metadata_origin(), extrinsics, notes);
   return Status::Ok();
 }
 

@@ -11,7 +11,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
-#include "livox_ros1.h"
+#include "ros1_raw_message.h"
 #include "rosbag_common.h"
 #include "rvlio/formats/cdr.h"
 #include "rvlio/formats/pcap.h"
@@ -21,7 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kRos1PacketType = "ouster_ros/PacketMsg";
+const char* const kRos1PacketType = OusterPacketRos1Message::type();
 constexpr const char* kRos2PacketTypes[] = {"ouster_sensor_msgs/msg/PacketMsg",
                                            "ouster_msgs/msg/PacketMsg"};
 constexpr const char* kRos1StringType = "std_msgs/String";
@@ -155,24 +155,8 @@ Status LoadMetadataFile(const std::string& path, OusterMetadata* meta, std::stri
   return Status::Ok();
 }
 
-// Strips the driver's extra trailing byte (ouster_ros buffers are one byte
-// longer than the packet) when the rest is exactly a lidar packet.
-void TrimDriverByte(const OusterMetadata& meta, OusterRawPacket* p) {
-  const size_t lidar_bytes = static_cast<size_t>(OusterFormatOf(meta).PacketBytes());
-  const size_t want = p->kind == OusterPacketKind::kLidar ? lidar_bytes
-                                                          : static_cast<size_t>(OusterImuPacketBytes(meta));
-  if (p->bytes.size() == want + 1) p->bytes.pop_back();
-}
-
-// ROS1: uint8[] buf = uint32 length + bytes; String: uint32 length + chars.
 StatusOr<std::vector<uint8_t>> Ros1Bytes(const std::vector<uint8_t>& raw, const std::string& where) {
-  if (raw.size() < 4) return Status::InvalidInput(where + ": message shorter than its length field");
-  const uint32_t n = uint32_t{raw[0]} | uint32_t{raw[1]} << 8 | uint32_t{raw[2]} << 16 |
-                     uint32_t{raw[3]} << 24;
-  if (n != raw.size() - 4)
-    return Status::InvalidInput(where + ": message of " + std::to_string(raw.size()) +
-                                " bytes holds a buffer length of " + std::to_string(n));
-  return std::vector<uint8_t>(raw.begin() + 4, raw.end());
+  return Ros1PacketBuffer(raw.data(), raw.size(), where);
 }
 
 class Ros1Source final : public OusterPacketSource {
@@ -210,7 +194,7 @@ class Ros1Source final : public OusterPacketSource {
         out->kind = m.getTopic() == topics_.lidar ? OusterPacketKind::kLidar : OusterPacketKind::kImu;
         out->receive_ns = t;
         out->bytes = std::move(bytes).value();
-        TrimDriverByte(meta_, out);
+        TrimDriverByte(meta_, out->kind, &out->bytes);
         return true;
       }
     } catch (const std::exception& e) {
@@ -296,15 +280,12 @@ class Ros2Source final : public OusterPacketSource {
     if (!got.ok() || !*got) return got;
     const bool lidar = m.topic == lidar_index_;
     const std::string where = "topic '" + (lidar ? topics_.lidar : topics_.imu) + "' in bag '" + path_ + "'";
-    cdr::Reader r(m.data.data(), m.data.size(), where);
-    const uint8_t* bytes = nullptr;
-    size_t size = 0;
-    if (Status s = r.Begin(); !s.ok()) return s;
-    if (Status s = r.ByteSequence(&bytes, &size, "buf"); !s.ok()) return s;
+    StatusOr<std::vector<uint8_t>> bytes = CdrPacketBuffer(m.data.data(), m.data.size(), where);
+    if (!bytes.ok()) return bytes.status();
     out->kind = lidar ? OusterPacketKind::kLidar : OusterPacketKind::kImu;
     out->receive_ns = m.stamp_ns;
-    out->bytes.assign(bytes, bytes + size);
-    TrimDriverByte(meta_, out);
+    out->bytes = std::move(bytes).value();
+    TrimDriverByte(meta_, out->kind, &out->bytes);
     return true;
   }
 
@@ -348,6 +329,40 @@ bool IsOusterPacketType(const std::string& type) {
   if (type == kRos1PacketType) return true;
   return std::find(std::begin(kRos2PacketTypes), std::end(kRos2PacketTypes), type) !=
          std::end(kRos2PacketTypes);
+}
+
+std::vector<std::string> OusterPacketTypes(bool ros2) {
+  if (!ros2) return {kRos1PacketType};
+  return {std::begin(kRos2PacketTypes), std::end(kRos2PacketTypes)};
+}
+
+// ROS1: uint8[] buf = uint32 length + bytes (a String too: length + chars).
+StatusOr<std::vector<uint8_t>> Ros1PacketBuffer(const uint8_t* data, size_t size,
+                                                const std::string& where) {
+  if (size < 4) return Status::InvalidInput(where + ": message shorter than its length field");
+  const uint32_t n = uint32_t{data[0]} | uint32_t{data[1]} << 8 | uint32_t{data[2]} << 16 |
+                     uint32_t{data[3]} << 24;
+  if (n != size - 4)
+    return Status::InvalidInput(where + ": message of " + std::to_string(size) +
+                                " bytes holds a buffer length of " + std::to_string(n));
+  return std::vector<uint8_t>(data + 4, data + size);
+}
+
+StatusOr<std::vector<uint8_t>> CdrPacketBuffer(const uint8_t* data, size_t size,
+                                               const std::string& where) {
+  cdr::Reader r(data, size, where);
+  const uint8_t* bytes = nullptr;
+  size_t n = 0;
+  if (Status s = r.Begin(); !s.ok()) return s;
+  if (Status s = r.ByteSequence(&bytes, &n, "buf"); !s.ok()) return s;
+  return std::vector<uint8_t>(bytes, bytes + n);
+}
+
+void TrimDriverByte(const OusterMetadata& meta, OusterPacketKind kind, std::vector<uint8_t>* bytes) {
+  const size_t want = kind == OusterPacketKind::kLidar
+                          ? static_cast<size_t>(OusterFormatOf(meta).PacketBytes())
+                          : static_cast<size_t>(OusterImuPacketBytes(meta));
+  if (bytes->size() == want + 1) bytes->pop_back();
 }
 
 bool UsesOusterPackets(const std::map<std::string, std::string>& topic_types,
@@ -407,14 +422,6 @@ StatusOr<std::string> FindOusterMetadata(const std::string& pcap_path,
                               " starting NAME_ next to it; give it with --ouster-metadata FILE");
 }
 
-StatusOr<OusterMetadata> ReadOusterMetadataFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::InvalidInput("cannot read Ouster metadata '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseOusterMetadata(text.str(), path);
-}
-
 StatusOr<std::unique_ptr<OusterPacketSource>> OpenOusterPcapSource(
     const std::string& path, const std::string& metadata_path,
     const std::optional<ReceiveTimeRange>& range) {
@@ -442,3 +449,15 @@ StatusOr<std::unique_ptr<OusterPacketSource>> OpenOusterBagSource(
 }
 
 }  // namespace rvlio::bag_detail
+
+namespace rvlio {
+
+StatusOr<OusterMetadata> ReadOusterMetadataFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::InvalidInput("cannot read Ouster metadata '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return ParseOusterMetadata(text.str(), path);
+}
+
+}  // namespace rvlio

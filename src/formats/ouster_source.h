@@ -4,6 +4,7 @@
 // ouster_sensor_msgs/msg/PacketMsg, metadata on a String topic) gives the
 // same stream of raw lidar and IMU packets with their receive times; one
 // SensorBagReader (ouster_reader.cpp) decodes them.
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -45,6 +46,61 @@ class OusterPacketSource {
 
 // ROS1 / ROS 2 message types of the drivers' packet topics.
 bool IsOusterPacketType(const std::string& type);
+// "ouster_ros/PacketMsg"; "ouster_sensor_msgs/msg/PacketMsg", "ouster_msgs/msg/PacketMsg".
+std::vector<std::string> OusterPacketTypes(bool ros2);
+
+// The packet a driver's PacketMsg (uint8[] buf) holds: ROS 1 wire format
+// (uint32 length + bytes) or CDR with its encapsulation header.
+// InvalidInput naming `where` when the message is not one.
+StatusOr<std::vector<uint8_t>> Ros1PacketBuffer(const uint8_t* data, size_t size,
+                                                const std::string& where);
+StatusOr<std::vector<uint8_t>> CdrPacketBuffer(const uint8_t* data, size_t size,
+                                               const std::string& where);
+// Strips the driver's extra trailing byte (ouster_ros buffers are one byte
+// longer than the packet) when the rest is exactly a packet of `kind`.
+void TrimDriverByte(const OusterMetadata& meta, OusterPacketKind kind, std::vector<uint8_t>* bytes);
+
+// Lidar and IMU packets of one sensor -> scans and IMU samples (SI units):
+// the one decoding of Ouster packets, for recordings (OusterSensorReader)
+// and `rvlio live` (LiveSensorSource). The lidar calls (DecodeLidar,
+// AddLidar, FlushLidar) and DecodeImu touch separate state, so one thread
+// may feed the lidar packets while another feeds the IMU packets; stats()
+// and Warnings() want both quiet.
+class OusterPacketDecoder {
+ public:
+  OusterPacketDecoder(OusterMetadata meta, std::string metadata_origin, const LidarOptions& lidar);
+
+  // A lidar packet checked against the metadata: a profile rvlio decodes,
+  // the profile's packet size, the initialization id where both carry one
+  // (InvalidInput naming `where` and the metadata). The first one decoded
+  // says whether the firmware writes a CRC-64.
+  StatusOr<OusterLidarPacket> DecodeLidar(const std::vector<uint8_t>& bytes, const std::string& where);
+  // DecodeLidar, then assembly: true with *scan set when the packet
+  // completed a frame. A packet without a matching CRC-64 (when the firmware
+  // writes one) is dropped and counted.
+  StatusOr<bool> AddLidar(const std::vector<uint8_t>& bytes, const std::string& where, Scan* scan,
+                          DecodeStats* decode);
+  // The frame being assembled, if any columns are pending.
+  bool FlushLidar(Scan* scan, DecodeStats* decode);
+  // The samples of an IMU packet, oldest first; none when its CRC-64 does
+  // not match (counted). InvalidInput naming `where` for another size.
+  StatusOr<std::vector<ImuSample>> DecodeImu(const std::vector<uint8_t>& bytes, const std::string& where);
+
+  OusterFrameStats stats() const;
+  bool crc_checked() const { return crc_checked_; }
+  const OusterMetadata& metadata() const { return meta_; }
+  const std::string& metadata_origin() const { return metadata_origin_; }
+  // One line each for frames with missing columns, late packets and
+  // packets with a wrong CRC-64, naming `source`.
+  std::vector<std::string> Warnings(const std::string& source) const;
+
+ private:
+  OusterMetadata meta_;
+  std::string metadata_origin_;
+  OusterScanAssembler assembler_;  // lidar side
+  bool first_decoded_ = false, crc_checked_ = false;
+  int64_t imu_packets_ = 0, imu_crc_errors_ = 0;  // IMU side
+};
 // True when the recording's topics hold Ouster packets and `lidar_topic` is
 // not a point cloud topic of it (a bag with both reads the clouds).
 bool UsesOusterPackets(const std::map<std::string, std::string>& topic_types,
@@ -60,7 +116,6 @@ StatusOr<bool> HoldsOusterPackets(const std::string& path, RecordingKind kind,
 // begins STEM (a capture cut from a longer recording keeps its prefix).
 StatusOr<std::string> FindOusterMetadata(const std::string& pcap_path,
                                          const std::string& explicit_path);
-StatusOr<OusterMetadata> ReadOusterMetadataFile(const std::string& path);
 
 StatusOr<std::unique_ptr<OusterPacketSource>> OpenOusterPcapSource(
     const std::string& path, const std::string& metadata_path,

@@ -260,6 +260,21 @@ class Ros2SensorWriter final : public SensorBagWriter {
                  EncodeNavSatFixCdr(fix));
   }
 
+  Status WriteOusterPacket(const std::string& topic, TimeNs receive_ns,
+                           const std::vector<uint8_t>& packet) override {
+    if (!storage_) return Closed();
+    if (Status s = CheckRos2Stamp(receive_ns, "packet receive time"); !s.ok()) return s;
+    cdr::Writer w;
+    w.Bytes(packet.data(), packet.size());
+    return Write(topic, "ouster_sensor_msgs/msg/PacketMsg", "uint8[] buf\n", receive_ns, w.Take());
+  }
+
+  Status WriteString(const std::string& topic, TimeNs receive_ns, const std::string& text) override {
+    if (!storage_) return Closed();
+    if (Status s = CheckRos2Stamp(receive_ns, "String receive time"); !s.ok()) return s;
+    return Write(topic, cdr::kStringType, "string data\n", receive_ns, cdr::EncodeString(text));
+  }
+
   Status Close() override {
     if (!storage_) return Closed();
     Status s = storage_->Close();

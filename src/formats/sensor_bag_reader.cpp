@@ -8,7 +8,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
-#include "livox_ros1.h"
+#include "ros1_raw_message.h"
 #include "ouster_source.h"
 #include "ros1_messages.h"
 #include "rosbag_common.h"

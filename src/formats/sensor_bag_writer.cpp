@@ -1,5 +1,6 @@
 // SensorBagWriter: ROS1 messages through rosbag::Bag, written to path + ".tmp"
 // and renamed into place on Close().
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -13,8 +14,9 @@
 #include <sensor_msgs/NavSatFix.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/PointField.h>
+#include <std_msgs/String.h>
 
-#include "livox_ros1.h"
+#include "ros1_raw_message.h"
 #include "rosbag_common.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/sensor_bag.h"
@@ -140,6 +142,26 @@ class RosbagSensorWriter final : public SensorBagWriter {
     for (int i = 0; i < 9; ++i) msg.position_covariance[i] = fix.position_covariance[i];
     msg.position_covariance_type = fix.covariance_type;
     return Write(topic, bag_detail::RecordTime(fix.header_stamp_ns), msg);
+  }
+
+  Status WriteOusterPacket(const std::string& topic, TimeNs receive_ns,
+                           const std::vector<uint8_t>& packet) override {
+    if (!open_) return Status::Internal("bag '" + path_ + "' is already closed");
+    if (Status s = CheckRosStamp(receive_ns, "packet receive time"); !s.ok()) return s;
+    bag_detail::OusterPacketRos1Bytes msg;
+    msg.bytes.resize(4 + packet.size());  // uint8[] buf: uint32 length + bytes
+    const uint32_t n = static_cast<uint32_t>(packet.size());
+    for (int i = 0; i < 4; ++i) msg.bytes[i] = static_cast<uint8_t>(n >> (8 * i));
+    std::copy(packet.begin(), packet.end(), msg.bytes.begin() + 4);
+    return Write(topic, bag_detail::RecordTime(receive_ns), msg);
+  }
+
+  Status WriteString(const std::string& topic, TimeNs receive_ns, const std::string& text) override {
+    if (!open_) return Status::Internal("bag '" + path_ + "' is already closed");
+    if (Status s = CheckRosStamp(receive_ns, "String receive time"); !s.ok()) return s;
+    std_msgs::String msg;
+    msg.data = text;
+    return Write(topic, bag_detail::RecordTime(receive_ns), msg);
   }
 
   Status Close() override {

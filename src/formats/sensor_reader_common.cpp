@@ -32,10 +32,15 @@ Status RequireTopic(const std::string& path, const std::map<std::string, std::st
 
 bool SensorGate::AcceptImu(TimeNs t_ns, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro,
                            ImuSample* out) {
+  const double scale = imu_.accel_unit == "g" ? kStandardGravity : 1.0;
+  return AcceptSiImu(t_ns, scale * acc, gyro, out);
+}
+
+bool SensorGate::AcceptSiImu(TimeNs t_ns, const Eigen::Vector3d& acc_mps2,
+                             const Eigen::Vector3d& gyro, ImuSample* out) {
   ImuSample s;
   s.t_ns = t_ns;
-  const double scale = imu_.accel_unit == "g" ? kStandardGravity : 1.0;
-  s.acc_imu = scale * acc;
+  s.acc_imu = acc_mps2;
   s.gyro_imu = gyro;
   if (!s.acc_imu.allFinite() || !s.gyro_imu.allFinite()) {
     ++stats_.imu_invalid;

@@ -40,6 +40,10 @@ class SensorGate {
   // (non-finite, duplicate or older stamp).
   bool AcceptImu(TimeNs t_ns, const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro,
                  ImuSample* out);
+  // The same for a sample in m/s^2 whatever imu.accel_unit says (Ouster IMU
+  // packets state their own unit).
+  bool AcceptSiImu(TimeNs t_ns, const Eigen::Vector3d& acc_mps2, const Eigen::Vector3d& gyro,
+                   ImuSample* out);
   // A decoded scan: counts the dropped points; true (and moves the scan into
   // *out) when it has points, false for an empty scan. InvalidInput when the
   // point times of the first scans span less than lidar.point_time_span_stop

@@ -5,6 +5,8 @@
 #include <chrono>
 
 #include "publisher.h"
+#include "rvlio/formats/ouster.h"
+#include "rvlio/formats/sensor_bag.h"
 #include "rvlio/outputs/output_stage.h"
 #include "rvlio/live/live.h"
 #include "transport.h"
@@ -14,8 +16,29 @@ namespace {
 
 using live_detail::Transport;
 
-constexpr int kLidarDepth = 4;    // messages a transport holds for the LiDAR thread
-constexpr int kImuDepth = 1000;   // and for the IMU thread (2.5 s at 400 Hz)
+constexpr int kLidarDepth = 4;    // scans a transport holds for the LiDAR thread
+constexpr int kImuDepth = 1000;   // messages for the IMU thread (2.5 s at 400 Hz)
+
+// Messages of kLidarDepth scans: Ouster packets come many to a scan.
+int LidarDepth(const std::optional<OusterMetadata>& ouster) {
+  if (!ouster) return kLidarDepth;
+  const int per_packet = std::max(ouster->columns_per_packet, 1);
+  return kLidarDepth * ((ouster->WindowColumns() + per_packet - 1) / per_packet);
+}
+
+// The sensor of Ouster packet topics (lidar.ouster_metadata, when given),
+// read before connecting; it gives the default extrinsic as it does to
+// `run` on a packet recording (*notes says so).
+Status LoadOusterSensor(Configuration* options, std::optional<OusterMetadata>* ouster,
+                        std::vector<std::string>* notes) {
+  const std::string& path = options->lidar.ouster_metadata;
+  if (path.empty()) return Status::Ok();
+  StatusOr<OusterMetadata> meta = ReadOusterMetadataFile(path);
+  if (!meta.ok()) return meta.status();
+  *ouster = std::move(meta).value();
+  ApplyOusterExtrinsics(**ouster, path, &options->extrinsics, notes);
+  return Status::Ok();
+}
 
 nlohmann::json LiveJson(const LiveFigures& f) {
   return {{"middleware", f.middleware},
@@ -49,6 +72,9 @@ StatusOr<std::unique_ptr<Transport>> Connect(const LiveArgs& args,
 StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   Configuration options = args.options;
   if (Status s = options.Validate(); !s.ok()) return s;
+  std::optional<OusterMetadata> ouster;
+  std::vector<std::string> notes;
+  if (Status s = LoadOusterSensor(&options, &ouster, &notes); !s.ok()) return s;
   if (!args.out_dir.empty()) {  // an unusable output folder is refused before connecting
     OutputFolder check(args.out_dir);  // removes again what it created
     if (Status s = check.Prepare(); !s.ok()) return s;
@@ -75,6 +101,8 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   source_options.lidar = options.lidar;
   source_options.imu = options.imu;
   source_options.live = options.live;
+  source_options.ouster = ouster;
+  source_options.ouster_origin = options.lidar.ouster_metadata;
   source_options.stopped = [&stop] { return !stop().empty(); };
   LiveSensorSource source(source_options);
   live_detail::LivePublisher publisher(&net, &source, options);
@@ -88,7 +116,7 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   if (Status s = net.Advertise(live_detail::OutputTopics(options.live.topic_namespace)); !s.ok())
     return s;
   Status subscribed = net.Subscribe(
-      options.lidar.topic, kLidarDepth,
+      options.lidar.topic, LidarDepth(ouster),
       [&source](const uint8_t* data, size_t size, const std::string& type) {
         source.PushLidar(data, size, type, std::chrono::steady_clock::now());
       });
@@ -96,7 +124,8 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
     subscribed = net.Subscribe(options.imu.topic, kImuDepth,
                                [&source, &publisher](const uint8_t* data, size_t size,
                                                      const std::string& type) {
-                                 if (auto s = source.PushImu(data, size, type)) publisher.OnImu(*s);
+                                 for (const ImuSample& s : source.PushImu(data, size, type))
+                                   publisher.OnImu(s);
                                });
   if (!subscribed.ok()) return subscribed;
   if (args.on_ready) args.on_ready(net.origin());
@@ -114,7 +143,9 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
   // recording, so the outputs hold every scan received, as `run` on a
   // recording of the same messages.
   run.progress = args.progress;
-  run.on_result = [&publisher](const ScanResult& r, const Odometry& odo) { publisher.OnResult(r, odo); };
+  run.on_result = [&publisher](const ScanResult& r, const Odometry& odo, const LocalOrigin& origin) {
+    publisher.OnResult(r, odo, origin);
+  };
   LiveFigures figures;
   figures.middleware = args.middleware == LiveMiddleware::kRos1 ? "ros1" : "ros2";
   figures.origin = net.origin();
@@ -130,6 +161,11 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
     net.Shutdown();  // nothing arrives any more: the figures are final
     fill();
     (*summary)["command"] = "live";
+    if (!notes.empty()) {  // as run's summary says them, first
+      nlohmann::json warnings = notes;
+      for (const nlohmann::json& w : (*summary)["warnings"]) warnings.push_back(w);
+      (*summary)["warnings"] = warnings;
+    }
     (*summary)["live"] = LiveJson(figures);
     (*summary)["interrupted"] = !stop_reason.empty();
     if (!stop_reason.empty()) {  // as an interrupted `run` says it
@@ -151,6 +187,7 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
     return out;
   }
   out.run = std::move(result).value();
+  out.run.warnings.insert(out.run.warnings.begin(), notes.begin(), notes.end());
   out.run.stopped = !stop_reason.empty();
   out.run.stop_reason = stop_reason;
   return out;

@@ -86,19 +86,16 @@ void LivePublisher::OnImu(const ImuSample& sample) {
   last_output_ = now;
 }
 
-void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometry) {
-  ImuKinematics state;
-  state.t_ns = r.t_ns;
-  state.R_world_imu = r.T_world_imu.R;
-  state.p_world_imu = r.T_world_imu.t;
-  state.v_world_imu = r.v_world_imu;
+void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometry,
+                             const LocalOrigin& origin) {
+  const ImuEstimate estimate = ImuEstimateOf(r);
   std::optional<LiveScanArrival> arrival = source_->TakeArrival(r.t_ns);
   std::vector<ImuSample> imu;
   Eigen::Vector3d gyro_imu = Eigen::Vector3d::Zero();
   OdometryMessage message;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    propagator_.SetEstimate(ImuEstimate{state, r.bg_imu, r.ba_imu, r.g_world});
+    propagator_.SetEstimate(estimate);
     bg_imu_ = r.bg_imu;
     pose_covariance_.fill(0.0);
     if (r.pose_covariance_world)
@@ -106,7 +103,7 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
           *r.pose_covariance_world;
     if (arrival) imu = propagator_.Covering(arrival->scan.t_start_ns, r.t_ns);
     if (!imu.empty()) gyro_imu = InterpolateImu(imu, r.t_ns).gyro_imu - r.bg_imu;
-    message = Odometry(r.t_ns, state, gyro_imu);
+    message = Odometry(r.t_ns, estimate.state, gyro_imu);
   }
   transport_->Publish(OdometryTopic::kScanRate, message);
   if (options_.live.publish_tf) {
@@ -133,7 +130,7 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
     transport_->Publish(path_);
   }
   PublishStatus(r);
-  PublishMap(r.t_ns, odometry);
+  PublishMap(r.t_ns, odometry, origin);
 }
 
 // The scan deskewed to its end by the IMU motion around the estimate (the
@@ -141,13 +138,9 @@ void LivePublisher::OnResult(const ScanResult& r, const rvlio::Odometry& odometr
 // the IMU samples), in the world frame at the estimated pose.
 void LivePublisher::PublishRegisteredScan(const ScanResult& r, const Scan& scan,
                                           const std::vector<ImuSample>& imu) {
-  ImuKinematics end;
-  end.t_ns = r.t_ns;
-  end.R_world_imu = r.T_world_imu.R;
-  end.p_world_imu = r.T_world_imu.t;
-  end.v_world_imu = r.v_world_imu;
-  const ImuPoseHistory history =
-      ImuPoseHistory::Integrate(end, imu, scan.t_start_ns, r.bg_imu, r.ba_imu, r.g_world);
+  const ImuPoseHistory history = ImuPoseHistory::Integrate(ImuEstimateOf(r).state, imu,
+                                                           scan.t_start_ns, r.bg_imu, r.ba_imu,
+                                                           r.g_world);
   const Pose3 T_imu_lidar = r.T_imu_lidar.value_or(T_imu_lidar_config_);
   std::vector<Eigen::Vector3d> p_lidar_end;
   DeskewToScanEnd(history.samples(), T_imu_lidar, scan.points, r.t_ns, &p_lidar_end);
@@ -158,11 +151,13 @@ void LivePublisher::PublishRegisteredScan(const ScanResult& r, const Scan& scan,
   transport_->Publish(CloudTopic::kRegisteredScan, cloud.view, options_.live.odom_frame);
 }
 
-void LivePublisher::PublishMap(TimeNs t_ns, const rvlio::Odometry& odometry) {
+void LivePublisher::PublishMap(TimeNs t_ns, const rvlio::Odometry& odometry,
+                               const LocalOrigin& origin) {
   const double period_s = options_.live.map_period;
   if (period_s <= 0.0 || (last_map_ns_ >= 0 && t_ns - last_map_ns_ < SecondsToNs(period_s))) return;
   last_map_ns_ = t_ns;
-  const MapCloud map = odometry.MapWithAttributes();  // intensity 0 where the recording has none
+  MapCloud map = odometry.MapWithAttributes();  // intensity 0 where the recording has none
+  origin.ToUser(&map.p);
   XyziCloud cloud(t_ns, map.size());
   for (size_t i = 0; i < map.size(); ++i)
     cloud.Set(i, map.p[i], map.has_intensity ? map.intensity[i] : 0.0f);

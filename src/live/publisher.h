@@ -26,7 +26,8 @@ class LivePublisher {
   LivePublisher(Transport* transport, LiveSensorSource* source, const Configuration& options);
 
   void OnImu(const ImuSample& sample);
-  void OnResult(const ScanResult& result, const Odometry& odometry);
+  // `result` in the user's frame; the odometry's map is `origin` away from it.
+  void OnResult(const ScanResult& result, const Odometry& odometry, const LocalOrigin& origin);
   // The figures of the publications (latency, IMU-rate output).
   void Fill(LiveFigures* figures) const;
   // The stamp of the newest result (-1 before any).
@@ -37,7 +38,7 @@ class LivePublisher {
   OdometryMessage Odometry(TimeNs t_ns, const ImuKinematics& state, const Eigen::Vector3d& gyro_imu) const;
   void PublishRegisteredScan(const ScanResult& result, const Scan& scan,
                              const std::vector<ImuSample>& imu);
-  void PublishMap(TimeNs t_ns, const rvlio::Odometry& odometry);
+  void PublishMap(TimeNs t_ns, const rvlio::Odometry& odometry, const LocalOrigin& origin);
   void PublishStatus(const ScanResult& result);
 
   Transport* transport_;

@@ -32,6 +32,18 @@ HealthSample HealthSampleOf(const ScanResult& r) {
   return s;
 }
 
+ImuEstimate ImuEstimateOf(const ScanResult& r) {
+  ImuEstimate e;
+  e.state.t_ns = r.t_ns;
+  e.state.R_world_imu = r.T_world_imu.R;
+  e.state.p_world_imu = r.T_world_imu.t;
+  e.state.v_world_imu = r.v_world_imu;
+  e.bg_imu = r.bg_imu;
+  e.ba_imu = r.ba_imu;
+  e.g_world = r.g_world;
+  return e;
+}
+
 ExtrinsicReport MakeExtrinsicReport(const ExtrinsicExcitation& excitation,
                                     const Pose3& T_imu_lidar_prior, const Pose3& T_imu_lidar) {
   ExtrinsicReport r;

@@ -11,6 +11,7 @@
 #include "rvlio/common/text.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/formats/trajectory_io.h"
 #include "rvlio/math/local_origin.h"
 #include "rvlio/outputs/map_fields.h"
 #include "rvlio/outputs/scan_columns.h"
@@ -275,6 +276,16 @@ Trajectory ToTrajectory(const std::vector<ScanResult>& results) {
     t.push_back(p);
   }
   return t;
+}
+
+Status WriteTrajectoryOutputs(OutputStage* stage, const Trajectory& trajectory,
+                              const Trajectory& imu_trajectory) {
+  if (Status s = WriteTum(stage->Path("trajectory.tum"), trajectory); !s.ok())
+    return stage->Explain(s);
+  if (imu_trajectory.empty()) return Status::Ok();
+  if (Status s = WriteTum(stage->Path(kImuTrajectoryFile), imu_trajectory); !s.ok())
+    return stage->Explain(s);
+  return Status::Ok();
 }
 
 TimingStats ComputeTimingStats(const std::vector<ScanResult>& results) {

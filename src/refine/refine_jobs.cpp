@@ -75,6 +75,32 @@ void Residuals(const SharedPoses& s, const Pose3& T, RefineJobAlignment* a) {
   a->rms_residual_m = std::sqrt(sum_sq / static_cast<double>(s.merged.size()));
 }
 
+// The chunk's poses carried into the merged frame by T_merged_chunk: at a
+// stamp the merged trajectory holds inside [shared_begin, shared_end] the two
+// blended (the chunk's weight rising linearly over the interval), elsewhere
+// the chunk's.
+void BlendInto(const Trajectory& chunk, const Pose3& T_merged_chunk, TimeNs shared_begin,
+               TimeNs shared_end, std::map<TimeNs, StampedPose>* merged) {
+  const double width = static_cast<double>(std::max<TimeNs>(1, shared_end - shared_begin));
+  for (const StampedPose& p : chunk) {
+    const StampedPose aligned = Apply(T_merged_chunk, p);
+    auto it = merged->find(p.t_ns);
+    if (it == merged->end() || p.t_ns > shared_end) {
+      (*merged)[p.t_ns] = aligned;
+      continue;
+    }
+    const double w = std::clamp(static_cast<double>(p.t_ns - shared_begin) / width, 0.0, 1.0);
+    it->second = BlendPoses(it->second, aligned, w);
+  }
+}
+
+Trajectory Values(const std::map<TimeNs, StampedPose>& merged) {
+  Trajectory out;
+  out.reserve(merged.size());
+  for (const auto& [t_ns, p] : merged) out.push_back(p);
+  return out;
+}
+
 Status CheckChunkSet(const std::vector<RefineJobTrajectory>& chunks) {
   if (chunks.empty()) return Status::InvalidInput("no chunks to merge");
   const int n = chunks.front().span.count;
@@ -157,22 +183,27 @@ StatusOr<RefineJobMerge> MergeRefineJobs(const std::vector<RefineJobTrajectory>&
     a.T_merged_chunk = AlignShared(shared);
     a.shared_poses = static_cast<int>(shared.merged.size());
     Residuals(shared, a.T_merged_chunk, &a);
-    const double width = static_cast<double>(std::max<TimeNs>(1, shared_end - shared_begin));
-    for (const StampedPose& p : chunks[k].trajectory) {
-      const StampedPose aligned = Apply(a.T_merged_chunk, p);
-      auto it = merged.find(p.t_ns);
-      if (it == merged.end() || p.t_ns > shared_end) {
-        merged[p.t_ns] = aligned;
-        continue;
-      }
-      const double w = std::clamp(static_cast<double>(p.t_ns - shared_begin) / width, 0.0, 1.0);
-      it->second = BlendPoses(it->second, aligned, w);
-    }
+    BlendInto(chunks[k].trajectory, a.T_merged_chunk, shared_begin, shared_end, &merged);
     out.alignments.push_back(a);
   }
-  out.trajectory.reserve(merged.size());
-  for (const auto& [t_ns, p] : merged) out.trajectory.push_back(p);
+  out.trajectory = Values(merged);
   return out;
+}
+
+StatusOr<Trajectory> MergeAlignedTrajectories(const std::vector<RefineJobTrajectory>& chunks,
+                                              const std::vector<RefineJobAlignment>& alignments) {
+  if (Status s = CheckChunkSet(chunks); !s.ok()) return s;
+  if (alignments.size() != chunks.size())
+    return Status::InvalidInput(std::to_string(alignments.size()) + " alignments for " +
+                                std::to_string(chunks.size()) + " chunks");
+  std::map<TimeNs, StampedPose> merged;
+  for (const StampedPose& p : chunks.front().trajectory) merged[p.t_ns] = p;
+  for (size_t k = 1; k < chunks.size(); ++k) {
+    const TimeNs shared_end = std::min(chunks[k - 1].span.end_ns, merged.rbegin()->first);
+    BlendInto(chunks[k].trajectory, alignments[k].T_merged_chunk, chunks[k].span.begin_ns,
+              shared_end, &merged);
+  }
+  return Values(merged);
 }
 
 }  // namespace rvlio

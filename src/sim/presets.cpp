@@ -109,7 +109,7 @@ SimOptions Portals() {
   o.trajectory.waypoints = "0,0,0; 0,0,1.5; -12,0,1.5; 72,0,1.5";
   o.marks.survey_frame = {500000.0, 5400000.0, 250.0, 30.0};
   o.gnss.enabled = true;
-  o.duration = 72.0;
+  o.duration = 76.0;  // ~74.3 s of motion, then a short hover beyond the far portal
   return o;
 }
 

@@ -185,7 +185,7 @@ TEST_F(ApiTest, AnOpenedSourceGivesTheRecordingsRunAndEveryResultOnce) {
   args.bag = "network";
   args.source = source->get();
   std::vector<TimeNs> seen;
-  args.on_result = [&](const ScanResult& r, const Odometry& odo) {
+  args.on_result = [&](const ScanResult& r, const Odometry& odo, const LocalOrigin&) {
     seen.push_back(r.t_ns);
     EXPECT_EQ(odo.stats().scans_processed, static_cast<int64_t>(seen.size()));
   };

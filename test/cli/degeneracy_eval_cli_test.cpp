@@ -190,7 +190,14 @@ TEST_F(DegeneracyEvalCli, TruthOfAnotherSimulationIsRefused) {
   const ToolRun shorter = testing_cli::CachedSimulate(
       "--preset featureless --seed 4 --duration 3 --set lidar.columns=512", dir_ + "/sim_3s", dir_);
   ASSERT_EQ(shorter.exit_code, 0) << shorter.err;
+  // Its simulation.json names another recording; without the record (an
+  // older simulation) the stamps disagree.
   testing_cli::ExpectOneErrorLine(RunTool(base + dir_ + "/sim_3s", dir_), "eval",
+                                  "the truth is of another simulation");
+  const std::string shorter_older = dir_ + "/sim_3s_older";
+  std::filesystem::copy(dir_ + "/sim_3s", shorter_older, std::filesystem::copy_options::recursive);
+  ASSERT_TRUE(std::filesystem::remove(shorter_older + "/simulation.json"));
+  testing_cli::ExpectOneErrorLine(RunTool(base + shorter_older, dir_), "eval",
                                   "the truth is of another recording");
   const ToolRun seed = testing_cli::CachedSimulate(
       "--preset featureless --seed 5 --duration 6 --set lidar.columns=512", dir_ + "/sim_seed5",

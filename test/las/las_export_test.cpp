@@ -229,7 +229,7 @@ TEST(LasExport, BadInputIsOneLineNamingTheFileAndLeavesNothing) {
       {dir.Path("twice.pcd"), dir.Path("o.las"), "local", StatusCode::kInvalidInput, "twice.pcd: field w appears twice"},
       {dir.Path("good.pcd"), dir.Path("o.las"), "EPSG:99999999", StatusCode::kInvalidInput, "survey.crs 'EPSG:99999999'"},
       {dir.Path("good.pcd"), dir.Path("o.laz"), "local", StatusCode::kInvalidInput, "must be a .las file"},
-      {dir.Path("good.pcd"), dir.Path("a_file/o.las"), "local", StatusCode::kIoError, "cannot write"},
+      {dir.Path("good.pcd"), dir.Path("a_file/o.las"), "local", StatusCode::kInvalidInput, "Not a directory"},
       {dir.Path("good.pcd"), dir.Path("no/such/o.las"), "local", StatusCode::kIoError, "cannot write"},
       {dir.Path("good.pcd"), dir.dir().string() + "/.las", "local", StatusCode::kInvalidInput, ""},
   };

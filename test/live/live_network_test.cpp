@@ -141,10 +141,11 @@ class LiveEnvironment : public ::testing::Environment {
 struct LiveProcess {
   std::string out, log;
   pid_t pid = -1;
-  LiveProcess(const std::string& name, const std::vector<std::string>& extra) {
+  LiveProcess(const std::string& name, const std::vector<std::string>& extra,
+              const std::string& config = world->config) {
     out = world->dir + "/" + name;
     log = world->dir + "/" + name + ".log";
-    std::vector<std::string> args = {"live", "--config", world->config, "--out", out};
+    std::vector<std::string> args = {"live", "--config", config, "--out", out};
     args.insert(args.end(), extra.begin(), extra.end());
     pid = signals_test::Spawn(args, log + ".out", log);
   }
@@ -192,13 +193,19 @@ void ExpectCompleteOutputs(const LiveProcess& live) {
             ReadTrajectory(live.out + "/trajectory.tum").size() + 1);
 }
 
-// rosbag play of the simulated recording at `rate`, after 1 s for the
-// subscribers to connect; returns its exit status.
-int Play(double rate) {
-  const pid_t play = SpawnProgram({"rosbag", "play", "-q", "-d", "1", "-r", std::to_string(rate),
-                                   world->bag},
+// rosbag play of a recording (the simulated one) at `rate`, after 1 s for
+// the subscribers to connect; returns its exit status.
+int Play(double rate, const std::string& bag = world->bag) {
+  const pid_t play = SpawnProgram({"rosbag", "play", "-q", "-d", "1", "-r", std::to_string(rate), bag},
                                   world->dir + "/play.out", world->dir + "/play.err", true);
   return Wait(play);
+}
+
+// One line on stderr starting "rvlio live: error: " and holding `what`.
+void ExpectOneLiveErrorLine(const std::string& err, const std::string& what) {
+  EXPECT_EQ(err.rfind("rvlio live: error: ", 0), 0u) << err;
+  EXPECT_NE(err.find(what), std::string::npos) << err;
+  EXPECT_EQ(err.find('\n'), err.size() - 1) << "more than one line: " << err;
 }
 
 // ---------------------------------------------------------------------------
@@ -345,6 +352,48 @@ TEST(LiveRos1, FallingBehindDropsScansNotImu) {
   EXPECT_GT(ReadTrajectory(live.out + "/trajectory.tum").size(), 3u);
 }
 
+// Ouster packets (`simulate --format ouster-bag`: the ROS driver's packet
+// topics in a ROS 1 bag) played by rosbag: `live --ouster-metadata` gives
+// `run`'s poses on that bag; without the metadata, or with another sensor's,
+// it stops at the first packet with one line, exit 2.
+TEST(LiveRos1, OusterPacketsGiveRunsEstimate) {
+  const std::string dir = world->dir + "/ouster";
+  const ToolRun sim = testing_cli::SimulateTunnel(dir, 4, 6, world->dir, "--format ouster-bag");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const std::string bag = dir + "/tunnel.bag", config = dir + "/tunnel.yaml";
+  const std::string json = dir + "/tunnel.json";
+  const ToolRun run = testing_cli::RunTool(
+      "run --quiet --bag " + bag + " --config " + config + " --out " + world->dir + "/run_ouster",
+      world->dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  LiveProcess live("ros1_ouster", {"--ros1", "--ouster-metadata", json}, config);
+  LiveProcess no_metadata("ros1_ouster_nometa", {"--ros1"}, config);
+  const std::string other = std::string(RVLIO_TEST_DATA) + "/ouster/OS-1-32-G_v2.1.1_1024x10.json";
+  LiveProcess other_sensor("ros1_ouster_other", {"--ros1", "--ouster-metadata", other}, config);
+  for (const LiveProcess* p : {&live, &no_metadata, &other_sensor})
+    ASSERT_TRUE(p->WaitReady()) << p->Err();
+  ASSERT_EQ(Play(1.0, bag), 0) << ReadFile(world->dir + "/play.err");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the last scans are estimated
+  EXPECT_EQ(live.Stop(SIGINT), 0) << live.Err();
+  ExpectCompleteOutputs(live);
+  const Trajectory want = ReadTrajectory(world->dir + "/run_ouster/trajectory.tum");
+  ASSERT_GT(want.size(), 40u);
+  ExpectSamePoses(want, ReadTrajectory(live.out + "/trajectory.tum"));
+  EXPECT_EQ(live.Summary()["live"]["scans_dropped"], 0);
+  EXPECT_EQ(live.Summary()["lidar_layout"], "ouster_packets") << live.Summary().dump();
+
+  EXPECT_EQ(Wait(no_metadata.pid), 2);
+  ExpectOneLiveErrorLine(no_metadata.Err(),
+                         "carries Ouster packets (ouster_ros/PacketMsg): give the sensor's "
+                         "metadata JSON with --ouster-metadata FILE");
+  EXPECT_EQ(Wait(other_sensor.pid), 2);
+  ExpectOneLiveErrorLine(other_sensor.Err(), "lidar.topic '/ouster/lidar_packets' (ROS 1 master ");
+  EXPECT_NE(other_sensor.Err().find(other + "): lidar packet of "), std::string::npos)
+      << other_sensor.Err();
+  for (const LiveProcess* p : {&no_metadata, &other_sensor})
+    EXPECT_FALSE(std::filesystem::exists(p->out + "/summary.json"));
+}
+
 TEST(LiveRos1, WrongTopicTypeIsOneLine) {
   LiveProcess live("ros1_type", {"--ros1", "--set", std::string("lidar.topic=") + kImuTopic});
   ASSERT_TRUE(live.WaitReady()) << live.Err();
@@ -385,6 +434,13 @@ TEST(LiveRos1, UnreachableMasterIsOneLine) {
                                                                  " live --ros1 --out " +
                                                                  world->dir + "/nomaster");
   testing_cli::ExpectOneErrorLine(unset, "live", "ROS_MASTER_URI is not set");
+  // Metadata that cannot be read is refused before connecting.
+  const ToolRun no_file = testing_cli::RunTool(
+      "live --ros1 --ouster-metadata " + world->dir + "/missing.json --out " + world->dir + "/nomaster",
+      world->dir);
+  testing_cli::ExpectOneErrorLine(no_file, "live",
+                                  "cannot read Ouster metadata '" + world->dir + "/missing.json'");
+  EXPECT_FALSE(std::filesystem::exists(world->dir + "/nomaster"));
 }
 
 // ---------------------------------------------------------------------------

@@ -95,6 +95,36 @@ TEST(OusterSimTest, CaptureDecodesExactlyToTheBagOfTheSameSimulation) {
   }
   EXPECT_GT(reader->stats().fragments, 0);
   EXPECT_EQ(reader->stats().incomplete_datagrams, 0);
+
+  // --format ouster-bag: the same packets in a ROS1 bag as the driver
+  // records them (metadata on its topic), read by the packet-bag reader
+  // with the configuration written beside it: the capture's scans and IMU
+  // samples.
+  args.out_dir = (dir / "packets").string();
+  args.format = "ouster-bag";
+  StatusOr<SimulateResult> packets = SimulateRecording(args);
+  ASSERT_TRUE(packets.ok()) << packets.status().message();
+  EXPECT_EQ(packets->bag_path, (dir / "packets" / "sim.bag").string());
+  EXPECT_EQ(packets->bag_path, SimulatedRecordingPath(args));
+  ASSERT_TRUE(fs::exists(dir / "packets" / "sim.json"));
+  StatusOr<Configuration> packet_options =
+      LoadConfig({(dir / "packets" / "sim.yaml").string()}, {}, &warnings);
+  ASSERT_TRUE(packet_options.ok()) << packet_options.status().message();
+  EXPECT_EQ(packet_options->lidar.topic, "/ouster/lidar_packets");
+  EXPECT_EQ(packet_options->imu.topic, "/ouster/imu_packets");
+  const Stream from_bag = ReadAll(packets->bag_path, *packet_options);
+  ASSERT_EQ(from_bag.scans.size(), pcap.scans.size());
+  for (size_t k = 0; k < pcap.scans.size(); ++k) {
+    ASSERT_EQ(from_bag.scans[k].points.size(), pcap.scans[k].points.size()) << "scan " << k;
+    EXPECT_EQ(from_bag.scans[k].t_end_ns, pcap.scans[k].t_end_ns);
+    for (size_t i = 0; i < pcap.scans[k].points.size(); ++i)
+      ASSERT_EQ(from_bag.scans[k].points[i].p_lidar, pcap.scans[k].points[i].p_lidar) << k << " " << i;
+  }
+  ASSERT_EQ(from_bag.imu.size(), pcap.imu.size());
+  for (size_t i = 0; i < pcap.imu.size(); ++i) {
+    EXPECT_EQ(from_bag.imu[i].t_ns, pcap.imu[i].t_ns);
+    EXPECT_EQ(from_bag.imu[i].acc_imu, pcap.imu[i].acc_imu) << i;
+  }
   fs::remove_all(dir);
 }
 

@@ -4,6 +4,7 @@
 // no step at the borders.
 #include "rvlio/refine/refine_jobs.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -65,7 +66,8 @@ StampedPose TruthAt(TimeNs t_ns) {
 
 // The chunks of the truth, each in its own frame (a different rigid
 // transform per chunk) with `noise_m` of position noise.
-std::vector<RefineJobTrajectory> ChunksOfTruth(int n, double overlap_s, double noise_m) {
+std::vector<RefineJobTrajectory> ChunksOfTruth(int n, double overlap_s, double noise_m,
+                                               TimeNs period_ns = kPeriod) {
   const TimeNs t1 = kJobsT0 + SecondsToNs(30.0);
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, noise_m);
@@ -75,7 +77,7 @@ std::vector<RefineJobTrajectory> ChunksOfTruth(int n, double overlap_s, double n
     c.span = MakeRefineJobSpan(kJobsT0, t1, k, n, overlap_s).value();
     const Pose3 T_chunk_world(Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * k, Eigen::Vector3d(1, 2, 3).normalized())),
                               Eigen::Vector3d(0.2 * k, -0.1 * k, 0.05 * k));
-    for (TimeNs t = kJobsT0; t <= t1; t += kPeriod) {
+    for (TimeNs t = kJobsT0; t <= t1; t += period_ns) {
       if (!c.span.Contains(t)) continue;
       StampedPose p = TruthAt(t);
       p.p_world_imu = T_chunk_world * p.p_world_imu +
@@ -130,6 +132,40 @@ TEST(MergeRefineJobs, AMissingChunkOrTooShortAnOverlapIsInvalidInput) {
   m = MergeRefineJobs(thin);
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.status().message().find("chunks 1 and 2 share"), std::string::npos) << m.status().message();
+}
+
+// The chunks' denser trajectories (trajectory_imu.tum: here 50 Hz, the 10 Hz
+// scan poses among them) merged by the scan poses' alignments: the merged
+// scan poses at the scan stamps, the truth in chunk 1's frame elsewhere.
+TEST(MergeAlignedTrajectories, MergesDenserTrajectoriesAsTheScanPoses) {
+  const double noise_m = 0.002;
+  const std::vector<RefineJobTrajectory> dense = ChunksOfTruth(3, 4.0, noise_m, kPeriod / 5);
+  std::vector<RefineJobTrajectory> scans = dense;
+  const auto between_scans = [](const StampedPose& p) { return (p.t_ns - kJobsT0) % kPeriod != 0; };
+  for (RefineJobTrajectory& c : scans)
+    c.trajectory.erase(
+        std::remove_if(c.trajectory.begin(), c.trajectory.end(), between_scans),
+        c.trajectory.end());
+  const StatusOr<RefineJobMerge> merged = MergeRefineJobs(scans);
+  ASSERT_TRUE(merged.ok()) << merged.status().message();
+  const StatusOr<Trajectory> merged_dense = MergeAlignedTrajectories(dense, merged->alignments);
+  ASSERT_TRUE(merged_dense.ok()) << merged_dense.status().message();
+  ASSERT_EQ(merged_dense->size(), 1501u);  // every 20 ms stamp of 30 s once
+  const Pose3 T1(Eigen::Quaterniond(Eigen::AngleAxisd(0.01, Eigen::Vector3d(1, 2, 3).normalized())),
+                 Eigen::Vector3d(0.2, -0.1, 0.05));
+  size_t at_scans = 0;
+  for (const StampedPose& p : *merged_dense) {
+    EXPECT_LT((p.p_world_imu - T1 * TruthAt(p.t_ns).p_world_imu).norm(), 5.0 * noise_m);
+    if (between_scans(p)) continue;
+    const StampedPose& s = merged->trajectory[at_scans++];
+    ASSERT_EQ(s.t_ns, p.t_ns);
+    EXPECT_EQ(s.p_world_imu, p.p_world_imu);
+    EXPECT_EQ(s.q_world_imu.coeffs(), p.q_world_imu.coeffs());
+  }
+  EXPECT_EQ(at_scans, merged->trajectory.size());
+  const std::vector<RefineJobAlignment> two(merged->alignments.begin(),
+                                            merged->alignments.begin() + 2);
+  EXPECT_EQ(MergeAlignedTrajectories(dense, two).status().code(), StatusCode::kInvalidInput);
 }
 
 TEST(BlendPoses, EndsAreTheInputsAndTheMiddleIsHalfway) {

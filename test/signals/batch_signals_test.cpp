@@ -27,6 +27,19 @@ class BatchSignalsTest : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
+  // The size of the bag being written under `out` (simulate writes into a
+  // staging folder inside it, formats/atomic_file.h); 0 while there is none.
+  static uintmax_t BagBeingWritten(const std::string& out) {
+    std::error_code ec;
+    for (auto it = std::filesystem::recursive_directory_iterator(out, ec);
+         !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec))
+      if (it->path().filename() == "tunnel.bag.tmp") {
+        const uintmax_t size = std::filesystem::file_size(it->path(), ec);
+        return ec ? 0 : size;
+      }
+    return 0;
+  }
+
   // Starts a long simulation and returns once its bag is being written.
   pid_t StartSimulation(const std::string& out) {
     const pid_t pid = Spawn({"simulate", "--preset", "tunnel", "--duration", "120", "--out", out,
@@ -35,17 +48,13 @@ class BatchSignalsTest : public ::testing::Test {
     int status = -1;
     const bool ready = WaitUntil(
         pid,
-        [&] {
-          const auto size = std::filesystem::file_size(out + "/tunnel.bag.tmp", ec_);
-          return !ec_ && size > 1000000;
-        },
+        [&] { return BagBeingWritten(out) > 1000000; },
         &status);
     EXPECT_TRUE(ready) << "simulate ended (status " << status << ") before writing its bag";
     return pid;
   }
 
   std::string dir_;
-  std::error_code ec_;
 };
 
 std::vector<std::string> Entries(const std::string& dir) {

@@ -5,8 +5,9 @@
 // them, on its own threads; the estimator's thread reads them with Next() as
 // it reads a recording, so `live` runs RunRecording's pipeline unchanged.
 // Messages are decoded by the recording readers' decoders (ROS1 wire:
-// ros1_messages.h, livox.h; CDR: cdr.h) and pass their acceptance rules
-// (SensorGate): the same scans and samples as from a recording of them.
+// ros1_messages.h, livox.h; CDR: cdr.h; Ouster packets: the packet
+// recordings' decoder and scan assembly, ouster.h) and pass their acceptance
+// rules (SensorGate): the same scans and samples as from a recording of them.
 //
 // Order: IMU samples are delivered as they arrive; a scan is held until an
 // IMU sample stamped at or after its end arrived (the odometry waits for that
@@ -35,6 +36,7 @@
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
 #include "rvlio/formats/live_options.h"
+#include "rvlio/formats/ouster.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/lidar/options.h"
@@ -48,17 +50,24 @@ enum class WireEncoding {
 };
 
 // The message types a live LiDAR topic may carry, by encoding: ROS 1
-// ("sensor_msgs/PointCloud2", "livox_ros_driver/CustomMsg") or ROS 2
-// ("sensor_msgs/msg/PointCloud2", "livox_ros_driver2/msg/CustomMsg").
+// ("sensor_msgs/PointCloud2", "livox_ros_driver/CustomMsg",
+// "ouster_ros/PacketMsg") or ROS 2 ("sensor_msgs/msg/PointCloud2",
+// "livox_ros_driver2/msg/CustomMsg", "ouster_sensor_msgs/msg/PacketMsg",
+// "ouster_msgs/msg/PacketMsg").
 std::vector<std::string> LiveLidarTypes(WireEncoding encoding);
-// "sensor_msgs/Imu" or "sensor_msgs/msg/Imu".
-std::string LiveImuType(WireEncoding encoding);
+// An IMU topic: "sensor_msgs/Imu" or "sensor_msgs/msg/Imu", or Ouster IMU
+// packets (the packet types above).
+std::vector<std::string> LiveImuTypes(WireEncoding encoding);
 
 struct LiveSourceOptions {
   WireEncoding encoding = WireEncoding::kRos1;
   std::string origin;  // where the messages come from, for messages ("ROS 1 master http://...")
   LidarOptions lidar;  // topic, decoding, time_offset, wait_timeout
   ImuOptions imu;
+  // The sensor of Ouster packet topics (lidar.ouster_metadata, read by the
+  // caller): a packet message without it ends the input with an error.
+  std::optional<OusterMetadata> ouster;
+  std::string ouster_origin;  // where the metadata came from (its file)
   LiveOptions live;    // scan_queue, imu_queue
   // Polled while Next() waits (every kLivePollMs): true ends the input
   // (Next returns kEnd), e.g. a signal.
@@ -91,10 +100,11 @@ class LiveSensorSource final : public SensorBagReader {
   ~LiveSensorSource() override;
 
   // --- Transport threads (thread-safe) ---
-  // An IMU message of type `type`. Returns the sample when it was accepted
-  // (for the IMU-rate output); a message of another type, or one that does
-  // not decode, ends the input with that error (Fail).
-  std::optional<ImuSample> PushImu(const uint8_t* data, size_t size, const std::string& type);
+  // An IMU message of type `type`. Returns the samples accepted (for the
+  // IMU-rate output): one, or none when dropped; an Ouster IMU packet may
+  // hold several. A message of another type, or one that does not decode,
+  // ends the input with that error (Fail).
+  std::vector<ImuSample> PushImu(const uint8_t* data, size_t size, const std::string& type);
   // A LiDAR message of type `type` received at `arrival`.
   void PushLidar(const uint8_t* data, size_t size, const std::string& type,
                  std::chrono::steady_clock::time_point arrival);
@@ -105,11 +115,15 @@ class LiveSensorSource final : public SensorBagReader {
   // Waits for the next message. InvalidInput naming the topic when its first
   // message does not arrive within lidar.wait_timeout of construction. Once
   // `stopped` says so, the input has ended: the messages received so far are
-  // delivered (scans still waiting for the IMU too, as a recording's last
-  // scans are), then kEnd; later messages are ignored.
+  // delivered (scans still waiting for the IMU too, and the frame of Ouster
+  // packets being assembled, as a recording's last scans are), then kEnd;
+  // later messages are ignored.
   StatusOr<SensorMessage> Next(ImuSample* imu, Scan* scan) override;
   const SensorReaderStats& stats() const override;
   std::string lidar_layout() const override;
+  // Ouster packets: frames with missing columns, late packets, CRC errors
+  // (as a packet recording's reader says them).
+  std::vector<std::string> warnings() const override;
   // The scan handed out that ends at t_end_ns (or the latest one before it),
   // with the ones before it forgotten; nothing when none is kept.
   std::optional<LiveScanArrival> TakeArrival(TimeNs t_end_ns);
@@ -128,6 +142,8 @@ class LiveSensorSource final : public SensorBagReader {
   class Decoder;
 
   void ReleasePendingScans(TimeNs imu_t_ns);  // mutex_ held
+  void QueueImu(const ImuSample& sample);     // mutex_ held
+  void FlushAssembly();                       // mutex_ held: the end of the input
   void QueueScan(Item item);                  // mutex_ held
   Status WaitTimeout() const;                 // mutex_ held
 

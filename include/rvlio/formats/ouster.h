@@ -85,6 +85,8 @@ struct OusterMetadata {
 // unknown lidar or IMU profile).
 StatusOr<OusterMetadata> ParseOusterMetadata(const std::string& json_text,
                                              const std::string& where);
+// ParseOusterMetadata of a file's text; InvalidInput when it cannot be read.
+StatusOr<OusterMetadata> ReadOusterMetadataFile(const std::string& path);
 // The nested-layout JSON of `meta` (what `rvlio simulate --format ouster-pcap`
 // writes next to its capture); ParseOusterMetadata reads it back exactly.
 std::string OusterMetadataJson(const OusterMetadata& meta);

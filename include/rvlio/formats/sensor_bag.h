@@ -19,6 +19,8 @@
 
 namespace rvlio {
 
+struct OusterMetadata;  // formats/ouster.h
+
 // Counts of what the reader skipped or repaired; reported in summary.json.
 struct SensorReaderStats {
   int64_t scans = 0;
@@ -115,6 +117,13 @@ class SensorBagWriter {
   // sensor_msgs/NavSatFix (ROS1) / sensor_msgs/msg/NavSatFix, received at its
   // header stamp (formats/navsatfix.h).
   virtual Status WriteNavSatFix(const std::string& topic, const NavSatFix& fix) = 0;
+  // One Ouster UDP packet as the drivers record it (ouster_ros/PacketMsg in
+  // ROS1, ouster_sensor_msgs/msg/PacketMsg in ROS 2: uint8[] buf), received
+  // at receive_ns.
+  virtual Status WriteOusterPacket(const std::string& topic, TimeNs receive_ns,
+                                   const std::vector<uint8_t>& packet) = 0;
+  // std_msgs/String (ROS1) / std_msgs/msg/String (the drivers' metadata topic).
+  virtual Status WriteString(const std::string& topic, TimeNs receive_ns, const std::string& text) = 0;
   virtual Status Close() = 0;
 };
 
@@ -175,6 +184,9 @@ StatusOr<BagInfo> ReadBagInfo(const std::string& path, const std::string& lidar_
 // recordings and configured extrinsics are left as they are.
 Status ApplyRecordingExtrinsics(const std::string& path, const LidarOptions& lidar,
                                 ExtrinsicsSection* extrinsics, std::vector<std::string>* notes);
+// The same from metadata at hand (`origin`: where it came from, for the note).
+void ApplyOusterExtrinsics(const OusterMetadata& meta, const std::string& origin,
+                           ExtrinsicsSection* extrinsics, std::vector<std::string>* notes);
 
 // Only path, storage, messages and the start/end times of ReadBagInfo, from
 // the recording's index or summary (no pass over an MCAP file's chunks).

@@ -12,6 +12,7 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/imu/propagator.h"
 #include "rvlio/lidar/options.h"
 #include "rvlio/map/map_cloud.h"
 #include "rvlio/math/extrinsic_excitation.h"
@@ -74,6 +75,11 @@ struct ScanResult {
 
 // The monitor's view of a scan result (odometry/divergence.h).
 HealthSample HealthSampleOf(const ScanResult& r);
+
+// The state at a scan result's stamp, to propagate the pose at IMU rate from
+// (imu/propagator.h for `rvlio live`, imu/imu_rate_trajectory.h for
+// trajectory_imu.tum).
+ImuEstimate ImuEstimateOf(const ScanResult& r);
 
 // Online extrinsic estimation (ieskf.estimate_extrinsics or
 // smoother.estimate_extrinsics), reported in summary.json ("extrinsic").

@@ -2,6 +2,8 @@
 // What a run writes besides its fixed outputs (config section `output`) and the
 // coordinate reference system of its map frame (config section `survey`):
 // map.las beside map.pcd in `run`, `refine` and `merge` (docs/outputs.md "map.las").
+// trajectory_imu.tum, the pose at IMU rate, in `run`, `refine` and `merge`
+// (docs/outputs.md "trajectory_imu.tum").
 // Plain option structs of the Configuration (config/configuration.h); the CRS is
 // resolved (PROJ, formats/crs.h) in the I/O layer only.
 #include <string>
@@ -12,12 +14,17 @@ namespace rvlio {
 
 struct OutputOptions {
   bool las = false;  // also write map.las (LAS 1.4, point format 6) beside map.pcd
+  bool imu_trajectory = false;  // also write trajectory_imu.tum (a pose at every IMU sample)
 
   template <class V>
   void Visit(V& v) {
     v.Field("las", las,
             Spec().Help("also write map.las (ASPRS LAS 1.4, point data record format 6, 1 mm "
                         "coordinates) beside map.pcd in run, refine and merge (docs/outputs.md)"));
+    v.Field("imu_trajectory", imu_trajectory,
+            Spec().Help("also write trajectory_imu.tum in run, refine and merge: the pose at every "
+                        "IMU sample between the first and the last scan's, as trajectory.tum "
+                        "(docs/outputs.md)"));
   }
   Status Validate() { return ValidateFields(*this, "output"); }
 };

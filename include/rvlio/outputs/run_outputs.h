@@ -11,6 +11,7 @@
 #include "rvlio/map/map_cloud.h"
 #include "rvlio/odometry/deviation.h"
 #include "rvlio/odometry/odometry.h"
+#include "rvlio/outputs/output_stage.h"
 
 namespace rvlio {
 
@@ -74,6 +75,14 @@ StatusOr<ScanTable> ReadScanTable(const std::string& path);
 
 // The estimated trajectory (IMU in world at each scan end).
 Trajectory ToTrajectory(const std::vector<ScanResult>& results);
+
+// trajectory_imu.tum (output.imu_trajectory, docs/outputs.md).
+inline constexpr const char* kImuTrajectoryFile = "trajectory_imu.tum";
+
+// trajectory.tum into the stage, and trajectory_imu.tum when imu_trajectory
+// is not empty (run, refine, merge). The error is the stage's explanation.
+Status WriteTrajectoryOutputs(OutputStage* stage, const Trajectory& trajectory,
+                              const Trajectory& imu_trajectory);
 
 // Median, 95th percentile and maximum of the per-scan processing times, ms.
 struct TimingStats {

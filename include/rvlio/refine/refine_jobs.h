@@ -76,6 +76,15 @@ struct RefineJobMerge {
 // fewer than kRefineJobMinSharedPoses stamps (naming both chunks).
 StatusOr<RefineJobMerge> MergeRefineJobs(const std::vector<RefineJobTrajectory>& chunks);
 
+// Other trajectories of the same chunks (their trajectory_imu.tum: a pose at
+// every IMU sample and scan end) merged as MergeRefineJobs merged their scan
+// poses: carried by its alignments, blended across the same shared intervals
+// with the same weights. Where a chunk's poses at the scan ends are those of
+// its scan-rate trajectory, so are the merged ones. InvalidInput as
+// MergeRefineJobs for a bad chunk set, or when the alignments are not one per chunk.
+StatusOr<Trajectory> MergeAlignedTrajectories(const std::vector<RefineJobTrajectory>& chunks,
+                                              const std::vector<RefineJobAlignment>& alignments);
+
 // The pose a fraction w in [0, 1] of the way from a to b (linear position, slerp).
 StampedPose BlendPoses(const StampedPose& a, const StampedPose& b, double w);
 
