@@ -5,7 +5,7 @@
 // points takes bounded memory, and the file appears at Commit(), complete, or
 // not at all. The public header's counts and bounds (and the extra-bytes
 // minima and maxima) are known only at the end: Commit() writes them over the
-// placeholder header.
+// provisional header (its counts and bounds zero).
 //
 // What the writer fixes (the caller cannot get them wrong):
 //  - X, Y, Z: scaled integers, scale 0.001 m, the offset a multiple of 1 km
@@ -90,7 +90,7 @@ struct LasWriteStats {
 class LasWriter {
  public:
   // Checks the options (InvalidInput naming what is wrong) and writes the
-  // placeholder header; the file appears only at Commit().
+  // provisional header (its counts and bounds zero); the file appears only at Commit().
   Status Open(const std::string& path, LasWriterOptions options);
   // InvalidInput for a non-finite coordinate or one outside the 32-bit range
   // around the offset; the writer is then discarded.
