@@ -96,9 +96,13 @@ nlohmann::json LocalizationJson(const RunArgs& args, const std::vector<ScanResul
           {"longest_out_of_map_s", longest_s}};
 }
 
-// The odometry's results (its local frame) in the user's frame.
+// An odometry result (its local frame) in the user's frame.
+void MoveToUserFrame(const LocalOrigin& origin, ScanResult* r) {
+  r->T_world_imu.t = origin.ToUser(r->T_world_imu.t);
+}
+
 void MoveToUserFrame(const LocalOrigin& origin, std::vector<ScanResult>* scans) {
-  for (ScanResult& r : *scans) r.T_world_imu.t = origin.ToUser(r.T_world_imu.t);
+  for (ScanResult& r : *scans) MoveToUserFrame(origin, &r);
 }
 
 struct RunData {
@@ -239,7 +243,7 @@ void StreamNewPoses(const std::vector<ScanResult>& results, const LocalOrigin& o
   for (; *streamed < results.size(); ++*streamed) {
     if (args.on_result) {
       ScanResult user = results[*streamed];
-      user.T_world_imu.t = origin.ToUser(user.T_world_imu.t);
+      MoveToUserFrame(origin, &user);
       args.on_result(user, odo, origin);
     }
     if (streams->imu_rate) streams->imu_rate->AddEstimate(ImuEstimateOf(results[*streamed]));
