@@ -38,7 +38,7 @@ int CmdMerge(int argc, char** argv) {
                 c.chunk, static_cast<int>(c.scans), c.shared_poses, c.translation_m,
                 c.rotation_deg, c.residual_rms_m);
   std::printf("rvlio merge: %zu chunks, %zu scans, %zu map points -> %s\n", req.chunk_dirs.size(),
-              result->trajectory.size(), result->map_points.size(), req.out_dir.c_str());
+              result->trajectory.size(), result->map.size(), req.out_dir.c_str());
   return 0;
 }
 

@@ -29,6 +29,7 @@ using nlohmann::json;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kDeviationField = "deviation_m";
+constexpr const char* kIntensityField = "intensity";
 
 // The columns of scans.csv the page plots when present: the RV activity, the
 // health of the estimate, and the reference-map localization columns.
@@ -220,15 +221,21 @@ json CloudJson(const std::string& run_name, const std::string& map_path, const L
   }
   const PointCloudField* deviation_field = cloud->Field(kDeviationField);
   const std::vector<float>* deviation = deviation_field ? &deviation_field->values : nullptr;
+  const PointCloudField* intensity_field = cloud->Field(kIntensityField);
   const size_t n = cloud->points.size();
   const size_t stride = ThinningStride(n, options.max_points);
-  std::vector<float> xyz, value;
+  std::vector<float> xyz, value, intensity;
   for (size_t i = 0; i < n; i += stride) {
     const Eigen::Vector3d p = origin.ToLocal(cloud->points[i]);
     if (!p.allFinite()) continue;
     for (int k = 0; k < 3; ++k) xyz.push_back(ToFloat(p[k]));
     value.push_back(deviation ? (*deviation)[i] : ToFloat(p.z()));
+    if (intensity_field != nullptr) intensity.push_back(intensity_field->values[i]);
   }
+  // The page colours by `field` first; height (from xyz) and these fields
+  // are offered beside it.
+  json others = json::object();
+  if (intensity_field != nullptr) others[kIntensityField] = ReportArray(intensity);
   return {{"run", run_name},
           {"file", map_path},
           {"field", deviation ? kDeviationField : "z"},
@@ -236,7 +243,8 @@ json CloudJson(const std::string& run_name, const std::string& map_path, const L
           {"shown", value.size()},
           {"stride", stride},
           {"xyz", ReportArray(xyz)},
-          {"value", ReportArray(value)}};
+          {"value", ReportArray(value)},
+          {"other_fields", others}};
 }
 
 // ---------------------------------------------------------------------------

@@ -31,17 +31,22 @@ set(rvlio_public_headers
   rvlio/eval/options.h
   rvlio/eval/stats.h
   rvlio/factors/parameter_blocks.h
+  rvlio/formats/control_file.h
   rvlio/formats/live_options.h
+  rvlio/formats/navsatfix.h
   rvlio/formats/reader_options.h
   rvlio/formats/sensor_bag.h
   rvlio/formats/sensor_stream.h
   rvlio/formats/trajectory_io.h
   rvlio/ieskf/options.h
+  rvlio/imu/integrator.h
   rvlio/imu/options.h
+  rvlio/imu/propagator.h
   rvlio/lidar/extrinsics.h
   rvlio/lidar/options.h
   rvlio/lidar/preprocess.h
   rvlio/lidar/range_window.h
+  rvlio/map/map_cloud.h
   rvlio/map/options.h
   rvlio/map/reference_map.h
   rvlio/map/voxel_key.h
@@ -59,7 +64,10 @@ set(rvlio_public_headers
   rvlio/odometry/localization_options.h
   rvlio/odometry/reference.h
   rvlio/outputs/output_options.h
+  rvlio/outputs/output_stage.h
   rvlio/outputs/run_outputs.h
+  rvlio/refine/control.h
+  rvlio/refine/control_options.h
   rvlio/refine/options.h
   rvlio/refine/refine.h
   rvlio/refine/refine_jobs.h

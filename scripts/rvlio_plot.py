@@ -9,6 +9,8 @@ Usage:
                              [--yscale auto|linear|log]
   rvlio_plot.py compare-bars --table CSV --out PREFIX [--metric NAME ...]
   rvlio_plot.py deviation    --run DIR --out PREFIX [--title TEXT]
+  rvlio_plot.py map          --run DIR --out PREFIX [--field intensity|z|NAME]
+                             [--box XMIN,XMAX,YMIN,YMAX] [--title TEXT]
   rvlio_plot.py control      --gt GT_SURVEY.tum [--run LABEL=DIR ...] [--run-origin LABEL=DIR ...]
                              [--control CSV] --out PREFIX
   rvlio_plot.py check        (exit 0 when matplotlib is usable)
@@ -898,6 +900,88 @@ class Parser(argparse.ArgumentParser):
     Fail(message, EXIT_BAD_INPUT)
 
 
+PCD_TYPES = {("F", 4): "<f4", ("F", 8): "<f8", ("U", 1): "u1", ("U", 2): "<u2", ("U", 4): "<u4",
+             ("U", 8): "<u8", ("I", 1): "i1", ("I", 2): "<i2", ("I", 4): "<i4", ("I", 8): "<i8"}
+
+
+def ReadMapPcd(path):
+  """The fields of a binary PCD as rvlio writes map.pcd (COUNT 1 each):
+  {name: array}."""
+  try:
+    with open(path, "rb") as f:
+      raw = f.read()
+  except OSError as e:
+    raise PlotError("%s: %s" % (path, e.strerror))
+  header, sep, body = raw.partition(b"DATA binary\n")
+  if not sep:
+    raise PlotError("%s: not a binary PCD (DATA binary)" % path)
+  words = {}
+  for line in header.decode("ascii", "replace").splitlines():
+    parts = line.split()
+    if parts and not parts[0].startswith("#"):
+      words[parts[0]] = parts[1:]
+  try:
+    dtype = np.dtype([(n, PCD_TYPES[(t, int(z))]) for n, t, z in
+                      zip(words["FIELDS"], words["TYPE"], words["SIZE"])])
+    count = int(words["POINTS"][0])
+  except (KeyError, ValueError, IndexError):
+    raise PlotError("%s: malformed PCD header" % path)
+  if len(body) < count * dtype.itemsize:
+    raise PlotError("%s: truncated: %d points declared" % (path, count))
+  cloud = np.frombuffer(body[:count * dtype.itemsize], dtype=dtype)
+  return {n: cloud[n].astype(np.float64) for n in dtype.names}
+
+
+def CmdMap(args):
+  """DIR/map.pcd coloured by a field (grey for intensity): a top view of the
+  points below their median height (the ceiling would hide the rest) and an
+  elevation of the +y side (the points within 0.5 m of the 99th percentile
+  of y), both of the points inside --box when given."""
+  path = os.path.join(args.run, "map.pcd")
+  m = ReadMapPcd(path)
+  if args.field not in m:
+    raise PlotError("%s has no field %s (fields: %s)" % (path, args.field, " ".join(m)))
+  keep = np.ones(len(m["x"]), dtype=bool)
+  if args.box:
+    x0, x1, y0, y1 = args.box
+    keep = (m["x"] >= x0) & (m["x"] <= x1) & (m["y"] >= y0) & (m["y"] <= y1)
+  x, y, z, v = m["x"][keep], m["y"][keep], m["z"][keep], m[args.field][keep]
+  if len(x) == 0:
+    raise PlotError("%s has no points%s" % (path, " in the box" if args.box else ""))
+  grey = args.field == "intensity"
+  lo, hi = np.nanpercentile(v, 2), np.nanpercentile(v, 98)
+  plt = Pyplot()
+  fig, (top, side) = plt.subplots(2, 1, figsize=(12, 5.5), sharex=True)
+  below = z < np.median(z)
+  wall = y >= np.percentile(y, 99) - 0.5
+  im = None
+  for ax, shown, vertical in ((top, below, y), (side, wall, z)):
+    order = np.argsort(v[shown])  # bright points drawn last
+    im = ax.scatter(x[shown][order], vertical[shown][order], c=v[shown][order], s=1.5,
+                    cmap="gray" if grey else "viridis", vmin=lo, vmax=hi, linewidths=0,
+                    rasterized=True)
+    ax.set_facecolor("0.82" if grey else "white")
+  top.set_ylabel("y [m] (top view)")
+  top.set_title(args.title or "map.pcd of %s, coloured by %s" %
+                (os.path.basename(os.path.normpath(args.run)), args.field))
+  side.set_ylabel("z [m] (the +y side)")
+  side.set_xlabel("x [m]")
+  fig.colorbar(im, ax=[top, side], label=args.field, shrink=0.9)
+  print("%d points, %s %.4g to %.4g (2nd to 98th percentile)" % (len(x), args.field, lo, hi))
+  SaveFigure(fig, args.out, "map_" + args.field)
+
+
+def Box(text):
+  try:
+    box = [float(t) for t in text.split(",")]
+  except ValueError:
+    box = []
+  if len(box) != 4 or not all(math.isfinite(b) for b in box) or box[0] >= box[1] or box[2] >= box[3]:
+    raise argparse.ArgumentTypeError("expected XMIN,XMAX,YMIN,YMAX with XMIN < XMAX, YMIN < YMAX, "
+                                     "got '%s'" % text)
+  return box
+
+
 def PositiveFloat(text):
   v = ToFloat(text)
   if not (math.isfinite(v) and v > 0):
@@ -940,6 +1024,13 @@ def BuildParser():
   p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
   p.add_argument("--title", help="figure title (default: from summary.json)")
   p.set_defaults(func=CmdDeviation)
+  p = sub.add_parser("map", help="map.pcd coloured by a field: top view and the +y wall")
+  p.add_argument("--run", required=True, help="run, refine or merge output folder")
+  p.add_argument("--out", required=True, help="output prefix (or folder ending in /)")
+  p.add_argument("--field", default="intensity", help="field to colour by (default intensity)")
+  p.add_argument("--box", type=Box, help="XMIN,XMAX,YMIN,YMAX: only the points inside [m]")
+  p.add_argument("--title", help="figure title")
+  p.set_defaults(func=CmdMap)
   p = sub.add_parser("control", help="error in the survey frame over the chainage, with marks")
   p.add_argument("--gt", required=True, help="ground truth in the survey frame (NAME_gt_survey.tum)")
   p.add_argument("--run", action="append", default=[],

@@ -230,9 +230,11 @@ var RvlioReport = (function () {
     show();
   }
 
-  // Blue-white-red for a signed deviation, viridis-like ramp for height.
+  // Blue-white-red for a signed deviation ("diverging"), grey for intensity
+  // ("grey", as survey software shows it), a viridis-like ramp for height.
   function colormap(u, diverging) {
     u = Math.min(1, Math.max(0, u));
+    if (diverging === "grey") return [0.08 + 0.92 * u, 0.08 + 0.92 * u, 0.08 + 0.92 * u];
     if (diverging) {
       return u < 0.5 ? [2 * u, 2 * u, 1] : [1, 2 * (1 - u), 2 * (1 - u)];
     }
@@ -253,8 +255,41 @@ var RvlioReport = (function () {
       ctx.fillStyle = "rgb(" + rgb.map(function (v) { return Math.round(255 * v); }).join(",") + ")";
       ctx.fillRect(x, 0, 1, c.height);
     }
+    var unit = field === "intensity" ? "" : " m";
     document.getElementById("colorbar-label").textContent =
-      (field === "z" ? "height z" : field) + ": " + fmtTick(lo) + " m to " + fmtTick(hi) + " m";
+      (field === "z" ? "height z" : field) + ": " + fmtTick(lo) + unit + " to " + fmtTick(hi) + unit;
+  }
+
+  var FIELD_TEXT = {z: "height", deviation_m: "deviation_m (distance to the reference map)",
+                    intensity: "intensity (the sensor's, its reflectivity where it gives one)"};
+
+  // The colourings the map offers: its first field, height, then the others
+  // (intensity where the map has it), each as {field, value}.
+  function cloudColourings(cloud, xyz) {
+    var out = [{field: cloud.field, value: decode(cloud.value)}];
+    if (cloud.field !== "z") {
+      var z = new Float32Array(xyz.length / 3);
+      for (var i = 0; i < z.length; i++) z[i] = xyz[3 * i + 2];
+      out.push({field: "z", value: z});
+    }
+    Object.keys(cloud.other_fields || {}).forEach(function (name) {
+      out.push({field: name, value: decode(cloud.other_fields[name])});
+    });
+    return out;
+  }
+
+  // Colours of the points for one colouring (2nd to 98th percentile; a
+  // deviation symmetric around 0); grey where a value is missing.
+  function colourPoints(c, colors) {
+    var value = c.value, kind = c.field === "z" ? false : c.field === "intensity" ? "grey" : true;
+    var lo = percentile(value, 0.02), hi = percentile(value, 0.98);
+    if (kind === true) { var m = Math.max(Math.abs(lo), Math.abs(hi)) || 1; lo = -m; hi = m; }
+    if (!(hi > lo)) hi = lo + 1;
+    for (var i = 0; i < value.length; i++) {
+      var rgb = isFinite(value[i]) ? colormap((value[i] - lo) / (hi - lo), kind) : [0.5, 0.5, 0.5];
+      colors[3 * i] = rgb[0]; colors[3 * i + 1] = rgb[1]; colors[3 * i + 2] = rgb[2];
+    }
+    drawColorbar(lo, hi, c.field, kind);
   }
 
   function drawCloud(model) {
@@ -265,27 +300,24 @@ var RvlioReport = (function () {
       box.style.display = "none"; document.querySelector(".colorbar").style.display = "none";
       return;
     }
-    caption.textContent = "map.pcd of " + cloud.run + ": " + cloud.shown + " of " + cloud.total + " points shown" +
-      (cloud.stride > 1 ? " (thinned: every " + cloud.stride + "th point, to keep the file small)" : " (all points)") +
-      ", coloured by " + (cloud.field === "z" ? "height" : cloud.field + " (distance to the reference map)") +
-      ". Drag to turn, right-drag to pan, wheel to zoom.";
+    var captionText = function (field) {
+      return "map.pcd of " + cloud.run + ": " + cloud.shown + " of " + cloud.total + " points shown" +
+        (cloud.stride > 1 ? " (thinned: every " + cloud.stride + "th point, to keep the file small)" : " (all points)") +
+        ", coloured by " + (FIELD_TEXT[field] || field) + ". Drag to turn, right-drag to pan, wheel to zoom.";
+    };
+    caption.textContent = captionText(cloud.field);
     var canvas = document.createElement("canvas");
     var gl = canvas.getContext("webgl", {preserveDrawingBuffer: true}) || canvas.getContext("experimental-webgl");
     if (typeof THREE === "undefined" || !gl) {
       box.appendChild(el("div", {"class": "msg"}, "This browser offers no WebGL: the map cannot be drawn."));
       return;
     }
-    var xyz = decode(cloud.xyz), value = decode(cloud.value);
-    var diverging = cloud.field !== "z";
-    var lo = percentile(value, 0.02), hi = percentile(value, 0.98);
-    if (diverging) { var m = Math.max(Math.abs(lo), Math.abs(hi)) || 1; lo = -m; hi = m; }
-    if (!(hi > lo)) hi = lo + 1;
+    var xyz = decode(cloud.xyz);
+    var colourings = cloudColourings(cloud, xyz);
     var colors = new Float32Array(xyz.length);
-    for (var i = 0; i < value.length; i++) {
-      var rgb = isFinite(value[i]) ? colormap((value[i] - lo) / (hi - lo), diverging) : [0.5, 0.5, 0.5];
-      colors[3 * i] = rgb[0]; colors[3 * i + 1] = rgb[1]; colors[3 * i + 2] = rgb[2];
-    }
-    drawColorbar(lo, hi, cloud.field, diverging);
+    colourPoints(colourings[0], colors);
+    var select = document.getElementById("cloud-field");
+    colourings.forEach(function (c, i) { select.appendChild(el("option", {value: String(i)}, FIELD_TEXT[c.field] || c.field)); });
     var min = [Infinity, Infinity, Infinity], max = [-Infinity, -Infinity, -Infinity];
     for (var j = 0; j < xyz.length; j++) { min[j % 3] = Math.min(min[j % 3], xyz[j]); max[j % 3] = Math.max(max[j % 3], xyz[j]); }
     var center = new THREE.Vector3((min[0] + max[0]) / 2, (min[1] + max[1]) / 2, (min[2] + max[2]) / 2);
@@ -293,7 +325,8 @@ var RvlioReport = (function () {
     var geometry = new THREE.BufferGeometry();
     var setAttr = (geometry.setAttribute || geometry.addAttribute).bind(geometry);
     setAttr("position", new THREE.BufferAttribute(xyz, 3));
-    setAttr("color", new THREE.BufferAttribute(colors, 3));
+    var colorAttribute = new THREE.BufferAttribute(colors, 3);
+    setAttr("color", colorAttribute);
     var material = new THREE.PointsMaterial({size: 2, sizeAttenuation: false,
       vertexColors: THREE.VertexColors !== undefined ? THREE.VertexColors : true});
     var scene = new THREE.Scene();
@@ -313,6 +346,13 @@ var RvlioReport = (function () {
     controls.screenSpacePanning = true;
     controls.addEventListener("change", render);
     controls.update();
+    select.addEventListener("change", function () {
+      var c = colourings[Number(select.value)];
+      colourPoints(c, colors);
+      colorAttribute.needsUpdate = true;
+      caption.textContent = captionText(c.field);
+      render();
+    });
     window.addEventListener("resize", function () {
       var W = box.clientWidth, H = box.clientHeight;
       renderer.setSize(W, H); camera.aspect = W / H; camera.updateProjectionMatrix(); render();

@@ -217,7 +217,9 @@ struct MergeResult {
   // The chunks' trajectory_imu.tum merged as `trajectory` (when every chunk
   // wrote one: output.imu_trajectory); empty otherwise.
   Trajectory imu_trajectory;
-  std::vector<Eigen::Vector3d> map_points;  // the chunks' maps carried into that frame, re-voxelized
+  // The chunks' maps carried into that frame, re-voxelized, with the
+  // attributes they have (scan_index: rows of `trajectory`).
+  MapCloud map;
   std::vector<MergedChunk> chunks;          // in order 1..N
   nlohmann::json summary;                   // summary.json
   std::vector<std::string> warnings;        // the chunks' warnings, each once

@@ -21,6 +21,7 @@ from ._rvlio import (  # noqa: F401
     evaluate_map,
     merge,
     read_bag,
+    read_map,
     refine,
     run,
     simulate,

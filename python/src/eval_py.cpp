@@ -1,7 +1,7 @@
 // rvlio.evaluate: the evaluation of `rvlio eval` (eval/evaluate.h), evo's
 // definitions of APE and RPE; rvlio.evaluate_map: `rvlio eval --map`
 // (eval/map_metrics.h); rvlio.evaluate_degeneracy: `rvlio eval --degeneracy`
-// (eval/degeneracy.h).
+// (eval/degeneracy.h); rvlio.read_map: a map.pcd with its fields.
 #include "eval_py.h"
 
 #include <pybind11/eigen.h>
@@ -14,6 +14,7 @@
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "odometry_py.h"  // PointsArray
 
 namespace rvlio::python {
 namespace {
@@ -158,9 +159,78 @@ py::dict MapResultDict(const MapEvalResult& r) {
   return d;
 }
 
+// A PCD's points and every scalar field, read in chunks (PointCloudStream).
+struct MapRead {
+  std::vector<PointCloudStreamField> fields;
+  std::vector<Eigen::Vector3d> xyz;
+  std::vector<std::vector<double>> values;  // per field, one per point
+};
+
+StatusOr<MapRead> ReadMapFields(const std::string& path) {
+  PointCloudStream stream;
+  if (Status s = stream.Open(path); !s.ok()) return s;
+  MapRead out;
+  out.fields = stream.fields();
+  out.values.resize(out.fields.size());
+  PointCloudChunk chunk;
+  for (;;) {
+    StatusOr<size_t> n = stream.Read(size_t{1} << 16, &chunk);
+    if (!n.ok()) return n.status();
+    if (*n == 0) return out;
+    out.xyz.insert(out.xyz.end(), chunk.points.begin(), chunk.points.begin() + *n);
+    for (size_t k = 0; k < out.fields.size(); ++k)
+      out.values[k].insert(out.values[k].end(), chunk.fields[k].begin(), chunk.fields[k].begin() + *n);
+  }
+}
+
+template <typename T>
+py::array ColumnOf(const std::vector<double>& values) {
+  py::array_t<T> a(static_cast<py::ssize_t>(values.size()));
+  T* out = a.mutable_data();
+  for (size_t i = 0; i < values.size(); ++i) out[i] = static_cast<T>(values[i]);
+  return a;
+}
+
+// One field as an array of the field's own type (F4 float32, F8 float64,
+// U2 uint16, ...).
+py::array FieldArray(const PointCloudStreamField& f, const std::vector<double>& values) {
+  if (f.type == 'F') return f.size == 8 ? ColumnOf<double>(values) : ColumnOf<float>(values);
+  const bool is_signed = f.type == 'I';
+  switch (f.size) {
+    case 1: return is_signed ? ColumnOf<int8_t>(values) : ColumnOf<uint8_t>(values);
+    case 2: return is_signed ? ColumnOf<int16_t>(values) : ColumnOf<uint16_t>(values);
+    case 4: return is_signed ? ColumnOf<int32_t>(values) : ColumnOf<uint32_t>(values);
+    default: return is_signed ? ColumnOf<int64_t>(values) : ColumnOf<uint64_t>(values);
+  }
+}
+
+py::dict ReadMap(const py::handle& path_obj) {
+  const std::string path = PathText(path_obj);
+  RequireExisting(path, "map");
+  StatusOr<MapRead> read = Status::Internal("not read");
+  {
+    py::gil_scoped_release release;
+    read = ReadMapFields(path);
+  }
+  const MapRead r = Take(std::move(read));
+  py::dict d;
+  d["xyz"] = PointsArray(r.xyz);
+  for (size_t k = 0; k < r.fields.size(); ++k)
+    d[py::str(r.fields[k].name)] = FieldArray(r.fields[k], r.values[k]);
+  return d;
+}
+
 }  // namespace
 
 void BindEval(py::module_& m) {
+  m.def("read_map", &ReadMap, py::arg("path"),
+        "A map.pcd (PCD DATA ascii or binary, any size: read in chunks) as a dict of numpy "
+        "arrays: xyz (N, 3) float64 in metres, then every other field of the file under its "
+        "own name in its own type: intensity float32, time float64 (UNIX seconds), ring "
+        "uint16, scan_index uint32, deviation_m float32 (NaN: no surface), as far as the "
+        "map has them (docs/outputs.md \"map.pcd\"). ValueError for a missing file, a "
+        "PLY or binary_compressed PCD, a malformed or truncated one.");
+
   m.def(
       "evaluate_map",
       [](const py::handle& map, const py::handle& ref, double max_distance, double profile_step,

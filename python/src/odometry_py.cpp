@@ -65,6 +65,7 @@ void FillPoints(const py::array& points, const py::array& times, const py::handl
   if (in) {
     const auto r = in.unchecked<1>();
     for (py::ssize_t i = 0; i < n; ++i) scan->points[static_cast<size_t>(i)].intensity = r(i);
+    scan->has_intensity = true;
   }
   scan->t_start_ns = t_min;
   scan->t_end_ns = t_max;

@@ -275,7 +275,7 @@ MergeOutput Merge(const py::iterable& chunks, const py::handle& out, const py::h
   MergeResult r = Take(std::move(result));
   MergeOutput o;
   o.trajectory = TrajectoryArray(r.trajectory);
-  o.map_points = PointsArray(r.map_points);
+  o.map_points = PointsArray(r.map.p);
   o.summary = ToPython(r.summary);
   o.warnings = r.warnings;
   o.written = r.written;

@@ -157,6 +157,8 @@ def test_refine_chunks_and_merge_give_the_cli_files(rvlio_bin, tunnel, cli_run, 
     for f in ("trajectory.tum", "map.pcd"):
         assert filecmp.cmp(tmp_path / "py_merged" / f, tmp_path / "cli_merged" / f, shallow=False)
     written = np.loadtxt(tmp_path / "py_merged" / "trajectory.tum")
+    # The merged map's scan indices are rows of the merged trajectory.
+    assert_times_in_their_scans(rvlio.read_map(tmp_path / "py_merged" / "map.pcd"), written[:, 0])
     np.testing.assert_allclose(merged.trajectory[:, 0], written[:, 0], rtol=0, atol=1e-6)  # s
     np.testing.assert_allclose(merged.trajectory[:, 1:], written[:, 1:], rtol=0, atol=1e-9)
     with pytest.raises(ValueError, match="missing chunk 2 of 2"):
@@ -165,6 +167,41 @@ def test_refine_chunks_and_merge_give_the_cli_files(rvlio_bin, tunnel, cli_run, 
         rvlio.refine(tunnel["bag"], init, config, chunk=1)
     with pytest.raises(ValueError, match="needs 1 <= chunk <= of"):
         rvlio.refine(tunnel["bag"], init, config, chunk=3, of=2)
+
+
+def assert_times_in_their_scans(m, stamps_s):
+    """Every map point's time lies in the scan its scan_index names: after the
+    previous row's stamp, at or before its own (stamps_s: trajectory.tum's t)."""
+    k = m["scan_index"].astype(np.int64)
+    assert k.max() < len(stamps_s)
+    assert np.all(m["time"] <= stamps_s[k] + 1e-6)
+    previous = np.where(k > 0, stamps_s[np.maximum(k - 1, 0)], -np.inf)
+    assert np.all(m["time"] > previous - 1e-6)
+
+
+def test_read_map_gives_every_field_of_map_pcd(cli_run, tmp_path):
+    m = rvlio.read_map(cli_run / "map.pcd")
+    assert list(m) == ["xyz", "intensity", "time", "ring", "scan_index"]
+    assert [m[k].dtype for k in m] == [np.float64, np.float32, np.float64, np.uint16, np.uint32]
+    # The same numbers as numpy's own reading of the binary PCD.
+    header, _, body = (cli_run / "map.pcd").read_bytes().partition(b"DATA binary\n")
+    assert b"FIELDS x y z intensity time ring scan_index\n" in header
+    raw = np.frombuffer(body, dtype=np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
+                                              ("intensity", "<f4"), ("time", "<f8"),
+                                              ("ring", "<u2"), ("scan_index", "<u4")]))
+    assert m["xyz"].shape == (len(raw), 3)
+    for i, axis in enumerate("xyz"):
+        np.testing.assert_array_equal(m["xyz"][:, i], raw[axis].astype(np.float64))
+    for name in ("intensity", "time", "ring", "scan_index"):
+        np.testing.assert_array_equal(m[name], raw[name])
+    assert_times_in_their_scans(m, np.loadtxt(cli_run / "trajectory.tum")[:, 0])
+    assert np.all(m["ring"] < 32) and np.mean(m["intensity"] > 0) > 0.9
+    with pytest.raises(FileNotFoundError):
+        rvlio.read_map(tmp_path / "none.pcd")
+    compressed = tmp_path / "compressed.pcd"
+    compressed.write_text("FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA binary_compressed\n")
+    with pytest.raises(ValueError, match="binary_compressed"):
+        rvlio.read_map(compressed)
 
 
 EXTRINSIC_COLUMNS = ("ext_roll_deg", "ext_pitch_deg", "ext_yaw_deg", "ext_x_m", "ext_y_m", "ext_z_m")

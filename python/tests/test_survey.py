@@ -37,14 +37,8 @@ def test_run_in_a_reference_map_gives_the_cli_files(rvlio_bin, tunnel, cli_run, 
 
 
 def read_map_pcd(path):
-    """x y z (N, 3) of a binary map.pcd (float32 or float64 x y z, optional deviation_m)."""
-    data = pathlib.Path(path).read_bytes()
-    end = data.index(b"DATA binary\n") + len(b"DATA binary\n")
-    fields = dict(line.split(" ", 1) for line in data[:end].decode().splitlines() if " " in line)
-    sizes = [int(v) for v in fields["SIZE"].split()]
-    dtype = np.dtype([(f"f{i}", "<f8" if s == 8 else "<f4") for i, s in enumerate(sizes)])
-    rec = np.frombuffer(data[end:], dtype=dtype)
-    return np.c_[rec["f0"], rec["f1"], rec["f2"]].astype(np.float64)
+    """x y z (N, 3) of a map.pcd (float32 or float64 x y z, with its attributes)."""
+    return rvlio.read_map(path)["xyz"]
 
 
 def write_map_pcd_f8(path, points):

@@ -200,21 +200,47 @@ Status CheckChunks(std::vector<ChunkFolder>* chunks) {
   return Status::Ok();
 }
 
+// A chunk map's scan indices (rows of the chunk's trajectory.tum) as rows of
+// the merged trajectory: the row with the same stamp. InvalidInput naming
+// the map for an index past the chunk's trajectory or a stamp the merged
+// trajectory lacks.
+Status RemapScanIndices(const std::string& path, const Trajectory& chunk, const Trajectory& merged,
+                        MapCloud* map) {
+  for (uint32_t& index : map->scan_index) {
+    if (index >= chunk.size())
+      return Status::InvalidInput(path + ": scan_index " + std::to_string(index) + " is past the " +
+                                  std::to_string(chunk.size()) + " poses of its trajectory.tum");
+    const TimeNs t_ns = chunk[index].t_ns;
+    const auto at = std::lower_bound(merged.begin(), merged.end(), t_ns,
+                                     [](const StampedPose& p, TimeNs t) { return p.t_ns < t; });
+    if (at == merged.end() || at->t_ns != t_ns)
+      return Status::InvalidInput(path + ": scan " + std::to_string(index) + " (" +
+                                  FormatSeconds(t_ns) + " s) is not in the merged trajectory");
+    index = static_cast<uint32_t>(at - merged.begin());
+  }
+  return Status::Ok();
+}
+
 // Each chunk's map carried into the merged frame, re-voxelized at the
-// chunks' resolution; in the local frame of `origin`, as the trajectories.
-StatusOr<std::vector<Eigen::Vector3d>> MergeMaps(const std::vector<ChunkFolder>& chunks,
-                                                 const RefineJobMerge& merge,
-                                                 const LocalOrigin& origin) {
+// chunks' resolution, with the attributes the chunks' maps have (scan_index
+// as rows of the merged trajectory); in the local frame of `origin`, as the
+// trajectories.
+StatusOr<MapCloud> MergeMaps(const std::vector<ChunkFolder>& chunks, const RefineJobMerge& merge,
+                             const LocalOrigin& origin) {
   OutputMap output(chunks.front().manifest["map_output_resolution"].get<double>());
   for (size_t k = 0; k < chunks.size(); ++k) {
-    StatusOr<std::vector<Eigen::Vector3d>> points = ReadMapPcd(FilePath(chunks[k].dir, "map.pcd"));
-    if (!points.ok()) return points.status();
-    origin.ToLocal(&*points);
+    const std::string path = FilePath(chunks[k].dir, "map.pcd");
+    StatusOr<MapCloudFile> read = ReadMapCloud(path);
+    if (!read.ok()) return read.status();
+    MapCloud& map = read->map;
+    if (Status s = RemapScanIndices(path, chunks[k].job.trajectory, merge.trajectory, &map); !s.ok())
+      return s;
+    origin.ToLocal(&map.p);
     const Pose3& T = merge.alignments[k].T_merged_chunk;
-    for (Eigen::Vector3d& p : *points) p = T * p;
-    output.Insert(*points);
+    for (Eigen::Vector3d& p : map.p) p = T * p;
+    output.InsertCloud(map);
   }
-  return output.Points();
+  return output.Cloud();
 }
 
 MergedChunk Merged(const ChunkFolder& c, const RefineJobAlignment& a) {
@@ -241,7 +267,7 @@ json Summary(const std::vector<ChunkFolder>& chunks, const MergeResult& r) {
   j["init_hash"] = chunks.front().manifest["init_hash"];
   j["scan_count"] = r.trajectory.size();
   j["sequence_duration_s"] = NsToSeconds(r.trajectory.back().t_ns - r.trajectory.front().t_ns);
-  j["map_points"] = r.map_points.size();
+  j["map_points"] = r.map.size();
   j["chunks"] = json::array();
   for (const MergedChunk& c : r.chunks) j["chunks"].push_back(MergedChunkJson(c));
   j["warnings"] = r.warnings;
@@ -257,7 +283,7 @@ Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
   if (!r.control_csv.empty())
     if (Status s = WriteFileAtomically(stage.Path("control.csv"), r.control_csv); !s.ok())
       return stage.Explain(s);
-  if (Status s = WriteMapOutputs(&stage, r.map_points, deviation, las); !s.ok()) return s;
+  if (Status s = WriteMapOutputs(&stage, r.map, deviation, las); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
     return stage.Explain(s);
@@ -399,9 +425,9 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   if (!merge.ok()) return merge.status();
   MergeResult r;
   r.trajectory = merge->trajectory;
-  StatusOr<std::vector<Eigen::Vector3d>> map = MergeMaps(chunks, *merge, origin);
+  StatusOr<MapCloud> map = MergeMaps(chunks, *merge, origin);
   if (!map.ok()) return map.status();
-  r.map_points = std::move(*map);
+  r.map = std::move(*map);
   for (const ChunkFolder& c : chunks) map_warnings.insert(map_warnings.end(), c.warnings.begin(), c.warnings.end());
   for (const std::string& w : map_warnings)  // each once
     if (std::find(r.warnings.begin(), r.warnings.end(), w) == r.warnings.end())
@@ -414,12 +440,12 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
     r.chunks.push_back(Merged(chunks[k], merge->alignments[k]));
   std::optional<MapDeviation> deviation;  // in the local frame, as the reference
   if (reference->surface != nullptr)
-    deviation = ComputeMapDeviation(r.map_points, *reference->surface, r.trajectory,
+    deviation = ComputeMapDeviation(r.map.p, *reference->surface, r.trajectory,
                                     reference->options);
   if (Status s = MergeImuTrajectories(chunks, *merge, origin, &r); !s.ok()) return s;
   origin.ToUser(&r.trajectory);
   origin.ToUser(&r.imu_trajectory);
-  origin.ToUser(&r.map_points);
+  origin.ToUser(&r.map.p);
   if (Status s = MergeControl(chunks, *merge, origin, &r); !s.ok()) return s;
   r.summary = Summary(chunks, r);
   r.summary["local_origin"] = LocalOriginJson(origin);

@@ -257,7 +257,7 @@ nlohmann::json Summary(const RefineArgs& args, const RefineRunResult& r,
   j["converged"] = res.converged;
   j["interrupted"] = res.stopped;
   if (res.stopped) j["signal"] = r.stop_reason;
-  j["map_points"] = res.map_points.size();
+  j["map_points"] = res.map.size();
   j["time_s"] = {{"read_bag", times.read_s},
                  {"init_solve", res.init_solve_s},
                  {"refine", res.total_s},
@@ -282,7 +282,7 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
       return stage.Explain(s);
   if (Status s = WriteTrajectoryOutputs(&stage, r.refine.trajectory, r.imu_trajectory); !s.ok())
     return s;
-  if (Status s = WriteMapOutputs(&stage, r.refine.map_points, deviation, las); !s.ok()) return s;
+  if (Status s = WriteMapOutputs(&stage, r.refine.map, deviation, las); !s.ok()) return s;
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
       !s.ok())
     return stage.Explain(s);
@@ -510,7 +510,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
                                    args.options.constraints.lidar_noise, args.options.imu.gravity);
   std::optional<MapDeviation> deviation;  // in the local frame, as the reference
   if (surface != nullptr && !r.refine.trajectory.empty())
-    deviation = ComputeMapDeviation(r.refine.map_points, *surface, r.refine.trajectory,
+    deviation = ComputeMapDeviation(r.refine.map.p, *surface, r.refine.trajectory,
                                     args.options.localization.deviation);
   if (*survey != nullptr) DeliverInSurveyFrame(survey->get(), &r);  // residuals, local frame
   if (args.options.output.imu_trajectory) {  // between the refined states, as their IMU factors
@@ -518,7 +518,7 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
     origin.ToUser(&r.imu_trajectory);
   }
   origin.ToUser(&r.refine.trajectory);
-  origin.ToUser(&r.refine.map_points);
+  origin.ToUser(&r.refine.map.p);
   times.wall_s = SecondsSince(t0);
   r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
   r.summary["local_origin"] = LocalOriginJson(origin);

@@ -96,9 +96,13 @@ nlohmann::json LocalizationJson(const RunArgs& args, const std::vector<ScanResul
           {"longest_out_of_map_s", longest_s}};
 }
 
-// The odometry's results (its local frame) in the user's frame.
+// An odometry result (its local frame) in the user's frame.
+void MoveToUserFrame(const LocalOrigin& origin, ScanResult* r) {
+  r->T_world_imu.t = origin.ToUser(r->T_world_imu.t);
+}
+
 void MoveToUserFrame(const LocalOrigin& origin, std::vector<ScanResult>* scans) {
-  for (ScanResult& r : *scans) r.T_world_imu.t = origin.ToUser(r.T_world_imu.t);
+  for (ScanResult& r : *scans) MoveToUserFrame(origin, &r);
 }
 
 struct RunData {
@@ -154,14 +158,14 @@ nlohmann::json Summary(const RunArgs& args, const Odometry& odo,
   return j;
 }
 
-Status WriteOutputs(const std::string& out_dir, const std::vector<Eigen::Vector3d>& p_map,
+Status WriteOutputs(const std::string& out_dir, const MapCloud& map,
                     const RunResult& result, const MapDeviation* deviation,
                     const MapLasRequest& las) {
   OutputStage stage(out_dir);
   if (Status s = stage.Open(); !s.ok()) return s;
   if (Status s = WriteTrajectoryOutputs(&stage, result.trajectory, result.imu_trajectory); !s.ok())
     return s;
-  if (Status s = WriteMapOutputs(&stage, p_map, deviation, las); !s.ok()) return s;
+  if (Status s = WriteMapOutputs(&stage, map, deviation, las); !s.ok()) return s;
   if (Status s = WriteScansCsv(stage.Path("scans.csv"), result.scans, result.rss_mb); !s.ok())
     return stage.Explain(s);
   if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(result.summary) + "\n");
@@ -239,7 +243,7 @@ void StreamNewPoses(const std::vector<ScanResult>& results, const LocalOrigin& o
   for (; *streamed < results.size(); ++*streamed) {
     if (args.on_result) {
       ScanResult user = results[*streamed];
-      user.T_world_imu.t = origin.ToUser(user.T_world_imu.t);
+      MoveToUserFrame(origin, &user);
       args.on_result(user, odo, origin);
     }
     if (streams->imu_rate) streams->imu_rate->AddEstimate(ImuEstimateOf(results[*streamed]));
@@ -410,14 +414,14 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
         NoScanMessage(args.bag, args.options, reader_stats, (*odo)->stats()));
   }
   SetFigures(data, &result);
-  std::vector<Eigen::Vector3d> p_map;  // the output map, when written or compared
-  if (write || reference != nullptr) p_map = (*odo)->MapPoints();
+  MapCloud map;  // the output map, when written or compared
+  if (write || reference != nullptr) map = (*odo)->MapWithAttributes();
   std::optional<MapDeviation> deviation;  // in the local frame, as the reference
   if (reference != nullptr)
-    deviation = ComputeMapDeviation(p_map, *reference, ToTrajectory(result.scans),
+    deviation = ComputeMapDeviation(map.p, *reference, ToTrajectory(result.scans),
                                     args.options.localization.deviation);
   MoveToUserFrame(origin, &result.scans);
-  origin.ToUser(&p_map);
+  origin.ToUser(&map.p);
   result.trajectory = ToTrajectory(result.scans);
   if (streams.imu_rate) {
     result.imu_trajectory = streams.imu_rate->TakePoses();
@@ -429,7 +433,7 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
   if (args.annotate_summary) args.annotate_summary(&result.summary);
   if (!write) return result;
   const Status written =
-      WriteOutputs(args.out_dir, p_map, result, deviation ? &*deviation : nullptr, *las);
+      WriteOutputs(args.out_dir, map, result, deviation ? &*deviation : nullptr, *las);
   partial.Remove();  // the complete outputs (or the folder as it was) replace it
   if (!written.ok()) return written;  // out_folder removes a folder it created
   out_folder.Keep();

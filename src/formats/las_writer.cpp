@@ -235,7 +235,9 @@ Status LasWriter::Write(const LasPoint& point) {
     ++stats_.ring_saturated;
     ring = ring < 0 ? 0 : 255;
   }
-  Put<uint8_t>(&r, 17, static_cast<uint8_t>(ring));  // 15, 16, 18-21 stay 0
+  Put<uint8_t>(&r, 17, static_cast<uint8_t>(ring));  // 15, 16, 18, 19 stay 0
+  Put<uint16_t>(&r, 20, options_.has_point_source ? static_cast<uint16_t>(point.scan_index % 65536)
+                                                  : uint16_t{0});
   Put<double>(&r, 22, options_.has_time ? UnixToAdjustedGpsTime(point.unix_time_s) : 0.0);
   size_t at = kFormat6Size;
   for (size_t k = 0; k < options_.extra_fields.size(); ++k) {
@@ -317,7 +319,10 @@ std::string LasWriter::Description() const {
                           : "none (0).")
     << " User data: " << (options_.has_ring ? "the LiDAR ring (beam), 255 for 255 and above."
                                            : "0.")
-    << " Point source ID: 0. Extra bytes: ";
+    << " Point source ID: "
+    << (options_.has_point_source ? "the scan index modulo 65536 (extra bytes scan_index: all of it)."
+                                  : "0.")
+    << " Extra bytes: ";
   if (options_.extra_fields.empty()) d << "none.";
   for (size_t k = 0; k < options_.extra_fields.size(); ++k)
     d << (k > 0 ? ", " : "") << options_.extra_fields[k].name;

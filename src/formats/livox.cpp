@@ -154,6 +154,8 @@ StatusOr<Scan> DecodeLivoxCustomMsg(const LivoxCustomMsg& msg, const LidarOption
     scan.points.push_back(p);
   }
   SetScanTimeBounds(msg.header_stamp_ns, &scan);
+  scan.has_intensity = true;  // reflectivity
+  scan.has_ring = true;       // line
   return scan;
 }
 

@@ -564,6 +564,8 @@ void OusterScanAssembler::Deliver(Scan* out, DecodeStats* decode) {
   }
   ++stats_.frames;
   SetScanTimeBounds(first_column_ns, out);
+  out->has_intensity = true;  // the reflectivity channel
+  out->has_ring = true;
   have_frame_ = false;
   have_delivered_ = true;
   last_delivered_ = frame_id_;

@@ -229,20 +229,26 @@ double LoadHost(const uint8_t* p) {
 
 // The common relative-time layouts (Ouster, Velodyne, Livox offset_time) in
 // host byte order: x, y, z float32, time TimeT (uint32 ns or float32 s),
-// intensity float32 or absent, ring RingT (uint8, uint16 or Absent). Every value is the double GenericReader
+// intensity float32, uint16 or uint8 (Ouster's reflectivity) or absent, ring
+// RingT (uint8, uint16 or Absent). Every value is the double GenericReader
 // reads, so both decode the same points.
 template <typename TimeT, bool kIntensity, typename RingT>
 class FastReader {
  public:
   FastReader(const Layout& layout, const PointFields& f)
       : kind_(layout.kind), t_(layout.time.offset), x_(f.x.offset), y_(f.y.offset),
-        z_(f.z.offset), i_(f.intensity.offset), r_(f.ring.offset) {}
+        z_(f.z.offset), i_(f.intensity.offset), r_(f.ring.offset),
+        i_type_(f.intensity.datatype) {}
   double Time(const uint8_t* p) const { return NormalizeTime(LoadHost<TimeT>(p + t_), kind_); }
   double X(const uint8_t* p) const { return LoadHost<float>(p + x_); }
   double Y(const uint8_t* p) const { return LoadHost<float>(p + y_); }
   double Z(const uint8_t* p) const { return LoadHost<float>(p + z_); }
   static constexpr bool has_intensity() { return kIntensity; }
-  double Intensity(const uint8_t* p) const { return LoadHost<float>(p + i_); }
+  double Intensity(const uint8_t* p) const {  // the same type in every point: predicted
+    if (i_type_ == kPointFloat32) return LoadHost<float>(p + i_);
+    if (i_type_ == kPointUint16) return LoadHost<uint16_t>(p + i_);
+    return LoadHost<uint8_t>(p + i_);
+  }
   static constexpr bool has_ring() { return !std::is_same<RingT, Absent>::value; }
   double Ring(const uint8_t* p) const {
     if constexpr (has_ring()) return LoadHost<RingT>(p + r_);
@@ -252,6 +258,7 @@ class FastReader {
  private:
   TimeKind kind_;
   uint32_t t_, x_, y_, z_, i_, r_;
+  uint8_t i_type_;
 };
 
 struct TimeRange {
@@ -357,7 +364,10 @@ Status FindPointFields(const PointCloud2View& cloud, const Layout& layout, Point
     return Status::InvalidInput(Where(cloud) + " has no x, y, z fields; fields are " +
                                 PointFieldNames(cloud.fields));
   }
-  f->intensity = Find(cloud, "intensity");
+  // The sensor's reflectivity where the layout gives one (Ouster), else its
+  // intensity (docs/input_formats.md).
+  f->intensity = Find(cloud, "reflectivity");
+  if (!f->intensity.present) f->intensity = Find(cloud, "intensity");
   f->ring = Find(cloud, "ring");
   if (!f->ring.present && layout.name == "livox") f->ring = Find(cloud, "line");
   return Status::Ok();
@@ -444,7 +454,8 @@ template <typename TimeT>
 bool TryFastIntensity(const PointCloud2View& cloud, const Layout& layout, const PointFields& f,
                       const LidarOptions& lidar, DecodeStats* stats, Scan* scan) {
   if (!f.intensity.present) return TryFastRing<TimeT, false>(cloud, layout, f, lidar, stats, scan);
-  if (f.intensity.datatype == kPointFloat32)
+  if (Is(f.intensity, kPointFloat32) || Is(f.intensity, kPointUint16) ||
+      Is(f.intensity, kPointUint8))
     return TryFastRing<TimeT, true>(cloud, layout, f, lidar, stats, scan);
   return false;
 }
@@ -485,6 +496,8 @@ StatusOr<Scan> Decode(const PointCloud2View& cloud, const LidarOptions& lidar,
   if (!stats->fast_path) {
     scan = DecodeWith(cloud, GenericReader(cloud, *layout, fields), *layout, lidar, stats);
   }
+  scan.has_intensity = fields.intensity.present;
+  scan.has_ring = fields.ring.present;
   return scan;
 }
 

@@ -153,6 +153,8 @@ void ScanPreprocessor::Downsample(const Scan& scan, Scan* out) {
   SelectIndices(scan, &indices_);
   out->t_start_ns = scan.t_start_ns;
   out->t_end_ns = scan.t_end_ns;
+  out->has_intensity = scan.has_intensity;
+  out->has_ring = scan.has_ring;
   out->points.clear();
   out->points.reserve(indices_.size());
   for (const int i : indices_) out->points.push_back(scan.points[i]);

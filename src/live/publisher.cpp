@@ -156,10 +156,11 @@ void LivePublisher::PublishMap(TimeNs t_ns, const rvlio::Odometry& odometry,
   const double period_s = options_.live.map_period;
   if (period_s <= 0.0 || (last_map_ns_ >= 0 && t_ns - last_map_ns_ < SecondsToNs(period_s))) return;
   last_map_ns_ = t_ns;
-  std::vector<Eigen::Vector3d> p_world = odometry.MapPoints();
-  origin.ToUser(&p_world);
-  XyziCloud cloud(t_ns, p_world.size());
-  for (size_t i = 0; i < p_world.size(); ++i) cloud.Set(i, p_world[i], 0.0f);
+  MapCloud map = odometry.MapWithAttributes();  // intensity 0 where the recording has none
+  origin.ToUser(&map.p);
+  XyziCloud cloud(t_ns, map.size());
+  for (size_t i = 0; i < map.size(); ++i)
+    cloud.Set(i, map.p[i], map.has_intensity ? map.intensity[i] : 0.0f);
   transport_->Publish(CloudTopic::kMap, cloud.view, options_.live.odom_frame);
 }
 

@@ -137,7 +137,7 @@ void IeskfBackend::Insert(ScanContext& scan) {
       options_.lidar.estimate_time_offset ? filter_.ScanTimeImuPose() : x.T_world_imu();
   const std::vector<Eigen::Vector3d>& p_world =
       scan.map->InsertScan(scan.t_ns, T_world_imu, x.T_imu_lidar(), *scan.p_lidar);
-  if (!provisional) scan.output_map->Insert(p_world);
+  if (!provisional) scan.output->Insert(scan.t_ns, p_world);
 }
 
 // The map hold (lidar.time_offset_map_hold, docs/time_offset.md "Map hold"):

@@ -3,6 +3,7 @@
 #include <limits>
 #include <utility>
 
+#include "rvlio/common/check.h"
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/lidar/deskew.h"
 #include "rvlio/lidar/extrinsics.h"
@@ -25,12 +26,24 @@ DivergenceOptions MonitorOptions(const OdometryOptions& options) {
 
 }  // namespace
 
+void OutputMapFeed::Hold(TimeNs t_ns, uint32_t scan_index, const Scan& returns) {
+  held_.push_back({t_ns, scan_index, returns});
+}
+
+void OutputMapFeed::Insert(TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_world) {
+  while (!held_.empty() && held_.front().t_ns < t_ns) held_.pop_front();
+  RVLIO_CHECK_MSG(!held_.empty() && held_.front().t_ns == t_ns,
+                  "odometry: a scan enters the output map without its returns");
+  map_.InsertScan(p_world, held_.front().returns, held_.front().scan_index);
+  held_.pop_front();
+}
+
 template <class Backend>
 ScanPipeline<Backend>::ScanPipeline(const OdometryOptions& options, Localization localization)
     : options_(options),
       backend_(options),
       map_(options.map, backend_.estimates_extrinsics()),
-      output_map_(options.map.output_resolution),
+      output_(options.map.output_resolution),
       preprocessor_(options.lidar),
       T_imu_lidar_prior_(ImuTLidar(options.extrinsics)),
       monitor_(MonitorOptions(options), options.constraints.lidar_noise, options.imu.gravity,
@@ -126,6 +139,7 @@ void ScanPipeline<Backend>::ProcessFrontScan(std::vector<ScanResult>* out) {
   if (localizer_.enabled() && !localizer_.started() && !StartInReference(&prediction)) return;
   ScanResult r = NewResult(*scan, prediction);
   ScanContext context = Context(scan->t_end_ns, prediction);
+  output_.Hold(scan->t_end_ns, static_cast<uint32_t>(stats_.scans_processed), downsampled_);
   r.status = backend_.Update(context, &r);                                             // associate + update
   backend_.Insert(context);                                                            // insert
   Report(scan->t_end_ns, prediction, start_ms, &r);                                    // report
@@ -158,7 +172,7 @@ bool ScanPipeline<Backend>::StartInReference(Prediction* prediction) {
 
 template <class Backend>
 ScanContext ScanPipeline<Backend>::Context(TimeNs t_ns, const Prediction& prediction) {
-  return ScanContext{t_ns, &p_lidar_end_, &prediction, &map_, &output_map_, &localizer_, &stats_};
+  return ScanContext{t_ns, &p_lidar_end_, &prediction, &map_, &output_, &localizer_, &stats_};
 }
 
 template <class Backend>

@@ -216,7 +216,7 @@ void SmootherBackend::Insert(ScanContext& scan) {
 void SmootherBackend::Finish(ScanContext& scan) {
   for (int k = 0; k < window_->size(); ++k) {
     TransformPoints(window_->ScanTimeImuPose(k) * T_imu_lidar(), window_->points(k), &p_world_);
-    scan.output_map->Insert(p_world_);
+    scan.output->Insert(window_->state(k).t_ns, p_world_);
   }
 }
 
@@ -234,11 +234,11 @@ void SmootherBackend::MarginalizeIfFull(ScanContext& scan) {
   scan.stats->marginalization_ms += ThreadCpuMs() - start_ms;
   window_filled_ = true;
   if (options_.smoother.map_update == "marginalized") {
-    scan.output_map->Insert(
-        scan.map->InsertScan(m->state.t_ns, m->scan_T_world_imu, T_imu_lidar(), m->p_lidar));
+    scan.output->Insert(m->state.t_ns, scan.map->InsertScan(m->state.t_ns, m->scan_T_world_imu,
+                                                            T_imu_lidar(), m->p_lidar));
   } else {
     TransformPoints(m->scan_T_world_imu * T_imu_lidar(), m->p_lidar, &p_world_);
-    scan.output_map->Insert(p_world_);
+    scan.output->Insert(m->state.t_ns, p_world_);
   }
   scan.stats->marginalization_failures = window_->stats().marginalization_failures;
 }

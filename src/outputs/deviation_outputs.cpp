@@ -33,14 +33,14 @@ nlohmann::json DeviationSummaryJson(const MapDeviation& d) {
           {"max_abs_m", abs_m.empty() ? nlohmann::json(nullptr) : nlohmann::json(abs_m.back())}};
 }
 
-Status WriteMapOutputs(OutputStage* stage, const std::vector<Eigen::Vector3d>& p_map,
-                       const MapDeviation* deviation, const MapLasRequest& las) {
+Status WriteMapOutputs(OutputStage* stage, const MapCloud& map, const MapDeviation* deviation,
+                       const MapLasRequest& las) {
   const std::vector<double>* deviation_m =
       deviation != nullptr ? &deviation->points.deviation_m : nullptr;
-  if (Status s = WriteMapPcd(stage->Path("map.pcd"), p_map, deviation_m); !s.ok())
+  if (Status s = WriteMapPcd(stage->Path("map.pcd"), map, deviation_m); !s.ok())
     return stage->Explain(s);
   if (las.enabled)
-    if (Status s = WriteMapLas(stage->Path("map.las"), p_map, deviation_m, las.crs_wkt); !s.ok())
+    if (Status s = WriteMapLas(stage->Path("map.las"), map, deviation_m, las.crs_wkt); !s.ok())
       return stage->Explain(s);
   if (deviation != nullptr)
     if (Status s = WriteDeviationCsv(stage->Path("deviation.csv"), deviation->bins); !s.ok())

@@ -8,6 +8,8 @@
 
 #include "rvlio/formats/crs.h"
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/outputs/map_fields.h"
+#include "rvlio/outputs/run_outputs.h"
 
 namespace rvlio {
 namespace {
@@ -17,10 +19,11 @@ namespace {
 constexpr const char* kIntensityFields[] = {"intensity", "reflectivity"};
 constexpr const char* kTimeFields[] = {"time", "timestamp", "t"};  // F8 only: UNIX seconds
 constexpr const char* kRingFields[] = {"ring"};
+constexpr const char* kScanIndexField = "scan_index";  // Point Source ID, and extra bytes
 constexpr const char* kDeviationField = "deviation_m";
 
 struct FieldRoles {
-  int intensity = -1, time = -1, ring = -1;
+  int intensity = -1, time = -1, ring = -1, scan_index = -1;
   std::vector<int> extra;  // indices into the stream's fields
 };
 
@@ -46,6 +49,7 @@ FieldRoles AssignRoles(const std::vector<PointCloudStreamField>& fields) {
   // A time in F4 or an integer type cannot hold absolute seconds: kept as extra bytes.
   r.time = FirstOf(fields, kTimeFields, true);
   r.ring = FirstOf(fields, kRingFields);
+  r.scan_index = FindField(fields, kScanIndexField);
   for (size_t i = 0; i < fields.size(); ++i) {
     const int k = static_cast<int>(i);
     if (k != r.intensity && k != r.time && k != r.ring) r.extra.push_back(k);
@@ -68,10 +72,6 @@ std::string DescriptionOf(const std::string& name) {
   if (name == kDeviationField) return "to the reference surface, m";
   if (name == "scan_index") return "index of the scan of the point";
   return "map.pcd field " + name.substr(0, 17);
-}
-
-LasExtraField DeviationField() {
-  return {kDeviationField, LasScalar::kFloat, DescriptionOf(kDeviationField)};
 }
 
 // The sensor's intensity range from the largest value (LasExportOptions).
@@ -141,6 +141,57 @@ void AddWarnings(const LasWriteStats& stats, const std::string& path,
                         " rings outside 0..255 were stored as 0 or 255 (LAS User Data is 8 bits)");
 }
 
+// The writer's options for a map of these fields (x y z apart) and the
+// names of what goes where; intensity_range > 0 (the sensor's levels).
+LasWriterOptions PlanLas(const std::vector<PointCloudStreamField>& fields, const FieldRoles& roles,
+                         double intensity_range, const std::string& crs_wkt,
+                         LasExportResult* result) {
+  LasWriterOptions w;
+  w.crs_wkt = crs_wkt;
+  if (roles.intensity >= 0) {
+    result->intensity_field = fields[roles.intensity].name;
+    result->intensity_range = intensity_range;
+    w.intensity_scale = 65536.0 / intensity_range;
+    w.intensity_source = "map.pcd field " + result->intensity_field + " (range " +
+                         std::to_string(static_cast<int64_t>(intensity_range)) + ")";
+  }
+  if (roles.time >= 0) result->time_field = fields[roles.time].name;
+  if (roles.ring >= 0) result->ring_field = fields[roles.ring].name;
+  w.has_time = roles.time >= 0;
+  w.has_ring = roles.ring >= 0;
+  w.has_point_source = roles.scan_index >= 0;
+  for (int k : roles.extra) {
+    w.extra_fields.push_back({fields[k].name, ScalarOf(fields[k]), DescriptionOf(fields[k].name)});
+    result->extra_fields.push_back(fields[k].name);
+  }
+  return w;
+}
+
+// The first n points of a chunk through the writer, each field in its role.
+Status WriteChunk(const PointCloudChunk& chunk, size_t n, const FieldRoles& roles,
+                  LasWriter* writer) {
+  std::vector<double> extra(roles.extra.size());
+  LasPoint point;
+  point.extra = extra.data();
+  for (size_t i = 0; i < n; ++i) {
+    point.p_m = chunk.points[i];
+    if (roles.intensity >= 0) point.intensity = chunk.fields[roles.intensity][i];
+    if (roles.time >= 0) point.unix_time_s = chunk.fields[roles.time][i];
+    if (roles.ring >= 0) {
+      const double ring = chunk.fields[roles.ring][i];
+      point.ring = std::isfinite(ring) ? static_cast<int>(std::clamp(ring, -1.0, 256.0)) : -1;
+    }
+    if (roles.scan_index >= 0) {
+      const double index = chunk.fields[roles.scan_index][i];
+      point.scan_index = std::isfinite(index) && index >= 0.0 && index < 1.8e19
+                             ? static_cast<uint64_t>(index) : 0;
+    }
+    for (size_t k = 0; k < roles.extra.size(); ++k) extra[k] = chunk.fields[roles.extra[k]][i];
+    if (Status s = writer->Write(point); !s.ok()) return s;
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 StatusOr<std::string> CrsWkt(const std::string& crs) {
@@ -159,18 +210,39 @@ StatusOr<MapLasRequest> MapLasRequestOf(const OutputOptions& output, const Surve
   return r;
 }
 
-Status WriteMapLas(const std::string& path, const std::vector<Eigen::Vector3d>& p_map,
-                   const std::vector<double>* deviation_m, const std::string& crs_wkt) {
-  LasWriterOptions options;
-  options.crs_wkt = crs_wkt;
-  if (deviation_m != nullptr) options.extra_fields.push_back(DeviationField());
+Status WriteMapLas(const std::string& path, const MapCloud& map,
+                   const std::vector<double>* deviation_m, const std::string& crs_wkt,
+                   size_t chunk_points) {
+  // The coordinates and fields as map.pcd has them (x y z in float32 below
+  // 8192 m: a step of 1 mm at most), so that `rvlio export` of that file
+  // writes the same bytes.
+  const bool float32_xyz = !MapNeedsFloat64(map.p);
+  std::vector<PointCloudStreamField> fields;
+  const std::vector<MapFieldSpec> specs = MapAttributeFields(map, deviation_m != nullptr);
+  for (const MapFieldSpec& f : specs) fields.push_back({f.name, f.type, f.size});
+  const FieldRoles roles = AssignRoles(fields);
+  double largest_intensity = 0.0;
+  for (float v : map.intensity)
+    if (std::isfinite(v)) largest_intensity = std::max(largest_intensity, static_cast<double>(v));
+  LasExportResult names;
   LasWriter writer;
-  if (Status s = writer.Open(path, std::move(options)); !s.ok()) return s;
-  LasPoint point;
-  for (size_t i = 0; i < p_map.size(); ++i) {
-    point.p_m = p_map[i];
-    point.extra = deviation_m != nullptr ? &(*deviation_m)[i] : nullptr;
-    if (Status s = writer.Write(point); !s.ok()) return s;
+  if (Status s = writer.Open(path, PlanLas(fields, roles, RangeOfLargest(largest_intensity),
+                                           crs_wkt, &names));
+      !s.ok())
+    return s;
+  PointCloudChunk chunk;
+  chunk.fields.resize(specs.size());
+  for (size_t first = 0; first < map.size(); first += chunk_points) {
+    const size_t n = std::min(chunk_points, map.size() - first);
+    chunk.points.assign(map.p.begin() + first, map.p.begin() + first + n);
+    if (float32_xyz)
+      for (Eigen::Vector3d& p : chunk.points) p = p.cast<float>().cast<double>();
+    for (size_t k = 0; k < specs.size(); ++k) {
+      chunk.fields[k].resize(n);
+      for (size_t i = 0; i < n; ++i)
+        chunk.fields[k][i] = MapFieldValue(specs[k].field, map, deviation_m, first + i);
+    }
+    if (Status s = WriteChunk(chunk, n, roles, &writer); !s.ok()) return s;
   }
   return writer.Commit();
 }
@@ -187,34 +259,16 @@ StatusOr<LasExportResult> ExportPointCloudToLas(const std::string& pcd_path,
   if (Status s = CheckFieldNames(pcd_path, fields); !s.ok()) return s;
   const FieldRoles roles = AssignRoles(fields);
   LasExportResult result;
-  LasWriterOptions w;
-  w.crs_wkt = std::move(*wkt);
-  if (roles.intensity >= 0) {
-    result.intensity_field = fields[roles.intensity].name;
-    result.intensity_range = options.intensity_range;
-    if (result.intensity_range <= 0.0) {
-      StatusOr<double> largest = LargestValue(pcd_path, roles.intensity, options.chunk_points);
-      if (!largest.ok()) return largest.status();
-      result.intensity_range = RangeOfLargest(*largest);
-    }
-    w.intensity_scale = 65536.0 / result.intensity_range;
-    w.intensity_source = "map.pcd field " + result.intensity_field + " (range " +
-                         std::to_string(static_cast<int64_t>(result.intensity_range)) + ")";
-  }
-  if (roles.time >= 0) result.time_field = fields[roles.time].name;
-  if (roles.ring >= 0) result.ring_field = fields[roles.ring].name;
-  w.has_time = roles.time >= 0;
-  w.has_ring = roles.ring >= 0;
-  for (int k : roles.extra) {
-    w.extra_fields.push_back({fields[k].name, ScalarOf(fields[k]), DescriptionOf(fields[k].name)});
-    result.extra_fields.push_back(fields[k].name);
+  double range = options.intensity_range;
+  if (roles.intensity >= 0 && range <= 0.0) {
+    StatusOr<double> largest = LargestValue(pcd_path, roles.intensity, options.chunk_points);
+    if (!largest.ok()) return largest.status();
+    range = RangeOfLargest(*largest);
   }
   LasWriter writer;
-  if (Status s = writer.Open(las_path, std::move(w)); !s.ok()) return s;
+  if (Status s = writer.Open(las_path, PlanLas(fields, roles, range, *wkt, &result)); !s.ok())
+    return s;
   PointCloudChunk chunk;
-  std::vector<double> extra(roles.extra.size());
-  LasPoint point;
-  point.extra = extra.data();
   for (;;) {
     if (options.stop && options.stop()) {
       result.stopped = true;
@@ -223,17 +277,7 @@ StatusOr<LasExportResult> ExportPointCloudToLas(const std::string& pcd_path,
     StatusOr<size_t> n = stream.Read(options.chunk_points, &chunk);
     if (!n.ok()) return n.status();
     if (*n == 0) break;
-    for (size_t i = 0; i < *n; ++i) {
-      point.p_m = chunk.points[i];
-      if (roles.intensity >= 0) point.intensity = chunk.fields[roles.intensity][i];
-      if (roles.time >= 0) point.unix_time_s = chunk.fields[roles.time][i];
-      if (roles.ring >= 0) {
-        const double ring = chunk.fields[roles.ring][i];
-        point.ring = std::isfinite(ring) ? static_cast<int>(std::clamp(ring, -1.0, 256.0)) : -1;
-      }
-      for (size_t k = 0; k < roles.extra.size(); ++k) extra[k] = chunk.fields[roles.extra[k]][i];
-      if (Status s = writer.Write(point); !s.ok()) return s;
-    }
+    if (Status s = WriteChunk(chunk, *n, roles, &writer); !s.ok()) return s;
   }
   if (Status s = writer.Commit(); !s.ok()) return s;
   result.stats = writer.stats();

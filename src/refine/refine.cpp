@@ -28,6 +28,22 @@ using Clock = std::chrono::steady_clock;
 constexpr double kConvergedTranslationM = 5e-4;  // rounds stop below both changes
 constexpr double kConvergedRotationDeg = 5e-3;
 
+// Refined scan `scan_index`'s deskewed points at T_world_lidar into the
+// output map, each with its return's attributes.
+void InsertRefinedScan(const RefineScanPoints& points, const Pose3& T_world_lidar,
+                       const std::vector<Eigen::Vector3d>& p_lidar_end, uint32_t scan_index,
+                       OutputMap* output) {
+  const MapAttributeSet given{!points.intensity.empty(), true, !points.ring.empty(), true};
+  MapPointAttributes a;
+  a.scan_index = scan_index;
+  for (size_t i = 0; i < p_lidar_end.size(); ++i) {
+    if (given.intensity) a.intensity = points.intensity[i];
+    if (given.ring) a.ring = points.ring[i];
+    a.t_ns = points.t_ns[i];
+    output->InsertPoint(T_world_lidar * p_lidar_end[i], a, given);
+  }
+}
+
 // The rounds over one sequence: owns the states and the round's map; each
 // step is a function of refine_*.h.
 class BatchRefiner {
@@ -203,13 +219,10 @@ void BatchRefiner::Finish() {
   DeskewRefineScans(sequence_, states_, result_.g_world, config_.T_imu_lidar, solver_.threads,
                     &p_lidar_end);
   OutputMap output(config_.map.output_resolution);
-  std::vector<Eigen::Vector3d> p_world;
   for (size_t k = 0; k < states_.size(); ++k) {
     const Pose3 T_world_imu = states_[k].T_world_imu();
-    const Pose3 T_world_lidar = T_world_imu * config_.T_imu_lidar;
-    p_world.resize(p_lidar_end[k].size());
-    for (size_t i = 0; i < p_world.size(); ++i) p_world[i] = T_world_lidar * p_lidar_end[k][i];
-    output.Insert(p_world);
+    InsertRefinedScan(sequence_.points[k], T_world_imu * config_.T_imu_lidar, p_lidar_end[k],
+                      static_cast<uint32_t>(k), &output);
     StampedPose sp;
     sp.t_ns = states_[k].t_ns;
     sp.p_world_imu = T_world_imu.t;
@@ -220,7 +233,7 @@ void BatchRefiner::Finish() {
     result_.gyro_bias.push_back(sb.bg);
     result_.accel_bias.push_back(sb.ba);
   }
-  result_.map_points = output.Points();
+  result_.map = output.Cloud();
 }
 
 StatusOr<RefineResult> BatchRefiner::Run(const RefineHooks& hooks) {

@@ -70,13 +70,18 @@ StatusOr<RefineSequence> SelectRefineScans(const RefineInput& input, RefineStats
   if (seq.kept.size() < 2) return TooFewScans(input, st, seq.kept.size());
   seq.points.resize(seq.kept.size());
   for (int k = 0; k < seq.size(); ++k) {
-    const std::vector<LidarPoint>& from = seq.scan(k).points;
+    const Scan& scan = seq.scan(k);
+    const std::vector<LidarPoint>& from = scan.points;
     RefineScanPoints& to = seq.points[k];
     to.p_lidar.resize(from.size());
     to.t_ns.resize(from.size());
+    to.intensity.resize(scan.has_intensity ? from.size() : 0);
+    to.ring.resize(scan.has_ring ? from.size() : 0);
     for (size_t i = 0; i < from.size(); ++i) {
       to.p_lidar[i] = from[i].p_lidar;
       to.t_ns[i] = from[i].t_ns;
+      if (scan.has_intensity) to.intensity[i] = from[i].intensity;
+      if (scan.has_ring) to.ring[i] = from[i].ring;
     }
   }
   return seq;

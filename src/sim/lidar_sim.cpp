@@ -39,6 +39,8 @@ Scan CastScan(const World& world, const FlightTrajectory& trajectory, const Lida
   const int rows = model.rows(), cols = model.cols();
   if (truth) truth->assign(static_cast<size_t>(rows) * cols, SurfaceHit());
   Scan scan;
+  scan.has_intensity = true;
+  scan.has_ring = true;
   scan.t_start_ns = t_start_ns;
   scan.t_end_ns = t_start_ns + model.ColumnOffsetNs(cols - 1);
   scan.points.resize(static_cast<size_t>(rows) * cols);

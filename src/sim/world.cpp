@@ -39,6 +39,21 @@ void World::DeformFace(int index, const HeightField::Bump& bump) {
   faces_[static_cast<size_t>(index)].relief.AddBump(bump);
 }
 
+void World::PaintFace(int index, const Rect2& area, float reflectivity) {
+  RVLIO_CHECK(index >= 0 && static_cast<size_t>(index) < faces_.size());
+  paints_.push_back({index, area, reflectivity});
+}
+
+float World::FaceReflectivity(int index, const Eigen::Vector3d& p) const {
+  float r = face_reflectivity_[static_cast<size_t>(index)];
+  for (const Paint& paint : paints_) {
+    if (paint.face != index) continue;
+    const Face& f = faces_[static_cast<size_t>(index)];
+    if (paint.area.Contains(p[f.UAxis()], p[f.VAxis()])) r = paint.reflectivity;
+  }
+  return r;
+}
+
 std::vector<Eigen::AlignedBox3d> World::FeatureBounds() const {
   std::vector<Eigen::AlignedBox3d> out;
   for (const Feature& f : features_)
@@ -102,9 +117,10 @@ bool World::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, d
     if (faces_[static_cast<size_t>(i)].Intersect(ray, 1e-9, best, &t)) {
       best = t;
       found = true;
-      *hit = {t, face_reflectivity_[static_cast<size_t>(i)], ShapeKind::kFace, i};
+      *hit = {t, 0.0f, ShapeKind::kFace, i};
     }
   }
+  if (found) hit->reflectivity = FaceReflectivity(hit->index, origin + best * dir);
   if (features_.empty()) return found;
   // Walk the buckets from the origin's in the direction of travel; stop when
   // the next bucket starts beyond the best hit so far. A feature that spans

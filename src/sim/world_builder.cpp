@@ -104,6 +104,7 @@ class Builder {
       world_.AddFace(std::move(f), 80.f);
     }
     Deform();
+    Paint();
     // Front and back walls (u = y, v = z).
     if (!open) {
       Face f = MakeFace(0, x0, {yc - hw - m, yc + hw + m, zf - m, zc + m}, true);
@@ -142,6 +143,26 @@ class Builder {
       b.v_length = d.across_length;
     }
     world_.DeformFace(face, b);
+  }
+
+  // world.band on the floor (face 0), ceiling (1), right (2) or left (3)
+  // wall: the whole surface across, x in [x_min, x_max]. Draws no random
+  // number.
+  void Paint() {
+    const SimBandOptions& b = o_.band;
+    if (b.reflectivity <= 0.0 || b.x_max <= b.x_min) return;
+    const int face = b.surface == "floor" ? 0 : b.surface == "ceiling" ? 1
+                     : b.surface == "right" ? 2 : 3;
+    const bool wall = face >= 2;
+    Rect2 area{-kFar, kFar, -kFar, kFar};
+    if (wall) {  // u = z, v = x
+      area.v_min = b.x_min;
+      area.v_max = b.x_max;
+    } else {  // u = x, v = y
+      area.u_min = b.x_min;
+      area.u_max = b.x_max;
+    }
+    world_.PaintFace(face, area, static_cast<float>(b.reflectivity));
   }
 
   // Flat walls kBackdrop outside the hall, seen through its doorways.

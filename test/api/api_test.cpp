@@ -3,6 +3,7 @@
 // in-memory trajectory, evaluation, and errors as Status (never a crash or
 // an exit). That the command writes the API's files byte for byte is checked
 // by scripts/install_test.sh against the installed tool.
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -132,6 +133,43 @@ TEST_F(ApiTest, RunWithAndWithoutOutputFolderGivesTheSameTrajectory) {
   const nlohmann::json j = EvalJson(*from_files);
   EXPECT_EQ(j["matched"], from_files->matched);
   EXPECT_NEAR(j["ape"]["rmse"].get<double>(), from_files->ape_m.rmse, 1e-9);
+}
+
+// Every point of map.pcd is one return with its attributes, for both
+// backends: the intensity and ring the recording gives, a time inside the
+// scan its scan_index names (a row of trajectory.tum: from the previous
+// row's stamp to its own).
+TEST_F(ApiTest, MapPointsKeepTheirReturnsAttributesInBothBackends) {
+  for (const Backend backend : {Backend::kIeskf, Backend::kSmoother}) {
+    const std::string out = dir_ + "/attributes_" + EnumName(backend);
+    RunArgs args = Run(out);
+    args.options.backend = backend;
+    StatusOr<RunResult> run = RunRecording(args);
+    ASSERT_TRUE(run.ok()) << run.status().message();
+    StatusOr<MapCloudFile> read = ReadMapCloud(out + "/map.pcd");
+    ASSERT_TRUE(read.ok()) << read.status().message();
+    const MapCloud& map = read->map;
+    ASSERT_TRUE(map.has_intensity && map.has_time && map.has_ring && map.has_scan_index);
+    ASSERT_GT(map.size(), 5000u) << EnumName(backend);
+    std::vector<int> per_scan(run->trajectory.size(), 0);
+    size_t bright = 0;
+    for (size_t i = 0; i < map.size(); ++i) {
+      const uint32_t k = map.scan_index[i];
+      ASSERT_LT(k, run->trajectory.size()) << i;
+      ++per_scan[k];
+      // The map stores UNIX seconds in a double: 0.24 us of rounding.
+      EXPECT_LE(map.t_ns[i], run->trajectory[k].t_ns + 1000) << i;
+      if (k > 0) {
+        EXPECT_GT(map.t_ns[i], run->trajectory[k - 1].t_ns - 1000) << i;
+      }
+      EXPECT_LT(map.ring[i], 32) << "the simulated OS1-32's beams";
+      bright += map.intensity[i] > 0.0f;
+    }
+    EXPECT_GT(bright, map.size() * 9 / 10) << "the simulator's returns all have an intensity";
+    // The survivors come from many scans, not the first one only.
+    EXPECT_GT(std::count_if(per_scan.begin(), per_scan.end(), [](int n) { return n > 0; }),
+              static_cast<long>(per_scan.size() / 2)) << EnumName(backend);
+  }
 }
 
 // An opened source instead of the recording (as `rvlio live` hands over its

@@ -77,6 +77,7 @@ struct RawCloud {
     Set(i, "y", y);
     Set(i, "z", z);
     if (Has("intensity")) Set(i, "intensity", intensity);
+    if (Has("reflectivity")) Set(i, "reflectivity", intensity);  // Ouster: what rvlio reads
     if (!time_field.empty()) Set(i, time_field, time);
     if (!ring_field.empty()) Set(i, ring_field, ring);
   }

@@ -63,7 +63,12 @@ std::vector<Case> Cases() {
       {"ouster_big_endian", big, false},
       {"ouster_t_int32", Retyped(test::OusterCloud(), "t", kPointInt32), false},
       {"ouster_t_float32", Retyped(test::OusterCloud(), "t", kPointFloat32), false},
-      {"ouster_intensity_u16", Retyped(test::OusterCloud(), "intensity", kPointUint16), false},
+      {"ouster_intensity_u16", Retyped(test::OusterCloud(), "intensity", kPointUint16), true},
+      {"ouster_reflectivity_u8", Retyped(test::OusterCloud(), "reflectivity", kPointUint8), true},
+      {"ouster_no_reflectivity", Without(test::OusterCloud(), "reflectivity"), true},
+      {"ouster_no_reflectivity_intensity_u16",
+       Retyped(Without(test::OusterCloud(), "reflectivity"), "intensity", kPointUint16), true},
+      {"ouster_reflectivity_f64", Retyped(test::OusterCloud(), "reflectivity", kPointFloat64), false},
       {"ouster_ring_i32", Retyped(test::OusterCloud(), "ring", kPointInt32), false},
       {"ouster_x_float64", x_f64, false},
       {"velodyne_time_float64", velodyne_f64, false},
@@ -103,6 +108,8 @@ void ExpectSameScan(const Scan& a, const Scan& b, const std::string& where) {
   ASSERT_EQ(a.points.size(), b.points.size()) << where;
   EXPECT_EQ(a.t_start_ns, b.t_start_ns) << where;
   EXPECT_EQ(a.t_end_ns, b.t_end_ns) << where;
+  EXPECT_EQ(a.has_intensity, b.has_intensity) << where;
+  EXPECT_EQ(a.has_ring, b.has_ring) << where;
   for (size_t i = 0; i < a.points.size(); ++i) {
     const LidarPoint& p = a.points[i];
     const LidarPoint& q = b.points[i];

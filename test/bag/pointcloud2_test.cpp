@@ -61,6 +61,33 @@ void ExpectPattern(const Scan& scan, uint32_t n, bool check_ring = true) {
   }
 }
 
+// Ouster gives reflectivity (calibrated) and intensity (signal): the
+// reflectivity is the point's intensity; a layout without either has none,
+// which the scan says (the map then has no intensity field, not zeros).
+TEST(PointCloud2Decode, ReflectivityBeforeIntensityAndTheScanSaysWhatItHas) {
+  RawCloud c = test::OusterCloud();
+  c.stamp_ns = kCloudStamp;
+  FillPattern(&c, 20, [](uint32_t i) { return 500.0 * i; });
+  for (uint32_t i = 0; i < 20; ++i) c.Set(i, "intensity", 1000.0 + i);  // signal photons
+  for (const bool fast : {true, false}) {
+    StatusOr<Scan> scan = fast ? DecodePointCloud2(c.View(), Lidar())
+                               : DecodePointCloud2Generic(c.View(), Lidar());
+    ASSERT_TRUE(scan.ok()) << scan.status().message();
+    EXPECT_TRUE(scan->has_intensity && scan->has_ring);
+    for (uint32_t i = 0; i < 20; ++i) EXPECT_EQ(scan->points[i].intensity, 10.0f + i) << i;
+  }
+  RawCloud bare = test::VelodyneCloud();
+  bare.fields.erase(bare.fields.begin() + 3);  // intensity
+  bare.fields.erase(bare.fields.begin() + 3);  // ring
+  bare.ring_field.clear();
+  bare.stamp_ns = kCloudStamp;
+  FillPattern(&bare, 20, [](uint32_t i) { return 1e-4 * i; });
+  StatusOr<Scan> scan = DecodePointCloud2(bare.View(), Lidar());
+  ASSERT_TRUE(scan.ok()) << scan.status().message();
+  EXPECT_FALSE(scan->has_intensity);
+  EXPECT_FALSE(scan->has_ring);
+}
+
 TEST(PointCloud2Decode, OusterRelativeNsFromStartStamp) {
   RawCloud c = test::OusterCloud();
   c.stamp_ns = kCloudStamp;

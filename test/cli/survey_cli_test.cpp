@@ -100,7 +100,9 @@ TEST_F(SurveyCli, InitialPoseFromATumFileAndRefineHeldToTheMap) {
   EXPECT_GT(dev["with_surface"].get<double>(), 0.5 * dev["map_points"].get<double>());
   EXPECT_LT(dev["median_abs_m"].get<double>(), 0.02);
   EXPECT_TRUE(std::filesystem::exists(refined + "/deviation.csv"));
-  EXPECT_NE(ReadFile(refined + "/map.pcd").substr(0, 400).find("FIELDS x y z deviation_m"),
+  EXPECT_NE(ReadFile(refined + "/map.pcd")
+                .substr(0, 400)
+                .find("FIELDS x y z intensity time ring scan_index deviation_m"),
             std::string::npos);
   std::printf("[ survey ] run --map %.4f m, refine --map %.4f m (ATE, no alignment)\n", run_ate,
               refine_ate);

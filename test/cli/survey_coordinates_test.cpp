@@ -119,7 +119,7 @@ TEST_F(SurveyCoordinates, ShiftedToUtmGivesTheSameTrajectoryAndDeviation) {
                            mb = ReadPointCloud(utm + "/map.pcd");
   ASSERT_TRUE(ma.ok() && mb.ok());
   ASSERT_EQ(ma->points.size(), mb->points.size());
-  EXPECT_NE(ReadFile(utm + "/map.pcd").find("SIZE 8 8 8 4\n"), std::string::npos);
+  EXPECT_NE(ReadFile(utm + "/map.pcd").find("SIZE 8 8 8 4 8 2 4 4\n"), std::string::npos);
   const PointCloudField *va = ma->Field("deviation_m"), *vb = mb->Field("deviation_m");
   ASSERT_TRUE(va != nullptr && vb != nullptr);
   size_t with_surface = 0;

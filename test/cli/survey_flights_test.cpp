@@ -145,7 +145,9 @@ void ExpectConvergenceInDeviationCsv(const std::string& folder, const std::strin
   for (const char* side : {"right", "floor", "ceiling"})
     EXPECT_LT(std::abs(at_c.at(std::string(side) + "_median_m")), 0.01) << tag << " " << side;
   const std::string pcd = testing_cli::ReadFile(folder + "/map.pcd");
-  EXPECT_NE(pcd.substr(0, 400).find("FIELDS x y z deviation_m"), std::string::npos) << tag;
+  EXPECT_NE(pcd.substr(0, 400).find("FIELDS x y z intensity time ring scan_index deviation_m"),
+            std::string::npos)
+      << tag;
 }
 
 TEST_F(SurveyFlights, SecondFlightInTheSurveyAndTheConvergenceInDeviationCsv) {

@@ -10,6 +10,7 @@
 #include "../cli/cli_util.h"
 #include "las_test_util.h"
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/map/map_cloud.h"
 #include "rvlio/outputs/map_las.h"
 #include "rvlio/outputs/run_outputs.h"
 
@@ -122,6 +123,7 @@ TEST(LasExport, EveryPcdFieldGoesToItsLasField) {
     EXPECT_NEAR(At<int32_t>(b, p + 4) * 0.001 + 5400000.0, rows[i][1], 5e-4 + 1e-9);
     EXPECT_EQ(At<uint16_t>(b, p + 12), rows[i][3] * 256.0);
     EXPECT_EQ(At<uint8_t>(b, p + 17), rows[i][5]);
+    EXPECT_EQ(At<uint16_t>(b, p + 20), rows[i][7]) << "point source ID: the scan index";
     EXPECT_NEAR(At<double>(b, p + 22), rows[i][4] - 315964800.0 + 18.0 - 1e9, 1e-6);
     const float dev = At<float>(b, p + 30);
     if (std::isnan(rows[i][6])) EXPECT_TRUE(std::isnan(dev));
@@ -162,19 +164,28 @@ TEST(LasExport, AFloatTimeIsKeptAsExtraBytesNotAsGpsTime) {
 
 TEST(LasExport, RunsMapPcdExportsToTheSameFileAsRunsMapLas) {
   ScratchDir dir;
-  std::vector<Eigen::Vector3d> points;
+  // A map as run writes it: every attribute, and deviation_m with NaNs.
+  MapCloud map;
+  map.has_intensity = map.has_time = map.has_ring = map.has_scan_index = true;
   std::vector<double> deviation;
   for (int i = 0; i < 2000; ++i) {
-    points.emplace_back(0.01 * i - 3.0, std::sin(0.01 * i), 1.5);
+    // Half millimetres: a float32 and a double often round to different mm.
+    map.p.emplace_back(0.0010001 * i + 0.0005 - 3.0, std::sin(0.01 * i), 12.3455 + 0.001 * i);
+    map.intensity.push_back(static_cast<float>((i * 37) % 200) + 0.25f);
+    map.t_ns.push_back(1'700'000'000'123'456'789 + 123'457LL * i);
+    map.ring.push_back(static_cast<uint16_t>(i % 128));
+    map.scan_index.push_back(static_cast<uint32_t>(i / 7));
     deviation.push_back(i % 7 == 0 ? std::nan("") : 0.0001 * i);
   }
-  ASSERT_TRUE(WriteMapPcd(dir.Path("map.pcd"), points, &deviation).ok());
-  StatusOr<PointCloudFile> pcd = ReadPointCloud(dir.Path("map.pcd"));  // float, as exported
-  ASSERT_TRUE(pcd.ok());
-  std::vector<double> deviation_f(pcd->fields[0].values.begin(), pcd->fields[0].values.end());
-  ASSERT_TRUE(WriteMapLas(dir.Path("run.las"), pcd->points, &deviation_f, "").ok());
+  ASSERT_TRUE(WriteMapPcd(dir.Path("map.pcd"), map, &deviation).ok());
+  // Small chunks: the chunking does not show in the file.
+  ASSERT_TRUE(WriteMapLas(dir.Path("run.las"), map, &deviation, "", 300).ok());
   StatusOr<LasExportResult> r = ExportPointCloudToLas(dir.Path("map.pcd"), dir.Path("export.las"), {});
   ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->intensity_field, "intensity");
+  EXPECT_EQ(r->time_field, "time");
+  EXPECT_EQ(r->ring_field, "ring");
+  EXPECT_EQ(r->extra_fields, (std::vector<std::string>{"scan_index", "deviation_m"}));
   std::string a = ReadBytes(dir.Path("run.las")), b = ReadBytes(dir.Path("export.las"));
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 90; i < 94; ++i) a[i] = b[i] = 0;  // the creation day and year

@@ -16,7 +16,20 @@
 
 #include <gtest/gtest.h>
 
+#include "../cli/cli_util.h"
+
 namespace rvlio::las_test {
+
+// 6 s of the tunnel (seed 3, 512 columns) with a band of reflectivity 250
+// on the left wall from x = 16 to 19 m (the walls' 80 elsewhere;
+// docs/simulator.md "A painted band"): tunnel.bag, tunnel.yaml,
+// tunnel_gt.tum in `out`. Simulated once per build (CachedSimulate) for
+// every test of test_las.
+inline testing_cli::ToolRun SimulateBandFlight(const std::string& out, const std::string& scratch) {
+  return testing_cli::SimulateTunnel(
+      out, 3, 6, scratch,
+      "--set world.band.reflectivity=250 --set world.band.x_min=16 --set world.band.x_max=19");
+}
 
 class ScratchDir {
  public:

@@ -186,23 +186,26 @@ TEST(LasWriter, GpsTimeIsUnixTimePlusLeapSecondsMinusTheGpsEpochAndOneBillion) {
   EXPECT_DOUBLE_EQ(UnixToAdjustedGpsTime(315964800.0), -1e9);
 }
 
-TEST(LasWriter, IntensityRingAndIntegerExtrasAreScaledClampedAndCounted) {
+TEST(LasWriter, IntensityRingScanIndexAndIntegerExtrasAreScaledClampedAndCounted) {
   ScratchDir dir;
   LasWriterOptions o;
   o.intensity_scale = 256.0;  // an 8-bit sensor
   o.intensity_source = "intensity";
   o.has_ring = true;
+  o.has_point_source = true;
   o.extra_fields = {{"code", LasScalar::kInt16, ""}};
   LasWriter w;
   ASSERT_TRUE(w.Open(dir.Path("i.las"), o).ok());
   const double intensity[] = {0.0, 255.0, 300.0, -4.0, std::nan("")};
   const int ring[] = {0, 127, 255, 300, -1};
   const double code[] = {-5.4, 40000.0, -40000.0, 3.5, 0.0};
+  const uint64_t scan_index[] = {0, 65535, 65536, 70000, 3};
   for (int i = 0; i < 5; ++i) {
     LasPoint q;
     q.p_m = Eigen::Vector3d(i, 0, 0);
     q.intensity = intensity[i];
     q.ring = ring[i];
+    q.scan_index = scan_index[i];
     q.extra = &code[i];
     ASSERT_TRUE(w.Write(q).ok());
   }
@@ -214,12 +217,18 @@ TEST(LasWriter, IntensityRingAndIntegerExtrasAreScaledClampedAndCounted) {
   const uint16_t want_intensity[] = {0, 65280, 65535, 0, 0};
   const uint8_t want_ring[] = {0, 127, 255, 255, 0};
   const int16_t want_code[] = {-5, 32767, -32768, 4, 0};
+  const uint16_t want_source[] = {0, 65535, 0, 4464, 3};  // modulo 65536
   for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(At<uint16_t>(b, start + 32 * i + 20), want_source[i]) << i;
     EXPECT_EQ(At<uint16_t>(b, start + 32 * i + 12), want_intensity[i]) << i;
     EXPECT_EQ(At<uint8_t>(b, start + 32 * i + 17), want_ring[i]) << i;
     EXPECT_EQ(At<int16_t>(b, start + 32 * i + 30), want_code[i]) << i;
     EXPECT_EQ(At<double>(b, start + 32 * i + 22), 0.0) << "no time given";
   }
+  const FoundVlr* text = Find(WalkVlrs(b), "LASF_Spec", 3);
+  ASSERT_NE(text, nullptr);
+  EXPECT_NE(text->payload.find("Point source ID: the scan index modulo 65536"), std::string::npos)
+      << text->payload;
 }
 
 TEST(LasWriter, EmptyMapIsAValidFileWithoutPoints) {

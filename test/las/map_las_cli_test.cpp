@@ -1,4 +1,5 @@
-// output.las and survey.crs end to end on a 6 s simulated tunnel: `run`,
+// output.las and survey.crs end to end on a 6 s simulated tunnel (the flight
+// past a painted band that LasReaders reads too): `run`,
 // `refine --chunk 1 --of 1` and `merge` write map.las beside map.pcd (the same
 // points, the CRS's WKT) only when asked; an unknown survey.crs is exit 2
 // before the recording is read, with nothing written.
@@ -35,7 +36,7 @@ void ExpectLasMatchesPcd(const std::string& dir, bool with_crs) {
 TEST(MapLasCli, RunRefineAndMergeWriteMapLasWhenAsked) {
   const std::string dir = testing_cli::MakeTempDir("rvlio_map_las");
   ASSERT_FALSE(dir.empty());
-  const ToolRun sim = testing_cli::SimulateTunnel(dir + "/sim", 3, 6, dir);
+  const ToolRun sim = las_test::SimulateBandFlight(dir + "/sim", dir);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   const std::string input = "--bag " + dir + "/sim/tunnel.bag --config " + dir + "/sim/tunnel.yaml";
   const std::string las = " --set output.las=true --set survey.crs=EPSG:25832";

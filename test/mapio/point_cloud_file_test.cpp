@@ -3,13 +3,16 @@
 // hand-written files for the cases PCL does not write (big-endian PLY, an
 // element before the vertices); and every refusal, one line naming the file.
 #include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/outputs/map_fields.h"
 #include "rvlio/outputs/run_outputs.h"
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/register_point_struct.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -24,10 +27,30 @@
 
 #include "test_dir.h"
 
+// A map.pcd point with every attribute, as a PCL user would declare it.
+struct RvlioMapPoint {
+  PCL_ADD_POINT4D;
+  float intensity;
+  double time;
+  uint16_t ring;
+  uint32_t scan_index;
+  float deviation_m;
+  EIGEN_MAKE_ALIGNED_OPERATOR_NEW
+};
+POINT_CLOUD_REGISTER_POINT_STRUCT(RvlioMapPoint,
+                                  (float, x, x)(float, y, y)(float, z, z)(float, intensity, intensity)
+                                  (double, time, time)(uint16_t, ring, ring)
+                                  (uint32_t, scan_index, scan_index)(float, deviation_m, deviation_m))
+
 namespace rvlio {
 namespace {
 
 namespace fs = std::filesystem;
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
 
 class PointCloudFileTest : public MapioTestDir {
  protected:
@@ -114,11 +137,7 @@ TEST_F(PointCloudFileTest, MapPcdIsWhatPclWritesAndReads) {
     cloud.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
                                   static_cast<float>(p.z())));
   ASSERT_EQ(pcl::PCDWriter().writeBinary(Path("pcl.pcd"), cloud), 0);
-  auto bytes = [](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  EXPECT_EQ(bytes(Path("ours.pcd")), bytes(Path("pcl.pcd")));
+  EXPECT_EQ(FileBytes(Path("ours.pcd")), FileBytes(Path("pcl.pcd")));
 
   const std::vector<double> deviation_m = {0.012, std::numeric_limits<double>::quiet_NaN(), -0.03};
   ASSERT_TRUE(WriteMapPcd(Path("deviation.pcd"), points, &deviation_m).ok());
@@ -143,6 +162,45 @@ TEST_F(PointCloudFileTest, MapPcdIsWhatPclWritesAndReads) {
   EXPECT_FLOAT_EQ(xyz[1].x, -4.5f);
 }
 
+struct BlobField {
+  const char* name;
+  uint32_t offset;
+  uint8_t type;
+};
+
+// An unorganized PCLPointCloud2 of n points of `point_step` bytes with these
+// fields, its data zeroed (the test fills it).
+pcl::PCLPointCloud2 Blob(const std::vector<BlobField>& fields, uint32_t point_step, size_t n) {
+  pcl::PCLPointCloud2 blob;
+  for (const BlobField& f : fields) {
+    pcl::PCLPointField field;
+    field.name = f.name;
+    field.offset = f.offset;
+    field.datatype = f.type;
+    field.count = 1;
+    blob.fields.push_back(field);
+  }
+  blob.point_step = point_step;
+  blob.width = static_cast<uint32_t>(n);
+  blob.height = 1;
+  blob.row_step = blob.point_step * blob.width;
+  blob.data.resize(blob.row_step);
+  return blob;
+}
+
+// `ours` is byte for byte what PCL's writer makes of `blob` (which pads its
+// file with zeros to a page); returns our file's bytes.
+std::string ExpectPclWritesTheSame(const std::string& ours, const pcl::PCLPointCloud2& blob,
+                                   const std::string& pcl_path) {
+  EXPECT_EQ(pcl::PCDWriter().writeBinary(pcl_path, blob), 0);
+  const std::string ours_bytes = FileBytes(ours), pcl_bytes = FileBytes(pcl_path);
+  EXPECT_GE(pcl_bytes.size(), ours_bytes.size());
+  EXPECT_EQ(pcl_bytes.substr(0, ours_bytes.size()), ours_bytes);
+  EXPECT_EQ(pcl_bytes.find_first_not_of('\0', std::min(ours_bytes.size(), pcl_bytes.size())),
+            std::string::npos);
+  return ours_bytes;
+}
+
 // A map in a national grid (UTM: easting 5e5 m, northing 5.4e6 m, where a
 // float32 keeps only decimetres) is written with x y z as float64: the header
 // and the bytes are PCL's for such a cloud, PCL reads the doubles back, and so
@@ -157,36 +215,18 @@ TEST_F(PointCloudFileTest, FarMapPcdIsFloat64AndWhatPclWrites) {
   EXPECT_TRUE(MapNeedsFloat64({{0.0, -8192.0, 0.0}}));
   ASSERT_TRUE(WriteMapPcd(Path("ours.pcd"), points, &deviation_m).ok());
 
-  pcl::PCLPointCloud2 blob;  // the same cloud through PCL's writer
-  const char* names[] = {"x", "y", "z", "deviation_m"};
-  for (int f = 0; f < 4; ++f) {
-    pcl::PCLPointField field;
-    field.name = names[f];
-    field.offset = 8 * f;
-    field.datatype = f < 3 ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32;
-    field.count = 1;
-    blob.fields.push_back(field);
-  }
-  blob.point_step = 28;
-  blob.width = static_cast<uint32_t>(points.size());
-  blob.height = 1;
-  blob.row_step = blob.point_step * blob.width;
-  blob.data.resize(blob.row_step);
+  // The same cloud through PCL's writer.
+  pcl::PCLPointCloud2 blob = Blob({{"x", 0, pcl::PCLPointField::FLOAT64},
+                                   {"y", 8, pcl::PCLPointField::FLOAT64},
+                                   {"z", 16, pcl::PCLPointField::FLOAT64},
+                                   {"deviation_m", 24, pcl::PCLPointField::FLOAT32}},
+                                  28, points.size());
   for (size_t i = 0; i < points.size(); ++i) {
     std::memcpy(&blob.data[i * 28], points[i].data(), 24);
     const float d = static_cast<float>(deviation_m[i]);
     std::memcpy(&blob.data[i * 28 + 24], &d, 4);
   }
-  ASSERT_EQ(pcl::PCDWriter().writeBinary(Path("pcl.pcd"), blob), 0);
-  auto bytes = [](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  };
-  // PCL's writer of a PCLPointCloud2 pads its file with zeros to a page.
-  const std::string ours_bytes = bytes(Path("ours.pcd")), pcl_bytes = bytes(Path("pcl.pcd"));
-  ASSERT_GE(pcl_bytes.size(), ours_bytes.size());
-  EXPECT_EQ(pcl_bytes.substr(0, ours_bytes.size()), ours_bytes);
-  EXPECT_EQ(pcl_bytes.find_first_not_of('\0', ours_bytes.size()), std::string::npos);
+  const std::string ours_bytes = ExpectPclWritesTheSame(Path("ours.pcd"), blob, Path("pcl.pcd"));
   EXPECT_NE(ours_bytes.find("SIZE 8 8 8 4\nTYPE F F F F\n"), std::string::npos);
 
   pcl::PCLPointCloud2 read;
@@ -207,7 +247,100 @@ TEST_F(PointCloudFileTest, FarMapPcdIsFloat64AndWhatPclWrites) {
 
   // Near the origin map.pcd stays float32, byte for byte PCL's PointXYZ file.
   ASSERT_TRUE(WriteMapPcd(Path("near.pcd"), {{8191.5, 0.0, 0.0}}).ok());
-  EXPECT_NE(bytes(Path("near.pcd")).find("SIZE 4 4 4\n"), std::string::npos);
+  EXPECT_NE(FileBytes(Path("near.pcd")).find("SIZE 4 4 4\n"), std::string::npos);
+}
+
+TEST_F(PointCloudFileTest, MapPcdWithAttributesIsWhatPclWritesAndReads) {
+  MapCloud map;
+  map.has_intensity = map.has_time = map.has_ring = map.has_scan_index = true;
+  std::vector<double> deviation_m;
+  for (int i = 0; i < 50; ++i) {
+    map.p.emplace_back(0.25 * i - 3.0, std::cos(0.1 * i), 1.5 + 0.01 * i);
+    map.intensity.push_back(static_cast<float>(i % 17) * 3.5f);
+    map.t_ns.push_back(1'700'000'000'123'456'789 + 9'876'543LL * i);
+    map.ring.push_back(static_cast<uint16_t>(i % 128));
+    map.scan_index.push_back(static_cast<uint32_t>(70000 + i / 3));
+    deviation_m.push_back(i % 6 == 0 ? std::numeric_limits<double>::quiet_NaN() : 0.001 * i);
+  }
+  ASSERT_TRUE(WriteMapPcd(Path("ours.pcd"), map, &deviation_m).ok());
+
+  // The same cloud through PCL's writer.
+  pcl::PCLPointCloud2 blob = Blob(
+      {{"x", 0, pcl::PCLPointField::FLOAT32},          {"y", 4, pcl::PCLPointField::FLOAT32},
+       {"z", 8, pcl::PCLPointField::FLOAT32},          {"intensity", 12, pcl::PCLPointField::FLOAT32},
+       {"time", 16, pcl::PCLPointField::FLOAT64},      {"ring", 24, pcl::PCLPointField::UINT16},
+       {"scan_index", 26, pcl::PCLPointField::UINT32}, {"deviation_m", 30, pcl::PCLPointField::FLOAT32}},
+      34, map.size());
+  for (size_t i = 0; i < map.size(); ++i) {
+    uint8_t* d = &blob.data[i * 34];
+    const float xyz[3] = {static_cast<float>(map.p[i].x()), static_cast<float>(map.p[i].y()),
+                          static_cast<float>(map.p[i].z())};
+    const double t = MapTimeSeconds(map.t_ns[i]);
+    const float dev = static_cast<float>(deviation_m[i]);
+    std::memcpy(d, xyz, 12);
+    std::memcpy(d + 12, &map.intensity[i], 4);
+    std::memcpy(d + 16, &t, 8);
+    std::memcpy(d + 24, &map.ring[i], 2);
+    std::memcpy(d + 26, &map.scan_index[i], 4);
+    std::memcpy(d + 30, &dev, 4);
+  }
+  const std::string ours_bytes = ExpectPclWritesTheSame(Path("ours.pcd"), blob, Path("pcl.pcd"));
+  EXPECT_NE(ours_bytes.find("FIELDS x y z intensity time ring scan_index deviation_m\n"
+                            "SIZE 4 4 4 4 8 2 4 4\nTYPE F F F F F U U F\n"),
+            std::string::npos);
+
+  // PCL's reader into a point type of these fields.
+  pcl::PointCloud<RvlioMapPoint> read;
+  ASSERT_EQ(pcl::io::loadPCDFile(Path("ours.pcd"), read), 0);
+  ASSERT_EQ(read.size(), map.size());
+  for (size_t i = 0; i < map.size(); ++i) {
+    EXPECT_EQ(read[i].x, static_cast<float>(map.p[i].x()));
+    EXPECT_EQ(read[i].z, static_cast<float>(map.p[i].z()));
+    EXPECT_EQ(read[i].intensity, map.intensity[i]);
+    EXPECT_EQ(read[i].time, MapTimeSeconds(map.t_ns[i]));
+    EXPECT_EQ(read[i].ring, map.ring[i]);
+    EXPECT_EQ(read[i].scan_index, map.scan_index[i]);
+    if (std::isnan(deviation_m[i])) EXPECT_TRUE(std::isnan(read[i].deviation_m));
+    else EXPECT_EQ(read[i].deviation_m, static_cast<float>(deviation_m[i]));
+  }
+  // And rvlio's own reader gives the map back, the time to what a double
+  // of UNIX seconds holds (half of its 0.24 us step in 2023).
+  StatusOr<MapCloudFile> back = ReadMapCloud(Path("ours.pcd"));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_TRUE(back->has_deviation);
+  EXPECT_EQ(back->map.intensity, map.intensity);
+  EXPECT_EQ(back->map.ring, map.ring);
+  EXPECT_EQ(back->map.scan_index, map.scan_index);
+  ASSERT_EQ(back->map.t_ns.size(), map.size());
+  for (size_t i = 0; i < map.size(); ++i) {
+    EXPECT_LE(std::abs(back->map.t_ns[i] - map.t_ns[i]), 125) << i;
+    EXPECT_EQ(back->map.p[i].y(), static_cast<double>(static_cast<float>(map.p[i].y())));
+  }
+}
+
+TEST_F(PointCloudFileTest, ReadMapCloudRefusesFieldsNoMapHas) {
+  const std::string header = "VERSION 0.7\nFIELDS x y z ring\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+                             "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n";
+  const struct { const char* name; std::string bytes; const char* says; } cases[] = {
+      {"negative_ring.pcd", header + "1 2 3 4\n1 2 3 -1\n", "point 1: ring -1 is not a whole number"},
+      {"fraction_ring.pcd", header + "1 2 3 4.5\n1 2 3 1\n", "point 0: ring 4.5"},
+      {"twice.pcd",
+       "VERSION 0.7\nFIELDS x y z ring ring\nSIZE 4 4 4 2 2\nTYPE F F F U U\nCOUNT 1 1 1 1 1\n"
+       "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 4 5\n",
+       "field ring appears twice"},
+      {"float_time.pcd",
+       "VERSION 0.7\nFIELDS x y z time\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+       "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 4\n",
+       "field time is F4"},
+  };
+  for (const auto& c : cases) {
+    StatusOr<MapCloudFile> r = ReadMapCloud(Write(c.name, c.bytes));
+    ASSERT_FALSE(r.ok()) << c.name;
+    EXPECT_EQ(r.status().code(), StatusCode::kInvalidInput);
+    EXPECT_NE(r.status().message().find(Path(c.name)), std::string::npos) << r.status().message();
+    EXPECT_NE(r.status().message().find(c.says), std::string::npos) << r.status().message();
+    EXPECT_EQ(r.status().message().find('\n'), std::string::npos);
+  }
 }
 
 TEST_F(PointCloudFileTest, ReadsPclPlyAsciiAndBinary) {

@@ -21,6 +21,8 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "rvlio/outputs/run_outputs.h"
+
 namespace rvlio {
 namespace {
 
@@ -456,6 +458,31 @@ TEST_F(PlotScriptTest, DeviationAlongTheChainage) {
   for (const auto& entry : fs::directory_iterator(dir_ + "/out")) fs::remove(entry.path());
   WriteText(run + "/deviation.csv", "chainage_m,count\n0,1\n");
   ExpectBadInput("deviation --run " + run + " " + Out(), "missing column(s) median_m");
+}
+
+// map.pcd coloured by its intensity (the picture of docs/outputs.md): the
+// range printed is the field's 2nd to 98th percentile; a field the map does
+// not have is refused naming the fields it has.
+TEST_F(PlotScriptTest, MapColouredByIntensity) {
+  const std::string run = dir_ + "/mapped";
+  fs::create_directories(run);
+  MapCloud map;
+  map.has_intensity = map.has_time = map.has_ring = map.has_scan_index = true;
+  for (int i = 0; i < 1000; ++i) {
+    map.p.emplace_back(0.05 * i, (i % 2 == 0 ? 5.0 : -5.0) + 0.001 * (i % 7), 0.007 * i);
+    map.intensity.push_back(static_cast<float>(i % 101));
+    map.t_ns.push_back(1'700'000'000'000'000'000 + 1'000'000LL * i);
+    map.ring.push_back(static_cast<uint16_t>(i % 32));
+    map.scan_index.push_back(static_cast<uint32_t>(i / 100));
+  }
+  ASSERT_TRUE(WriteMapPcd(run + "/map.pcd", map, nullptr).ok());
+  const Result r = Plot("map --run " + run + " " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("1000 points, intensity 1.98 to 98"), std::string::npos) << r.out;
+  ExpectFigures("map_intensity");
+  for (const auto& entry : fs::directory_iterator(dir_ + "/out")) fs::remove(entry.path());
+  ExpectBadInput("map --run " + run + " --field deviation_m " + Out(),
+                 "has no field deviation_m (fields: x y z intensity time ring scan_index)");
 }
 
 // An --out ending in '/' is a folder: FOLDER/<kind>.png and .pdf.

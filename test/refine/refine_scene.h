@@ -35,15 +35,22 @@ inline Vector3d HitBox(const Vector3d& o, const Vector3d& d) {
   return o + t_hit * d;
 }
 
+// The time of return i of n in the sweep starting at t_start.
+inline TimeNs ReturnTime(TimeNs t_start, int i, int n) { return t_start + (kScanNs * i) / (n - 1); }
+
 // One sweep ending at t_end: n returns in random directions, each observed
-// from the LiDAR pose at its own time.
+// from the LiDAR pose at its own time; return i has intensity i + 0.5 and
+// ring i % 16 (so a map point tells which return it is).
 inline Scan SimulateScan(std::mt19937& rng, TimeNs t_end, int n) {
   Scan scan;
   scan.t_start_ns = t_end - kScanNs;
   scan.t_end_ns = t_end;
+  scan.has_intensity = scan.has_ring = true;
   for (int i = 0; i < n; ++i) {
     LidarPoint p;
-    p.t_ns = scan.t_start_ns + (kScanNs * i) / (n - 1);
+    p.t_ns = ReturnTime(scan.t_start_ns, i, n);
+    p.intensity = static_cast<float>(i) + 0.5f;
+    p.ring = static_cast<uint16_t>(i % 16);
     const Pose3 T_world_lidar = test::TruePose(p.t_ns).ToPose3() * ImuTLidar();
     const Vector3d d = test::RandomVector(rng, 1.0).normalized();
     const Vector3d hit = HitBox(T_world_lidar.t, T_world_lidar.R * d);

@@ -479,7 +479,7 @@ TEST(RefineSteps, RefineIsBitIdenticalOnOneAndTwoThreads) {
     EXPECT_EQ(a->trajectory[k].p_world_imu, b->trajectory[k].p_world_imu) << k;
     EXPECT_EQ(a->trajectory[k].q_world_imu.coeffs(), b->trajectory[k].q_world_imu.coeffs()) << k;
   }
-  EXPECT_EQ(a->map_points, b->map_points);
+  EXPECT_EQ(a->map, b->map);
   EXPECT_EQ(a->rounds.back().constraints, b->rounds.back().constraints);
 }
 

@@ -65,7 +65,19 @@ TEST(Refine, RecoversTheTruthFromADriftingInitialTrajectory) {
   EXPECT_EQ(r->stats.scans_refined, 30);
   EXPECT_FALSE(r->stats.gravity_from_static);  // the motion never rests
   EXPECT_NE(r->linear_solver.find("SPARSE_NORMAL_CHOLESKY"), std::string::npos);
-  EXPECT_GT(r->map_points.size(), 1000u);
+  EXPECT_GT(r->map.size(), 1000u);
+  // Each map point is one return with its own attributes: its scan index is
+  // a row of the trajectory, and its intensity names the return whose time
+  // and ring it has.
+  ASSERT_TRUE(r->map.Consistent());
+  ASSERT_TRUE(r->map.has_intensity && r->map.has_time && r->map.has_ring && r->map.has_scan_index);
+  for (size_t i = 0; i < r->map.size(); ++i) {
+    const uint32_t k = r->map.scan_index[i];
+    ASSERT_LT(k, r->trajectory.size());
+    const int ret = static_cast<int>(r->map.intensity[i]);
+    EXPECT_EQ(r->map.t_ns[i], ReturnTime(r->trajectory[k].t_ns - kScanNs, ret, 1500)) << i;
+    EXPECT_EQ(r->map.ring[i], ret % 16) << i;
+  }
   // Velocities and biases: the truth has none.
   for (size_t k = 0; k < r->v_world_imu.size(); ++k) {
     EXPECT_LT((r->v_world_imu[k] - test::Swing(NsToSeconds(kT0 + k * kScanNs)).v).norm(), 0.05);
@@ -192,7 +204,7 @@ TEST(Refine, ResumedFromARoundStateEqualsTheUninterruptedResult) {
       EXPECT_EQ(resumed->trajectory[k].q_world_imu.coeffs(), full->trajectory[k].q_world_imu.coeffs());
       EXPECT_EQ(resumed->v_world_imu[k], full->v_world_imu[k]);
     }
-    EXPECT_EQ(resumed->map_points, full->map_points);
+    EXPECT_EQ(resumed->map, full->map);
     EXPECT_EQ(resumed->rounds.size(), 3u);
   }
   // A state of another input is refused.

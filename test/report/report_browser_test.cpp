@@ -218,6 +218,8 @@ TEST(ReportBrowserTest, PageLoadsWithoutConsoleErrorsDrawsTheMapAndHoldsTheRunsF
   ASSERT_EQ(dom_run.exit_code, 0) << dom_run.err;
   const std::string& dom = dom_run.out;
   EXPECT_EQ(Attribute(dom, "data-rvlio-ready"), "1") << "the page's script did not finish";
+  // The simulated map has an intensity: offered in the colouring list.
+  EXPECT_NE(dom.find(">intensity (the sensor's"), std::string::npos) << "no intensity colouring";
   const nlohmann::json eval = testing_cli::EvalJson(gt, dir + "/run/trajectory.tum", dir);
   const nlohmann::json summary = nlohmann::json::parse(ReadFile(dir + "/run/summary.json"));
   ASSERT_TRUE(eval.is_object());

@@ -83,7 +83,8 @@ class ReportDataTest : public ::testing::Test {
   }
 
   // A run folder: trajectory, scans.csv (two scans), summary.json, map.pcd
-  // with `points` points, optionally with a deviation_m field (value = i).
+  // with `points` points, optionally with a deviation_m field (value =
+  // 0.001 i) and an intensity field (3 i).
   void WriteRun(const std::string& rel, const Trajectory& est, size_t points, bool deviation) {
     fs::create_directories(Path(rel));
     ASSERT_TRUE(WriteTum(Path(rel + "/trajectory.tum"), est).ok());
@@ -93,15 +94,15 @@ class ReportDataTest : public ::testing::Test {
     Write(rel + "/summary.json", R"({"scan_count": 2, "real_time_factor": 12.5,
         "per_scan_ms": {"median": 3.25}, "config": {"backend": "ieskf"}})");
     std::string pcd = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z" +
-                      std::string(deviation ? " deviation_m" : "") + "\nSIZE 4 4 4" +
-                      (deviation ? " 4" : "") + "\nTYPE F F F" + (deviation ? " F" : "") +
-                      "\nCOUNT 1 1 1" + (deviation ? " 1" : "") + "\nWIDTH " +
+                      std::string(deviation ? " deviation_m intensity" : "") + "\nSIZE 4 4 4" +
+                      (deviation ? " 4 4" : "") + "\nTYPE F F F" + (deviation ? " F F" : "") +
+                      "\nCOUNT 1 1 1" + (deviation ? " 1 1" : "") + "\nWIDTH " +
                       std::to_string(points) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " +
                       std::to_string(points) + "\nDATA binary\n";
     for (size_t i = 0; i < points; ++i) {
-      const float row[4] = {static_cast<float>(i), 1.0f, 2.0f + 0.5f * static_cast<float>(i),
-                            static_cast<float>(i) * 0.001f};
-      pcd.append(reinterpret_cast<const char*>(row), (deviation ? 4 : 3) * sizeof(float));
+      const float row[5] = {static_cast<float>(i), 1.0f, 2.0f + 0.5f * static_cast<float>(i),
+                            static_cast<float>(i) * 0.001f, 3.0f * static_cast<float>(i)};
+      pcd.append(reinterpret_cast<const char*>(row), (deviation ? 5 : 3) * sizeof(float));
     }
     Write(rel + "/map.pcd", pcd);
   }
@@ -175,6 +176,11 @@ TEST_F(ReportDataTest, RunFolderWithDeviationIsThinnedAndColouredByDeviation) {
     EXPECT_EQ(xyz[3 * k], static_cast<float>(4 * k));                    // every 4th point
     EXPECT_FLOAT_EQ(value[k], static_cast<float>(4 * k) * 0.001f);  // its deviation_m
   }
+  // The intensity is offered beside it, for the same points.
+  ASSERT_TRUE(cloud["other_fields"].contains("intensity"));
+  const std::vector<float> intensity = DecodeArray(cloud["other_fields"]["intensity"]);
+  ASSERT_EQ(intensity.size(), 250u);
+  for (size_t k = 0; k < intensity.size(); ++k) EXPECT_EQ(intensity[k], 12.0f * static_cast<float>(k));
   // The estimate equals the truth: aligned onto it, no along-axis error.
   const json& run = (*m)["runs"][0];
   EXPECT_TRUE(run["aligned"].get<bool>());
@@ -213,6 +219,7 @@ TEST_F(ReportDataTest, RunWithoutDeviationIsColouredByHeightAndBadGtIsInvalidInp
   StatusOr<json> m = BuildReportModel(Path("run"), ReportOptions());
   ASSERT_TRUE(m.ok()) << m.status().message();
   EXPECT_EQ((*m)["cloud"]["field"], "z");
+  EXPECT_TRUE((*m)["cloud"]["other_fields"].empty()) << "no intensity in the map: none offered";
   EXPECT_EQ(DecodeArray((*m)["cloud"]["value"])[3], 3.5f);  // z of point 3
   EXPECT_EQ((*m)["cloud"]["stride"], 1);
   EXPECT_TRUE((*m)["gt"].is_null());

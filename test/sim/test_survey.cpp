@@ -186,16 +186,19 @@ SimOptions Bare() {
   return o;
 }
 
+// The shell's surfaces as world.deformation and world.band name them.
+struct ShellSurface {
+  const char* surface;
+  Eigen::Vector3d dir;  // from the centre line towards the surface
+  float reflectivity;   // its own (world_builder.cpp)
+};
+const ShellSurface kShell[] = {{"left", Eigen::Vector3d::UnitY(), 80.0f},
+                               {"right", -Eigen::Vector3d::UnitY(), 80.0f},
+                               {"ceiling", Eigen::Vector3d::UnitZ(), 60.0f},
+                               {"floor", -Eigen::Vector3d::UnitZ(), 40.0f}};
+
 TEST(Deformation, MovesTheSurfaceByTheAmplitudeAtItsCentreAndNotOutside) {
-  struct Case {
-    const char* surface;
-    Eigen::Vector3d dir;  // from the centre line towards the surface
-  };
-  const Case cases[] = {{"left", Eigen::Vector3d::UnitY()},
-                        {"right", -Eigen::Vector3d::UnitY()},
-                        {"ceiling", Eigen::Vector3d::UnitZ()},
-                        {"floor", -Eigen::Vector3d::UnitZ()}};
-  for (const Case& c : cases) {
+  for (const ShellSurface& c : kShell) {
     for (const double amplitude : {0.05, -0.03}) {
       SimOptions o = Bare();
       o.world.deformation.surface = c.surface;
@@ -224,6 +227,38 @@ TEST(Deformation, MovesTheSurfaceByTheAmplitudeAtItsCentreAndNotOutside) {
         // Outside the extent only the root finder's tolerance (1e-9 m) differs.
         for (double x : {30.0, 35.0, 45.0, 46.0, 60.0, 5.0})
           EXPECT_NEAR(moved(x, across), 0.0, 1e-8) << what;
+      }
+    }
+  }
+}
+
+// world.band: a ray that hits the painted surface within [x_min, x_max]
+// returns the band's reflectivity, elsewhere the surface's own; the other
+// surfaces and the geometry are as without it.
+TEST(Band, PaintsItsSurfaceBetweenItsXAndNothingElse) {
+  for (const ShellSurface& c : kShell) {
+    SimOptions o = Bare();
+    o.world.band.surface = c.surface;
+    o.world.band.x_min = 16.0;
+    o.world.band.x_max = 19.0;
+    o.world.band.reflectivity = 250.0;
+    SimOptions plain_options = o;
+    plain_options.world.band.reflectivity = 0.0;
+    const auto painted = Make(o), plain = Make(plain_options);
+    ASSERT_TRUE(painted && plain);
+    const WorldLayout& L = plain->layout();
+    const Eigen::Vector3d centre(0.0, L.y_center, 0.5 * (L.z_floor + L.z_ceiling));
+    for (double x : {15.9, 16.1, 17.5, 18.9, 19.1, 40.0}) {
+      for (const ShellSurface& target : kShell) {
+        RayHit a, b;
+        const Eigen::Vector3d origin = centre + Eigen::Vector3d(x, 0.0, 0.0);
+        ASSERT_TRUE(painted->world().Raycast(origin, target.dir, 100.0, &a));
+        ASSERT_TRUE(plain->world().Raycast(origin, target.dir, 100.0, &b));
+        EXPECT_EQ(a.range, b.range) << c.surface << " x " << x;  // paint, not geometry
+        EXPECT_EQ(b.reflectivity, target.reflectivity);
+        const bool on_band = &target == &c && x > 16.0 && x < 19.0;
+        EXPECT_EQ(a.reflectivity, on_band ? 250.0f : target.reflectivity)
+            << c.surface << " band, ray to " << target.surface << " at x " << x;
       }
     }
   }

@@ -20,9 +20,9 @@ struct ImuSample {
 // One LiDAR return in the LiDAR frame with its own acquisition time.
 struct LidarPoint {
   Eigen::Vector3f p_lidar = Eigen::Vector3f::Zero();  // m
-  float intensity = 0.0f;
+  float intensity = 0.0f;  // the sensor's unit: its reflectivity where it gives one (Scan::has_intensity)
   TimeNs t_ns = 0;     // absolute acquisition time of this point
-  uint16_t ring = 0;   // beam index (0 when the driver has none)
+  uint16_t ring = 0;   // beam index (0 when the driver has none: Scan::has_ring)
 };
 
 // One LiDAR sweep. Points are in acquisition order when the driver provides
@@ -31,6 +31,11 @@ struct Scan {
   TimeNs t_start_ns = 0;  // earliest point time
   TimeNs t_end_ns = 0;    // latest point time: the deskew target and output stamp
   std::vector<LidarPoint> points;
+  // Whether the recording's layout gives an intensity (or reflectivity) and
+  // a ring per point; without, those fields of the points are 0 and the
+  // output map has no such attribute (docs/outputs.md "map.pcd").
+  bool has_intensity = false;
+  bool has_ring = false;
 };
 
 // Adds dt_ns to every time of the scan (t_start_ns, t_end_ns, each point):

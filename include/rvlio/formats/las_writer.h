@@ -5,7 +5,7 @@
 // points takes bounded memory, and the file appears at Commit(), complete, or
 // not at all. The public header's counts and bounds (and the extra-bytes
 // minima and maxima) are known only at the end: Commit() writes them over the
-// placeholder header.
+// provisional header (its counts and bounds zero).
 //
 // What the writer fixes (the caller cannot get them wrong):
 //  - X, Y, Z: scaled integers, scale 0.001 m, the offset a multiple of 1 km
@@ -17,7 +17,8 @@
 //    rvlio's times are UNIX seconds (UTC) of the recording; GPS time adds the
 //    leap seconds since 1980-01-06 (18 since 2017) and is written minus 1e9.
 //  - Return number 1 of 1, classification 0 (never classified), scan angle 0,
-//    point source ID 0 (no source assigned), file source ID 0.
+//    file source ID 0; point source ID: the scan index modulo 65536 when the
+//    caller gives one (has_point_source), else 0.
 //  - WKT (global encoding bit 4) is set, as point format 6 requires; the CRS is
 //    an OGC coordinate system WKT VLR (LASF_Projection 2112) when one is given.
 //  - Extra bytes (LASF_Spec 4) describe the per-point attributes after the 30
@@ -63,6 +64,7 @@ struct LasWriterOptions {
   std::string intensity_source;  // what the intensity was (e.g. "intensity, 8 bit"), for the description
   bool has_time = false;  // LasPoint::unix_time_s holds the acquisition time (else GPS time 0)
   bool has_ring = false;  // LasPoint::ring goes to User Data (else 0)
+  bool has_point_source = false;  // LasPoint::scan_index goes to Point Source ID (else 0)
   std::vector<LasExtraField> extra_fields;  // LasPoint::extra, in this order
   std::string system_identifier = "rvlio lidar-inertial map";  // at most 32 characters
   std::string generating_software;  // default "rvlio VERSION"
@@ -73,6 +75,7 @@ struct LasPoint {
   double intensity = 0.0;    // the sensor's unit
   double unix_time_s = 0.0;  // acquisition time, UNIX seconds (UTC)
   int ring = 0;              // beam; 0..255 (User Data), larger saturate at 255
+  uint64_t scan_index = 0;   // Point Source ID: modulo 65536 (16 bits)
   const double* extra = nullptr;  // one value per extra field (NaN allowed for floats)
 };
 
@@ -87,7 +90,7 @@ struct LasWriteStats {
 class LasWriter {
  public:
   // Checks the options (InvalidInput naming what is wrong) and writes the
-  // placeholder header; the file appears only at Commit().
+  // provisional header (its counts and bounds zero); the file appears only at Commit().
   Status Open(const std::string& path, LasWriterOptions options);
   // InvalidInput for a non-finite coordinate or one outside the 32-bit range
   // around the offset; the writer is then discarded.

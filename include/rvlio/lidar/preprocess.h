@@ -41,7 +41,8 @@ class ScanPreprocessor {
 
   // Indices into scan.points of the kept points, ascending.
   void SelectIndices(const Scan& scan, std::vector<int>* indices);
-  // The kept points as a compact scan (same t_start_ns / t_end_ns as the input).
+  // The kept points as a compact scan (same t_start_ns / t_end_ns and
+  // attribute flags as the input).
   void Downsample(const Scan& scan, Scan* out);
 
   const PreprocessStats& stats() const { return stats_; }  // of the last call

@@ -14,6 +14,7 @@
 #include "rvlio/common/types.h"
 #include "rvlio/imu/propagator.h"
 #include "rvlio/lidar/options.h"
+#include "rvlio/map/map_cloud.h"
 #include "rvlio/math/extrinsic_excitation.h"
 #include "rvlio/math/time_offset_excitation.h"
 #include "rvlio/math/pose.h"
@@ -182,6 +183,10 @@ class Odometry {
   virtual const DivergenceReport& divergence() const = 0;
   // The full map for output (coarse resolution), world frame.
   virtual std::vector<Eigen::Vector3d> MapPoints() const = 0;
+  // The same points with their attributes (map/output_map.h): intensity and
+  // ring as the recording gives them, each point's time (on the IMU clock, as
+  // the results' stamps) and the index of its scan's result.
+  virtual MapCloud MapWithAttributes() const = 0;
   // Not ok once the run cannot go on: with a reference map, the first scan
   // did not align to it (InvalidInput naming the cause). Poll/Finish then do nothing.
   virtual const Status& status() const = 0;

@@ -35,6 +35,7 @@
 //   void AddReports(OdometryStats*) const; std::vector<std::string> Warnings(const OdometryStats&) const;
 // A new backend is one such class and one line in Odometry::Create and at
 // the end of pipeline.cpp. No I/O.
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -67,6 +68,33 @@ struct Prediction {
   ImuSample mean_imu;  // mean specific force and rate of the scan's IMU samples (zero: none)
 };
 
+// The output map (map.pcd, map.las) and the returns of the scans not in it
+// yet. A backend inserts a scan's points once their pose is final (the IESKF
+// right after the update, the smoother when the state leaves the window);
+// the points keep the attributes of the scan's downsampled returns
+// (map/output_map.h) and its result's index.
+class OutputMapFeed {
+ public:
+  explicit OutputMapFeed(double resolution_m) : map_(resolution_m) {}
+  // The scan being processed, before its update: the state's time at its
+  // end, its result's index and its downsampled returns.
+  void Hold(TimeNs t_ns, uint32_t scan_index, const Scan& returns);
+  // The points (world, m) of the held scan of time t_ns, returns[i] at
+  // p_world[i]. Held scans older than t_ns never enter (an IESKF scan kept
+  // provisional, a window state dropped unmarginalized).
+  void Insert(TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_world);
+  const OutputMap& map() const { return map_; }
+
+ private:
+  struct HeldScan {
+    TimeNs t_ns;
+    uint32_t scan_index;
+    Scan returns;
+  };
+  OutputMap map_;
+  std::deque<HeldScan> held_;  // oldest first
+};
+
 // What a backend's Update, Insert and Finish work with: one scan and the
 // maps of the backbone.
 struct ScanContext {
@@ -74,7 +102,7 @@ struct ScanContext {
   const std::vector<Eigen::Vector3d>* p_lidar;     // its points deskewed to t_ns, LiDAR frame
   const Prediction* prediction;
   WorkingMap* map;                                 // what scans are associated with
-  OutputMap* output_map;                           // map.pcd
+  OutputMapFeed* output;                           // map.pcd
   const ReferenceLocalizer* localizer;             // the reference map, when there is one
   OdometryStats* stats;
 };
@@ -108,7 +136,8 @@ class ScanPipeline {
   const OdometryStats& stats() const { return stats_; }
   std::vector<std::string> warnings() const;
   const DivergenceReport& divergence() const { return monitor_.report(); }
-  std::vector<Eigen::Vector3d> MapPoints() const { return output_map_.Points(); }
+  std::vector<Eigen::Vector3d> MapPoints() const { return output_.map().Points(); }
+  MapCloud MapWithAttributes() const { return output_.map().Cloud(); }
   const Status& status() const { return status_; }
   const Backend& backend() const { return backend_; }
   Backend& backend() { return backend_; }
@@ -134,7 +163,7 @@ class ScanPipeline {
   OdometryOptions options_;
   Backend backend_;
   WorkingMap map_;
-  OutputMap output_map_;
+  OutputMapFeed output_;
   ScanPreprocessor preprocessor_;
   Pose3 T_imu_lidar_prior_;  // configured (the prior of an estimated extrinsic)
   OdometryStats stats_;
@@ -179,6 +208,7 @@ class PipelineOdometry : public Odometry {
   std::vector<std::string> warnings() const override { return pipeline_.warnings(); }
   const DivergenceReport& divergence() const override { return pipeline_.divergence(); }
   std::vector<Eigen::Vector3d> MapPoints() const override { return pipeline_.MapPoints(); }
+  MapCloud MapWithAttributes() const override { return pipeline_.MapWithAttributes(); }
   const Status& status() const override { return pipeline_.status(); }
 
  protected:

@@ -33,11 +33,12 @@ MapDeviation ComputeMapDeviation(const std::vector<Eigen::Vector3d>& p_map,
 // percentile and maximum absolute deviation (null without any surface).
 nlohmann::json DeviationSummaryJson(const MapDeviation& d);
 
-// map.pcd of p_map into the stage, with the deviation_m field and
-// deviation.csv beside it when `deviation` (of p_map) is not null, and map.las
-// of the same points and fields when las.enabled (output.las). The error is
-// the stage's explanation (nothing of the stage is committed).
-Status WriteMapOutputs(OutputStage* stage, const std::vector<Eigen::Vector3d>& p_map,
-                       const MapDeviation* deviation, const MapLasRequest& las = {});
+// map.pcd of the map (its points and attributes) into the stage, with the
+// deviation_m field and deviation.csv beside it when `deviation` (of the
+// map's points) is not null, and map.las of the same points and fields when
+// las.enabled (output.las). The error is the stage's explanation (nothing of
+// the stage is committed).
+Status WriteMapOutputs(OutputStage* stage, const MapCloud& map, const MapDeviation* deviation,
+                       const MapLasRequest& las = {});
 
 }  // namespace rvlio

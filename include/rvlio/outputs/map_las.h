@@ -12,6 +12,7 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/formats/las_writer.h"
+#include "rvlio/map/map_cloud.h"
 #include "rvlio/outputs/output_options.h"
 
 namespace rvlio {
@@ -29,10 +30,16 @@ struct MapLasRequest {
 };
 StatusOr<MapLasRequest> MapLasRequestOf(const OutputOptions& output, const SurveyOptions& survey);
 
-// map.las of the output map's points (the map.pcd frame) with deviation_m
-// (one per point, NaN allowed) as extra bytes when it is not null; atomically.
-Status WriteMapLas(const std::string& path, const std::vector<Eigen::Vector3d>& p_map,
-                   const std::vector<double>* deviation_m, const std::string& crs_wkt);
+// map.las of the output map (the map.pcd frame) with its attributes and
+// deviation_m (one per point, NaN allowed) when it is not null, atomically:
+// the coordinates as map.pcd stores them (float32 below 8192 m,
+// MapNeedsFloat64) and every field where `rvlio export` of the map.pcd of
+// the same map puts it (the same bytes), the intensity range from the
+// largest intensity. Built
+// chunk_points at a time (the memory beyond the map's).
+Status WriteMapLas(const std::string& path, const MapCloud& map,
+                   const std::vector<double>* deviation_m, const std::string& crs_wkt,
+                   size_t chunk_points = size_t{1} << 16);
 
 struct LasExportOptions {
   std::string crs = kLocalCrs;  // survey.crs syntax

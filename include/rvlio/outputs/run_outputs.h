@@ -8,6 +8,7 @@
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
+#include "rvlio/map/map_cloud.h"
 #include "rvlio/odometry/deviation.h"
 #include "rvlio/odometry/odometry.h"
 #include "rvlio/outputs/output_stage.h"
@@ -23,11 +24,15 @@ namespace rvlio {
 bool MapNeedsFloat64(const std::vector<Eigen::Vector3d>& p_world);
 
 // Binary PCD (x y z float32, or float64 when MapNeedsFloat64; header made by
-// PCL), written atomically.
+// PCL), written atomically: x y z, then the map's attributes (intensity F4,
+// time F8 in UNIX seconds, ring U2, scan_index U4: outputs/map_fields.h),
+// then the float32 field deviation_m (one per point; NaN allowed) when
+// deviation_m is not null: what PCL viewers and CloudCompare show as scalar
+// fields (docs/outputs.md "map.pcd"; deviation_m: run --map, docs/survey.md).
+Status WriteMapPcd(const std::string& path, const MapCloud& map,
+                   const std::vector<double>* deviation_m);
+// The same for points without attributes.
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world);
-// The same with a fourth float32 field deviation_m (one per point; NaN
-// allowed) when deviation_m is not null: what PCL viewers and CloudCompare
-// show as a scalar field (run --map, docs/survey.md).
 Status WriteMapPcd(const std::string& path, const std::vector<Eigen::Vector3d>& p_world,
                    const std::vector<double>* deviation_m);
 // deviation.csv: one row per chainage bin (odometry/deviation.h).
@@ -36,6 +41,17 @@ Status WriteDeviationCsv(const std::string& path, const std::vector<DeviationBin
 // point-cloud reader; an empty cloud is allowed). InvalidInput naming the
 // file for an unreadable, malformed, truncated or non-finite cloud.
 StatusOr<std::vector<Eigen::Vector3d>> ReadMapPcd(const std::string& path);
+// A map.pcd with its attributes (the fields of outputs/map_fields.h, by
+// name; other fields are skipped), read in chunks (PointCloudStream: DATA
+// ascii or binary). InvalidInput naming the file for what ReadMapPcd
+// refuses, binary_compressed and PLY, a field given twice, a time that is
+// not F8, and a ring or scan index that is not a whole number in its range.
+struct MapCloudFile {
+  MapCloud map;
+  bool has_deviation = false;
+  std::vector<double> deviation_m;  // one per point with has_deviation
+};
+StatusOr<MapCloudFile> ReadMapCloud(const std::string& path);
 
 // A stamp in seconds with all nine decimals (the t column of the CSV files).
 std::string FormatSeconds(TimeNs t_ns);

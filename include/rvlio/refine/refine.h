@@ -79,6 +79,7 @@
 #include "rvlio/degeneracy/options.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/lidar/preprocess.h"
+#include "rvlio/map/map_cloud.h"
 #include "rvlio/map/options.h"
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/math/pose.h"
@@ -156,7 +157,10 @@ struct RefineStats {
 struct RefineResult {
   Trajectory trajectory;  // refined T_world_imu at every refined scan's end
   std::vector<Eigen::Vector3d> v_world_imu, gyro_bias, accel_bias;  // per refined scan
-  std::vector<Eigen::Vector3d> map_points;  // output map (map.output_resolution) at the result
+  // The output map (map.output_resolution) at the result: every refined
+  // scan re-projected with its refined pose, each point with its return's
+  // attributes; scan_index is the refined scan's row in `trajectory`.
+  MapCloud map;
   std::vector<RefineRound> rounds;
   RefineStats stats;
   Eigen::Vector3d g_world = Eigen::Vector3d(0.0, 0.0, -9.81);

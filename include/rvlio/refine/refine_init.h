@@ -21,11 +21,14 @@ namespace rvlio {
 constexpr TimeNs kRefineVelocityHalfWindowNs = 50000000;  // 50 ms
 
 // The points of a refined scan as refinement reads them (LiDAR frame, m;
-// absolute times): 20 bytes a point instead of a LidarPoint's 32, the same
-// coordinates and times.
+// absolute times), and their intensity and ring for the output map when
+// the scan has them: 20 to 26 bytes a point instead of a LidarPoint's 32,
+// the same values.
 struct RefineScanPoints {
   std::vector<Eigen::Vector3f> p_lidar;
   std::vector<TimeNs> t_ns;
+  std::vector<float> intensity;  // empty without Scan::has_intensity
+  std::vector<uint16_t> ring;    // empty without Scan::has_ring
 };
 
 // The refined scans of an input: refined scan k is input scan kept[k]. Holds

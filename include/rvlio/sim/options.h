@@ -56,6 +56,31 @@ struct SimDeformationOptions {
   }
 };
 
+// A painted band across one surface of the shell: returns from world x in
+// [x_min, x_max] on it have the band's reflectivity instead of the
+// surface's (80 on the walls, 40 on the floor, 60 on the ceiling), so the
+// map's intensity shows a known pattern (docs/simulator.md "A painted
+// band"). Off by default; draws no random number, so the rest of the world
+// and every recording without it stay as they are.
+struct SimBandOptions {
+  std::string surface = "left";  // left (+y wall) | right (-y wall) | ceiling | floor
+  double x_min = 0.0;            // m, world x where the band starts
+  double x_max = 0.0;            // m, world x where it ends
+  double reflectivity = 0.0;     // 0..255 (0: off)
+
+  template <class V>
+  void Visit(V& v) {
+    v.Field("surface", surface,
+            Spec()
+                .Choices({"left", "right", "ceiling", "floor"})
+                .Help("painted surface: left (+y wall), right (-y wall), ceiling, floor"));
+    v.Field("x_min", x_min, Spec().Unit("m").Range(-20000.0, 20000.0).Help("world x of its start"));
+    v.Field("x_max", x_max, Spec().Unit("m").Range(-20000.0, 20000.0).Help("world x of its end"));
+    v.Field("reflectivity", reflectivity,
+            Spec().Range(0.0, 255.0).Help("reflectivity of the paint (0: no band)"));
+  }
+};
+
 // Geometry of the simulated world: a rectangular tunnel (or a closed hall)
 // with rough surfaces, a feature-rich entrance region and sparse features.
 struct SimWorldOptions {
@@ -80,6 +105,7 @@ struct SimWorldOptions {
   int openings = 0;              // doorways in the hall walls (hall only)
   bool stairs = false;           // a flight of stairs along a wall (hall only)
   SimDeformationOptions deformation;  // a convergence or bulge of one surface (default off)
+  SimBandOptions band;                // a painted band of known reflectivity (default off)
 
   template <class V>
   void Visit(V& v) {
@@ -115,6 +141,7 @@ struct SimWorldOptions {
     v.Field("openings", openings, Spec().Range(0, 32).Help("doorways in the hall walls"));
     v.Field("stairs", stairs, Spec().Help("a flight of stairs (hall)"));
     v.Section("deformation", deformation);
+    v.Section("band", band);
   }
 };
 

@@ -29,6 +29,9 @@ class World {
   void AddCylinder(const Cylinder& cylinder, float reflectivity);
   // Adds a raised-cosine patch to the relief of face `index` (a deformation).
   void DeformFace(int index, const HeightField::Bump& bump);
+  // Paints the part `area` (face coordinates u, v) of face `index`: a ray
+  // that hits the face there returns `reflectivity` (the last paint wins).
+  void PaintFace(int index, const Rect2& area, float reflectivity);
   // Builds the feature buckets; call after the last Add*, before Raycast.
   void Finalize(double bucket_size = 1.0);
 
@@ -58,8 +61,17 @@ class World {
   bool IntersectFeature(const Feature& f, const Ray& ray, double t_max, double* t) const;
   int BucketOf(double x) const;
 
+  struct Paint {
+    int face;
+    Rect2 area;
+    float reflectivity;
+  };
+  // The reflectivity of face `index` at p (its paint there, else its own).
+  float FaceReflectivity(int index, const Eigen::Vector3d& p) const;
+
   std::vector<Face> faces_;
   std::vector<float> face_reflectivity_;
+  std::vector<Paint> paints_;
   std::vector<Box> boxes_;
   std::vector<Cylinder> cylinders_;
   std::vector<float> box_reflectivity_, cylinder_reflectivity_;
