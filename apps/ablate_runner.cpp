@@ -10,7 +10,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -20,16 +19,15 @@
 #include <sstream>
 
 #include "interrupt.h"
-#include "rvlio/api.h"
-#include "rvlio/eval/evaluate.h"
-#include "rvlio/eval/map_metrics.h"
-#include "rvlio/formats/point_cloud_file.h"
+#include "rvlio/experiments/ablate_cells.h"
 #include "rvlio/formats/atomic_file.h"
-#include "rvlio/formats/trajectory_io.h"
 
 extern char** environ;
 
 namespace rvlio::cli::ablate {
+
+using experiments::ablate::CellRunEnd;
+using experiments::ablate::CellStatus;
 namespace {
 
 namespace fs = std::filesystem;
@@ -234,13 +232,6 @@ std::string ReadText(const std::string& path) {
   return s.str();
 }
 
-json ReadJsonFile(const std::string& path) {
-  const std::string text = ReadText(path);
-  if (text.empty()) return nullptr;
-  json j = json::parse(text, nullptr, false);
-  return j.is_discarded() ? json(nullptr) : j;
-}
-
 // The last lines of a log, for cell.json.
 std::string Tail(const std::string& text) {
   size_t pos = text.size();
@@ -271,134 +262,34 @@ std::string Describe(int status, int* exit_code) {
   return "ended abnormally";
 }
 
-json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-// map_rms and map_completeness of run/map.pcd against the cell's reference
-// cloud (as `rvlio eval --map`), the map moved by T_ref_est_poses (the run's
-// poses aligned to the ground truth, as `compare` does); "" or why it failed.
-std::string CollectMapMetrics(const Cell& cell, const Similarity3& T_ref_est, json* metrics) {
-  if (cell.ref_map.empty()) return "";
-  const PointCloudReadOptions xyz_only{false};
-  StatusOr<PointCloudFile> map = ReadPointCloud(cell.RunDir() + "/map.pcd", xyz_only);
-  if (!map.ok()) return "map eval: " + map.status().message();
-  for (Eigen::Vector3d& p : map->points) p = T_ref_est * p;
-  StatusOr<PointCloudFile> ref = ReadPointCloud(cell.ref_map, xyz_only);
-  if (!ref.ok()) return "map eval: " + ref.status().message();
-  StatusOr<MapEvalResult> r = EvaluateMap(map->points, ref->points, MapEvalOptions());
-  if (!r.ok()) return "map eval: " + r.status().message();
-  (*metrics)["map_rms"] = Number(r->accuracy.rmse);
-  (*metrics)["map_completeness"] = Number(r->completeness);
-  return "";
-}
-
-// A simulated cell: the run's degeneracy detection against the simulator's
-// localizability.csv (as `rvlio eval --degeneracy`, its default truth
-// threshold). A scoring error is a warning, not a failed cell (the
-// trajectory metrics stand); the metrics stay null then.
-void CollectDetectionMetrics(const Cell& cell, json* metrics, json* warnings) {
-  if (cell.data_index < 0) return;
-  (*metrics)["detect_precision"] = (*metrics)["detect_recall"] = nullptr;
-  DegeneracyEvalArgs args;
-  args.run_dir = cell.RunDir();
-  args.truth_dir = fs::path(cell.gt).parent_path().string();
-  args.gt_path = cell.gt;
-  StatusOr<DegeneracyEvalResult> r = EvaluateDegeneracyFiles(args);
-  if (!r.ok()) {
-    warnings->push_back("detection: " + r.status().message());
-    return;
-  }
-  (*metrics)["detect_precision"] = Number(r->scores.precision);
-  (*metrics)["detect_recall"] = Number(r->scores.recall);
-}
-
-// Metrics from run/summary.json and the evaluation against ground truth
-// (and the reference cloud). Returns "" or why the cell failed after a
-// successful run.
-std::string CollectMetrics(const Cell& cell, json* metrics, json* warnings) {
-  const json summary = ReadJsonFile(cell.RunDir() + "/summary.json");
-  if (!summary.is_object())
-    return "run finished but " + cell.RunDir() + "/summary.json is unreadable";
-  const double scans = summary.value("scan_count", 0.0);
-  (*metrics)["scans"] = scans;
-  (*metrics)["ms_per_scan"] =
-      summary.contains("per_scan_ms") ? summary["per_scan_ms"].value("median", 0.0) : 0.0;
-  (*metrics)["rtf"] = summary.value("real_time_factor", 0.0);
-  (*metrics)["rv_active_fraction"] =
-      scans > 0 ? summary.value("rv_active_scans", 0.0) / scans : 0.0;
-  (*metrics)["degenerate_fraction"] =
-      scans > 0 ? summary.value("degenerate_scans", 0.0) / scans : 0.0;
-  for (const char* m : {"ate_rmse", "rpe_rmse", "axis_rmse", "axis_max", "end_point"})
-    (*metrics)[m] = nullptr;
-  if (!cell.ref_map.empty()) (*metrics)["map_rms"] = (*metrics)["map_completeness"] = nullptr;
-  if (cell.gt.empty()) return CollectMapMetrics(cell, Similarity3(), metrics);
-  StatusOr<Trajectory> gt = ReadTrajectory(cell.gt);
-  if (!gt.ok()) return "eval: " + gt.status().message();
-  StatusOr<Trajectory> est = ReadTrajectory(cell.RunDir() + "/trajectory.tum");
-  if (!est.ok()) return "eval: " + est.status().message();
-  StatusOr<EvalResult> r = Evaluate(*gt, *est, EvalOptions());
-  if (!r.ok()) return "eval: " + r.status().message();
-  (*metrics)["ate_rmse"] = Number(r->ape_m.rmse);
-  (*metrics)["rpe_rmse"] = Number(r->rpe.trans_m.rmse);
-  (*metrics)["axis_rmse"] = Number(r->along_axis.rmse_m);
-  (*metrics)["axis_max"] = Number(r->along_axis.max_abs_m);
-  (*metrics)["end_point"] = Number(r->end_point_error_m);
-  *warnings = r->warnings;
-  CollectDetectionMetrics(cell, metrics, warnings);
-  return CollectMapMetrics(cell, r->T_ref_est_poses, metrics);
-}
-
-json CellHeader(const Cell& cell) {
-  json params = json::object();
-  for (const auto& [k, v] : cell.params) params[k] = v;
-  return {{"format", 1},
-          {"id", cell.id},
-          {"hash", cell.hash},
-          {"sequence", cell.sequence},
-          {"seed", cell.has_seed ? json(cell.seed) : json(nullptr)},
-          {"variant", cell.variant},
-          {"params", params},
-          {"label", cell.label},
-          {"run_argv", cell.RunArgs()}};
-}
-
-bool WriteCellRecord(const Cell& cell, json record) {
-  const Status s = WriteFileAtomically(cell.CellJson(), JsonText(record) + "\n");
-  if (!s.ok()) std::fprintf(stderr, "rvlio ablate: error: %s\n", s.message().c_str());
-  return s.ok() && (record["status"] == "done" || record["status"] == "diverged");
+// True when the cell finished (done or diverged); a failed write is an error line.
+bool Recorded(const StatusOr<CellStatus>& status) {
+  if (!status.ok())
+    std::fprintf(stderr, "rvlio ablate: error: %s\n", status.status().message().c_str());
+  return status.ok() && experiments::ablate::Finished(*status);
 }
 
 // Records a cell that could not run because its data is missing or failed.
 bool RecordDataFailure(const Cell& cell, const DataItem& d) {
   std::error_code ec;
   fs::create_directories(cell.dir, ec);
-  json r = CellHeader(cell);
-  r["status"] = "failed";
-  r["exit_code"] = nullptr;
-  r["error"] = "data " + d.id + " could not be simulated (see " + d.dir + "/simulate.log)";
-  r["stderr_tail"] = Tail(ReadText(d.dir + "/simulate.log"));
-  r["metrics"] = json::object();
-  r["wall_s"] = 0.0;
-  return WriteCellRecord(cell, r);
+  return Recorded(
+      experiments::ablate::RecordDataFailure(cell, d, Tail(ReadText(d.dir + "/simulate.log"))));
+}
+
+bool CellDone(const Cell& cell) {
+  return experiments::ablate::Finished(experiments::ablate::ReadCellStatus(cell));
 }
 
 bool FinishCell(const Cell& cell, int status, double wall_s) {
-  json r = CellHeader(cell);
+  CellRunEnd end;
   int exit_code = -1;
-  const std::string how = Describe(status, &exit_code);
-  r["exit_code"] = exit_code >= 0 ? json(exit_code) : json(nullptr);
-  r["wall_s"] = wall_s;
-  r["stderr_tail"] = Tail(ReadText(cell.dir + "/run.log"));
-  json metrics = json::object(), warnings = json::array();
-  // Exit 3: the run went to the end but its divergence monitor fired. The
-  // cell is finished, its metrics are kept, and its status says so.
-  const bool diverged = exit_code == kExitDiverged;
-  std::string error = exit_code == 0 || diverged ? CollectMetrics(cell, &metrics, &warnings)
-                                                 : "rvlio run " + how;
-  r["status"] = !error.empty() ? "failed" : diverged ? "diverged" : "done";
-  r["error"] = error.empty() ? json(nullptr) : json(error);
-  r["metrics"] = metrics;
-  r["eval_warnings"] = warnings;
-  return WriteCellRecord(cell, r);
+  end.how = Describe(status, &exit_code);
+  if (exit_code >= 0) end.exit_code = exit_code;
+  end.diverged = exit_code == kExitDiverged;  // ran to the end: metrics kept
+  end.wall_s = wall_s;
+  end.log_tail = Tail(ReadText(cell.dir + "/run.log"));
+  return Recorded(experiments::ablate::RecordCell(cell, end));
 }
 
 bool DataReady(const DataItem& d) {
@@ -421,11 +312,6 @@ bool FinishData(const DataItem& d, int status, double wall_s) {
                        {"simulate_argv", d.simulate_args}};
   const Status s = WriteFileAtomically(d.Marker(), JsonText(marker) + "\n");
   return ok && s.ok();
-}
-
-bool CellDone(const Cell& cell) {
-  const json r = ReadCellRecord(cell);
-  return r.is_object() && (r.value("status", "") == "done" || r.value("status", "") == "diverged");
 }
 
 Job DataJob(const DataItem& d) {
@@ -487,34 +373,6 @@ void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& 
 }
 
 }  // namespace
-
-MetricSet MetricSetOf(const Plan& plan) { return {plan.HasRefMap(), plan.HasSimulated()}; }
-
-const std::vector<MetricColumn>& MetricColumns(MetricSet set) {
-  static const std::vector<MetricColumn> kAlways = {
-      {"ate_rmse", "ATE [m]"},       {"rpe_rmse", "RPE [m]"},
-      {"axis_rmse", "axis RMSE [m]"}, {"axis_max", "axis max [m]"},
-      {"end_point", "end [m]"},       {"ms_per_scan", "ms/scan"},
-      {"rtf", "RTF"},                 {"rv_active_fraction", "RV active"},
-      {"degenerate_fraction", "degenerate"}};
-  static const std::vector<std::vector<MetricColumn>> kSets = [] {
-    std::vector<std::vector<MetricColumn>> sets(4, kAlways);
-    for (int i = 0; i < 4; ++i) {
-      if (i & 1)
-        sets[i].insert(sets[i].end(), {{"map_rms", "map RMS [m]"}, {"map_completeness", "completeness"}});
-      if (i & 2)
-        sets[i].insert(sets[i].end(), {{"detect_precision", "precision"}, {"detect_recall", "recall"}});
-    }
-    return sets;
-  }();
-  return kSets[(set.map ? 1 : 0) + (set.detection ? 2 : 0)];
-}
-
-json ReadCellRecord(const Cell& cell) {
-  json r = ReadJsonFile(cell.CellJson());
-  if (!r.is_object() || r.value("hash", "") != cell.hash) return nullptr;
-  return r;
-}
 
 RunCounts RunPlan(const Plan& plan, const RunnerOptions& options) {
   RunCounts counts;

@@ -1,7 +1,8 @@
 #pragma once
-// Runs the cells of an ablation plan: each simulated sequence once per seed
-// (`rvlio simulate`) and each cell as its own `rvlio run` process (spawned
-// directly, no shell), then evaluates the trajectory in-process and writes
+// Runs the cells of an ablation plan (rvlio/experiments/ablate_grid.h): each
+// simulated sequence once per seed (`rvlio simulate`) and each cell as its
+// own `rvlio run` process (spawned directly, no shell), then records the
+// cell (rvlio/experiments/ablate_cells.h: evaluated in-process) in
 // CELL/cell.json atomically. A crashing or failing run is recorded in its
 // cell.json ("status": "failed"), never fatal for the others. Finished cells
 // (status done, same hash) and finished data (data.json, same hash) are skipped.
@@ -10,11 +11,13 @@
 // the children the signal stopped leave no cell.json and no run folder.
 #include <string>
 
-#include <nlohmann/json.hpp>
-
-#include "ablate_grid.h"
+#include "rvlio/experiments/ablate_grid.h"
 
 namespace rvlio::cli::ablate {
+
+using experiments::ablate::Cell;
+using experiments::ablate::DataItem;
+using experiments::ablate::Plan;
 
 struct RunCounts {
   int total = 0;
@@ -38,24 +41,5 @@ RunCounts RunPlan(const Plan& plan, const RunnerOptions& options);
 // data first if that is missing. Returns false when `id` is not in the plan.
 bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& options,
             RunCounts* counts);
-
-// cell.json of a finished cell with the plan's hash (status done, diverged
-// (the run's divergence monitor fired: exit 3, metrics kept) or failed), or
-// null when there is none.
-nlohmann::json ReadCellRecord(const Cell& cell);
-
-// Which optional metric groups a grid's tables carry.
-struct MetricSet {
-  bool map = false;        // map_rms, map_completeness: some cell has a ref_map
-  bool detection = false;  // detect_precision, detect_recall: some sequence is simulated
-};
-MetricSet MetricSetOf(const Plan& plan);
-
-// The metric fields of cell.json "metrics" (name) and the Markdown table's
-// header of each, in table order.
-struct MetricColumn {
-  std::string name, header;
-};
-const std::vector<MetricColumn>& MetricColumns(MetricSet set = MetricSet());
 
 }  // namespace rvlio::cli::ablate

@@ -1,5 +1,7 @@
 #include "cli.h"
 
+#include "rvlio/experiments/compare.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -43,15 +45,7 @@ int Fail(const std::string& command, const std::string& message, int exit_code) 
   return exit_code;
 }
 
-int ExitCode(StatusCode code) {
-  switch (code) {
-    case StatusCode::kOk: return 0;
-    case StatusCode::kInvalidInput: return 2;
-    case StatusCode::kIoError: return 2;
-    case StatusCode::kInternal: return 1;
-  }
-  return 1;  // not reached: every code is listed above
-}
+int ExitCode(StatusCode code) { return experiments::ExitStatus(code); }
 
 int Fail(const std::string& command, const Status& status) {
   return Fail(command, status.message(), ExitCode(status.code()));

@@ -46,8 +46,8 @@ bool ParseWholeNumber(const std::string& text, long long min, long long max, lon
 // One-line error on stderr in the contract's form: "rvlio CMD: error: MSG".
 int Fail(const std::string& command, const std::string& message, int exit_code = 2);
 
-// The command-line contract's exit status for a library error, the one place that maps
-// them: 2 bad input or an output that cannot be written, 1 internal failure (divergence,
+// The command-line contract's exit status for a library error
+// (experiments::ExitStatus, the one place that maps them): 2 bad input or an output that cannot be written, 1 internal failure (divergence,
 // 3, and signals, 130 / 143, are not Status errors: see divergence_cli.h, interrupt.h).
 int ExitCode(StatusCode code);
 // Fail with the status's message and ExitCode(status.code()).

@@ -10,16 +10,16 @@
 #include <filesystem>
 #include <iostream>
 
-#include "ablate_grid.h"
-#include "rvlio/outputs/output_stage.h"
-#include "rvlio/outputs/summary_json.h"
 #include "ablate_runner.h"
-#include "ablate_summary.h"
 #include "commands.h"
 #include "common_options.h"
 #include "interrupt.h"
-#include "run_pipeline.h"
+#include "plot_runner.h"
+#include "rvlio/experiments/ablate_grid.h"
+#include "rvlio/experiments/ablate_summary.h"
 #include "rvlio/formats/atomic_file.h"
+#include "rvlio/outputs/output_stage.h"
+#include "rvlio/outputs/summary_json.h"
 
 namespace rvlio::cli {
 namespace {
@@ -38,7 +38,8 @@ CommandSpec AblateSpec() {
            {"out", "DIR", "output folder", true},
            {"jobs", "N", "cells run in parallel (default 1)"},
            {"max-cells", "N",
-            "largest grid accepted (default " + std::to_string(ablate::kDefaultMaxCells) +
+            "largest grid accepted (default " +
+                std::to_string(experiments::ablate::kDefaultMaxCells) +
                 " cells)"},
            {"plan", "", "print the expanded cells as JSON and exit (runs nothing)"},
            {"summarize", "", "only build the summary from the finished cells"},
@@ -56,7 +57,7 @@ std::string SelfPath() {
 
 // Returns 0 and sets `max_cells`, or the exit status after an error.
 int ReadMaxCells(const Args& args, int64_t* max_cells) {
-  *max_cells = ablate::kDefaultMaxCells;
+  *max_cells = experiments::ablate::kDefaultMaxCells;
   if (!args.Has("max-cells")) return 0;
   const std::string text = args.Get("max-cells");
   char* end = nullptr;
@@ -81,16 +82,28 @@ int ReadJobs(const Args& args, int* jobs) {
   return 0;
 }
 
+// The summary's bar chart: "plots: ..." or why there is none.
+std::string DrawSummaryPlot(const ablate::Plan& plan, const experiments::ablate::SummaryResult& r) {
+  if (r.done == 0) return "plots skipped: no finished cell";
+  std::string prefix;
+  const PlotResult p = RunPlotScript(experiments::ablate::SummaryPlotArgs(plan, &prefix));
+  if (!p.ran) return "plots skipped: " + p.message;
+  if (!p.ok) return "plots failed: " + p.message;
+  return "plots: " + prefix + "_ablation.png, " + prefix + "_ablation.pdf";
+}
+
 int Summarize(const ablate::Plan& plan, const Args& args) {
-  StatusOr<ablate::SummaryResult> r = ablate::WriteSummary(plan, !args.Has("no-plots"));
+  StatusOr<experiments::ablate::SummaryResult> r = experiments::ablate::WriteSummary(plan);
   if (!r.ok()) return Fail(kAblate, r.status());
+  const std::string plot_note =
+      args.Has("no-plots") ? "plots skipped: --no-plots" : DrawSummaryPlot(plan, *r);
   std::cout << r->table_md;
   std::printf("rvlio ablate: %d cells: %d done, %d failed, %d not run -> %s/table.md\n", r->cells,
               r->done, r->failed, r->missing, plan.out_dir.c_str());
   if (r->diverged > 0)
     std::printf("rvlio ablate: %d cells diverged (status diverged in summary.csv; left out of the "
                 "means)\n", r->diverged);
-  std::printf("rvlio ablate: %s\n", r->plot_note.c_str());
+  std::printf("rvlio ablate: %s\n", plot_note.c_str());
   WriteFolderReport(kAblate, plan.out_dir, false);
   return 0;
 }
@@ -132,10 +145,11 @@ int CmdAblate(int argc, char** argv) {
 
   int64_t max_cells = 0;
   if (int rc = ReadMaxCells(args, &max_cells); rc != 0) return rc;
-  StatusOr<ablate::Plan> plan = ablate::LoadPlan(args.Get("grid"), args.Get("out"), max_cells);
+  StatusOr<ablate::Plan> plan =
+      experiments::ablate::LoadPlan(args.Get("grid"), args.Get("out"), max_cells);
   if (!plan.ok()) return Fail(kAblate, plan.status());
   if (args.Has("plan")) {
-    std::cout << JsonText(ablate::PlanJson(*plan)) << "\n";
+    std::cout << experiments::ablate::PlanJsonText(*plan);
     return 0;
   }
   OutputFolder out_folder(plan->out_dir);  // removed again when it stays empty
@@ -145,9 +159,8 @@ int CmdAblate(int argc, char** argv) {
   if (args.Has("cell")) return RunSingle(*plan, args.Get("cell"), options);
   if (args.Has("data")) return RunSingle(*plan, args.Get("data"), options);
 
-  if (Status s =
-          WriteFileAtomically(plan->out_dir + "/plan.json", JsonText(ablate::PlanJson(*plan)) + "\n");
-      !s.ok())
+  const std::string plan_json = experiments::ablate::PlanJsonText(*plan);
+  if (Status s = WriteFileAtomically(plan->out_dir + "/plan.json", plan_json); !s.ok())
     return Fail(kAblate, s);
   if (options.progress)
     std::printf("rvlio ablate: the grid has %zu cells (%zu simulated sequences) -> %s\n",

@@ -10,7 +10,6 @@
 
 #include "commands.h"
 #include "common_options.h"
-#include "compare_engine.h"
 #include "interrupt.h"
 
 namespace rvlio::cli {
@@ -28,13 +27,14 @@ int CmdDemo(int argc, char** argv) {
   if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
   const std::string out = args.Get("out", "out/demo"), preset = args.Get("preset", "tunnel");
   const std::string data_dir = out + "/data";
-  CompareRequest compare;
+  experiments::CompareRequest compare;
   compare.bag = data_dir + "/" + preset + ".bag";
   compare.gt = data_dir + "/" + preset + "_gt.tum";
   compare.config_files = {data_dir + "/" + preset + ".yaml"};
   compare.out_dir = out;
-  compare.first_step = 2;
-  compare.total_steps = 1 + CompareSteps(compare);
+  CompareOptions lines;
+  lines.first_step = 2;
+  lines.total_steps = 1 + experiments::CompareSteps(compare);
 
   SimulateArgs sim;
   sim.preset = preset;
@@ -46,7 +46,7 @@ int CmdDemo(int argc, char** argv) {
     return Fail("demo", err);
   if (std::string err = ReadDurationOption(args, &sim.duration_s); !err.empty())
     return Fail("demo", err);
-  std::printf("[1/%d] simulating preset '%s' into %s\n", compare.total_steps, preset.c_str(),
+  std::printf("[1/%d] simulating preset '%s' into %s\n", lines.total_steps, preset.c_str(),
               data_dir.c_str());
   std::fflush(stdout);
   {
@@ -56,7 +56,7 @@ int CmdDemo(int argc, char** argv) {
   // The simulator's survey of the world (reference_map.pcd): the map columns.
   const std::string reference = data_dir + "/reference_map.pcd";
   if (std::filesystem::is_regular_file(reference)) compare.ref_map = reference;
-  return RunCompare(compare);
+  return CompareOnDisk(std::move(compare), lines);
 }
 
 }  // namespace rvlio::cli

@@ -14,6 +14,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "rvlio/common/number_text.h"
 #include "rvlio/outputs/summary_json.h"
 #include "common_options.h"
 #include "rvlio/api.h"
@@ -56,12 +57,6 @@ CommandSpec EvalSpec() {
        {"rpe-unit", "UNIT", "frames | meters (default frames)", false, false},
        {"max-dt", "S", "association tolerance in seconds (default 0.01)", false, false},
        {"json", "", "print one JSON object instead of the table", false, false}}};
-}
-
-bool ParseNumber(const std::string& text, double* value) {
-  char* end = nullptr;
-  *value = std::strtod(text.c_str(), &end);
-  return !text.empty() && *end == '\0' && std::isfinite(*value);
 }
 
 // Fills `options` from the arguments; returns an error message or "".

@@ -28,17 +28,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void PrintRound(std::FILE* out, const RefineRound& r, int rounds) {
-  std::fprintf(out,
-      "rvlio refine: round %d/%d: cost %.6g -> %.6g, %d iterations, max change %.4f m %.4f deg, "
-      "%lld constraints, %d RV-active scans, %.1f s (deskew %.1f, map %.1f, associate %.1f, "
-      "solve %.1f)\n",
-      r.round, rounds, r.cost_before, r.cost_after, r.iterations, r.max_translation_change_m,
-      r.max_rotation_change_deg, static_cast<long long>(r.constraints), r.rv_active_scans,
-      r.total_s, r.deskew_s, r.map_s, r.associate_s, r.solve_s);
-  std::fflush(out);
-}
-
 // --checkpoint DIR / --resume DIR (the same folder goes on receiving checkpoints).
 int ReadCheckpointArgs(const Args& args, RefineArgs* req) {
   if (args.Has("checkpoint") && args.Has("resume") &&
@@ -121,8 +110,7 @@ int CmdRefine(int argc, char** argv) {
   req.allow_divergence = args.Has("allow-divergence");
   if (int rc = ReadCheckpointArgs(args, &req.args); rc != 0) return rc;
   if (int rc = ReadChunkArgs(args, &req.args); rc != 0) return rc;
-  RefineOutcome outcome;
-  return RefineOnBag(std::move(req), &outcome);
+  return RefineOnBag(std::move(req));
 }
 
 namespace {
@@ -153,10 +141,10 @@ void PrintControl(std::FILE* out, const nlohmann::json& summary) {
 
 }  // namespace
 
-int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
+int RefineOnBag(RefineRequest request) {
   const auto t0 = Clock::now();
   RefineArgs& req = request.args;
-  std::FILE* out = request.out;
+  std::FILE* out = stdout;
   std::vector<std::string> config_warnings;
   StatusOr<Configuration> options =
       LoadConfig(request.config_files, request.overrides, &config_warnings);
@@ -170,7 +158,7 @@ int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
     req.init = std::move(*init);
   }
   const int rounds = req.options.refine.rounds;
-  req.on_round = [out, rounds](const RefineRound& r) { PrintRound(out, r, rounds); };
+  req.on_round = [out, rounds](const RefineRound& r) { PrintRefineRound(out, r, rounds); };
   req.on_resume = [out, &req](int rounds_done) {
     std::fprintf(out, "rvlio refine: resuming after round %d from %s\n", rounds_done,
                  req.checkpoint_dir.c_str());
@@ -194,11 +182,6 @@ int RefineOnBag(RefineRequest request, RefineOutcome* outcome) {
                  req.out_dir.c_str());
     return InterruptExitCode();
   }
-  outcome->scans = static_cast<int>(refined.trajectory.size());
-  outcome->refine_s = refined.total_s;
-  outcome->sequence_duration_s =
-      NsToSeconds(refined.trajectory.back().t_ns - refined.trajectory.front().t_ns);
-  outcome->diverged = result->divergence.detected;
   if (const std::optional<RefineJobSpan>& job = result->job)
     std::fprintf(out, "rvlio refine: chunk %d of %d: scans ending %.3f .. %.3f s (its own %.3f .. %.3f s)\n",
                  job->chunk, job->count, job->begin_ns * 1e-9, job->end_ns * 1e-9,

@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "rvlio/api.h"
+#include "rvlio/experiments/compare.h"
 
 namespace rvlio::cli {
 
@@ -34,6 +35,22 @@ std::string ReadSimulateArgs(const Args& args, SimulateArgs* sim);
 // `rvlio simulate` after its arguments are parsed: SimulateRecording with the
 // command's signals and lines; returns the exit status. Needs an InterruptScope.
 int SimulateOnDisk(SimulateArgs sim);
+
+// How `rvlio compare`'s lines look (demo continues its own step count).
+struct CompareOptions {
+  bool plots = true;
+  bool quiet = false;  // no step lines; the table and the summary lines remain
+  // Step numbering "[k/n] ...": the first step is first_step of total_steps
+  // (total_steps 0: compare's own count).
+  int first_step = 1;
+  int total_steps = 0;
+};
+// `rvlio compare` after its arguments are parsed (cmd_compare.cpp):
+// experiments::RunCompare with the command's signals and lines, the tables,
+// the plots and report.html; returns the exit status (0: some variant ran
+// without diverging, 1: every variant failed, 3: none ran cleanly but some
+// diverged, 2: bad input before any run, nothing written).
+int CompareOnDisk(experiments::CompareRequest request, const CompareOptions& options);
 
 // Writes DIR/report.html for the folder `command` just wrote (compare, demo,
 // ablate); a failure is a warning line, never the command's failure.

@@ -27,8 +27,7 @@ std::string EscapeHtml(const std::string& text) {
 
 // JSON inside <script>: "</" would end the element early; "<\/" is the same
 // JSON string.
-std::string ScriptSafeJson(const nlohmann::json& model) {
-  std::string text = model.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+std::string ScriptSafeJson(const std::string& text) {
   std::string out;
   out.reserve(text.size());
   for (size_t i = 0; i < text.size(); ++i) {
@@ -40,11 +39,11 @@ std::string ScriptSafeJson(const nlohmann::json& model) {
 
 }  // namespace
 
-std::string RenderReportHtml(const nlohmann::json& model) {
+std::string RenderReportHtml(const experiments::report::ReportModel& model) {
   const std::string_view page = assets::ReportTemplate();
-  const std::string data = ScriptSafeJson(model);
+  const std::string data = ScriptSafeJson(model.json);
   const std::string generator = std::string("rvlio ") + RVLIO_VERSION;
-  const std::string title = EscapeHtml(model.value("title", "rvlio report"));
+  const std::string title = EscapeHtml(model.title);
   // The markers in the order they appear in the template.
   const std::pair<std::string_view, std::string_view> fills[] = {
       {"@RVLIO_GENERATOR@", generator}, {"@RVLIO_TITLE@", title},
@@ -70,7 +69,7 @@ std::string RenderReportHtml(const nlohmann::json& model) {
 
 StatusOr<WrittenReport> WriteReport(const std::string& dir, const std::string& out_path,
                                     const ReportOptions& options) {
-  StatusOr<nlohmann::json> model = BuildReportModel(dir, options);
+  StatusOr<experiments::report::ReportModel> model = experiments::report::BuildReport(dir, options);
   if (!model.ok()) return model.status();
   WrittenReport written;
   written.path = out_path.empty() ? dir + "/report.html" : out_path;

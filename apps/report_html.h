@@ -2,18 +2,18 @@
 // report.html: the page template (apps/report/report.html with report.css and
 // report.js) and three.js, compiled into the tool (CMake embeds them from the
 // source tree and from libjs-three, docs/report.md), filled with the model of
-// report_data.h. The page needs nothing else: no network, no files.
+// rvlio/experiments/report_data.h. The page needs nothing else: no network, no files.
 #include <string>
 
-#include <nlohmann/json.hpp>
-
-#include "report_data.h"
 #include "rvlio/common/status.h"
+#include "rvlio/experiments/report_data.h"
 
 namespace rvlio::cli::report {
 
-// The whole page for `model` (BuildReportModel).
-std::string RenderReportHtml(const nlohmann::json& model);
+using experiments::report::ReportOptions;
+
+// The whole page for `model` (experiments::report::BuildReport).
+std::string RenderReportHtml(const experiments::report::ReportModel& model);
 
 // Builds the model of `dir` and writes its page atomically to `out_path`
 // ("" = DIR/report.html). Returns the path written and its size in bytes.

@@ -12,21 +12,6 @@
 namespace rvlio::cli {
 namespace {
 
-// The run's progress line: scans, their rate, the share of the window read.
-class Progress {
- public:
-  explicit Progress(bool enabled) : line_(enabled) {}
-  void Update(const RunProgress& p) {
-    if (!line_.Due(p.wall_s)) return;
-    char what[64];
-    std::snprintf(what, sizeof(what), "scans %d  %.1f scans/s", p.scans, p.scans / p.wall_s);
-    line_.Update(p.wall_s, p.fraction, what);
-  }
-
- private:
-  ProgressLine line_;
-};
-
 // The one line of an interrupted run; returns its exit status (130 / 143).
 int ReportInterrupt(const RunRequest& req, const RunResult& r) {
   if (r.scans.empty()) {
@@ -43,6 +28,24 @@ int ReportInterrupt(const RunRequest& req, const RunResult& r) {
 
 }  // namespace
 
+void RunProgressLine::Update(const RunProgress& p) {
+  if (!line_.Due(p.wall_s)) return;
+  char what[64];
+  std::snprintf(what, sizeof(what), "scans %d  %.1f scans/s", p.scans, p.scans / p.wall_s);
+  line_.Update(p.wall_s, p.fraction, what);
+}
+
+void PrintRefineRound(std::FILE* out, const RefineRound& r, int rounds) {
+  std::fprintf(out,
+      "rvlio refine: round %d/%d: cost %.6g -> %.6g, %d iterations, max change %.4f m %.4f deg, "
+      "%lld constraints, %d RV-active scans, %.1f s (deskew %.1f, map %.1f, associate %.1f, "
+      "solve %.1f)\n",
+      r.round, rounds, r.cost_before, r.cost_after, r.iterations, r.max_translation_change_m,
+      r.max_rotation_change_deg, static_cast<long long>(r.constraints), r.rv_active_scans,
+      r.total_s, r.deskew_s, r.map_s, r.associate_s, r.solve_s);
+  std::fflush(out);
+}
+
 int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   std::vector<std::string> config_warnings;
   StatusOr<Configuration> options =
@@ -58,7 +61,7 @@ int RunOdometryOnBag(const RunRequest& req, RunOutcome* outcome) {
   args.initial_pose = req.initial_pose;
   args.initial_pose_tum = req.initial_pose_tum;
   args.stop = [] { return InterruptSignalName(); };
-  Progress progress(!req.quiet);
+  RunProgressLine progress(!req.quiet);
   size_t divergence_warned = 0;
   args.progress = [&progress, &divergence_warned](const RunProgress& p) {
     progress.Update(p);

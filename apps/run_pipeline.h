@@ -1,12 +1,13 @@
 #pragma once
-// `rvlio run` and `rvlio refine` as functions, so that demo and compare reuse
-// them in-process: RunRecording / RefineRecording (rvlio/api.h) with the
-// command's signals, progress and round lines and messages.
+// `rvlio run` and `rvlio refine` after their arguments are parsed:
+// RunRecording / RefineRecording (rvlio/api.h) with the command's signals,
+// progress and round lines and messages; the lines compare prints as well.
 #include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "cli.h"
 #include "rvlio/api.h"
 #include "rvlio/outputs/output_stage.h"
 #include "rvlio/formats/sensor_bag.h"
@@ -53,20 +54,26 @@ struct RefineRequest {
   std::vector<std::string> config_files;
   std::vector<std::string> overrides;  // --set key=value
   bool allow_divergence = false;       // exit 0 even if the checks of the result fired
-  std::FILE* out = stdout;             // the round lines and the closing line
-};
-
-struct RefineOutcome {
-  int scans = 0;
-  double refine_s = 0.0;             // the batch solve (summary.json time_s.refine)
-  double sequence_duration_s = 0.0;  // first to last refined pose
-  bool diverged = false;             // the checks of the result fired (summary.json divergence)
 };
 
 // `rvlio refine` after its arguments are parsed (cmd_refine.cpp): loads the
 // configuration and the initial trajectory, refines, writes the outputs and
 // prints the command's lines (warnings and errors on stderr). Returns the exit
-// status; the outcome is filled when the refinement finished.
-int RefineOnBag(RefineRequest request, RefineOutcome* outcome);
+// status.
+int RefineOnBag(RefineRequest request);
+
+// The run's progress line on a terminal: scans, their rate, the share of the
+// recording read.
+class RunProgressLine {
+ public:
+  explicit RunProgressLine(bool enabled) : line_(enabled) {}
+  void Update(const RunProgress& p);
+
+ private:
+  ProgressLine line_;
+};
+
+// refine's line after each round ("rvlio refine: round 2/3: cost ...").
+void PrintRefineRound(std::FILE* out, const RefineRound& round, int rounds);
 
 }  // namespace rvlio::cli

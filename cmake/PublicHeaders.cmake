@@ -1,6 +1,7 @@
 # The public API: the headers `cmake --install` puts under include/rvlio
 # (docs/library.md "The public headers"). The entry points are rvlio/api.h
-# (whole recordings), config/config.h, odometry/odometry.h (scan by scan),
+# (whole recordings), experiments/ (compare, ablation grids, the report's
+# data), config/config.h, odometry/odometry.h (scan by scan),
 # formats/sensor_stream.h and formats/trajectory_io.h (reading recordings and
 # trajectories), eval/evaluate.h, sim/simulator.h and sim/presets.h, and
 # math/so3.h; the rest of the list is what those include. Every other header
@@ -17,6 +18,7 @@ set(rvlio_public_headers
   rvlio/common/types.h
   rvlio/config/config.h
   rvlio/config/configuration.h
+  rvlio/config/yaml_tree.h
   rvlio/constraints/constraint.h
   rvlio/constraints/options.h
   rvlio/constraints/plane_fit.h
@@ -30,6 +32,12 @@ set(rvlio_public_headers
   rvlio/eval/metrics.h
   rvlio/eval/options.h
   rvlio/eval/stats.h
+  rvlio/eval/time_matching.h
+  rvlio/experiments/ablate_cells.h
+  rvlio/experiments/ablate_grid.h
+  rvlio/experiments/ablate_summary.h
+  rvlio/experiments/compare.h
+  rvlio/experiments/report_data.h
   rvlio/factors/parameter_blocks.h
   rvlio/formats/control_file.h
   rvlio/formats/live_options.h

@@ -16,6 +16,7 @@ from ._rvlio import (  # noqa: F401
     RvReport,
     ScanResult,
     __version__,
+    compare,
     evaluate,
     evaluate_degeneracy,
     evaluate_map,

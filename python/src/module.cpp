@@ -2,6 +2,7 @@
 // re-exports it).
 #include "bag_py.h"
 #include "common.h"
+#include "compare_py.h"
 #include "config_py.h"
 #include "eval_py.h"
 #include "odometry_py.h"
@@ -18,4 +19,5 @@ PYBIND11_MODULE(_rvlio, m) {
   rvlio::python::BindBag(m);
   rvlio::python::BindEval(m);
   rvlio::python::BindRun(m);
+  rvlio::python::BindCompare(m);
 }

@@ -14,6 +14,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "rvlio/common/number_text.h"
+
 namespace rvlio {
 namespace config_detail {
 namespace {
@@ -45,12 +47,6 @@ bool IsDigits(const std::string& s, size_t begin, size_t end) {
   for (size_t i = begin; i < end; ++i)
     if (s[i] < '0' || s[i] > '9') return false;
   return true;
-}
-
-// [+-]? digits: what an integer key accepts (no 1.5, no 1e3, no 0x10).
-bool IsIntegerText(const std::string& s) {
-  const size_t begin = (!s.empty() && (s[0] == '+' || s[0] == '-')) ? 1 : 0;
-  return IsDigits(s, begin, s.size());
 }
 
 // A decimal number: [+-]? (d+ (. d*)? | . d+) ([eE] [+-]? d+)?
@@ -598,6 +594,20 @@ std::string DumpVisitor::Comment(const Spec& spec) {
 }
 
 }  // namespace config_detail
+
+const YamlNode* YamlNode::Find(const std::string& key) const {
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (keys[i] == key) return &items[i];
+  return nullptr;
+}
+
+StatusOr<YamlNode> ReadYamlFile(const std::string& path) {
+  return config_detail::ParseYamlFile(path);
+}
+
+std::string YamlWhere(const std::string& source, int line) {
+  return config_detail::Where(source, line);
+}
 
 Status AttributeToSources(const Status& status, const std::vector<std::string>& leaf_keys,
                           const ConfigSources& sources) {

@@ -37,6 +37,7 @@ StatusOr<EvalResult> Evaluate(const Trajectory& ref, const Trajectory& est, Eval
   r.rpe = *rpe;
   r.end_point_error_m = EndPointError(ref_m, est_aligned);
   r.along_axis = ComputeAlongAxisError(ref_m, est_aligned);
+  r.association = std::move(*association);
   return r;
 }
 

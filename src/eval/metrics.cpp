@@ -134,6 +134,7 @@ AlongAxisError ComputeAlongAxisError(const Trajectory& ref, const Trajectory& es
   double sum_sq = 0.0;
   for (size_t k = 0; k < ref.size(); ++k) {
     const double a = out.axis.dot(est[k].p_world_imu - ref[k].p_world_imu);
+    out.errors_m.push_back(a);
     sum_sq += a * a;
     out.max_abs_m = std::max(out.max_abs_m, std::fabs(a));
   }

@@ -406,6 +406,12 @@ std::string FormatTumLine(const StampedPose& pose) {
   return buf;
 }
 
+StatusOr<Trajectory> RoundTripTum(const Trajectory& trajectory, const std::string& source) {
+  std::string text = kTumColumnsComment;
+  for (const StampedPose& pose : trajectory) text += FormatTumLine(pose);
+  return ParseTumText(text, source);
+}
+
 Status WriteTum(const std::string& path, const Trajectory& trajectory, const std::string& header) {
   AtomicFileWriter writer;
   if (Status s = writer.Open(path); !s.ok()) return s;

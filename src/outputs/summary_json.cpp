@@ -5,10 +5,18 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 
 #include "rvlio/common/text.h"
 
 namespace rvlio {
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return nullptr;
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_discarded() ? nlohmann::json(nullptr) : j;
+}
 namespace {
 
 }  // namespace

@@ -7,7 +7,7 @@
 // a one-line message that names the key and the file (or "--set").
 //
 // yaml-cpp stays in config.cpp: files and override values are parsed there
-// into the plain config_detail::Node tree, which the visitors below walk.
+// into the plain YamlNode tree (yaml_tree.h), which the visitors below walk.
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -22,6 +22,7 @@
 #include "rvlio/common/options.h"
 #include "rvlio/common/status.h"
 #include "rvlio/config/configuration.h"
+#include "rvlio/config/yaml_tree.h"
 
 namespace rvlio {
 
@@ -31,19 +32,8 @@ using ConfigSources = std::map<std::string, std::string>;
 
 namespace config_detail {
 
-// A parsed YAML document, free of yaml-cpp types.
-struct Node {
-  enum class Kind { kNull, kScalar, kSequence, kMap };
-  Kind kind = Kind::kNull;
-  std::string scalar;             // kScalar: the text as written (unquoted)
-  std::vector<Node> items;        // kSequence elements; kMap values
-  std::vector<std::string> keys;  // kMap keys, parallel to items
-  std::vector<int> key_lines;     // kMap: line of each key
-  int line = 0;                   // 1-based line in the source, 0 if unknown (--set)
-  // Root only: the document has more values than a configuration can (an
-  // alias bomb, or a large section); the values past the limit are nulls.
-  std::string over_budget;
-};
+// A parsed YAML document (yaml_tree.h).
+using Node = YamlNode;
 
 // Parses a whole file (top level must be a mapping or empty). Errors name the
 // file, and the line for syntax errors and duplicate keys. A document over the

@@ -11,11 +11,13 @@
 #include "rvlio/eval/metrics.h"
 #include "rvlio/eval/options.h"
 #include "rvlio/eval/stats.h"
+#include "rvlio/eval/time_matching.h"
 
 namespace rvlio {
 
 struct EvalResult {
   size_t matched = 0;
+  Association association;  // the matched poses: indices into ref and est, in order
   AlignMode align = AlignMode::kSe3;  // the alignment used (origin after a fallback)
   Similarity3 T_ref_est;
   Similarity3 T_ref_est_poses;  // PoseAlignment of the matched poses (for maps)

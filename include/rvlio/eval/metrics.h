@@ -54,6 +54,7 @@ struct AlongAxisError {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  // principal axis of the reference positions
   double rmse_m = 0.0;                              // of a_k = axis . (t_est_k - t_ref_k)
   double max_abs_m = 0.0;                           // max |a_k|
+  std::vector<double> errors_m;                     // a_k at each matched pose, in order
 };
 
 // Position error projected on the principal axis (eigenvector of the largest

@@ -58,6 +58,11 @@ StatusOr<Trajectory> ParseTrajectoryText(const std::string& text, const std::str
 // with 9 decimals (nm), quaternion with 12 decimals.
 std::string FormatTumLine(const StampedPose& pose);
 
+// The trajectory as its TUM file holds it (FormatTumLine's decimals, read
+// back as ReadTum reads them): what `rvlio eval` and `refine --init` see of
+// it, without the file. `source` names it in error messages (no poses).
+StatusOr<Trajectory> RoundTripTum(const Trajectory& trajectory, const std::string& source);
+
 // The comment line naming the columns, after the header of every TUM file we write.
 inline constexpr const char* kTumColumnsComment = "# t x y z qx qy qz qw\n";
 

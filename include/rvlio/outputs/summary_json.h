@@ -29,6 +29,10 @@ nlohmann::json ReaderStatsJson(const SensorReaderStats& stats);
 std::vector<std::string> ReaderWarnings(const SensorReaderStats& stats, const LidarOptions& lidar,
                                         const ImuOptions& imu);
 
+// A JSON file the commands wrote (summary.json, cell.json, compare.json,
+// plan.json), or null when it is missing, empty or not valid JSON.
+nlohmann::json ReadJsonFile(const std::string& path);
+
 // {detected, first_time_s, scans_flagged, events: {kind: episodes}, episodes: [...]}.
 nlohmann::json DivergenceJson(const DivergenceReport& report);
 

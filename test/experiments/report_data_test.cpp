@@ -1,5 +1,6 @@
-// `rvlio report`'s data extraction (apps/report_data.h) and page assembly
-// (apps/report_html.h) on folders built here with known contents.
+// `rvlio report`'s data extraction (rvlio/experiments/report_data.h, its
+// model src/experiments/report_model.h) and page assembly (apps/report_html.h)
+// on folders built here with known contents.
 #include <stdlib.h>
 
 #include <algorithm>
@@ -15,13 +16,18 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "report_data.h"
 #include "report_html.h"
-#include "rvlio/outputs/run_outputs.h"
+#include "report_model.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/outputs/summary_json.h"
 
-namespace rvlio::cli::report {
+namespace rvlio::experiments::report {
 namespace {
+
+using cli::report::RenderReportHtml;
+using cli::report::WriteReport;
+using cli::report::WrittenReport;
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -330,7 +336,7 @@ TEST_F(ReportDataTest, PageInlinesEverythingAndEscapesTheData) {
   StatusOr<json> m = BuildReportModel(Path("run"), ReportOptions());
   ASSERT_TRUE(m.ok()) << m.status().message();
   (*m)["title"] = "a </script><b> title";
-  const std::string page = RenderReportHtml(*m);
+  const std::string page = RenderReportHtml({FolderKind::kRun, (*m)["title"], JsonText(*m, -1)});
   EXPECT_EQ(page.find("@RVLIO_"), std::string::npos);        // every marker filled
   EXPECT_NE(page.find("REVISION"), std::string::npos);       // three.js is inlined
   EXPECT_NE(page.find("RvlioReport"), std::string::npos);    // and the page's script
@@ -351,4 +357,4 @@ TEST_F(ReportDataTest, PageInlinesEverythingAndEscapesTheData) {
 }
 
 }  // namespace
-}  // namespace rvlio::cli::report
+}  // namespace rvlio::experiments::report

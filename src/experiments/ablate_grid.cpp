@@ -1,12 +1,10 @@
-#include "ablate_grid.h"
-#include "rvlio/common/text.h"
-#include "rvlio/outputs/summary_json.h"
+#include "rvlio/experiments/ablate_grid.h"
+
 
 #include <sys/stat.h>
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -17,14 +15,18 @@
 #include <sstream>
 
 #include "rvlio/common/fnv1a.h"
+#include "rvlio/common/number_text.h"
+#include "rvlio/common/text.h"
 #include "rvlio/config/config.h"
+#include "rvlio/config/yaml_tree.h"
+#include "rvlio/outputs/summary_json.h"
 #include "rvlio/sim/presets.h"
 
-namespace rvlio::cli::ablate {
+namespace rvlio::experiments::ablate {
 namespace {
 
 namespace fs = std::filesystem;
-using config_detail::Node;
+using Node = YamlNode;
 
 constexpr size_t kMaxRangeValues = 10000;
 
@@ -34,7 +36,7 @@ class GridContext {
   explicit GridContext(std::string grid_path)
       : path_(std::move(grid_path)), base_(fs::path(path_).parent_path()) {}
   Status Error(const Node& n, const std::string& key, const std::string& msg) const {
-    return Status::InvalidInput(config_detail::Where(path_, n.line) + ": " + key + ": " + msg);
+    return Status::InvalidInput(YamlWhere(path_, n.line) + ": " + key + ": " + msg);
   }
   // A path of the grid, relative to the grid file's folder.
   std::string Resolve(const std::string& p) const {
@@ -47,11 +49,7 @@ class GridContext {
   fs::path base_;
 };
 
-const Node* Find(const Node& map, const std::string& key) {
-  for (size_t i = 0; i < map.keys.size(); ++i)
-    if (map.keys[i] == key) return &map.items[i];
-  return nullptr;
-}
+const Node* Find(const Node& map, const std::string& key) { return map.Find(key); }
 
 // Every key of `map` must be one of `known`.
 Status CheckKeys(const GridContext& g, const Node& map, const std::string& path,
@@ -129,20 +127,6 @@ Status ReadConfigFiles(const GridContext& g, const Node* n, const std::string& w
     out->push_back(path);
   }
   return Status::Ok();
-}
-
-bool IsIntegerText(const std::string& s) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  std::strtoll(s.c_str(), &end, 10);
-  return *end == '\0' && errno == 0;
-}
-
-bool ParseNumber(const std::string& s, double* v) {
-  char* end = nullptr;
-  *v = std::strtod(s.c_str(), &end);
-  return !s.empty() && *end == '\0' && std::isfinite(*v);
 }
 
 std::string FormatValue(double v, bool integer) {
@@ -252,9 +236,10 @@ Status ReadSeeds(const GridContext& g, const Node* n, const std::string& where,
   StatusOr<std::vector<std::string>> values = ReadValues(g, *n, where);
   if (!values.ok()) return values.status();
   for (const std::string& v : *values) {
-    if (!IsIntegerText(v) || std::strtoll(v.c_str(), nullptr, 10) < 0)
+    int64_t seed = -1;
+    if (!ParseInteger(v, &seed) || seed < 0)
       return g.Error(*n, where, "'" + v + "' is not a non-negative integer seed");
-    seeds->push_back(std::strtoll(v.c_str(), nullptr, 10));
+    seeds->push_back(seed);
   }
   return Status::Ok();
 }
@@ -397,9 +382,8 @@ Status ReadResources(const GridContext& g, const Node* n, JobResources* r) {
     const Node* v = Find(*n, f.key);
     if (v == nullptr) continue;
     const std::string where = std::string("resources.") + f.key;
-    const long long x = v->kind == Node::Kind::kScalar && IsIntegerText(v->scalar)
-                            ? std::strtoll(v->scalar.c_str(), nullptr, 10)
-                            : 0;
+    int64_t x = 0;
+    if (v->kind != Node::Kind::kScalar || !ParseInteger(v->scalar, &x)) x = 0;
     if (x < 1 || x > f.max)
       return g.Error(*v, where,
                      "'" + v->scalar + "' is not a whole number of " + f.unit + " in [1, " +
@@ -619,7 +603,7 @@ double CountCells(const Grid& grid, std::string* how) {
 StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir,
                         int64_t max_cells) {
   const GridContext g(grid_path);
-  StatusOr<Node> root = config_detail::ParseYamlFile(grid_path);
+  StatusOr<Node> root = ReadYamlFile(grid_path);
   if (!root.ok()) {
     const std::string& m = root.status().message();
     return Status::InvalidInput(m.rfind(grid_path, 0) == 0 ? m : grid_path + ": " + m);
@@ -661,7 +645,7 @@ StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir
   return plan;
 }
 
-nlohmann::json PlanJson(const Plan& plan) {
+std::string PlanJsonText(const Plan& plan) {
   nlohmann::json data = nlohmann::json::array(), cells = nlohmann::json::array();
   for (const DataItem& d : plan.data)
     data.push_back({{"id", d.id},
@@ -692,15 +676,16 @@ nlohmann::json PlanJson(const Plan& plan) {
                      {"eval_argv", c.EvalArgs()},
                      {"ref_map", c.ref_map}});
   }
-  return {{"grid", plan.grid_path},
-          {"out", plan.out_dir},
-          {"param_keys", plan.param_keys},
-          {"resources",
-           {{"cpus", plan.resources.cpus},
-            {"mem_mb", plan.resources.mem_mb},
-            {"runtime", plan.resources.runtime_min}}},
-          {"data", data},
-          {"cells", cells}};
+  const nlohmann::json j = {{"grid", plan.grid_path},
+                            {"out", plan.out_dir},
+                            {"param_keys", plan.param_keys},
+                            {"resources",
+                             {{"cpus", plan.resources.cpus},
+                              {"mem_mb", plan.resources.mem_mb},
+                              {"runtime", plan.resources.runtime_min}}},
+                            {"data", data},
+                            {"cells", cells}};
+  return JsonText(j) + "\n";
 }
 
-}  // namespace rvlio::cli::ablate
+}  // namespace rvlio::experiments::ablate

@@ -1,6 +1,7 @@
 #pragma once
-// The data of `rvlio report` (docs/report.md): what a compare, demo, ablate or
-// run folder holds, gathered into one JSON model that report.html draws.
+// The data of `rvlio report` (docs/report.md, target rvlio::experiments):
+// what a compare, demo, ablate or run folder holds, gathered into one JSON
+// model that report.html draws.
 // Arrays travel as base64 of little-endian float32 (ReportArray), so a 100 s
 // run stays compact; the map is thinned by a stride to at most
 // ReportOptions::max_points points and the page says so.
@@ -9,12 +10,9 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
-
 #include "rvlio/common/status.h"
 
-namespace rvlio::cli::report {
+namespace rvlio::experiments::report {
 
 enum class FolderKind { kCompare, kDemo, kAblate, kRun };
 const char* FolderKindName(FolderKind kind);
@@ -37,19 +35,16 @@ std::string ReportArray(const std::vector<float>& values);
 // Every stride-th point so that at most max_points remain (stride 1 keeps all).
 size_t ThinningStride(size_t points, size_t max_points);
 
-// The columns of a metrics table from JSON rows: the given leading keys, then
-// every number or boolean at the top level of any row, then those of nested
-// objects one level down as "parent.key" (skipping the `skip` objects), in the
-// order they first appear. Map metrics added to compare.json or cell.json thus
-// appear without a change here.
-std::vector<std::string> MetricColumns(const std::vector<nlohmann::json>& rows,
-                                       const std::vector<std::string>& leading,
-                                       const std::vector<std::string>& skip);
-// The value of a "parent.key" or "key" column in `row` (null when absent).
-nlohmann::json ColumnValue(const nlohmann::json& row, const std::string& column);
+// The model of a folder's page: its title and the JSON text report.html
+// embeds (runs, table, ground truth, map cloud, control points, notes).
+struct ReportModel {
+  FolderKind kind = FolderKind::kRun;
+  std::string title;
+  std::string json;
+};
 
 // The whole model for `dir` (DetectFolderKind first). InvalidInput when the
 // folder holds nothing reportable or a file it names cannot be read.
-StatusOr<nlohmann::json> BuildReportModel(const std::string& dir, const ReportOptions& options);
+StatusOr<ReportModel> BuildReport(const std::string& dir, const ReportOptions& options);
 
-}  // namespace rvlio::cli::report
+}  // namespace rvlio::experiments::report

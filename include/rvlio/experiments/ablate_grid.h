@@ -1,7 +1,8 @@
 #pragma once
-// `rvlio ablate` grid files: parsing, expansion into cells, stable hashes and
-// the machine-readable plan (JSON) that workflow/Snakefile consumes. This is
-// the one grid parser of the project; the Snakefile never reads the YAML.
+// Ablation grid files (`rvlio ablate`, target rvlio::experiments): parsing,
+// expansion into cells, stable hashes and the machine-readable plan (JSON)
+// that workflow/Snakefile consumes. This is the one grid parser of the
+// project; the Snakefile never reads the YAML.
 //
 // Grid YAML (paths relative to the grid file):
 //   config: [files]                 common to all cells (optional)
@@ -23,11 +24,9 @@
 #include <utility>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "rvlio/common/status.h"
 
-namespace rvlio::cli::ablate {
+namespace rvlio::experiments::ablate {
 
 // One simulated sequence for one seed, generated into D/data/<id>/.
 struct DataItem {
@@ -94,9 +93,9 @@ constexpr int64_t kDefaultMaxCells = 10000;
 StatusOr<Plan> LoadPlan(const std::string& grid_path, const std::string& out_dir,
                         int64_t max_cells = kDefaultMaxCells);
 
-// The plan as JSON: {grid, out, param_keys, resources: {cpus, mem_mb, runtime},
-// data: [...], cells: [...]}.
-nlohmann::json PlanJson(const Plan& plan);
+// The plan as JSON text (plan.json, `rvlio ablate --plan`): {grid, out,
+// param_keys, resources: {cpus, mem_mb, runtime}, data: [...], cells: [...]}.
+std::string PlanJsonText(const Plan& plan);
 
 
 // Expands a {from, to, step} range inclusively without float drift: values
@@ -105,4 +104,4 @@ nlohmann::json PlanJson(const Plan& plan);
 StatusOr<std::vector<std::string>> ExpandRange(const std::string& from, const std::string& to,
                                                const std::string& step);
 
-}  // namespace rvlio::cli::ablate
+}  // namespace rvlio::experiments::ablate

@@ -1,4 +1,4 @@
-#include "ablate_summary.h"
+#include "rvlio/experiments/ablate_summary.h"
 
 #include <cmath>
 #include <cstdio>
@@ -6,23 +6,16 @@
 #include <map>
 #include <sstream>
 
-#include "ablate_runner.h"
-#include "plot_runner.h"
+#include "csv_text.h"
 #include "rvlio/common/text.h"
+#include "ablate_records.h"
 #include "rvlio/formats/atomic_file.h"
 
-namespace rvlio::cli::ablate {
+namespace rvlio::experiments::ablate {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-std::string Csv(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
 
 // Mean and sample standard deviation (n-1) of the finite values.
 struct Stats {
@@ -60,16 +53,16 @@ double MetricOf(const json& record, const std::string& m) {
 std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
   std::ostringstream o;
   o << "id,sequence,variant,seed";
-  for (const auto& k : plan.param_keys) o << "," << Csv(k);
+  for (const auto& k : plan.param_keys) o << "," << CsvField(k);
   o << ",status,exit_code";
   for (const MetricColumn& m : MetricColumns(MetricSetOf(plan))) o << "," << m.name;
   o << ",wall_s,error\n";
   for (size_t i = 0; i < plan.cells.size(); ++i) {
     const Cell& c = plan.cells[i];
     const json& r = records[i];
-    o << c.id << "," << Csv(c.sequence) << "," << Csv(c.variant) << ","
+    o << c.id << "," << CsvField(c.sequence) << "," << CsvField(c.variant) << ","
       << (c.has_seed ? std::to_string(c.seed) : "");
-    for (const auto& [k, v] : c.params) o << "," << Csv(v);
+    for (const auto& [k, v] : c.params) o << "," << CsvField(v);
     const std::string status = r.is_object() ? r.value("status", "missing") : "missing";
     o << "," << status << ","
       << (r.is_object() && r["exit_code"].is_number() ? std::to_string(r["exit_code"].get<int>())
@@ -77,7 +70,8 @@ std::string SummaryCsv(const Plan& plan, const std::vector<json>& records) {
     for (const MetricColumn& m : MetricColumns(MetricSetOf(plan)))
       o << "," << FormatFinite(r.is_object() ? MetricOf(r, m.name) : NAN, 12);
     o << "," << FormatFinite(r.is_object() ? r.value("wall_s", NAN) : NAN, 12) << ","
-      << Csv(r.is_object() && r["error"].is_string() ? r["error"].get<std::string>() : "") << "\n";
+      << CsvField(r.is_object() && r["error"].is_string() ? r["error"].get<std::string>() : "")
+      << "\n";
   }
   return o.str();
 }
@@ -112,14 +106,14 @@ std::vector<Group> GroupCells(const Plan& plan, const std::vector<json>& records
 std::string TableCsv(const Plan& plan, const std::vector<Group>& groups) {
   std::ostringstream o;
   o << "sequence,variant";
-  for (const auto& k : plan.param_keys) o << "," << Csv(k);
+  for (const auto& k : plan.param_keys) o << "," << CsvField(k);
   o << ",cells,n,failed,diverged";
   const MetricSet set = MetricSetOf(plan);
   for (const auto& [m, header] : MetricColumns(set)) o << "," << m << "_mean," << m << "_std";
   o << "\n";
   for (const Group& g : groups) {
-    o << Csv(g.first->sequence) << "," << Csv(g.first->label);
-    for (const auto& [k, v] : g.first->params) o << "," << Csv(v);
+    o << CsvField(g.first->sequence) << "," << CsvField(g.first->label);
+    for (const auto& [k, v] : g.first->params) o << "," << CsvField(v);
     o << "," << g.cells << "," << g.done << "," << g.failed << "," << g.diverged;
     for (const auto& [m, header] : MetricColumns(set)) {
       const Stats s = Describe(g.values.count(m) ? g.values.at(m) : std::vector<double>());
@@ -165,24 +159,9 @@ std::string TableMarkdown(const std::vector<Group>& groups, MetricSet set) {
   return o.str();
 }
 
-std::string MakePlots(const Plan& plan, const SummaryResult& result) {
-  if (result.done == 0) return "plots skipped: no finished cell";
-  const std::string prefix = (fs::path(plan.out_dir) / "plots" / "summary").string();
-  std::vector<std::string> args = {"ablation", "--table", plan.out_dir + "/table.csv", "--out",
-                                   prefix, "--metric", "ate_rmse", "--metric", "axis_max",
-                                   "--metric", "ms_per_scan"};
-  if (plan.HasRefMap()) args.insert(args.end(), {"--metric", "map_rms"});
-  if (plan.HasSimulated())
-    args.insert(args.end(), {"--metric", "detect_precision", "--metric", "detect_recall"});
-  const PlotResult p = RunPlotScript(args);
-  if (!p.ran) return "plots skipped: " + p.message;
-  if (!p.ok) return "plots failed: " + p.message;
-  return "plots: " + prefix + "_ablation.png, " + prefix + "_ablation.pdf";
-}
-
 }  // namespace
 
-StatusOr<SummaryResult> WriteSummary(const Plan& plan, bool plots) {
+StatusOr<SummaryResult> WriteSummary(const Plan& plan) {
   SummaryResult result;
   std::vector<json> records;
   for (const Cell& c : plan.cells) {
@@ -206,8 +185,18 @@ StatusOr<SummaryResult> WriteSummary(const Plan& plan, bool plots) {
         {"table.csv", TableCsv(plan, groups)},
         {"table.md", result.table_md}})
     if (Status s = WriteFileAtomically((out / name).string(), text); !s.ok()) return s;
-  result.plot_note = plots ? MakePlots(plan, result) : "plots skipped: --no-plots";
   return result;
 }
 
-}  // namespace rvlio::cli::ablate
+std::vector<std::string> SummaryPlotArgs(const Plan& plan, std::string* prefix) {
+  *prefix = (fs::path(plan.out_dir) / "plots" / "summary").string();
+  std::vector<std::string> args = {"ablation", "--table", plan.out_dir + "/table.csv", "--out",
+                                   *prefix, "--metric", "ate_rmse", "--metric", "axis_max",
+                                   "--metric", "ms_per_scan"};
+  if (plan.HasRefMap()) args.insert(args.end(), {"--metric", "map_rms"});
+  if (plan.HasSimulated())
+    args.insert(args.end(), {"--metric", "detect_precision", "--metric", "detect_recall"});
+  return args;
+}
+
+}  // namespace rvlio::experiments::ablate

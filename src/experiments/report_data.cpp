@@ -1,4 +1,6 @@
-#include "report_data.h"
+#include "rvlio/experiments/report_data.h"
+
+#include "report_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,16 +14,16 @@
 #include <optional>
 #include <sstream>
 
-#include "rvlio/eval/time_matching.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/formats/control_file.h"
 #include "rvlio/math/local_origin.h"
+#include "rvlio/outputs/summary_json.h"
 #include "rvlio/version.h"
 
-namespace rvlio::cli::report {
+namespace rvlio::experiments::report {
 namespace {
 
 namespace fs = std::filesystem;
@@ -46,12 +48,7 @@ bool IsFile(const fs::path& p) {
   return fs::is_regular_file(p, ec);
 }
 
-json ReadJson(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) return nullptr;
-  json j = json::parse(in, nullptr, false);
-  return j.is_discarded() ? json(nullptr) : j;
-}
+json ReadJson(const fs::path& path) { return ReadJsonFile(path.string()); }
 
 // A path recorded in a folder's JSON (relative to the directory the command
 // ran in): as written when it exists, else re-rooted at `dir` when it starts
@@ -127,8 +124,8 @@ struct RunEntry {
   std::string name, label, status, dir;
 };
 
-// The estimate aligned to the ground truth (as `rvlio eval` aligns it) and
-// the along-axis error a_k = axis . (p_est_k - p_ref_k) at matched poses.
+// The estimate aligned to the ground truth and its along-axis error at the
+// matched poses, both as `rvlio eval` computes them (rvlio/eval/evaluate.h).
 struct Aligned {
   Trajectory est_in_ref;
   std::vector<float> axis_t, axis_err_m;
@@ -136,21 +133,17 @@ struct Aligned {
 
 std::optional<Aligned> AlignToTruth(const Trajectory& truth, const Trajectory& est, double t0_s,
                                     std::vector<std::string>* notes, const std::string& name) {
-  const EvalOptions options;
-  StatusOr<EvalResult> e = Evaluate(truth, est, options);
-  StatusOr<Association> a = Associate(truth, est, options.max_dt);
-  if (!e.ok() || !a.ok()) {
-    notes->push_back(name + ": not aligned to the ground truth (" +
-                     (e.ok() ? a.status() : e.status()).message() + ")");
+  StatusOr<EvalResult> e = Evaluate(truth, est, EvalOptions());
+  if (!e.ok()) {
+    notes->push_back(name + ": not aligned to the ground truth (" + e.status().message() + ")");
     return std::nullopt;
   }
   Aligned out;
   out.est_in_ref = e->T_ref_est.Apply(est);
-  for (size_t k = 0; k < a->size(); ++k) {
-    const StampedPose& ref = truth[a->ref_index[k]];
-    const StampedPose& p = out.est_in_ref[a->est_index[k]];
-    out.axis_t.push_back(ToFloat(NsToSeconds(ref.t_ns) - t0_s));
-    out.axis_err_m.push_back(ToFloat(e->along_axis.axis.dot(p.p_world_imu - ref.p_world_imu)));
+  const std::vector<size_t>& ref_index = e->association.ref_index;
+  for (size_t k = 0; k < ref_index.size(); ++k) {
+    out.axis_t.push_back(ToFloat(NsToSeconds(truth[ref_index[k]].t_ns) - t0_s));
+    out.axis_err_m.push_back(ToFloat(e->along_axis.errors_m[k]));
   }
   return out;
 }
@@ -552,4 +545,15 @@ StatusOr<json> BuildReportModel(const std::string& dir, const ReportOptions& opt
   return model;
 }
 
-}  // namespace rvlio::cli::report
+StatusOr<ReportModel> BuildReport(const std::string& dir, const ReportOptions& options) {
+  StatusOr<json> model = BuildReportModel(dir, options);
+  if (!model.ok()) return model.status();
+  ReportModel out;
+  StatusOr<FolderKind> kind = DetectFolderKind(dir);
+  if (kind.ok()) out.kind = *kind;
+  out.title = model->value("title", "rvlio report");
+  out.json = JsonText(*model, -1);
+  return out;
+}
+
+}  // namespace rvlio::experiments::report

@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 using testing_cli::RunTool;
 using testing_cli::ToolRun;
 
-int Lines(const std::string& text) {
+int CountLines(const std::string& text) {
   int n = 0;
   for (char c : text) n += c == '\n' ? 1 : 0;
   return n;
@@ -41,7 +41,7 @@ TEST(ReportCliTest, BadInputIsOneLineAndExitTwo) {
   for (const auto& c : cases) {
     const ToolRun r = RunTool(c.args, dir);
     EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
-    EXPECT_EQ(Lines(r.err), 1) << c.args << "\n" << r.err;
+    EXPECT_EQ(CountLines(r.err), 1) << c.args << "\n" << r.err;
     EXPECT_NE(r.err.find("rvlio report: error: "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.args << "\n" << r.err;
   }
