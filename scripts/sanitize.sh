@@ -37,7 +37,8 @@ jobs=$(nproc 2>/dev/null || echo 2)
 # cases of each long suite so that each of its paths runs under the
 # sanitizers: the reader thread with an error midway and an early stop, `info`
 # on every storage, one divergence detection, one refine interruption, one
-# compare with a failing variant. test_plot (PlotScriptTest) runs Python only
+# compare with a failing variant, and the library's compare stopped after its
+# first run (CompareLibraryTest). test_plot (PlotScriptTest) runs Python only
 # and is not built here. The refine
 # memory bound measures a Release build's peak (ASan's shadow memory is not
 # ours); the chunk jobs' bad-input and partial-init cases stay. The report's
@@ -91,6 +92,7 @@ ex=(
   CompareTest.EveryVariantFailedIsExitOne
   CompareTest.RefMapAddsMapColumnsInTheGroundTruthFrame
   DemoTest.ShortDemoSimulatesComparesAndWritesTheReport
+  CompareLibraryTest.TypedRowsInMemoryEqualTheRunFilesAndTheCallbackComesOncePerRun
   'AblateRunTest\..*' 'ExtrinsicCliTest\..*' 'ExtrinsicCliSway\..*'
   'PresetsAndBackends/TimeOffsetMatrix\..*'
   DivergenceCli.UpsideDownLidarIsCaughtOnAShortFlight

@@ -136,6 +136,20 @@ void MarkInterrupted(const CompareRequest& req, CompareRow* row) {
   row->exit_code = StopExitCode(req);
 }
 
+// Runs `call` (a library call giving a StatusOr) timed into `row`: a failed
+// row, or the result handed to `take`.
+template <class Call, class Take>
+CompareRow TimedStep(const CompareRequest& req, CompareRow row, Call call, Take take) {
+  const auto t0 = Clock::now();
+  auto result = call();
+  row.wall_s = SecondsSince(t0);
+  if (!result.ok())
+    MarkFailed(req, result.status(), &row);
+  else
+    take(*result, &row);
+  return row;
+}
+
 // Fills `row` from a finished run (the command `rvlio run` with
 // --allow-divergence would have exited 0, or 2 after a read error).
 void TakeRunResult(const CompareRequest& req, const Truth& truth, const RunResult& r,
@@ -163,14 +177,9 @@ CompareRow RunVariant(const CompareRequest& req, CompareRow row, const Configura
   run.window = req.window;
   run.stop = req.stop;
   run.progress = req.on_run_progress;
-  const auto t0 = Clock::now();
-  StatusOr<RunResult> result = RunRecording(run);
-  row.wall_s = SecondsSince(t0);
-  if (!result.ok())
-    MarkFailed(req, result.status(), &row);
-  else
-    TakeRunResult(req, truth, *result, &row);
-  return row;
+  return TimedStep(
+      req, std::move(row), [&] { return RunRecording(run); },
+      [&](const RunResult& r, CompareRow* out) { TakeRunResult(req, truth, r, out); });
 }
 
 void TakeRefineResult(const CompareRequest& req, const Truth& truth, const RefineRunResult& r,
@@ -202,14 +211,9 @@ CompareRow RunRefine(const CompareRequest& req, CompareRow row, const CompareRow
     refine.on_round = [&req, rounds = options.refine.rounds](const RefineRound& r) {
       req.on_refine_round(r, rounds);
     };
-  const auto t0 = Clock::now();
-  StatusOr<RefineRunResult> result = RefineRecording(refine);
-  row.wall_s = SecondsSince(t0);
-  if (!result.ok())
-    MarkFailed(req, result.status(), &row);
-  else
-    TakeRefineResult(req, truth, *result, &row);
-  return row;
+  return TimedStep(
+      req, std::move(row), [&] { return RefineRecording(refine); },
+      [&](const RefineRunResult& r, CompareRow* out) { TakeRefineResult(req, truth, r, out); });
 }
 
 bool Stopped(const CompareRequest& req) { return req.stop && !req.stop().empty(); }
