@@ -225,13 +225,6 @@ JobCounts RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress
   return counts;
 }
 
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The last lines of a log, for cell.json.
 std::string Tail(const std::string& text) {
   size_t pos = text.size();
@@ -274,7 +267,7 @@ bool RecordDataFailure(const Cell& cell, const DataItem& d) {
   std::error_code ec;
   fs::create_directories(cell.dir, ec);
   return Recorded(
-      experiments::ablate::RecordDataFailure(cell, d, Tail(ReadText(d.dir + "/simulate.log"))));
+      experiments::ablate::RecordDataFailure(cell, d, Tail(ReadFileText(d.dir + "/simulate.log"))));
 }
 
 bool CellDone(const Cell& cell) {
@@ -288,7 +281,7 @@ bool FinishCell(const Cell& cell, int status, double wall_s) {
   if (exit_code >= 0) end.exit_code = exit_code;
   end.diverged = exit_code == kExitDiverged;  // ran to the end: metrics kept
   end.wall_s = wall_s;
-  end.log_tail = Tail(ReadText(cell.dir + "/run.log"));
+  end.log_tail = Tail(ReadFileText(cell.dir + "/run.log"));
   return Recorded(experiments::ablate::RecordCell(cell, end));
 }
 

@@ -1,6 +1,7 @@
 // `rvlio compare` (and the comparison of `rvlio demo`): the flags into an
 // experiments::CompareRequest, the library's RunCompare (rvlio/experiments/
 // compare.h), then the command's lines, the plots and the tables.
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "interrupt.h"
 #include "plot_runner.h"
 #include "run_pipeline.h"
+#include "rvlio/common/cpu_time.h"
 #include "rvlio/experiments/compare.h"
 #include "rvlio/outputs/output_stage.h"
 #include "time_range_options.h"
@@ -64,6 +66,7 @@ class StepPrinter {
       std::error_code ec;
       fs::create_directories(dir, ec);  // for the log; refine itself reports a bad folder
       log_ = std::fopen((dir + "/refine.log").c_str(), "w");
+      refine_t0_ = std::chrono::steady_clock::now();
     } else {
       Say(total, s.index, "rvlio run " + row.name + ": " + row.label);
       progress_ = std::make_unique<RunProgressLine>(!o_.quiet);
@@ -78,6 +81,12 @@ class StepPrinter {
   void Round(const RefineRound& r, int rounds) {
     PrintRefineRound(log_ != nullptr ? log_ : stdout, r, rounds);
   }
+  void RefineDone(const RefineRunResult& r) {
+    size_t warned = 0;
+    WarnDivergence("refine", r.divergence, &warned);
+    PrintRefineDone(log_ != nullptr ? log_ : stdout, r, SecondsSince(refine_t0_),
+                    req_.out_dir + "/" + ex::kRefineStep);
+  }
   ~StepPrinter() {
     if (log_ != nullptr) std::fclose(log_);
   }
@@ -91,6 +100,7 @@ class StepPrinter {
   std::unique_ptr<RunProgressLine> progress_;
   size_t divergence_warned_ = 0;
   std::FILE* log_ = nullptr;
+  std::chrono::steady_clock::time_point refine_t0_;
 };
 
 void PrintTable(const ex::CompareResult& result, bool with_map) {
@@ -248,6 +258,7 @@ int CompareOnDisk(experiments::CompareRequest req, const CompareOptions& o) {
   req.on_step = [&printer](const ex::CompareStep& s) { printer.Step(s); };
   req.on_run_progress = [&printer](const RunProgress& p) { printer.Run(p); };
   req.on_refine_round = [&printer](const RefineRound& r, int rounds) { printer.Round(r, rounds); };
+  req.on_refine_result = [&printer](const RefineRunResult& r) { printer.RefineDone(r); };
   req.on_warning = [](const std::string& w) {
     std::fprintf(stderr, "rvlio %s: warning: %s\n", kCompare, w.c_str());
   };

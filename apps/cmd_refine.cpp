@@ -141,6 +141,21 @@ void PrintControl(std::FILE* out, const nlohmann::json& summary) {
 
 }  // namespace
 
+void PrintRefineDone(std::FILE* out, const RefineRunResult& result, double wall_s,
+                     const std::string& out_dir) {
+  const RefineResult& refined = result.refine;
+  if (const std::optional<RefineJobSpan>& job = result.job)
+    std::fprintf(out, "rvlio refine: chunk %d of %d: scans ending %.3f .. %.3f s (its own %.3f .. %.3f s)\n",
+                 job->chunk, job->count, job->begin_ns * 1e-9, job->end_ns * 1e-9,
+                 job->core_begin_ns * 1e-9, job->core_end_ns * 1e-9);
+  std::fprintf(out, "rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
+               refined.trajectory.size(), refined.rounds.size(),
+               refined.converged ? " (converged)" : "", refined.linear_solver.c_str(), wall_s,
+               PeakMemoryMb(), out_dir.c_str());
+  PrintControl(out, result.summary);
+  std::fflush(out);
+}
+
 int RefineOnBag(RefineRequest request) {
   const auto t0 = Clock::now();
   RefineArgs& req = request.args;
@@ -182,16 +197,7 @@ int RefineOnBag(RefineRequest request) {
                  req.out_dir.c_str());
     return InterruptExitCode();
   }
-  if (const std::optional<RefineJobSpan>& job = result->job)
-    std::fprintf(out, "rvlio refine: chunk %d of %d: scans ending %.3f .. %.3f s (its own %.3f .. %.3f s)\n",
-                 job->chunk, job->count, job->begin_ns * 1e-9, job->end_ns * 1e-9,
-                 job->core_begin_ns * 1e-9, job->core_end_ns * 1e-9);
-  std::fprintf(out, "rvlio refine: %zu scans, %zu rounds%s, %s, %.1f s, peak memory %.0f MB -> %s\n",
-               refined.trajectory.size(), refined.rounds.size(),
-               refined.converged ? " (converged)" : "", refined.linear_solver.c_str(),
-               SecondsSince(t0), PeakMemoryMb(), req.out_dir.c_str());
-  PrintControl(out, result->summary);
-  std::fflush(out);
+  PrintRefineDone(out, *result, SecondsSince(t0), req.out_dir);
   if (result->divergence.detected)
     return FinishDiverged("refine", result->divergence, req.out_dir, request.allow_divergence);
   return 0;

@@ -75,5 +75,9 @@ class RunProgressLine {
 
 // refine's line after each round ("rvlio refine: round 2/3: cost ...").
 void PrintRefineRound(std::FILE* out, const RefineRound& round, int rounds);
+// refine's closing lines: a chunk job's span, "N scans, R rounds, solver,
+// S s, peak memory -> DIR", and the control points' figures.
+void PrintRefineDone(std::FILE* out, const RefineRunResult& result, double wall_s,
+                     const std::string& out_dir);
 
 }  // namespace rvlio::cli

@@ -44,12 +44,6 @@ struct ChunkFolder {
   std::optional<Trajectory> imu_trajectory;
 };
 
-// The whole file ("" when it cannot be read: the JSON parse then says so).
-std::string ReadFileText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 std::string FilePath(const std::string& dir, const char* name) {
   return (std::filesystem::path(dir) / name).string();
 }

@@ -164,13 +164,6 @@ StatusOr<std::vector<std::string>> ReadValues(const GridContext& g, const Node& 
   return values;
 }
 
-std::string ReadFileText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // Recorded bags are identified by path, size and modification time (hashing
 // gigabytes of bag on every plan would be slow); a ROS 2 bag folder by those
 // of each of its files.

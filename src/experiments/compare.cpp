@@ -185,6 +185,7 @@ CompareRow RunVariant(const CompareRequest& req, CompareRow row, const Configura
 void TakeRefineResult(const CompareRequest& req, const Truth& truth, const RefineRunResult& r,
                       CompareRow* row) {
   if (!r.read_complete || r.stopped) return MarkInterrupted(req, row);
+  if (req.on_refine_result) req.on_refine_result(r);
   const RefineResult& refined = r.refine;
   for (const std::string& w : refined.warnings) Warn(req, row->name, w);
   row->scans = static_cast<int>(refined.trajectory.size());

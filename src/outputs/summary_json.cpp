@@ -6,10 +6,16 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 
 #include "rvlio/common/text.h"
 
 namespace rvlio {
+
+std::string ReadFileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
 
 nlohmann::json ReadJsonFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -64,6 +64,9 @@ struct CompareRequest {
   // with the number of rounds configured (refine.rounds).
   std::function<void(const RunProgress&)> on_run_progress;
   std::function<void(const RefineRound&, int rounds)> on_refine_round;
+  // refine's whole result when it finished (not after a stop), before it is
+  // evaluated (e.g. for its closing lines).
+  std::function<void(const RefineRunResult&)> on_refine_result;
 };
 
 // The steps (runs) a request makes: 4 variants, + refine.

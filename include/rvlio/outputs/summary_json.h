@@ -29,8 +29,10 @@ nlohmann::json ReaderStatsJson(const SensorReaderStats& stats);
 std::vector<std::string> ReaderWarnings(const SensorReaderStats& stats, const LidarOptions& lidar,
                                         const ImuOptions& imu);
 
-// A JSON file the commands wrote (summary.json, cell.json, compare.json,
-// plan.json), or null when it is missing, empty or not valid JSON.
+// Reading back what the commands wrote: the whole file as text ("" when it
+// cannot be read), and a JSON file (summary.json, cell.json, compare.json,
+// plan.json) or null when it is missing, empty or not valid JSON.
+std::string ReadFileText(const std::string& path);
 nlohmann::json ReadJsonFile(const std::string& path);
 
 // {detected, first_time_s, scans_flagged, events: {kind: episodes}, episodes: [...]}.
