@@ -109,11 +109,11 @@ check "the install holds exactly the $n_public public headers of cmake/PublicHea
 # Each installed header compiles on its own from the prefix with only Eigen and
 # Ceres (so the public list is closed under #include), and opens no PCL, ROS,
 # yaml-cpp, sqlite, zstd or lz4 header; the rvlio::core and rvlio::sim headers
-# (all but rvlio/api.h, config/, formats/ and outputs/; formats/reader_options.h
+# (all but rvlio/api.h, config/, experiments/, formats/ and outputs/; formats/reader_options.h
 # and outputs/output_options.h are plain options structs the odometry options
 # hold) open no nlohmann either.
 is_io_header() {
-  [[ $1 == rvlio/api.h || $1 =~ ^rvlio/(api|config|formats|outputs)/ ]] &&
+  [[ $1 == rvlio/api.h || $1 =~ ^rvlio/(api|config|experiments|formats|outputs)/ ]] &&
     [[ $1 != rvlio/formats/reader_options.h && $1 != rvlio/outputs/output_options.h ]]
 }
 compiles_alone() {  # compiles_alone HEADER: syntax check, and the headers it opened
