@@ -14,6 +14,7 @@
 #include "rvlio/config/yaml_tree.h"
 #include "rvlio/experiments/ablate_cells.h"
 #include "rvlio/experiments/ablate_grid.h"
+#include "rvlio/experiments/ablate_runner.h"
 
 namespace rvlio::experiments::ablate {
 namespace {
@@ -102,6 +103,41 @@ TEST(AblateLibrary, PlanExpandsTheGridAndCellsRecordTheirStatus) {
   ASSERT_FALSE(typo.ok());
   EXPECT_EQ(typo.status().message().rfind(dir + "/typo.yaml:10: varaints: unknown key", 0), 0u)
       << typo.status().message();
+  fs::remove_all(dir);
+}
+
+// The hooks see every batch and item; a program that cannot be started is
+// a failed item, recorded, never a crash (no process runs here).
+class CountingHooks : public RunnerHooks {
+ public:
+  void BatchStarted(const std::string& what, int total, int skipped) override {
+    batches.push_back(what + ":" + std::to_string(total) + ":" + std::to_string(skipped));
+  }
+  void Finished(const std::string&, bool ok, double) override { ok ? ++ok_items : ++failed_items; }
+  void BatchEnded() override { ++ended; }
+  std::vector<std::string> batches;
+  int ok_items = 0, failed_items = 0, ended = 0;
+};
+
+TEST(AblateLibrary, RunnerRecordsItemsThatCannotStartAndCallsTheHooks) {
+  const std::string dir = MakeTempDir("rvlio_ablate_runner");
+  Write(dir + "/grid.yaml", kSmallGrid);
+  StatusOr<Plan> plan = LoadPlan(dir + "/grid.yaml", dir + "/out");
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  RunnerOptions options;
+  options.rvlio_bin = dir + "/no_such_program";
+  CountingHooks hooks;
+  const RunCounts c = RunPlan(*plan, options, &hooks);
+  EXPECT_EQ(hooks.batches, (std::vector<std::string>{"data:2:0", "cell:8:0"}));
+  EXPECT_EQ(hooks.ended, 2);
+  EXPECT_EQ(hooks.ok_items, 0);
+  EXPECT_EQ(hooks.failed_items, 2 + 8);
+  EXPECT_EQ(c.total, 8);
+  EXPECT_EQ(c.failed, 8);
+  EXPECT_EQ(c.done + c.skipped + c.interrupted + c.not_started, 0);
+  for (const Cell& cell : plan->cells) EXPECT_EQ(ReadCellStatus(cell), CellStatus::kFailed);
+  RunCounts one;
+  EXPECT_FALSE(RunOne(*plan, "no_such_cell", options, &hooks, &one));
   fs::remove_all(dir);
 }
 

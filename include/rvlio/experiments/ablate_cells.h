@@ -3,8 +3,8 @@
 // the run's figures from its summary.json, its trajectory against the ground
 // truth (rvlio/eval/evaluate.h), its map against the reference cloud and,
 // on simulated data, its degeneracy detection against the simulator's truth.
-// The runner that starts each cell's `rvlio run` is the command's
-// (apps/ablate_runner.h); summary and report read only these records.
+// The runner (ablate_runner.h) starts each cell's `rvlio run` and records it
+// here; the summary and the report read only these records.
 #include <optional>
 #include <string>
 #include <vector>

@@ -1,6 +1,4 @@
-#include "ablate_runner.h"
-#include "divergence_cli.h"
-#include "rvlio/outputs/summary_json.h"
+#include "rvlio/experiments/ablate_runner.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -18,16 +16,13 @@
 #include <map>
 #include <sstream>
 
-#include "interrupt.h"
 #include "rvlio/experiments/ablate_cells.h"
 #include "rvlio/formats/atomic_file.h"
+#include "rvlio/outputs/summary_json.h"
 
 extern char** environ;
 
-namespace rvlio::cli::ablate {
-
-using experiments::ablate::CellRunEnd;
-using experiments::ablate::CellStatus;
+namespace rvlio::experiments::ablate {
 namespace {
 
 namespace fs = std::filesystem;
@@ -51,15 +46,17 @@ struct Job {
   std::function<void()> discard;
 };
 
-// A child stopped by the signal forwarded to it (exit 130/143 or killed by it).
+// A child stopped by the signal forwarded to it (exit 128 + SIGINT or
+// SIGTERM, the contract's 130 / 143, or killed by it).
 bool StoppedBySignal(int status) {
-  if (WIFEXITED(status)) return IsInterruptExit(WEXITSTATUS(status));
+  if (WIFEXITED(status))
+    return WEXITSTATUS(status) == 128 + SIGINT || WEXITSTATUS(status) == 128 + SIGTERM;
   return WIFSIGNALED(status) && (WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM);
 }
 
 // Blocks SIGINT and SIGTERM while alive: a signal arriving between the
-// Interrupted() check and the registration of a new child is delivered after
-// it, and so forwarded to that child too.
+// hooks' Stopped() check and ChildStarted() of a new child is delivered after
+// it, and so forwarded to that child too (by a caller that forwards signals).
 class BlockInterrupts {
  public:
   BlockInterrupts() {
@@ -105,49 +102,6 @@ pid_t Spawn(const std::string& program, const Job& job) {
   return rc == 0 ? pid : -1;
 }
 
-// "[12/40] done 11, failed 1, running 2": rewritten in place on a terminal,
-// one plain line per finished item otherwise.
-class Progress {
- public:
-  Progress(bool enabled, const std::string& what, int total, int skipped)
-      : tty_(enabled && isatty(STDERR_FILENO)),
-        enabled_(enabled),
-        what_(what),
-        total_(total),
-        skipped_(skipped) {}
-  void Running(int n) {
-    running_ = n;
-    if (tty_) Draw();
-  }
-  void Stopped(const std::string& name) {
-    ++stopped_;
-    if (!tty_ && enabled_) std::fprintf(stderr, "%s %s interrupted\n", what_.c_str(), name.c_str());
-  }
-  void Finished(const std::string& name, bool ok, double wall_s) {
-    (ok ? done_ : failed_)++;
-    if (tty_)
-      Draw();
-    else if (enabled_)
-      std::fprintf(stderr, "[%d/%d] %s %s %s (%.1f s)\n", skipped_ + done_ + failed_, total_,
-                   what_.c_str(), name.c_str(), ok ? "done" : "FAILED", wall_s);
-  }
-  ~Progress() {
-    if (drawn_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  void Draw() {
-    std::fprintf(stderr, "\r[%d/%d] %s: done %d, failed %d, running %d   ",
-                 skipped_ + done_ + failed_, total_, what_.c_str(), skipped_ + done_, failed_,
-                 running_);
-    drawn_ = true;
-  }
-  bool tty_, enabled_;
-  std::string what_;
-  int total_, skipped_, done_ = 0, failed_ = 0, running_ = 0, stopped_ = 0;
-  bool drawn_ = false;
-};
-
 struct JobCounts {
   int ok = 0, failed = 0, stopped = 0;  // stopped: by a signal, discarded
   void Add(bool good) { (good ? ok : failed)++; }
@@ -155,32 +109,32 @@ struct JobCounts {
 
 // Starts a job; false when it did not start (recorded by prepare() or
 // finish(-1)). Called with signals blocked (BlockInterrupts).
-bool Start(Job& job, const RunnerOptions& options, Progress* progress, JobCounts* counts,
+bool Start(Job& job, const RunnerOptions& options, RunnerHooks* hooks, JobCounts* counts,
            pid_t* pid_out) {
   if (job.prepare && !job.prepare()) {  // recorded as failed by prepare()
     counts->Add(false);
-    progress->Finished(job.name, false, 0.0);
+    hooks->Finished(job.name, false, 0.0);
     return false;
   }
   const pid_t pid = Spawn(options.rvlio_bin, job);
-  if (pid < 0 || !AddForwardPid(pid)) {
-    if (pid > 0) {  // more children than the forwarding table holds: not started
+  if (pid < 0 || !hooks->ChildStarted(pid)) {
+    if (pid > 0) {  // more children than the caller follows: not started
       ::kill(pid, SIGKILL);
       ::waitpid(pid, nullptr, 0);
     }
     const bool good = job.finish(-1, 0.0);
     counts->Add(good);
-    progress->Finished(job.name, good, 0.0);
+    hooks->Finished(job.name, good, 0.0);
     return false;
   }
   *pid_out = pid;
   return true;
 }
 
-// Runs the jobs `parallel` at a time. After a signal (forwarded to the
-// running children by the handler) no job starts; the running ones end, and
+// Runs the jobs `parallel` at a time. After a stop (a signal the caller
+// forwards to the running children) no job starts; the running ones end, and
 // those the signal stopped are discarded.
-JobCounts RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress* progress) {
+JobCounts RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, RunnerHooks* hooks) {
   struct Running {
     size_t index;
     Clock::time_point t0;
@@ -189,16 +143,16 @@ JobCounts RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress
   size_t next = 0;
   JobCounts counts;
   const size_t parallel = static_cast<size_t>(std::max(1, options.jobs));
-  while ((next < jobs.size() && !Interrupted()) || !running.empty()) {
+  while ((next < jobs.size() && !hooks->Stopped()) || !running.empty()) {
     {
       BlockInterrupts block;
-      for (; running.size() < parallel && next < jobs.size() && !Interrupted(); ++next) {
+      for (; running.size() < parallel && next < jobs.size() && !hooks->Stopped(); ++next) {
         pid_t pid = -1;
-        if (Start(jobs[next], options, progress, &counts, &pid))
+        if (Start(jobs[next], options, hooks, &counts, &pid))
           running[pid] = {next, Clock::now()};
       }
     }
-    progress->Running(static_cast<int>(running.size()));
+    hooks->Running(static_cast<int>(running.size()));
     if (running.empty()) continue;
     int status = 0;
     const pid_t pid = waitpid(-1, &status, 0);
@@ -206,21 +160,21 @@ JobCounts RunJobs(std::vector<Job>& jobs, const RunnerOptions& options, Progress
       if (errno == EINTR) continue;
       break;  // ECHILD: nothing left to wait for
     }
-    RemoveForwardPid(pid);
+    hooks->ChildEnded(pid);
     auto it = running.find(pid);
     if (it == running.end()) continue;
     const double wall = std::chrono::duration<double>(Clock::now() - it->second.t0).count();
     Job& job = jobs[it->second.index];
     running.erase(it);
-    if (Interrupted() && StoppedBySignal(status)) {
+    if (hooks->Stopped() && StoppedBySignal(status)) {
       if (job.discard) job.discard();
       ++counts.stopped;
-      progress->Stopped(job.name);
+      hooks->StoppedItem(job.name);
       continue;
     }
     const bool good = job.finish(status, wall);
     counts.Add(good);
-    progress->Finished(job.name, good, wall);
+    hooks->Finished(job.name, good, wall);
   }
   return counts;
 }
@@ -255,34 +209,31 @@ std::string Describe(int status, int* exit_code) {
   return "ended abnormally";
 }
 
-// True when the cell finished (done or diverged); a failed write is an error line.
-bool Recorded(const StatusOr<CellStatus>& status) {
-  if (!status.ok())
-    std::fprintf(stderr, "rvlio ablate: error: %s\n", status.status().message().c_str());
-  return status.ok() && experiments::ablate::Finished(*status);
+// True when the cell finished (done or diverged); a failed write goes to the hooks.
+bool Recorded(const StatusOr<CellStatus>& status, RunnerHooks* hooks) {
+  if (!status.ok()) hooks->RecordError(status.status());
+  return status.ok() && Finished(*status);
 }
 
 // Records a cell that could not run because its data is missing or failed.
-bool RecordDataFailure(const Cell& cell, const DataItem& d) {
+bool RecordDataMissing(const Cell& cell, const DataItem& d, RunnerHooks* hooks) {
   std::error_code ec;
   fs::create_directories(cell.dir, ec);
-  return Recorded(
-      experiments::ablate::RecordDataFailure(cell, d, Tail(ReadFileText(d.dir + "/simulate.log"))));
+  return Recorded(RecordDataFailure(cell, d, Tail(ReadFileText(d.dir + "/simulate.log"))), hooks);
 }
 
-bool CellDone(const Cell& cell) {
-  return experiments::ablate::Finished(experiments::ablate::ReadCellStatus(cell));
-}
+bool CellDone(const Cell& cell) { return Finished(ReadCellStatus(cell)); }
 
-bool FinishCell(const Cell& cell, int status, double wall_s) {
+bool FinishCell(const Cell& cell, int status, double wall_s, const RunnerOptions& options,
+                RunnerHooks* hooks) {
   CellRunEnd end;
   int exit_code = -1;
   end.how = Describe(status, &exit_code);
   if (exit_code >= 0) end.exit_code = exit_code;
-  end.diverged = exit_code == kExitDiverged;  // ran to the end: metrics kept
+  end.diverged = exit_code == options.diverged_exit_code;  // ran to the end: metrics kept
   end.wall_s = wall_s;
   end.log_tail = Tail(ReadFileText(cell.dir + "/run.log"));
-  return Recorded(experiments::ablate::RecordCell(cell, end));
+  return Recorded(RecordCell(cell, end), hooks);
 }
 
 bool DataReady(const DataItem& d) {
@@ -326,23 +277,25 @@ Job DataJob(const DataItem& d) {
   return job;
 }
 
-Job CellJob(const Plan& plan, const Cell& cell) {
+Job CellJob(const Plan& plan, const Cell& cell, const RunnerOptions& options, RunnerHooks* hooks) {
   Job job;
   job.name = cell.id;
   job.args = cell.RunArgs();
   job.log = cell.dir + "/run.log";
-  job.prepare = [&plan, &cell] {
+  job.prepare = [&plan, &cell, hooks] {
     std::error_code ec;
     fs::create_directories(cell.dir, ec);
     fs::remove(cell.CellJson(), ec);
     fs::remove_all(cell.RunDir(), ec);
     if (cell.data_index >= 0 && !DataReady(plan.data[cell.data_index])) {
-      RecordDataFailure(cell, plan.data[cell.data_index]);
+      RecordDataMissing(cell, plan.data[cell.data_index], hooks);
       return false;
     }
     return true;
   };
-  job.finish = [&cell](int status, double wall) { return FinishCell(cell, status, wall); };
+  job.finish = [&cell, &options, hooks](int status, double wall) {
+    return FinishCell(cell, status, wall, options, hooks);
+  };
   job.discard = [&cell] {  // no half result: the cell runs again next time
     std::error_code ec;
     fs::remove(cell.CellJson(), ec);
@@ -353,10 +306,11 @@ Job CellJob(const Plan& plan, const Cell& cell) {
 
 // Runs the given jobs under one progress display; updates the counts.
 void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& what,
-              const RunnerOptions& options, RunCounts* counts) {
+              const RunnerOptions& options, RunnerHooks* hooks, RunCounts* counts) {
   if (jobs.empty()) return;
-  Progress progress(options.progress, what, total, skipped);
-  const JobCounts c = RunJobs(jobs, options, &progress);
+  hooks->BatchStarted(what, total, skipped);
+  const JobCounts c = RunJobs(jobs, options, hooks);
+  hooks->BatchEnded();
   if (counts != nullptr) {
     counts->done += c.ok;
     counts->failed += c.failed;
@@ -367,7 +321,9 @@ void RunBatch(std::vector<Job> jobs, int total, int skipped, const std::string& 
 
 }  // namespace
 
-RunCounts RunPlan(const Plan& plan, const RunnerOptions& options) {
+RunCounts RunPlan(const Plan& plan, const RunnerOptions& options, RunnerHooks* hooks) {
+  RunnerHooks none;
+  if (hooks == nullptr) hooks = &none;
   RunCounts counts;
   counts.total = static_cast<int>(plan.cells.size());
   // Data needed by a cell that is not finished yet.
@@ -379,7 +335,7 @@ RunCounts RunPlan(const Plan& plan, const RunnerOptions& options) {
       continue;
     }
     if (c.data_index >= 0) needed[c.data_index] = true;
-    cell_jobs.push_back(CellJob(plan, c));
+    cell_jobs.push_back(CellJob(plan, c, options, hooks));
   }
   std::vector<Job> data_jobs;
   int data_total = 0, data_skipped = 0;
@@ -391,17 +347,19 @@ RunCounts RunPlan(const Plan& plan, const RunnerOptions& options) {
     else
       data_jobs.push_back(DataJob(plan.data[i]));
   }
-  RunBatch(std::move(data_jobs), data_total, data_skipped, "data", options, nullptr);
-  RunBatch(std::move(cell_jobs), counts.total, counts.skipped, "cell", options, &counts);
+  RunBatch(std::move(data_jobs), data_total, data_skipped, "data", options, hooks, nullptr);
+  RunBatch(std::move(cell_jobs), counts.total, counts.skipped, "cell", options, hooks, &counts);
   return counts;
 }
 
 bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& options,
-            RunCounts* counts) {
+            RunnerHooks* hooks, RunCounts* counts) {
+  RunnerHooks none;
+  if (hooks == nullptr) hooks = &none;
   for (const DataItem& d : plan.data)
     if (d.id == id) {
       if (!DataReady(d))
-        RunBatch({DataJob(d)}, 1, 0, "data", options, counts);
+        RunBatch({DataJob(d)}, 1, 0, "data", options, hooks, counts);
       else if (counts != nullptr)
         ++counts->skipped;
       return true;
@@ -416,11 +374,11 @@ bool RunOne(const Plan& plan, const std::string& id, const RunnerOptions& option
       // Simulate missing data (not data that already failed: parallel
       // Snakemake cell jobs of one sequence must not simulate it twice).
       if (c.data_index >= 0 && !fs::exists(plan.data[c.data_index].Marker()))
-        RunBatch({DataJob(plan.data[c.data_index])}, 1, 0, "data", options, nullptr);
-      RunBatch({CellJob(plan, c)}, 1, 0, "cell", options, counts);
+        RunBatch({DataJob(plan.data[c.data_index])}, 1, 0, "data", options, hooks, nullptr);
+      RunBatch({CellJob(plan, c, options, hooks)}, 1, 0, "cell", options, hooks, counts);
       return true;
     }
   return false;
 }
 
-}  // namespace rvlio::cli::ablate
+}  // namespace rvlio::experiments::ablate
