@@ -1,4 +1,3 @@
-#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/window/window.h"
 
 #include <algorithm>
@@ -15,12 +14,13 @@
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/constraints/robust_kernel.h"
-#include "rvlio/math/so3.h"
 #include "rvlio/factors/imu_factor.h"
 #include "rvlio/factors/plane_extrinsic_factor.h"
-#include "rvlio/factors/plane_time_offset_factor.h"
 #include "rvlio/factors/plane_summary_factor.h"
+#include "rvlio/factors/plane_time_offset_factor.h"
 #include "rvlio/factors/pose_projected_factor.h"
+#include "rvlio/lidar/extrinsics.h"
+#include "rvlio/math/so3.h"
 
 namespace rvlio {
 
@@ -685,10 +685,6 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   nodes_.pop_front();
   return out;
 }
-
-}  // namespace rvlio
-
-namespace rvlio {
 
 void SlidingWindow::CountExcitationScan() {
   if (nodes_.empty()) return;

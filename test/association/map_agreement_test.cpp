@@ -15,7 +15,7 @@
 #include "rvlio/map/voxel_map.h"
 #include "rvlio/sim/presets.h"
 #include "rvlio/sim/simulator.h"
-#include "rvlio/refine/refine_map.h"
+#include "rvlio/refine/map.h"
 
 namespace rvlio {
 namespace {

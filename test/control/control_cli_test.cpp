@@ -13,7 +13,7 @@
 #include "rvlio/math/pose_interpolation.h"
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/formats/trajectory_io.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/states.h"
 
 namespace rvlio {
 namespace {
@@ -261,11 +261,7 @@ TEST_F(ControlCli, SimulatedMarksAndBadControlFilesRefusedWithOneLineNothingWrit
   EXPECT_FALSE(fs::exists(out));
 }
 
-}  // namespace
-}  // namespace rvlio
 
-namespace rvlio {
-namespace {
 
 // A 40 s flight through an 8 m tunnel open at both ends: out of the entrance,
 // back in to land on a mark 3 m inside, and out beyond the far portal. GNSS

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/odometry/divergence.h"
-#include "rvlio/refine/refine_divergence.h"
+#include "rvlio/refine/divergence.h"
 
 namespace rvlio {
 namespace {

@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_map.h"
+#include "rvlio/refine/map.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_chunks.h"
+#include "rvlio/refine/chunks.h"
 
 #include <algorithm>
 #include <cmath>

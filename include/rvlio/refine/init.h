@@ -3,7 +3,7 @@
 // "Initialization"). Which scans are refined, the gravity vector and the
 // gyro bias to start from, and each scan's initial state from the initial
 // trajectory. The IMU-only velocity and bias solve that follows is in
-// refine_problem.h (SolveVelocityAndBias).
+// refine/problem.h (SolveVelocityAndBias).
 #include <string>
 #include <vector>
 
@@ -13,7 +13,7 @@
 #include "rvlio/common/types.h"
 #include "rvlio/imu/options.h"
 #include "rvlio/refine/refine.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/states.h"
 
 namespace rvlio {
 

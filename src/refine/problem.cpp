@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_problem.h"
+#include "rvlio/refine/problem.h"
 
 #include <algorithm>
 #include <cmath>

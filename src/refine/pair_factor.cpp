@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_pair_factor.h"
+#include "rvlio/refine/pair_factor.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_divergence.h"
+#include "rvlio/refine/divergence.h"
 
 #include <cmath>
 #include <cstddef>

@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_init.h"
+#include "rvlio/refine/init.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // (refine/refine.h, "Solve"). One Ceres problem per chunk: PoseBlock +
 // SpeedBiasBlock per scan, ImuFactor between consecutive scans (preintegrated
 // at the current biases), each scan's plane factors from the association
-// round (refine_association.h), the chunk's first pose held (gauge, or the
+// round (refine/association.h), the chunk's first pose held (gauge, or the
 // previous chunk's result). Linear solver SPARSE_NORMAL_CHOLESKY with
 // SuiteSparse CHOLMOD, Eigen's sparse Cholesky when Ceres lacks it. The
 // IMU-only velocity and bias solve of the initialization uses the same
@@ -19,10 +19,10 @@
 
 #include "rvlio/imu/noise.h"
 #include "rvlio/factors/manifolds.h"
-#include "rvlio/refine/refine_association.h"
-#include "rvlio/refine/refine_chunks.h"
-#include "rvlio/refine/refine_init.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/association.h"
+#include "rvlio/refine/chunks.h"
+#include "rvlio/refine/init.h"
+#include "rvlio/refine/states.h"
 
 namespace rvlio {
 

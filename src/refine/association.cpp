@@ -1,5 +1,4 @@
-#include "rvlio/constraints/robust_kernel.h"
-#include "rvlio/refine/refine_association.h"
+#include "rvlio/refine/association.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +7,7 @@
 #endif
 
 #include "rvlio/common/parallel.h"
+#include "rvlio/constraints/robust_kernel.h"
 
 namespace rvlio {
 

@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/states.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rvlio/refine/refine_jobs.h"
+#include "rvlio/refine/jobs.h"
 
 #include <algorithm>
 #include <cmath>

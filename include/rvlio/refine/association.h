@@ -1,7 +1,7 @@
 #pragma once
 // Batch refinement, step 2: the association round (refine/refine.h, "Each
 // outer round"). Deskew every scan at its current state, build the
-// leave-one-out map of all scans (refine_map.h), then per scan of a chunk:
+// leave-one-out map of all scans (refine/map.h), then per scan of a chunk:
 // associate against the map, RV (rv/rv.h), Huber IRLS weights, and split the
 // constraints into the scan's plane factors: planes attached to their source
 // scans (ScanPairPlaneFactor) or world-fixed (PlaneFactor), the latter
@@ -25,11 +25,11 @@
 #include "rvlio/factors/plane_summary_factor.h"
 #include "rvlio/factors/pose_projected_factor.h"
 #include "rvlio/refine/refine.h"
-#include "rvlio/refine/refine_chunks.h"
-#include "rvlio/refine/refine_init.h"
-#include "rvlio/refine/refine_map.h"
-#include "rvlio/refine/refine_pair_factor.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/chunks.h"
+#include "rvlio/refine/init.h"
+#include "rvlio/refine/map.h"
+#include "rvlio/refine/pair_factor.h"
+#include "rvlio/refine/states.h"
 
 namespace rvlio {
 
@@ -65,7 +65,7 @@ void ReleaseAssociatedScans(const ScanRange& chunk, int next_begin, RefineRoundM
 
 // The plane factors of one scan: world-fixed planes (PlaneFactor, or
 // PlaneSummaryFactor), and planes attached to their source scans
-// (refine_pair_factor.h: ScanPairPlaneFactor, or ScanPairSummaryFactor), one
+// (refine/pair_factor.h: ScanPairPlaneFactor, or ScanPairSummaryFactor), one
 // factor per source. With refine.summarize_pairs a group of at
 // least kRefineSummaryMinConstraints constraints becomes a summary: below,
 // the summary's fixed size (~3 KB with Ceres' Jacobian) exceeds the ~190 B

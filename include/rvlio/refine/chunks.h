@@ -3,7 +3,7 @@
 // ranges solved one after the other in a round. Each chunk after the first
 // starts `overlap` scans before the previous one ends and holds its first
 // pose at the previous chunk's result; the map always spans the sequence.
-// A chunk is the unit a solve works on (refine_problem.h) and the unit a
+// A chunk is the unit a solve works on (refine/problem.h) and the unit a
 // bounded-memory or distributed refine would hand out.
 #include <vector>
 
