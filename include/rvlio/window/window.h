@@ -10,7 +10,8 @@
 //     SpeedBiasContinuityFactor instead (prior_factor.h);
 //   - one plane factor per state with that scan's point-to-plane constraints
 //     (PlaneSummaryFactor: PlaneFactor's cost in 13 exact residuals,
-//     plane_summary_factor.h). Per-point information = Constraint::weight / sigma^2
+//     plane_summary_factor.h; its kind, chosen once from the options, makes
+//     it and names its blocks: src/window/scan_factor.h). Per-point information = Constraint::weight / sigma^2
 //     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
 //     min(1, sliding_window_huber_delta / |r|) at the pose of association);
 //   - with degeneracy.method localizability or regularized (and remap in
