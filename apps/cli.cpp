@@ -118,14 +118,6 @@ int Parse(const CommandSpec& spec, int argc, char** argv, int first, Args* out) 
   return 0;
 }
 
-}  // namespace rvlio::cli
-
-namespace rvlio::cli {
-int EngineComesLater(const CommandSpec& spec, int argc, char** argv, const std::string& what) {
-  Args args;
-  if (int rc = Parse(spec, argc, argv, 2, &args); rc != 0) return rc < 0 ? 0 : rc;
-  return Fail(spec.name, "this build has no " + what + " yet; it lands with a later issue", 2);
-}
 bool ParseWholeNumber(const std::string& text, long long min, long long max, long long* value) {
   char* end = nullptr;
   errno = 0;

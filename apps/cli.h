@@ -74,9 +74,3 @@ class ProgressLine {
 };
 
 }  // namespace rvlio::cli
-
-namespace rvlio::cli {
-// For a subcommand whose engine lands with a later issue: parses the options
-// (so --help works and typos are caught) and then exits 2 saying so.
-int EngineComesLater(const CommandSpec& spec, int argc, char** argv, const std::string& what);
-}  // namespace rvlio::cli

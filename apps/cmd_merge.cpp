@@ -1,6 +1,6 @@
 // `rvlio merge`: MergeRefineChunks (rvlio/api.h) with the command's arguments
 // and lines: the output folders of `rvlio refine --chunk K --of N` (K = 1..N)
-// into one trajectory.tum, map.pcd and summary.json (refine/refine_jobs.h:
+// into one trajectory.tum, map.pcd and summary.json (refine/jobs.h:
 // each chunk aligned to the previous one on their shared scans and blended
 // across them).
 #include <cstdio>

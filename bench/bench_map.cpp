@@ -271,12 +271,7 @@ void BM_LookupStdUnorderedMap(benchmark::State& state) {
 }
 BENCHMARK(BM_LookupStdUnorderedMap);
 
-}  // namespace
-}  // namespace rvlio
 
-BENCHMARK_MAIN();
-namespace rvlio {
-namespace {
 void BM_KNearestHot(benchmark::State& state) {
   const Fixture& f = GetFixture();
   std::vector<Eigen::Vector3d> queries;
@@ -291,3 +286,5 @@ void BM_KNearestHot(benchmark::State& state) {
 BENCHMARK(BM_KNearestHot);
 }  // namespace
 }  // namespace rvlio
+
+BENCHMARK_MAIN();

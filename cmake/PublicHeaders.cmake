@@ -78,8 +78,8 @@ set(rvlio_public_headers
   rvlio/refine/control_options.h
   rvlio/refine/options.h
   rvlio/refine/refine.h
-  rvlio/refine/refine_jobs.h
-  rvlio/refine/refine_states.h
+  rvlio/refine/jobs.h
+  rvlio/refine/states.h
   rvlio/rv/criterion.h
   rvlio/rv/options.h
   rvlio/rv/rv.h

@@ -176,7 +176,7 @@ def config_seeds(sim_yaml):
                       ["rv.eps0=0.3", "extrinsics.imu_T_lidar.translation=[0.1,0,0.05]",
                        "backend=smoother"]))
     write("config", "simulated_sensor_yaml", config_seed(read(sim_yaml), ["lidar.type=ouster"]))
-    # Inputs of bugs the fuzzer found (fixed; test/fuzzregress).
+    # Inputs of bugs the fuzzer found (fixed; test/formats/fuzzregress).
     write("config", "recursive_alias", config_seed(b"a: &x [*x]\n"))
     bomb = ["a0: &a0 [1,1,1,1,1,1,1,1,1,1]"]
     for i in range(1, 6):
@@ -224,7 +224,7 @@ def trajectory_seeds(gt_tum):
     write("trajectory", "kitti_10hz", trajectory_seed(1, kitti))
     write("trajectory", "kitti_with_times", trajectory_seed(2, kitti, times="\n".join(stamps) + "\n"))
     write("trajectory", "kitti_detected", trajectory_seed(3, kitti))
-    # Inputs of bugs the fuzzer found (fixed; test/fuzzregress).
+    # Inputs of bugs the fuzzer found (fixed; test/formats/fuzzregress).
     write("trajectory", "tum_huge_quaternion", trajectory_seed(0, "0 0 0 0 1e200 1e200 1e200 1e200\n"))
     write("trajectory", "kitti_tiny_rate", trajectory_seed(1, kitti, rate_pick=4))
 

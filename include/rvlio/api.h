@@ -38,7 +38,7 @@
 #include "rvlio/config/configuration.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/refine/refine.h"
-#include "rvlio/refine/refine_jobs.h"
+#include "rvlio/refine/jobs.h"
 #include "rvlio/version.h"
 
 namespace rvlio {
@@ -144,7 +144,7 @@ struct RefineArgs {
   StopFn stop;  // polled while reading and between rounds: the last completed round is the result
   std::function<void(const RefineRound&)> on_round;  // after each round
   std::function<void(int rounds_done)> on_resume;    // a checkpoint was loaded
-  // Chunk job (`rvlio refine --chunk K --of N`, refine/refine_jobs.h): when
+  // Chunk job (`rvlio refine --chunk K --of N`, refine/jobs.h): when
   // chunk_count > 0, refines only chunk `chunk` (1-based) of chunk_count
   // chunks of the initial trajectory's span, overlapping by
   // refine.job_overlap_s; only that chunk's scans (and the IMU
@@ -233,7 +233,7 @@ struct MergeResult {
 // InvalidInput (one line naming the folder or the chunk) for a folder without
 // a readable chunk.json, trajectory.tum or map.pcd, chunks of different N,
 // options, initial trajectory or overlap, a chunk given twice, a missing
-// chunk K, or neighbours that share too few poses (refine/refine_jobs.h);
+// chunk K, or neighbours that share too few poses (refine/jobs.h);
 // and for a `map` that is not the one the chunks were refined with (by
 // content) or chunks refined without one.
 StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args);

@@ -1,4 +1,4 @@
-"""The Python API with the bad inputs of the command-line matrix (test/badinput):
+"""The Python API with the bad inputs of the command-line matrix (test/cli/badinput):
 the same refusals and the same marks, raised as exceptions."""
 import os
 

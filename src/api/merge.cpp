@@ -1,5 +1,5 @@
 // MergeRefineChunks (rvlio/api.h): the output folders of `rvlio refine
-// --chunk K --of N` into one trajectory and map (refine/refine_jobs.h for
+// --chunk K --of N` into one trajectory and map (refine/jobs.h for
 // the alignment and the blend). `rvlio merge` is this call plus arguments.
 #include <algorithm>
 #include <cmath>
@@ -23,7 +23,7 @@
 #include "rvlio/outputs/summary_json.h"
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/map/output_map.h"
-#include "rvlio/refine/refine_jobs.h"
+#include "rvlio/refine/jobs.h"
 
 namespace rvlio {
 namespace {

@@ -4,6 +4,8 @@
 // trajectory (refine/refine.h) and, given an output folder, writes
 // trajectory.tum, map.pcd and summary.json atomically. `rvlio refine` is this
 // call plus argument parsing, signals and the terminal lines.
+#include "rvlio/api.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -11,28 +13,27 @@
 #include <optional>
 #include <utility>
 
-#include "rvlio/math/pose_interpolation.h"
-#include "rvlio/common/cpu_time.h"
-#include "rvlio/api.h"
-#include "rvlio/formats/atomic_file.h"
-#include "rvlio/lidar/extrinsics.h"
-#include "rvlio/outputs/output_stage.h"
-#include "rvlio/outputs/deviation_outputs.h"
-#include "rvlio/formats/reference_map_file.h"
 #include "rvlio/api/refine_checkpoint.h"
 #include "rvlio/api/survey_ties.h"
-#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/common/cpu_time.h"
+#include "rvlio/formats/atomic_file.h"
+#include "rvlio/formats/reference_map_file.h"
 #include "rvlio/formats/sensor_bag.h"
-#include "rvlio/outputs/summary_json.h"
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/imu/imu_rate_trajectory.h"
 #include "rvlio/lidar/deskew.h"
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/lidar/preprocess.h"
+#include "rvlio/math/pose_interpolation.h"
 #include "rvlio/math/so3.h"
 #include "rvlio/odometry/reference.h"
-#include "rvlio/refine/refine_divergence.h"
-#include "rvlio/refine/refine_states.h"
-#include "rvlio/refine/refine_jobs.h"
+#include "rvlio/outputs/deviation_outputs.h"
+#include "rvlio/outputs/output_stage.h"
+#include "rvlio/outputs/run_outputs.h"
+#include "rvlio/outputs/summary_json.h"
+#include "rvlio/refine/divergence.h"
+#include "rvlio/refine/jobs.h"
+#include "rvlio/refine/states.h"
 
 namespace rvlio {
 namespace {
@@ -76,7 +77,7 @@ struct ScansSeen {
 // A chunk job keeps the IMU samples around its scans and, as the whole
 // refinement, those of the recording's first imu.init_duration (from
 // `static_end_ns` on: the static alignment that gives gravity and the gyro
-// bias, refine_init.h), so every chunk starts from the same gravity vector.
+// bias, refine/init.h), so every chunk starts from the same gravity vector.
 bool KeepImu(const RefineJobSpan* job, TimeNs static_end_ns, TimeNs t_ns) {
   if (job == nullptr || t_ns <= static_end_ns) return true;
   return (job->chunk == 1 || t_ns >= job->begin_ns - kChunkImuMarginNs) &&

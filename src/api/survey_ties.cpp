@@ -413,10 +413,6 @@ nlohmann::json SurveyTies::SurveyJson(const std::string& crs) const {
 
 nlohmann::json SurveyTies::ControlJson() const { return ControlSummaryJson(residuals_); }
 
-}  // namespace rvlio
-
-namespace rvlio {
-
 uint64_t SurveyTies::ContentHash() const {
   Fnv1a h;
   for (const ControlRow& row : rows_) {

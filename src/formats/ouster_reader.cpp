@@ -7,7 +7,8 @@
 #include "ouster_source.h"
 #include "sensor_reader_common.h"
 
-namespace rvlio::bag_detail {
+namespace rvlio {
+namespace bag_detail {
 
 OusterPacketDecoder::OusterPacketDecoder(OusterMetadata meta, std::string metadata_origin,
                                          const LidarOptions& lidar)
@@ -251,9 +252,16 @@ StatusOr<OusterRecordingInfo> ReadOusterRecordingInfo(const std::string& path, R
   return info;
 }
 
-}  // namespace rvlio::bag_detail
+StatusOr<std::unique_ptr<SensorBagReader>> OpenOusterReader(
+    std::unique_ptr<OusterPacketSource> source, const LidarOptions& lidar, const ImuOptions& imu) {
+  auto reader = std::make_unique<OusterSensorReader>(std::move(source), lidar, imu);
+  if (Status s = reader->Init(); !s.ok()) return s;
+  return std::unique_ptr<SensorBagReader>(std::move(reader));
+}
 
-namespace rvlio {
+
+}  // namespace bag_detail
+
 
 void ApplyOusterExtrinsics(const OusterMetadata& meta, const std::string& origin,
                            ExtrinsicsSection* extrinsics, std::vector<std::string>* notes) {
@@ -293,14 +301,3 @@ Status ApplyRecordingExtrinsics(const std::string& path, const LidarOptions& lid
 }
 
 }  // namespace rvlio
-
-namespace rvlio::bag_detail {
-
-StatusOr<std::unique_ptr<SensorBagReader>> OpenOusterReader(
-    std::unique_ptr<OusterPacketSource> source, const LidarOptions& lidar, const ImuOptions& imu) {
-  auto reader = std::make_unique<OusterSensorReader>(std::move(source), lidar, imu);
-  if (Status s = reader->Init(); !s.ok()) return s;
-  return std::unique_ptr<SensorBagReader>(std::move(reader));
-}
-
-}  // namespace rvlio::bag_detail

@@ -9,18 +9,12 @@
 #include "rvlio/common/check.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/math/so3.h"
+#include "state_policies.h"
 
 namespace rvlio {
 namespace {
 
-using Matrix12d = Eigen::Matrix<double, 12, 12>;
-using Vector12d = Eigen::Matrix<double, 12, 1>;
 using Matrix24x12d = Eigen::Matrix<double, 24, 12>;
-using Matrix16d = Eigen::Matrix<double, 16, 16>;
-using Vector16d = Eigen::Matrix<double, 16, 1>;
-using Matrix25d = Eigen::Matrix<double, 25, 25>;
-using Vector25d = Eigen::Matrix<double, 25, 1>;
-constexpr int kTimeOffsetIndex = FilterState::kDim;  // the augmented error-state entry
 
 // Fixed extrinsics: a tiny std keeps P invertible; no update touches the block.
 constexpr double kFixedExtrinsicStd = 1e-5;  // rad and m
@@ -53,64 +47,6 @@ bool IsHealthy(const FilterState& x, const Matrix24d& P) {
     return false;
   // Exploding covariance: a position std of kilometres means the filter lost it.
   return P.diagonal().maxCoeff() < 1e6 && P.diagonal().minCoeff() > -1e-9;
-}
-
-// Accumulates H^T R^-1 H and H^T R^-1 z over the constraints (paper Eq. 1).
-// Columns: [dtheta, dp] and, when extrinsics are estimated, [dphi, dt].
-int AccumulateNormalEquations(const ConstraintList& constraints, const FilterState& x,
-                              bool with_extrinsics, double inv_sigma2, Matrix12d* HtRinvH,
-                              Vector12d* HtRinvz, double* zRinvz) {
-  HtRinvH->setZero();
-  HtRinvz->setZero();
-  *zRinvz = 0.0;
-  const Pose3 T_world_imu = x.T_world_imu(), T_imu_lidar = x.T_imu_lidar();
-  Eigen::Matrix<double, 1, 12> h;
-  for (const Constraint& c : constraints) {
-    const double r = PointToPlaneResidualWithExtrinsics(c, T_world_imu, T_imu_lidar, &h);
-    const double w = c.weight * inv_sigma2;
-    *zRinvz += w * r * r;
-    if (with_extrinsics) {
-      HtRinvH->noalias() += w * h.transpose() * h;
-      HtRinvz->noalias() += w * r * h.transpose();
-    } else {
-      const auto h6 = h.leftCols<6>();
-      HtRinvH->topLeftCorner<6, 6>().noalias() += w * h6.transpose() * h6;
-      HtRinvz->head<6>().noalias() += w * r * h6.transpose();
-    }
-  }
-  return static_cast<int>(constraints.size());
-}
-
-// The same with the time-offset columns (TimeOffsetJacobian): the sums of
-// the 12 columns at the scan-time pose (AccumulateNormalEquations, the same
-// per-constraint work as without the offset) mapped once to the 16 columns
-// [dtheta, dp, dphi, dt_ext, dv, d(td)] (ScanTimeLinearization::h_to_J);
-// extrinsic columns zero unless estimated.
-void AccumulateNormalEquationsWithTimeOffset(const ConstraintList& constraints,
-                                             const FilterState& x_scan,
-                                             const ScanTimeLinearization& lin,
-                                             bool with_extrinsics, double inv_sigma2,
-                                             Matrix16d* HtRinvH, Vector16d* HtRinvz,
-                                             double* zRinvz) {
-  Matrix12d H12;
-  Vector12d b12;
-  AccumulateNormalEquations(constraints, x_scan, with_extrinsics, inv_sigma2, &H12, &b12, zRinvz);
-  HtRinvH->noalias() = lin.h_to_J.transpose() * H12 * lin.h_to_J;
-  HtRinvz->noalias() = lin.h_to_J.transpose() * b12;
-}
-
-// A += E H E^T, b += E g for a column map E with one 1 per used column:
-// index[c] is the error-state row of column c, -1 for an unused column.
-template <int N, int C>
-void ScatterNormalEquations(const std::array<int, C>& index, const Eigen::Matrix<double, C, C>& H,
-                            const Eigen::Matrix<double, C, 1>& g,
-                            Eigen::Matrix<double, N, N>* A, Eigen::Matrix<double, N, 1>* b) {
-  for (int i = 0; i < C; ++i) {
-    if (index[i] < 0) continue;
-    (*b)(index[i]) += g(i);
-    for (int j = 0; j < C; ++j)
-      if (index[j] >= 0) (*A)(index[i], index[j]) += H(i, j);
-  }
 }
 
 void PropagateCovariance(const Matrix24d& F, const ImuOptions& imu, double dt_s, Matrix24d* P) {
@@ -153,15 +89,6 @@ Eigen::Vector3d LidarOnlyRotation(const MatrixC& HtRinvH, const VectorC& HtRinvz
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return unknown;
   const Eigen::Vector3d dtheta = -ldlt.solve(HtRinvz.template head<3>());
   return dtheta.allFinite() ? dtheta : unknown;
-}
-
-// The motion a scan's time offset is observed through (its Jacobian column
-// h_theta w + h_p v): below these, at rest within the IMU noise.
-constexpr double kTimeOffsetMinRate = 0.05;   // rad/s
-constexpr double kTimeOffsetMinSpeed = 0.05;  // m/s
-
-bool TimeOffsetObservable(const Eigen::Vector3d& v_world_imu, const ScanTimeMotion& motion) {
-  return motion.gyro_imu.norm() >= kTimeOffsetMinRate || v_world_imu.norm() >= kTimeOffsetMinSpeed;
 }
 
 // The degeneracy stage of one iteration on the pose block of the normal
@@ -220,20 +147,6 @@ Matrix24x12d ErrorStateColumns(const std::array<bool, 6>& free) {
   return E;
 }
 
-// The rows of TimeOffsetJacobian's 16 columns in the 25-dim augmented error
-// state [FilterState, td]; -1 for an extrinsic axis held fixed.
-static std::array<int, 16> TimeOffsetErrorStateRows(const std::array<bool, 6>& free) {
-  std::array<int, 16> rows{};
-  for (int i = 0; i < 3; ++i) {
-    rows[i] = FilterState::kRot + i;
-    rows[3 + i] = FilterState::kPos + i;
-    rows[12 + i] = FilterState::kVel + i;
-  }
-  for (int i = 0; i < 6; ++i) rows[6 + i] = free[i] ? FilterState::kExtRot + i : -1;
-  rows[15] = kTimeOffsetIndex;
-  return rows;
-}
-
 Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
              const ConstraintOptions& constraints, const RvOptions& rv, const LidarOptions& lidar,
              const DegeneracyOptions& degeneracy)
@@ -252,21 +165,20 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
   excitation_ = ExtrinsicExcitation(ExtrinsicPriorStd(options_));
   t_ns_ = t_ns;
   last_imu_ = last_imu;
-  td_s_ = td_lin_s_ = lidar_.time_offset;
-  scan_motion_ = ScanTimeMotion();
-  P_x_td_.setZero();
-  P_td_td_ = lidar_.estimate_time_offset ? lidar_.time_offset_init_std * lidar_.time_offset_init_std
-                                         : 0.0;
-  td_observed_ = false;
+  td_ = TimeOffsetEstimate();
+  td_.td_s = td_.td_lin_s = lidar_.time_offset;
+  td_.P_td_td = lidar_.estimate_time_offset
+                    ? lidar_.time_offset_init_std * lidar_.time_offset_init_std
+                    : 0.0;
   ClearPoseHistory();
 }
 
-double Ieskf::time_offset_std_s() const { return std::sqrt(std::max(P_td_td_, 0.0)); }
+double Ieskf::time_offset_std_s() const { return std::sqrt(std::max(td_.P_td_td, 0.0)); }
 
 void Ieskf::SetTimeOffset(double td_s, double std_s) {
-  td_s_ = td_lin_s_ = td_s;
-  P_x_td_.setZero();
-  P_td_td_ = std_s * std_s;
+  td_.td_s = td_.td_lin_s = td_s;
+  td_.P_x_td.setZero();
+  td_.P_td_td = std_s * std_s;
 }
 
 // A copy of the filter is propagated as Predict would: the state Update
@@ -357,8 +269,8 @@ void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu
 
   PropagateCovariance(F, imu_, dt_s, &P_);
   if (lidar_.estimate_time_offset) {
-    P_x_td_ = F * P_x_td_;  // the offset itself is constant: identity row
-    P_td_td_ += lidar_.time_offset_random_walk * lidar_.time_offset_random_walk * dt_s;
+    td_.P_x_td = F * td_.P_x_td;  // the offset itself is constant: identity row
+    td_.P_td_td += lidar_.time_offset_random_walk * lidar_.time_offset_random_walk * dt_s;
   }
   if (options_.estimate_extrinsics) {
     PropagateCovariance(F, imu_, dt_s, &P_all_extrinsic_);
@@ -382,8 +294,8 @@ void Ieskf::AddExtrinsicRandomWalk(double dt_s) {
 // which equals -K z - (I - K H) e of Eq. (1); the posterior covariance
 // (I - K H) Pv equals (H^T R^-1 H + Pv^-1)^-1.
 IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
-  if (lidar_.estimate_time_offset) return UpdateImpl<true>(associate);
-  return UpdateImpl<false>(associate);
+  if (lidar_.estimate_time_offset) return UpdateImpl<TimeOffsetState>(associate);
+  return UpdateImpl<NoTimeOffsetState>(associate);
 }
 
 // The motion held at the state's time: the newest pose sample's (the IMU
@@ -396,74 +308,30 @@ ScanTimeMotion Ieskf::MotionAtStateTime() const {
   return m;
 }
 
-// kTimeOffset: the error state is augmented with the time offset (index 24),
-// the residuals are taken at the scan's time (PointToPlaneResidualWithTimeOffset)
-// and the normal equations have the 16 columns of TimeOffsetJacobian. Without
-// it the 24-dim filter of paper Eq. (1) as it is.
-template <bool kTimeOffset>
+// StatePolicy: the optional states (state_policies.h), NoTimeOffsetState
+// or TimeOffsetState; the extrinsic columns from ExtrinsicColumnsNow().
+template <class StatePolicy>
 IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
-  constexpr int N = kTimeOffset ? 25 : 24;  // error-state dimension
-  constexpr int C = kTimeOffset ? 16 : 12;  // Jacobian columns
-  using MatrixN = Eigen::Matrix<double, N, N>;
-  using VectorN = Eigen::Matrix<double, N, 1>;
-  using MatrixC = Eigen::Matrix<double, C, C>;
-  using VectorC = Eigen::Matrix<double, C, 1>;
+  using MatrixN = typename StatePolicy::MatrixN;
+  using VectorN = typename StatePolicy::VectorN;
   IeskfUpdateResult result;
   result.degeneracy.method = degeneracy_.method;  // also when no iteration runs
   if (options_.estimate_extrinsics) ReleaseExcitedAxes();
   const FilterState x0 = x_;
-  MatrixN P0;
-  if constexpr (kTimeOffset) {
-    P0 << P_, P_x_td_, P_x_td_.transpose(), P_td_td_;
-    td_lin_s_ = td_s_;
-    scan_motion_ = MotionAtStateTime();
-  } else {
-    P0 = P_;
-  }
+  StatePolicy state(StateUpdateStart{P_, x0, ExtrinsicColumnsNow(), &td_, MotionAtStateTime(),
+                                     lidar_.time_offset_max});
+  const MatrixN P0 = state.Prior();
   const MatrixN P0_inv = P0.ldlt().solve(MatrixN::Identity());
-  const bool with_ext = options_.estimate_extrinsics;
   const double inv_sigma2 = 1.0 / (constraints_.lidar_noise * constraints_.lidar_noise);
-  const int cols = with_ext ? 12 : 6;
-  std::array<bool, 6> free{};
-  for (int i = 0; i < 6; ++i) free[i] = with_ext && excitation_.excited(i);
-  // Where the Jacobian columns go: ErrorStateColumns (24) or
-  // TimeOffsetErrorStateRows (25).
-  [[maybe_unused]] std::array<int, 16> td_rows{};
-  [[maybe_unused]] Matrix24x12d E;
-  if constexpr (kTimeOffset) {
-    td_rows = TimeOffsetErrorStateRows(free);
-    // At rest the offset's column (w, v) is IMU noise alone: no update of
-    // the offset (it would fit the noise and leave a confident wrong value
-    // for the motion to undo).
-    td_observed_ = TimeOffsetObservable(x0.v_world_imu, scan_motion_);
-    if (!td_observed_) td_rows[15] = -1;
-  } else {
-    E = ErrorStateColumns(free);
-  }
   Matrix24d J = Matrix24d::Identity();
 
   FilterState x = x0;
-  double td_s = td_s_;
-  // The state at the scan's time, as association, RV and the residuals see
-  // it; lin: the scan-time linearization of the iteration (kTimeOffset).
-  [[maybe_unused]] ScanTimeLinearization lin;
-  auto at_scan_time = [&](const FilterState& s) {
-    if constexpr (kTimeOffset) {
-      lin = LinearizeAtScanTime(s, scan_motion_, td_s - td_lin_s_);
-      FilterState moved = s;
-      moved.R_world_imu = lin.T_world_imu.R;
-      moved.p_world_imu = lin.T_world_imu.t;
-      return moved;
-    } else {
-      return s;
-    }
-  };
   MatrixN S = P0;
   ConstraintList constraints;
-  MatrixC HtRinvH;
-  VectorC HtRinvz;
+  typename StatePolicy::MatrixC HtRinvH;
+  typename StatePolicy::VectorC HtRinvz;
   for (int it = 0; it < options_.max_iterations; ++it) {
-    const FilterState x_scan = at_scan_time(x);
+    const FilterState x_scan = state.AtScanTime(x);
     associate(x_scan, &constraints);
     // Alg. 3: criterion, reinforcement, repair; a no-op edit when RV is off
     // (the report still carries the localizability figure).
@@ -471,40 +339,18 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
     result.num_constraints = static_cast<int>(constraints.size());
     if (result.num_constraints < kMinPoseConstraints) break;
     double zRinvz = 0.0;
-    if constexpr (kTimeOffset) {
-      AccumulateNormalEquationsWithTimeOffset(constraints, x_scan, lin, with_ext, inv_sigma2,
-                                              &HtRinvH, &HtRinvz, &zRinvz);
-    } else {
-      AccumulateNormalEquations(constraints, x, with_ext, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
-    }
+    state.Accumulate(constraints, x_scan, inv_sigma2, &HtRinvH, &HtRinvz, &zRinvz);
     const DegeneracyTreatment degeneracy =
         AnalyzeScanDegeneracy(degeneracy_, result.rv, HtRinvH, inv_sigma2, constraints, x_scan);
     result.degeneracy = degeneracy.report;
 
-    const Matrix24d J_inv = BoxminusJacobianInverse(x, x0);
     J = BoxminusJacobian(x, x0);
-    VectorN e;
-    MatrixN Jn;
-    if constexpr (kTimeOffset) {
-      e << J_inv * Boxminus(x, x0), td_s - td_s_;
-      Jn.setIdentity();
-      Jn.template topLeftCorner<24, 24>() = J;
-    } else {
-      e = J_inv * Boxminus(x, x0);
-      Jn = J;
-    }
+    const VectorN e = state.PriorError(BoxminusJacobianInverse(x, x0), x, x0);
+    const MatrixN Jn = state.Lift(J);
     const MatrixN Pv_inv = Jn.transpose() * P0_inv * Jn;
     MatrixN A = Pv_inv;
     VectorN b = Pv_inv * e;
-    if constexpr (kTimeOffset) {
-      ScatterNormalEquations<N, C>(td_rows, HtRinvH, HtRinvz, &A, &b);
-    } else if (with_ext) {
-      A.noalias() += E * HtRinvH * E.transpose();
-      b.noalias() += E * HtRinvz;
-    } else {
-      A.topLeftCorner(cols, cols) += HtRinvH.topLeftCorner(cols, cols);
-      b.head(cols) += HtRinvz.head(cols);
-    }
+    state.AddColumns(HtRinvH, HtRinvz, &A, &b);
     const Eigen::LDLT<MatrixN> ldlt(A);
     VectorN dx = -ldlt.solve(b);
     S = ldlt.solve(MatrixN::Identity());
@@ -517,7 +363,7 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
     // the plain posterior (docs/degeneracy.md).
     TreatIncrement(degeneracy_.method, degeneracy, inv_sigma2, A, b, &dx);
     x = Boxplus(x, dx.template head<24>());
-    if constexpr (kTimeOffset) td_s += dx(kTimeOffsetIndex);
+    state.Apply(dx);
     result.iterations = it + 1;
     result.last_step_norm = dx.norm();
     if (!dx.allFinite()) break;
@@ -525,30 +371,26 @@ IeskfUpdateResult Ieskf::UpdateImpl(const AssociateFn& associate) {
   }
   if (result.iterations == 0) return result;  // too few constraints: prediction only
   S = 0.5 * (S + S.transpose());
-  if (!IsHealthy(x, S.template topLeftCorner<24, 24>()) || !std::isfinite(td_s)) {
+  if (!IsHealthy(x, S.template topLeftCorner<24, 24>()) || !state.finite()) {
     result.diverged = true;  // keep the prior (x0, P0): the last good state
     return result;
   }
   x_ = x;
-  P_ = S.template topLeftCorner<24, 24>();
-  if constexpr (kTimeOffset) {
-    P_x_td_ = S.col(kTimeOffsetIndex).template head<24>();
-    P_td_td_ = S(kTimeOffsetIndex, kTimeOffsetIndex);
-    td_s_ = td_s;
-    HoldTimeOffsetInBound();
-  }
-  if (with_ext) UpdateExcitation(HtRinvH.template topLeftCorner<12, 12>(), J);
+  state.Commit(S, &P_);
+  if (options_.estimate_extrinsics) UpdateExcitation(HtRinvH.template topLeftCorner<12, 12>(), J);
   result.ok = true;
-  const FilterState x_scan = at_scan_time(x_);
+  const FilterState x_scan = state.AtScanTime(x_);
   result.residuals = ComputeResidualStats(constraints, x_scan.T_world_imu(), x_scan.T_imu_lidar());
   return result;
 }
 
-// An estimate past +-time_offset_max is held at the bound (and reported:
-// time_offset_at_bound()); the state's pose is left as the update made it.
-void Ieskf::HoldTimeOffsetInBound() {
-  const double bound_s = lidar_.time_offset_max;
-  if (std::abs(td_s_) > bound_s) td_s_ = std::copysign(bound_s, td_s_);
+// The extrinsic columns of this update: with estimate_extrinsics, the axes
+// excited so far.
+ExtrinsicColumns Ieskf::ExtrinsicColumnsNow() const {
+  ExtrinsicColumns c;
+  c.estimated = options_.estimate_extrinsics;
+  for (int i = 0; i < 6; ++i) c.free[i] = c.estimated && excitation_.excited(i);
+  return c;
 }
 
 // A held extrinsic axis carries the tiny kFixedExtrinsicStd in P (a loose

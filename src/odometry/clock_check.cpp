@@ -1,15 +1,15 @@
-#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/odometry/clock_check.h"
 
 #include <algorithm>
 #include <array>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "rvlio/common/median.h"
 #include "rvlio/constraints/plane_association.h"
 #include "rvlio/constraints/point_to_plane.h"
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/math/so3.h"
 
 namespace rvlio {

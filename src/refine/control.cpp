@@ -15,7 +15,7 @@
 #include "rvlio/factors/position_factor.h"
 #include "rvlio/math/pose_interpolation.h"
 #include "rvlio/math/so3.h"
-#include "rvlio/refine/refine_chunks.h"
+#include "rvlio/refine/chunks.h"
 
 namespace rvlio {
 

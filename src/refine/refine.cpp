@@ -1,9 +1,9 @@
 // Batch refinement: Deskew -> Map -> Associate -> RV -> Solve, a few rounds
 // (see refine.h). This file runs the rounds; the steps are
-//   refine_init.h         state initialization (scans, gravity, states),
-//   refine_association.h  the association round (deskew, map, plane factors),
-//   refine_problem.h      problem build and solve (chunks, IMU-only solve),
-//   refine_chunks.h       the chunks of a round.
+//   refine/init.h         state initialization (scans, gravity, states),
+//   refine/association.h  the association round (deskew, map, plane factors),
+//   refine/problem.h      problem build and solve (chunks, IMU-only solve),
+//   refine/chunks.h       the chunks of a round.
 #include "rvlio/refine/refine.h"
 
 #include <algorithm>
@@ -15,10 +15,10 @@
 #include "rvlio/common/parallel.h"
 #include "rvlio/imu/noise.h"
 #include "rvlio/map/output_map.h"
-#include "rvlio/refine/refine_association.h"
-#include "rvlio/refine/refine_chunks.h"
-#include "rvlio/refine/refine_init.h"
-#include "rvlio/refine/refine_problem.h"
+#include "rvlio/refine/association.h"
+#include "rvlio/refine/chunks.h"
+#include "rvlio/refine/init.h"
+#include "rvlio/refine/problem.h"
 
 namespace rvlio {
 namespace {

@@ -1,8 +1,8 @@
-#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/sim/simulator.h"
 
 #include <cmath>
 
+#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/sim/imu_sim.h"
 #include "rvlio/sim/random.h"
 

@@ -1,4 +1,3 @@
-#include "rvlio/lidar/extrinsics.h"
 #include "rvlio/window/window.h"
 
 #include <algorithm>
@@ -15,12 +14,12 @@
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/constraints/point_to_plane.h"
 #include "rvlio/constraints/robust_kernel.h"
-#include "rvlio/math/so3.h"
 #include "rvlio/factors/imu_factor.h"
-#include "rvlio/factors/plane_extrinsic_factor.h"
 #include "rvlio/factors/plane_time_offset_factor.h"
-#include "rvlio/factors/plane_summary_factor.h"
 #include "rvlio/factors/pose_projected_factor.h"
+#include "rvlio/lidar/extrinsics.h"
+#include "rvlio/math/so3.h"
+#include "scan_factor.h"
 
 namespace rvlio {
 
@@ -33,9 +32,9 @@ struct SlidingWindow::Node {
   RvReport rv;
   Pose3 associated_at;  // T_world_imu of the last association
   bool associated = false;
-  std::unique_ptr<PlaneSummaryFactor> plane;         // null: too few constraints
-  std::unique_ptr<PlaneExtrinsicFactor> plane_ext;   // instead of plane: estimate_extrinsics
-  std::unique_ptr<PlaneTimeOffsetFactor> plane_td;   // instead of plane: estimate_time_offset
+  // The scan's plane factor, of the window's ScanFactorKind (scan_factor.h);
+  // null: too few constraints, or its summary overflowed.
+  std::unique_ptr<ceres::CostFunction> plane;
   ScanTimeMotion motion;   // held at t_ns (estimate_time_offset)
   double td_lin_s = 0.0;   // the time offset the scan was deskewed with
   std::unique_ptr<ImuFactor> imu;                    // from the previous node, or null
@@ -48,18 +47,12 @@ struct SlidingWindow::Node {
   // used while the pose is tied to no other state (ScanCost).
   std::unique_ptr<PoseProjectedFactor> plane_remapped;
 
-  // The plane factor there is (plane, plane_ext or plane_td), or null.
-  const ceres::CostFunction* PlaneFactor() const {
-    if (plane) return plane.get();
-    if (plane_ext) return plane_ext.get();
-    return plane_td.get();
-  }
-  // The cost of the given plane factor in a solve or a marginalization.
+  // The cost of the plane factor in a solve or a marginalization.
   // tied: an IMU factor or a prior also ties the pose, so the projected form
   // leaves no direction free; untied (IMU gaps on both sides), the remapped
   // directions are held at the anchor instead.
-  ceres::CostFunction* ScanCost(ceres::CostFunction* plane_factor, bool tied) const {
-    return plane_remapped && tied ? plane_remapped.get() : plane_factor;
+  ceres::CostFunction* ScanCost(bool tied) const {
+    return plane_remapped && tied ? plane_remapped.get() : plane.get();
   }
   PosePriorFactor* DegeneracyPrior(bool tied) const {
     return plane_remapped && tied ? nullptr : degeneracy_prior.get();
@@ -155,7 +148,9 @@ ceres::LinearSolverType WindowLinearSolver(const std::string& name) {
 SlidingWindow::SlidingWindow(const WindowOptions& options)
     : options_(options),
       T_imu_lidar_config_(ImuTLidar(options.extrinsics)),
-      first_prior_(FirstPriorStd(options.ieskf)) {
+      first_prior_(FirstPriorStd(options.ieskf)),
+      scan_factor_kind_(MakeScanFactorKind(options.smoother.estimate_extrinsics,
+                                           options.lidar.estimate_time_offset)) {
   RVLIO_CHECK(options_.smoother.window_size >= 2);
   RVLIO_CHECK(options_.constraints.lidar_noise > 0.0 &&
               options_.smoother.sliding_window_huber_delta > 0.0);
@@ -362,33 +357,16 @@ void SlidingWindow::AssociateNode(const ScanAssociateFn& associate, Node* node) 
   node->associated_at = node->T_world_imu();
   node->associated = true;
   node->plane.reset();
-  node->plane_ext.reset();
-  node->plane_td.reset();
   ClearDegeneracy(node);
   if (static_cast<int>(node->constraints.size()) < kMinPoseConstraints) return;
-  if (!MakePlaneFactor(T_world_imu, node)) {
+  node->plane = scan_factor_kind_->Make({node->constraints, options_.constraints.lidar_noise,
+                                         T_imu_lidar_config_, node->motion, node->td_lin_s,
+                                         T_world_imu.t});
+  if (!node->plane) {
     RejectOverflowingScan(node);
     return;
   }
   TreatDegeneracy(degeneracy, node);
-}
-
-// The scan's plane factor at this association: a time-offset, extrinsic or
-// summary factor. False when its summary overflows.
-bool SlidingWindow::MakePlaneFactor(const Pose3& T_world_imu, Node* node) const {
-  if (estimate_time_offset()) {
-    node->plane_td = std::make_unique<PlaneTimeOffsetFactor>(
-        node->constraints, options_.constraints.lidar_noise, T_imu_lidar_config_, node->motion,
-        node->td_lin_s, T_world_imu.t);
-    return node->plane_td->finite();
-  }
-  if (estimate_extrinsics()) {
-    node->plane_ext = std::make_unique<PlaneExtrinsicFactor>(node->constraints, options_.constraints.lidar_noise);
-    return true;
-  }
-  node->plane = std::make_unique<PlaneSummaryFactor>(node->constraints, T_imu_lidar_config_,
-                                                     options_.constraints.lidar_noise, T_world_imu.t);
-  return node->plane->information().allFinite();
 }
 
 // remap, localizability, regularized: the scan's pose information at the
@@ -419,7 +397,7 @@ void SlidingWindow::TreatDegeneracy(const LeastSquaresDegeneracy& d, Node* node)
   if (options_.degeneracy.method == DegeneracyMethod::kRemap &&
       options_.degeneracy.remap_window_form == RemapWindowForm::kProject && d.num_held > 0)
     node->plane_remapped = std::make_unique<PoseProjectedFactor>(
-        node->PlaneFactor(), PoseBlock(node->associated_at), d.held_pose.leftCols(d.num_held));
+        node->plane.get(), PoseBlock(node->associated_at), d.held_pose.leftCols(d.num_held));
   if (d.has_prior)
     node->degeneracy_prior = std::make_unique<PosePriorFactor>(node->anchor, d.sqrt_information);
 }
@@ -437,8 +415,6 @@ void SlidingWindow::ClearDegeneracy(Node* node) const {
 void SlidingWindow::RejectOverflowingScan(Node* node) {
   ClearDegeneracy(node);
   node->plane.reset();
-  node->plane_ext.reset();
-  node->plane_td.reset();
   node->constraints.clear();
   node->associated = false;
   ++stats_.rejected_scans;
@@ -476,6 +452,12 @@ bool SlidingWindow::PoseTied(size_t k) const {
   return std::find(blocks.begin(), blocks.end(), nodes_[0]->pose) != blocks.end();
 }
 
+// The parameter blocks of a node's scan factor (ScanFactorKind::Blocks);
+// time_offset: the window's, or in a marginalization the leaving scan's.
+std::vector<double*> SlidingWindow::ScanBlocks(Node* node, double* time_offset) {
+  return scan_factor_kind_->Blocks({node->pose, node->sb, extrinsic_, time_offset});
+}
+
 bool SlidingWindow::SolveRound(WindowSolveReport* report) {
   RefreshImuFactors();
   Backup();
@@ -488,14 +470,7 @@ bool SlidingWindow::SolveRound(WindowSolveReport* report) {
     problem.AddParameterBlock(n.pose, PoseBlock::kNumParams, &pose_manifold_);
     problem.AddParameterBlock(n.sb, SpeedBiasBlock::kNumParams);
     if (n.plane) {
-      problem.AddResidualBlock(n.ScanCost(n.plane.get(), tied), nullptr, n.pose);
-      pose_used[k] = true;
-    } else if (n.plane_ext) {
-      problem.AddResidualBlock(n.ScanCost(n.plane_ext.get(), tied), nullptr, n.pose, extrinsic_);
-      pose_used[k] = true;
-    } else if (n.plane_td) {
-      problem.AddResidualBlock(n.ScanCost(n.plane_td.get(), tied), nullptr, n.pose, n.sb,
-                               time_offset_);
+      problem.AddResidualBlock(n.ScanCost(tied), nullptr, ScanBlocks(&n, time_offset_));
       pose_used[k] = true;
     }
     if (PosePriorFactor* prior = n.DegeneracyPrior(tied))
@@ -639,14 +614,11 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
     info.AddResidualBlock(marginal_prior_.get(), nullptr, blocks, dropped(blocks));
   }
   if (state_prior_) info.AddResidualBlock(state_prior_.get(), nullptr, {old.pose, old.sb}, {0, 1});
-  if (old.plane) info.AddResidualBlock(old.ScanCost(old.plane.get(), old_tied), nullptr, {old.pose}, {0});
-  if (old.plane_ext)
-    info.AddResidualBlock(old.ScanCost(old.plane_ext.get(), old_tied), nullptr, {old.pose, extrinsic_},
-                          {0});
+  if (old.plane) {
+    const std::vector<double*> blocks = ScanBlocks(&old, td_old);
+    info.AddResidualBlock(old.ScanCost(old_tied), nullptr, blocks, dropped(blocks));
+  }
   if (extrinsic_prior_) info.AddResidualBlock(extrinsic_prior_.get(), nullptr, {extrinsic_}, {});
-  if (old.plane_td)
-    info.AddResidualBlock(old.ScanCost(old.plane_td.get(), old_tied), nullptr, {old.pose, old.sb, td_old},
-                          dropped({old.pose, old.sb, td_old}));
   if (time_offset_prior_)
     info.AddResidualBlock(time_offset_prior_.get(), nullptr, {td_old}, dropped({td_old}));
   std::unique_ptr<TimeOffsetRandomWalkFactor> td_walk;
@@ -685,10 +657,6 @@ std::optional<MarginalizedScan> SlidingWindow::MarginalizeIfFull() {
   nodes_.pop_front();
   return out;
 }
-
-}  // namespace rvlio
-
-namespace rvlio {
 
 void SlidingWindow::CountExcitationScan() {
   if (nodes_.empty()) return;

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../cli/cli_util.h"
+#include "cli/cli_util.h"
 #include "rvlio/api.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "../cli/cli_util.h"
+#include "cli/cli_util.h"
 
 namespace rvlio::testing_cli {
 namespace {

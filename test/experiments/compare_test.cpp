@@ -17,7 +17,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "../cli/cli_util.h"
+#include "cli/cli_util.h"
 
 namespace rvlio {
 namespace {
@@ -275,7 +275,7 @@ TEST_F(CompareTest, FullCompareWritesTablesEqualToEvalAndPlots) {
   CheckNumbersEqualEval(out, Truth(), dir_);
   CheckAccuracyAndRefineStart(out);
   // report.html (docs/report.md) for the folder, its line on stdout; its
-  // contents are checked in test/report.
+  // contents are checked in test/experiments/report_*_test.cpp.
   EXPECT_TRUE(fs::is_regular_file(out + "/report.html"));
   EXPECT_NE(full.out.find("report: " + out + "/report.html"), std::string::npos) << full.out;
   if (!PlotScriptUsable()) {

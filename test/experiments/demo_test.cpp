@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../cli/cli_util.h"
+#include "cli/cli_util.h"
 
 namespace rvlio {
 namespace {

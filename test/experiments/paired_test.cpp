@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../cli/cli_util.h"
+#include "cli/cli_util.h"
 
 namespace rvlio::testing_cli {
 namespace {

@@ -29,7 +29,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "../cli/cli_util.h"
+#include "cli/cli_util.h"
 
 extern char** environ;
 

@@ -57,11 +57,7 @@ TEST(PositionFactor, ResidualIsTheWhitenedInterpolatedPointError) {
   EXPECT_TRUE(f.Predict(params).isApprox(Eigen::Vector3d(1.5, 3, 3), 1e-12));
 }
 
-}  // namespace
-}  // namespace rvlio
 
-namespace rvlio {
-namespace {
 
 TEST(ZeroVelocityFactor, ResidualAndJacobian) {
   std::mt19937 rng(43);

@@ -29,7 +29,7 @@
 #include "rvlio/formats/cdr.h"
 #include "rvlio/formats/recording.h"
 #include "rvlio/formats/trajectory_io.h"
-#include "signals/signals_util.h"
+#include "cli/signals/signals_util.h"
 
 namespace rvlio::live_test {
 namespace {

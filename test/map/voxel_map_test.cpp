@@ -308,11 +308,7 @@ TEST(VoxelMap, ClearEmptiesTheMap) {
   EXPECT_EQ(map.KNearest(Eigen::Vector3d::Zero(), 3, 10.0, &nb), 0);
 }
 
-}  // namespace
-}  // namespace rvlio
 
-namespace rvlio {
-namespace {
 
 // Points and queries on a lattice aligned with the voxel faces (queries on
 // faces, edges and corners: zero in-voxel offsets, many equal distances),

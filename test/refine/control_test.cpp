@@ -11,7 +11,7 @@
 
 #include "rvlio/factors/manifolds.h"
 #include "rvlio/refine/control.h"
-#include "rvlio/refine/refine_chunks.h"
+#include "rvlio/refine/chunks.h"
 
 namespace rvlio {
 namespace {
@@ -159,11 +159,7 @@ TEST(PositionTies, PullFreePosesOntoTheMarksInTheirChunkOnly) {
   EXPECT_LT(states[1].T_world_imu().t.norm(), 1e-12);  // its tie was not in the chunk
 }
 
-}  // namespace
-}  // namespace rvlio
 
-namespace rvlio {
-namespace {
 
 TEST(FitYawTranslation, RefinesATiltThePointsFixAndKeepsGravitysWhereTheyDoNot) {
   // The frame is tilted by 0.25 deg in pitch (an accelerometer bias read as
@@ -192,11 +188,7 @@ TEST(FitYawTranslation, RefinesATiltThePointsFixAndKeepsGravitysWhereTheyDoNot) 
   EXPECT_NEAR(tilted->tilt_deg[0], 0.0, 1e-6);
 }
 
-}  // namespace
-}  // namespace rvlio
 
-namespace rvlio {
-namespace {
 
 TEST(TieKernelWeight, HuberCauchyNone) {
   EXPECT_DOUBLE_EQ(TieKernelWeight(TieKernel::kHuber, 3.0, 2.0), 1.0);

@@ -1,8 +1,8 @@
-// Chunk jobs (refine/refine_jobs.h): the spans cover the initial
+// Chunk jobs (refine/jobs.h): the spans cover the initial
 // trajectory's time with the stated overlap, bad chunk parameters are
 // InvalidInput, and the merge undoes each chunk's own rigid frame and leaves
 // no step at the borders.
-#include "rvlio/refine/refine_jobs.h"
+#include "rvlio/refine/jobs.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rvlio/refine/refine_map.h"
+#include "rvlio/refine/map.h"
 
 namespace rvlio {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "rvlio/factors/manifolds.h"
 #include "rvlio/factors/plane_factor.h"
-#include "rvlio/refine/refine_pair_factor.h"
+#include "rvlio/refine/pair_factor.h"
 #include "support/smoother_test_util.h"
 
 namespace rvlio {

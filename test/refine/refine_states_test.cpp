@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "rvlio/math/so3.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/states.h"
 #include "support/smoother_test_util.h"
 
 namespace rvlio {

@@ -1,5 +1,5 @@
-// The named steps of batch refinement, one by one (refine_init.h,
-// refine_chunks.h, refine_association.h, refine_problem.h), on the box-room
+// The named steps of batch refinement, one by one (refine/init.h,
+// refine/chunks.h, refine/association.h, refine/problem.h), on the box-room
 // scene of refine_scene.h; and the whole refinement giving the same bits
 // with one thread and with two.
 #include <cmath>
@@ -11,10 +11,10 @@
 
 #include "refine_scene.h"
 #include "rvlio/math/so3.h"
-#include "rvlio/refine/refine_association.h"
-#include "rvlio/refine/refine_chunks.h"
-#include "rvlio/refine/refine_init.h"
-#include "rvlio/refine/refine_problem.h"
+#include "rvlio/refine/association.h"
+#include "rvlio/refine/chunks.h"
+#include "rvlio/refine/init.h"
+#include "rvlio/refine/problem.h"
 #include "support/smoother_test_util.h"
 
 namespace rvlio {

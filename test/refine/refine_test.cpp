@@ -104,7 +104,7 @@ TEST(Refine, ChunksOfTenScansAlsoRecoverTheTruth) {
 }
 
 // The plane-to-source attachment is what makes the rounds converge fast
-// (refine_pair_factor.h): with world-fixed planes only (refine_plane_window 0)
+// (refine/pair_factor.h): with world-fixed planes only (refine_plane_window 0)
 // the same rounds leave a clearly larger error on the drifting start.
 TEST(Refine, PlanesMovingWithTheirScansConvergeFasterThanAWorldFixedMap) {
   RefineConfig fixed_map = Config();
@@ -119,7 +119,7 @@ TEST(Refine, PlanesMovingWithTheirScansConvergeFasterThanAWorldFixedMap) {
 }
 
 // Summarized pair and world-plane factors (refine.summarize_pairs,
-// refine_pair_factor.h) have the exact factors' cost, gradient and
+// refine/pair_factor.h) have the exact factors' cost, gradient and
 // Gauss-Newton Hessian: the refined trajectories agree to rounding, far
 // below the error left.
 TEST(Refine, SummarizedFactorsAgreeWithExactFactors) {

@@ -285,11 +285,7 @@ TEST(WorldLayout, HallHasPillarsStairsAndDoorways) {
   EXPECT_GE(w.boxes().size(), static_cast<size_t>(o.world.clutter_count / 2));
 }
 
-}  // namespace
-}  // namespace rvlio::sim
 
-namespace rvlio::sim {
-namespace {
 
 // The weak-feature surfaces are rough by a few centimetres, tilting local
 // normals by a few degrees (paper Fig. 1b), and the roughness is seeded.

@@ -23,7 +23,7 @@
 #include "rvlio/imu/noise.h"
 #include "rvlio/imu/preintegration.h"
 #include "rvlio/window/window.h"
-#include "../degeneracy/degeneracy_scenes.h"
+#include "degeneracy/degeneracy_scenes.h"
 #include "support/smoother_test_util.h"
 
 namespace rvlio {

@@ -30,7 +30,7 @@ StatusOr<uint64_t> FileContentHash(const std::string& path);
 // The same hash (FNV-1a 64) over the configuration alone (its JSON, except
 // refine.threads: refine's result is bit-identical on any thread
 // count) and over a trajectory's stamps and poses: what chunk.json records so
-// that `rvlio merge` only merges chunks of one refinement (refine_jobs.h).
+// that `rvlio merge` only merges chunks of one refinement (refine/jobs.h).
 uint64_t RefineOptionsHash(const Configuration& options);
 uint64_t TrajectoryHash(const Trajectory& trajectory);
 // A hash as chunk.json writes it: 16 lower-case hex digits.

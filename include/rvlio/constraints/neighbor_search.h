@@ -14,7 +14,7 @@
 // time: the per-point loop has no virtual call and each map keeps its own
 // neighbour record (the refinement map adds the scan each neighbour came from).
 // Specializations: VoxelMap and ReferenceMap here, LeaveOneOutSearch in
-// refine/refine_map.h.
+// refine/map.h.
 #include <Eigen/Core>
 
 #include "rvlio/map/reference_map.h"

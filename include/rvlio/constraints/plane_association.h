@@ -7,7 +7,7 @@
 // One routine serves every map: AssociateWith<Search> below, where Search is
 // any type with a NeighborSearchTraits specialization (neighbor_search.h):
 // the odometry's working map (VoxelMap: IESKF and sliding window) and the
-// leave-one-out map of batch refinement (refine/refine_map.h). The plane
+// leave-one-out map of batch refinement (refine/map.h). The plane
 // status mapping, normal orientation, residual gate, record filling and the
 // scan loop with its statistics live only here.
 // Output in point order; on several threads (AssociateWith's `threads`) the

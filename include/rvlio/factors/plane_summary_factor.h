@@ -20,7 +20,7 @@
 // equal those of PlaneFactor, so Ceres takes the same steps.
 //
 // The rows a_i and the square root are shared with the scan-pair summary of
-// batch refinement (ScanPairSummaryFactor, refine_pair_factor.h), whose z is
+// batch refinement (ScanPairSummaryFactor, refine/pair_factor.h), whose z is
 // the relative pose of two scans instead of one world pose.
 #include <Eigen/Core>
 #include <ceres/sized_cost_function.h>

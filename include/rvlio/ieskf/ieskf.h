@@ -61,6 +61,20 @@ struct IeskfUpdateResult {
 // Extrinsic axes with free[i] false get no row (held fixed).
 Eigen::Matrix<double, 24, 12> ErrorStateColumns(const std::array<bool, 6>& free_extrinsic_axes);
 
+// The LiDAR-IMU time offset as the filter holds it: with
+// lidar.estimate_time_offset an augmented state (TimeOffsetState of the
+// update, src/ieskf/state_policies.h), else the configured offset, no variance.
+struct TimeOffsetEstimate {
+  double td_s = 0.0;           // the estimate, s
+  double td_lin_s = 0.0;       // the offset the last scan was predicted and deskewed with
+  ScanTimeMotion scan_motion;  // the motion held at the last updated scan's state time
+  Vector24d P_x_td = Vector24d::Zero();  // cross covariance with the 24-dim error state
+  double P_td_td = 0.0;        // variance, s^2
+  bool observed = false;       // the last update estimated the offset (not at rest)
+};
+
+struct ExtrinsicColumns;
+
 class Ieskf {
  public:
   // `lidar`: the time-offset keys (estimate_time_offset and its noise, bound).
@@ -105,17 +119,17 @@ class Ieskf {
   TimeNs time_ns() const { return t_ns_; }
 
   // The LiDAR-IMU time offset (lidar.time_offset, or its online estimate), s.
-  double time_offset_s() const { return td_s_; }
+  double time_offset_s() const { return td_.td_s; }
   // Its 1-sigma (0 when not estimated).
   double time_offset_std_s() const;
   // True while the estimate is held at +-lidar.time_offset_max (an update
   // pushed it there or past it).
   bool time_offset_at_bound() const {
-    return lidar_.estimate_time_offset && std::abs(td_s_) >= lidar_.time_offset_max;
+    return lidar_.estimate_time_offset && std::abs(td_.td_s) >= lidar_.time_offset_max;
   }
   // True when the last update estimated the offset: the motion showed it
   // (not at rest; estimate_time_offset only).
-  bool time_offset_observed() const { return td_observed_; }
+  bool time_offset_observed() const { return td_.observed; }
   // True when a scan predicted to t_end_ns from the current state would show
   // the offset (the test Update applies; const: the filter is not moved).
   bool TimeOffsetObservableAt(const std::deque<ImuSample>& imu, TimeNs t_end_ns) const;
@@ -124,13 +138,17 @@ class Ieskf {
   void SetTimeOffset(double td_s, double std_s);
   // The IMU pose at the time of the last updated scan (the state's pose when
   // the offset is not estimated; see ScanTimeMotion).
-  Pose3 ScanTimeImuPose() const { return ScanTimePose(x_, scan_motion_, td_s_ - td_lin_s_); }
+  Pose3 ScanTimeImuPose() const {
+    return ScanTimePose(x_, td_.scan_motion, td_.td_s - td_.td_lin_s);
+  }
 
  private:
-  template <bool kTimeOffset>
+  // The update of paper Eq. (1) with the optional states of StatePolicy
+  // (NoTimeOffsetState or TimeOffsetState, src/ieskf/state_policies.h).
+  template <class StatePolicy>
   IeskfUpdateResult UpdateImpl(const AssociateFn& associate);
+  ExtrinsicColumns ExtrinsicColumnsNow() const;
   ScanTimeMotion MotionAtStateTime() const;
-  void HoldTimeOffsetInBound();
   void Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s);
   void RecordPose(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu);
   void ReleaseExcitedAxes();
@@ -151,15 +169,8 @@ class Ieskf {
   ImuSample last_imu_;
   ImuPoseHistory pose_history_;
   RvWorkspace rv_workspace_;
-  // Time offset (augmented state, estimate_time_offset): value, cross
-  // covariance with the 24-dim error state, variance.
   LidarOptions lidar_;
-  double td_s_ = 0.0;
-  double td_lin_s_ = 0.0;  // the offset the last scan was predicted and deskewed with
-  ScanTimeMotion scan_motion_;
-  Vector24d P_x_td_ = Vector24d::Zero();
-  double P_td_td_ = 0.0;
-  bool td_observed_ = false;  // the last update estimated the offset (not at rest)
+  TimeOffsetEstimate td_;
 };
 
 }  // namespace rvlio

@@ -22,7 +22,7 @@
 #include "rvlio/common/types.h"
 #include "rvlio/math/pose.h"
 #include "rvlio/refine/control_options.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/states.h"
 
 namespace ceres {
 class LossFunction;

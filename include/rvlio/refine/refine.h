@@ -23,9 +23,9 @@
 //
 // Each outer round (refine.rounds):
 //   Deskew   every scan with the current estimate (IMU integrated backwards
-//            from the scan-end state: refine_states.h);
+//            from the scan-end state: refine/states.h);
 //   Map      one leave-one-out map of all scans' world points at the current
-//            estimates (refine_map.h): a scan never matches its own points;
+//            estimates (refine/map.h): a scan never matches its own points;
 //   Associate every scan against the others' points (threads over scans);
 //   RV       per scan when rv.enabled (rv/rv.h: 1/K on SCVs, normal repair),
 //            then Huber IRLS weights (refine.huber_delta) folded into the
@@ -39,7 +39,7 @@
 //            scan, ImuFactor between consecutive scans (preintegrated at the
 //            current biases), and the scan's point-to-plane constraints: a
 //            plane fitted mostly to scan j's points moves with scan j
-//            (ScanPairPlaneFactor, refine_pair_factor.h) when j is in the
+//            (ScanPairPlaneFactor, refine/pair_factor.h) when j is in the
 //            chunk and |k - j| <= refine.plane_window, otherwise it
 //            is world-fixed (one PlaneFactor per scan, at the current estimate
 //            of its source scan). Attached planes make each round a joint
@@ -60,9 +60,9 @@
 // A solve that fails or produces non-finite values restores the chunk's
 // states from before the solve and is counted; the output never holds NaN.
 //
-// The steps, each with its own header: refine_init.h (state
-// initialization), refine_association.h (deskew, map, association round),
-// refine_problem.h (problem build and solve), refine_chunks.h (chunking);
+// The steps, each with its own header: refine/init.h (state
+// initialization), refine/association.h (deskew, map, association round),
+// refine/problem.h (problem build and solve), refine/chunks.h (chunking);
 // how they fit, what they hold and cost: docs/refine.md.
 #include <array>
 #include <cstdint>
@@ -86,7 +86,7 @@
 #include "rvlio/rv/options.h"
 #include "rvlio/refine/control.h"
 #include "rvlio/refine/options.h"
-#include "rvlio/refine/refine_states.h"
+#include "rvlio/refine/states.h"
 
 namespace rvlio {
 

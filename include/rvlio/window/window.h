@@ -10,7 +10,8 @@
 //     SpeedBiasContinuityFactor instead (prior_factor.h);
 //   - one plane factor per state with that scan's point-to-plane constraints
 //     (PlaneSummaryFactor: PlaneFactor's cost in 13 exact residuals,
-//     plane_summary_factor.h). Per-point information = Constraint::weight / sigma^2
+//     plane_summary_factor.h; its kind, chosen once from the options, makes
+//     it and names its blocks: src/window/scan_factor.h). Per-point information = Constraint::weight / sigma^2
 //     with weight = (RV: 1/K for SCVs, rv/rv.h) x (Huber IRLS weight
 //     min(1, sliding_window_huber_delta / |r|) at the pose of association);
 //   - with degeneracy.method localizability or regularized (and remap in
@@ -109,9 +110,7 @@ class Problem;
 namespace rvlio {
 
 class ImuFactor;
-class PlaneExtrinsicFactor;
-class PlaneSummaryFactor;
-class PlaneTimeOffsetFactor;
+class ScanFactorKind;
 
 // The window's configuration: the option sections it reads, with the names
 // and types they have in the odometry's options (OdometryOptions), listed in
@@ -259,12 +258,12 @@ class SlidingWindow {
   int AssociateRound(const ScanAssociateFn& associate, WindowSolveReport* report);
   void AssociateNode(const ScanAssociateFn& associate, Node* node);
   void RejectOverflowingScan(Node* node);
-  bool MakePlaneFactor(const Pose3& T_world_imu, Node* node) const;
   LeastSquaresDegeneracy AnalyzeNodeDegeneracy(const Pose3& T_world_imu, const Pose3& T_imu_lidar,
                                                const Node& node) const;
   void TreatDegeneracy(const LeastSquaresDegeneracy& d, Node* node) const;
   void ClearDegeneracy(Node* node) const;
   bool PoseTied(size_t k) const;
+  std::vector<double*> ScanBlocks(Node* node, double* time_offset);
   void RefreshImuFactors();
   void ResetCalibrationPriors();
   bool DropNewestImuFactor();
@@ -284,6 +283,7 @@ class SlidingWindow {
   Pose3 T_imu_lidar_config_;    // options_.extrinsics
   StatePriorStd first_prior_;   // options_.ieskf.init_*_std
   PoseManifold pose_manifold_;
+  std::unique_ptr<ScanFactorKind> scan_factor_kind_;  // the plane factor of every scan
   std::deque<std::unique_ptr<Node>> nodes_;
   std::unique_ptr<StatePriorFactor> state_prior_;        // on nodes_[0], or null
   std::unique_ptr<MarginalizationFactor> marginal_prior_;  // on nodes_[0], or null
