@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "rvlio/formats/pointcloud2.h"
@@ -89,6 +91,11 @@ struct RawCloud {
   }
   template <typename T>
   void Store(uint8_t* p, double v) {
+    // An integer field saturates, as a driver's would (a value beyond the
+    // type's range has no conversion: undefined behaviour).
+    if constexpr (std::is_integral_v<T>)
+      v = std::clamp(v, static_cast<double>(std::numeric_limits<T>::lowest()),
+                     static_cast<double>(std::numeric_limits<T>::max()));
     const T value = static_cast<T>(v);
     uint8_t bytes[sizeof(T)];
     std::memcpy(bytes, &value, sizeof(T));

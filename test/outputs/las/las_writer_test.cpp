@@ -49,6 +49,8 @@ const FoundVlr* Find(const std::vector<FoundVlr>& vlrs, const std::string& user,
     if (v.user_id == user && v.record_id == id) return &v;
   return nullptr;
 }
+// The result points into `vlrs`: a temporary would leave it dangling.
+const FoundVlr* Find(std::vector<FoundVlr>&& vlrs, const std::string& user, uint16_t id) = delete;
 
 TEST(LasWriter, HeaderVlrsAndRecordsFollowTheSpecification) {
   ScratchDir dir;
@@ -225,7 +227,8 @@ TEST(LasWriter, IntensityRingScanIndexAndIntegerExtrasAreScaledClampedAndCounted
     EXPECT_EQ(At<int16_t>(b, start + 32 * i + 30), want_code[i]) << i;
     EXPECT_EQ(At<double>(b, start + 32 * i + 22), 0.0) << "no time given";
   }
-  const FoundVlr* text = Find(WalkVlrs(b), "LASF_Spec", 3);
+  const std::vector<FoundVlr> vlrs = WalkVlrs(b);  // Find points into it
+  const FoundVlr* text = Find(vlrs, "LASF_Spec", 3);
   ASSERT_NE(text, nullptr);
   EXPECT_NE(text->payload.find("Point source ID: the scan index modulo 65536"), std::string::npos)
       << text->payload;
