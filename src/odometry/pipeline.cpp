@@ -27,15 +27,27 @@ DivergenceOptions MonitorOptions(const OdometryOptions& options) {
 }  // namespace
 
 void OutputMapFeed::Hold(TimeNs t_ns, uint32_t scan_index, const Scan& returns) {
-  held_.push_back({t_ns, scan_index, returns});
+  current_t_ns_ = t_ns;
+  current_index_ = scan_index;
+  current_ = &returns;
 }
 
 void OutputMapFeed::Insert(TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_world) {
   while (!held_.empty() && held_.front().t_ns < t_ns) held_.pop_front();
+  if (current_ != nullptr && current_t_ns_ == t_ns) {
+    map_.InsertScan(p_world, *current_, current_index_);
+    current_ = nullptr;
+    return;
+  }
   RVLIO_CHECK_MSG(!held_.empty() && held_.front().t_ns == t_ns,
                   "odometry: a scan enters the output map without its returns");
   map_.InsertScan(p_world, held_.front().returns, held_.front().scan_index);
   held_.pop_front();
+}
+
+void OutputMapFeed::Release() {
+  if (current_ != nullptr) held_.push_back({current_t_ns_, current_index_, *current_});
+  current_ = nullptr;
 }
 
 template <class Backend>
@@ -142,6 +154,7 @@ void ScanPipeline<Backend>::ProcessFrontScan(std::vector<ScanResult>* out) {
   output_.Hold(scan->t_end_ns, static_cast<uint32_t>(stats_.scans_processed), downsampled_);
   r.status = backend_.Update(context, &r);                                             // associate + update
   backend_.Insert(context);                                                            // insert
+  output_.Release();
   Report(scan->t_end_ns, prediction, start_ms, &r);                                    // report
   out->push_back(std::move(r));
 }

@@ -77,12 +77,17 @@ class OutputMapFeed {
  public:
   explicit OutputMapFeed(double resolution_m) : map_(resolution_m) {}
   // The scan being processed, before its update: the state's time at its
-  // end, its result's index and its downsampled returns.
+  // end, its result's index and its downsampled returns (referred to, not
+  // copied: they must stay until Release).
   void Hold(TimeNs t_ns, uint32_t scan_index, const Scan& returns);
   // The points (world, m) of the held scan of time t_ns, returns[i] at
   // p_world[i]. Held scans older than t_ns never enter (an IESKF scan kept
   // provisional, a window state dropped unmarginalized).
   void Insert(TimeNs t_ns, const std::vector<Eigen::Vector3d>& p_world);
+  // The end of the scan's step: returns not inserted yet (the smoother's
+  // window) are copied to wait for their Insert; the IESKF's, inserted at
+  // once, are never copied.
+  void Release();
   const OutputMap& map() const { return map_; }
 
  private:
@@ -92,7 +97,11 @@ class OutputMapFeed {
     Scan returns;
   };
   OutputMap map_;
-  std::deque<HeldScan> held_;  // oldest first
+  std::deque<HeldScan> held_;  // oldest first, copied at Release
+  // The scan of the step under way (between Hold and Release), not copied.
+  TimeNs current_t_ns_ = -1;
+  uint32_t current_index_ = 0;
+  const Scan* current_ = nullptr;
 };
 
 // What a backend's Update, Insert and Finish work with: one scan and the
