@@ -1,7 +1,7 @@
 // rvlio eval: ATE/RPE of an estimated trajectory against ground truth with the
 // definitions of evo (docs/design.md "Evaluation"), or with --map a map against
 // a reference cloud (docs/map_eval.md). Argument parsing and output only;
-// EvaluateFiles / EvaluateMapFiles and EvalJson / MapEvalJson (rvlio/api.h)
+// EvaluateFiles / EvaluateMapFiles (rvlio/api.h) and EvalJson / MapEvalJson (rvlio/api/result_json.h)
 // do the work.
 #include <algorithm>
 #include <chrono>
@@ -18,6 +18,7 @@
 #include "rvlio/outputs/summary_json.h"
 #include "common_options.h"
 #include "rvlio/api.h"
+#include "rvlio/api/result_json.h"
 
 namespace rvlio::cli {
 namespace {

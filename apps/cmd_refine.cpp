@@ -116,24 +116,21 @@ int CmdRefine(int argc, char** argv) {
 namespace {
 
 // "control points: 3, RMS 0.004 m; check points: 2, RMS 0.011 m, largest 0.015 m (M4)".
-void PrintControl(std::FILE* out, const nlohmann::json& summary) {
-  if (!summary.contains("control")) return;
+void PrintControl(std::FILE* out, const RefineRunResult& result) {
   std::string line;
-  for (const char* role : {"control", "check"}) {
-    const nlohmann::json& j = summary["control"][role];
-    if (j.value("count", 0) == 0) continue;
+  for (ControlRole role : {ControlRole::kControl, ControlRole::kCheck}) {
+    const ControlRoleSummary r = SummarizeControlRole(result.control, role);
+    if (r.count == 0) continue;
     char buf[256];
     std::snprintf(buf, sizeof(buf), "%s%s points: %d, RMS %.4f m, largest %.4f m (%s)",
-                  line.empty() ? "" : "; ", role, j["count"].get<int>(), j["rms_m"].get<double>(),
-                  j["max_m"].get<double>(), j["max_name"].get<std::string>().c_str());
+                  line.empty() ? "" : "; ", ControlRoleName(role), r.count, r.rms_m, r.max_m,
+                  r.max_name.c_str());
     line += buf;
   }
-  const nlohmann::json& survey = summary["survey"];
-  if (survey.value("gnss_fixes", 0) > 0) {
+  if (result.gnss_fixes > 0) {
     char buf[160];
     std::snprintf(buf, sizeof(buf), "%sGNSS fixes: %d (%d outliers left out)",
-                  line.empty() ? "" : "; ", survey["gnss_fixes"].get<int>(),
-                  survey["gnss_outliers"].get<int>());
+                  line.empty() ? "" : "; ", result.gnss_fixes, result.gnss_outliers);
     line += buf;
   }
   if (!line.empty()) std::fprintf(out, "rvlio refine: %s\n", line.c_str());
@@ -152,7 +149,7 @@ void PrintRefineDone(std::FILE* out, const RefineRunResult& result, double wall_
                refined.trajectory.size(), refined.rounds.size(),
                refined.converged ? " (converged)" : "", refined.linear_solver.c_str(), wall_s,
                PeakMemoryMb(), out_dir.c_str());
-  PrintControl(out, result.summary);
+  PrintControl(out, result);
   std::fflush(out);
 }
 

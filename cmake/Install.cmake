@@ -13,9 +13,8 @@ install(TARGETS rvlio_core rvlio_sim rvlio_io EXPORT rvlioTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
 install(TARGETS rvlio RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 # The public headers, an explicit list (cmake/PublicHeaders.cmake); none
-# includes PCL, ROS, sqlite or yaml-cpp (checked by scripts/install_test.sh);
-# rvlio/config/config.h and rvlio/api.h include nlohmann/json.hpp, part of
-# rvlio::io's interface.
+# includes PCL, ROS, sqlite, yaml-cpp or nlohmann/json (checked by
+# scripts/install_test.sh and the HeadersWithoutJson test).
 include(${CMAKE_CURRENT_LIST_DIR}/PublicHeaders.cmake)
 foreach(header ${rvlio_public_headers})
   get_filename_component(header_dir ${header} DIRECTORY)

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "rvlio/config/config.h"
+#include "rvlio/config/config_json.h"
 
 namespace {
 

@@ -8,9 +8,9 @@
 #   2. the installed `rvlio --version` and its libraries (from P, not build/)
 #   3. exactly the public headers of cmake/PublicHeaders.cmake are installed;
 #      each compiles on its own with only P + Eigen + Ceres include folders
-#      and opens no PCL, ROS, yaml-cpp, sqlite, zstd or lz4 header (nlohmann
-#      only in rvlio::io's); the exported rvlio::core target names only
-#      Eigen and Ceres as interface libraries
+#      and opens no PCL, ROS, yaml-cpp, nlohmann, sqlite, zstd or lz4
+#      header; the exported rvlio::core target names only Eigen and Ceres as
+#      interface libraries, and the package asks for no nlohmann_json
 #   4. examples/consumer configured (find_package(rvlio) with P only) and
 #      built in its own folder, without the source tree's include folder;
 #      ieskf_tunnel (rvlio::core) runs the IESKF on a simulated tunnel
@@ -108,32 +108,25 @@ check "the install holds exactly the $n_public public headers of cmake/PublicHea
   only_public_installed
 # Each installed header compiles on its own from the prefix with only Eigen and
 # Ceres (so the public list is closed under #include), and opens no PCL, ROS,
-# yaml-cpp, sqlite, zstd or lz4 header; the rvlio::core and rvlio::sim headers
-# (all but rvlio/api.h, config/, experiments/, formats/ and outputs/; formats/reader_options.h
-# and outputs/output_options.h are plain options structs the odometry options
-# hold) open no nlohmann either.
-is_io_header() {
-  [[ $1 == rvlio/api.h || $1 =~ ^rvlio/(api|config|experiments|formats|outputs)/ ]] &&
-    [[ $1 != rvlio/formats/reader_options.h && $1 != rvlio/outputs/output_options.h ]]
-}
+# yaml-cpp, nlohmann, sqlite, zstd or lz4 header: the API's results are
+# typed, its JSON is the writer's (private headers).
 compiles_alone() {  # compiles_alone HEADER: syntax check, and the headers it opened
-  local header=$1 tu allowed='^$' bad
+  local header=$1 tu bad
   tu="$work/tu/${header//\//_}.cpp"
   mkdir -p "$work/tu"
   printf '#include "%s"\nint main() { return 0; }\n' "$header" >"$tu"
   g++ -std=c++17 -fsyntax-only -H -I"$prefix/include" $eigen_inc $ceres_inc "$tu" 2>"$tu.headers" ||
     { echo "  $header does not compile alone:" >&2; grep -v '^\.' "$tu.headers" | head -5 >&2; return 1; }
-  is_io_header "$header" && allowed='/nlohmann/'
-  bad=$(grep -E '^\.+ ' "$tu.headers" | grep -E "$forbidden" | grep -vE "$allowed" || true)
+  bad=$(grep -E '^\.+ ' "$tu.headers" | grep -E "$forbidden" || true)
   [[ -z $bad ]] || { echo "  $header pulls in: $(head -3 <<<"$bad")" >&2; return 1; }
 }
-export -f compiles_alone is_io_header
+export -f compiles_alone
 export prefix work eigen_inc ceres_inc forbidden
 every_header_alone() {
   (cd "$prefix/include" && find rvlio -name '*.h' | sort) |
     xargs -P "$jobs" -I{} bash -c 'compiles_alone "$1"' _ {}
 }
-check "every installed header ($(cd "$prefix/include" && find rvlio -name '*.h' | wc -l)) compiles on its own from the prefix and pulls in no PCL/ROS/yaml-cpp/sqlite/zstd/lz4 header (nlohmann only in rvlio::io's)" \
+check "every installed header ($(cd "$prefix/include" && find rvlio -name '*.h' | wc -l)) compiles on its own from the prefix and pulls in no PCL/ROS/yaml-cpp/nlohmann/sqlite/zstd/lz4 header" \
   every_header_alone
 core_interface() {
   local libs
@@ -142,6 +135,10 @@ core_interface() {
   [[ $libs == "Eigen3::Eigen;Ceres::ceres" ]] || { echo "  rvlio::core interface: $libs" >&2; return 1; }
 }
 check "the exported rvlio::core links only Eigen3::Eigen and Ceres::ceres in its interface" core_interface
+no_json_dependency() {  # JSON is the I/O layer's own business (private headers)
+  ! grep -l nlohmann "$prefix"/lib/cmake/rvlio/*.cmake >&2
+}
+check "the installed package (rvlioConfig, rvlioTargets) asks for no nlohmann_json" no_json_dependency
 
 # 4. the consumer example against the prefix
 consumer_builds() {

@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
                                   rvlio::EvalOptions());
   if (!ate.ok()) return Fail("eval", ate.status());
   std::printf("run_recording: %zu scans, per-scan median %.2f ms: ATE rmse %.4f m -> %s\n",
-              result->scans.size(), result->summary["per_scan_ms"]["median"].get<double>(),
+              result->scans.size(), result->per_scan.median_ms,
               ate->ape_m.rmse, run.out_dir.c_str());
   return 0;
 }

@@ -15,14 +15,16 @@
 // call that is stopped (`stop`) returns normally with `stopped` set.
 //
 // Configuration: LoadConfig (rvlio/config/config.h) gives the Configuration from
-// YAML files plus `key=value` overrides; DumpYaml / ToJson write it back.
+// YAML files plus `key=value` overrides; DumpYaml writes it back.
+//
+// No JSON type is part of this API: results carry typed figures, and the
+// text of summary.json (or chunk.json) as written, for programs that want
+// the file without reading it back.
 #include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "rvlio/common/status.h"
 #include "rvlio/common/types.h"
@@ -88,8 +90,6 @@ struct RunArgs {
   // odometry that made it and the odometry's local frame (where its
   // MapPoints are) relative to the user's frame (math/local_origin.h).
   std::function<void(const ScanResult&, const Odometry&, const LocalOrigin&)> on_result;
-  // Called with summary.json before it is written (e.g. `live` adds its figures).
-  std::function<void(nlohmann::json* summary)> annotate_summary;
 };
 
 struct RunResult {
@@ -107,9 +107,9 @@ struct RunResult {
   double wall_s = 0.0;               // reading and estimating
   double real_time_factor = 0.0;     // sequence duration / estimator time (0: none measured)
   double real_time_factor_wall = 0.0;  // sequence duration / wall_s
-  // summary.json, serialized once from the fields above and the run's
-  // configuration, statistics and checks (for writing and for Python).
-  nlohmann::json summary;
+  // summary.json's text (as written to out_dir, or as it would be): the
+  // figures above with the run's configuration, statistics and checks.
+  std::string summary_json;
   std::vector<std::string> warnings;  // reader, estimator and output warnings
   DivergenceReport divergence;
   std::string lidar_layout;       // the reader's name for the point layout
@@ -168,16 +168,20 @@ struct RefineRunResult {
   // (trajectory_imu.tum, as RunResult::imu_trajectory); empty otherwise.
   Trajectory imu_trajectory;
   DivergenceReport divergence;  // the checks of the refined result
-  nlohmann::json summary;       // summary.json
+  std::string summary_json;     // summary.json's text (as RunResult::summary_json)
   bool stopped = false;         // `stop` ended it (after a round, or while reading)
   std::string stop_reason;
   bool read_complete = true;    // false: stopped while reading; nothing refined or written
   bool written = false;
   std::optional<RefineJobSpan> job;  // a chunk job's span (chunk.json; none otherwise)
-  nlohmann::json chunk;         // chunk.json of a chunk job (null otherwise)
+  std::string chunk_json;       // chunk.json's text of a chunk job (empty otherwise)
   // With a control file: control.csv's text (the residual of every row) and
-  // its rows; empty otherwise.
+  // its rows (SummarizeControl, refine/control.h, gives summary.json
+  // "control"); empty otherwise.
   std::string control_csv;
+  std::vector<ControlResidual> control;
+  int gnss_fixes = 0;     // GNSS fixes used as ties (gnss.topic)
+  int gnss_outliers = 0;  // fixes the robust alignment left out
 };
 
 // Errors: unreadable inputs, a checkpoint that is missing or belongs to other
@@ -209,8 +213,6 @@ struct MergedChunk {
   double residual_max_m = 0.0;
   double residual_max_deg = 0.0;
 };
-// summary.json's entry of one chunk.
-nlohmann::json MergedChunkJson(const MergedChunk& chunk);
 
 struct MergeResult {
   Trajectory trajectory;                    // T_world_imu, the merged frame is chunk 1's
@@ -221,7 +223,7 @@ struct MergeResult {
   // attributes they have (scan_index: rows of `trajectory`).
   MapCloud map;
   std::vector<MergedChunk> chunks;          // in order 1..N
-  nlohmann::json summary;                   // summary.json
+  std::string summary_json;                 // summary.json's text
   std::vector<std::string> warnings;        // the chunks' warnings, each once
   // Chunks refined with --control: the merged control.csv (each row from the
   // chunk that owns its tie time, in the merged frame); empty otherwise.
@@ -304,9 +306,6 @@ std::string SimulatedRecordingPath(const SimulateArgs& args);
 // evaluates (rvlio/eval/evaluate.h; Evaluate() takes trajectories directly).
 StatusOr<EvalResult> EvaluateFiles(const std::string& gt_path, const std::string& est_path,
                                    const EvalOptions& options);
-// `rvlio eval --json`: matched, align, scale, ape, ape_rot_deg, rpe,
-// rpe_rot_deg, end_point_error, along_axis, warnings (10 significant digits).
-nlohmann::json EvalJson(const EvalResult& result);
 
 // eval --degeneracy: a run's per-scan degeneracy detection against the
 // simulator's true localizability (eval/degeneracy.h, docs/degeneracy_truth.md).
@@ -333,8 +332,6 @@ struct DegeneracyEvalArgs {
 // file for a missing file or column, a non-finite value, or no scans matched
 // by time.
 StatusOr<DegeneracyEvalResult> EvaluateDegeneracyFiles(const DegeneracyEvalArgs& args);
-// `rvlio eval --degeneracy --json`.
-nlohmann::json DegeneracyEvalJson(const DegeneracyEvalResult& result);
 
 // ---------------------------------------------------------------------------
 // eval --map: a map against a reference cloud (eval/map_metrics.h)
@@ -348,11 +345,5 @@ nlohmann::json DegeneracyEvalJson(const DegeneracyEvalResult& result);
 StatusOr<MapEvalResult> EvaluateMapFiles(const std::string& map_path, const std::string& ref_path,
                                          const MapEvalOptions& options,
                                          const MapEvalProgress& progress = nullptr);
-// `rvlio eval --map --json`: map_points, ref_points, max_distance, inliers,
-// no_plane, outlier_fraction, accuracy and nearest {count, mean, rms, median,
-// p95, max}, completeness, chamfer, chamfer_definition, axis {origin,
-// direction}, profile [{chainage, map_points, map_with_plane, rms, median,
-// p95, ref_points, completeness}] (10 significant digits; null for NaN).
-nlohmann::json MapEvalJson(const MapEvalResult& result);
 
 }  // namespace rvlio

@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include "rvlio/config/config.h"
+#include "rvlio/config/config_json.h"
 
 namespace rvlio::python {
 namespace {

@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "rvlio/api.h"
+#include "rvlio/api/result_json.h"
 #include "rvlio/eval/evaluate.h"
 #include "rvlio/eval/map_metrics.h"
 #include "rvlio/formats/point_cloud_file.h"

@@ -161,7 +161,7 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
   RunOutput o;
   o.trajectory = TrajectoryArray(r.trajectory);
   o.scans = ScanTable(r.scans, r.rss_mb);
-  o.summary = ToPython(r.summary);
+  o.summary = ToPython(nlohmann::json::parse(r.summary_json));
   o.results = std::move(r.scans);
   o.poses = std::move(r.trajectory);
   o.warnings = std::move(r.warnings);
@@ -249,7 +249,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   RefineRunResult r = Take(std::move(result));
   RefineOutput o;
   o.trajectory = TrajectoryArray(r.refine.trajectory);
-  o.summary = ToPython(r.summary);
+  o.summary = ToPython(nlohmann::json::parse(r.summary_json));
   for (const RefineRound& round : r.refine.rounds) o.rounds.append(RoundDict(round));
   o.converged = r.refine.converged;
   o.warnings = r.refine.warnings;
@@ -276,7 +276,7 @@ MergeOutput Merge(const py::iterable& chunks, const py::handle& out, const py::h
   MergeOutput o;
   o.trajectory = TrajectoryArray(r.trajectory);
   o.map_points = PointsArray(r.map.p);
-  o.summary = ToPython(r.summary);
+  o.summary = ToPython(nlohmann::json::parse(r.summary_json));
   o.warnings = r.warnings;
   o.written = r.written;
   return o;

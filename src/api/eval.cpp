@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "rvlio/api.h"
+#include "rvlio/api/result_json.h"
 #include "rvlio/api/refine_checkpoint.h"
 #include "rvlio/eval/time_matching.h"
 #include "rvlio/formats/point_cloud_file.h"

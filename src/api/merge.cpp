@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "rvlio/api.h"
+#include "rvlio/api/result_json.h"
 #include "rvlio/api/survey_ties.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/config/config.h"
@@ -278,7 +279,7 @@ Status WriteOutputs(const std::string& out_dir, const MergeResult& r,
     if (Status s = WriteFileAtomically(stage.Path("control.csv"), r.control_csv); !s.ok())
       return stage.Explain(s);
   if (Status s = WriteMapOutputs(&stage, r.map, deviation, las); !s.ok()) return s;
-  if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), r.summary_json);
       !s.ok())
     return stage.Explain(s);
   return stage.Commit();
@@ -441,13 +442,14 @@ StatusOr<MergeResult> MergeRefineChunks(const MergeArgs& args) {
   origin.ToUser(&r.imu_trajectory);
   origin.ToUser(&r.map.p);
   if (Status s = MergeControl(chunks, *merge, origin, &r); !s.ok()) return s;
-  r.summary = Summary(chunks, r);
-  r.summary["local_origin"] = LocalOriginJson(origin);
-  if (!r.control_csv.empty()) r.summary["control"] = ControlSummaryJson(r.control);
+  json summary = Summary(chunks, r);
+  summary["local_origin"] = LocalOriginJson(origin);
+  if (!r.control_csv.empty()) summary["control"] = ControlSummaryJson(r.control);
   if (deviation) {
-    r.summary["map"] = args.map;
-    r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+    summary["map"] = args.map;
+    summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
   }
+  r.summary_json = JsonText(summary) + "\n";
   if (args.out_dir.empty()) return r;
   if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr, *las); !s.ok())
     return s;

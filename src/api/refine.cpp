@@ -16,6 +16,7 @@
 #include "rvlio/api/refine_checkpoint.h"
 #include "rvlio/api/survey_ties.h"
 #include "rvlio/common/cpu_time.h"
+#include "rvlio/config/config_json.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/formats/reference_map_file.h"
 #include "rvlio/formats/sensor_bag.h"
@@ -275,8 +276,8 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
                     const MapDeviation* deviation, const MapLasRequest& las) {
   OutputStage stage(out_dir);  // all outputs or none
   if (Status s = stage.Open(); !s.ok()) return s;
-  if (!r.chunk.is_null())
-    if (Status s = WriteFileAtomically(stage.Path("chunk.json"), JsonText(r.chunk) + "\n"); !s.ok())
+  if (!r.chunk_json.empty())
+    if (Status s = WriteFileAtomically(stage.Path("chunk.json"), r.chunk_json); !s.ok())
       return stage.Explain(s);
   if (!r.control_csv.empty())
     if (Status s = WriteFileAtomically(stage.Path("control.csv"), r.control_csv); !s.ok())
@@ -284,7 +285,7 @@ Status WriteOutputs(const std::string& out_dir, const RefineRunResult& r,
   if (Status s = WriteTrajectoryOutputs(&stage, r.refine.trajectory, r.imu_trajectory); !s.ok())
     return s;
   if (Status s = WriteMapOutputs(&stage, r.refine.map, deviation, las); !s.ok()) return s;
-  if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(r.summary) + "\n");
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), r.summary_json);
       !s.ok())
     return stage.Explain(s);
   return stage.Commit();
@@ -504,7 +505,9 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   r.refine.warnings.insert(r.refine.warnings.begin(), notes.begin(), notes.end());
   if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
   r.job = job;
-  if (job) r.chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
+  nlohmann::json chunk;  // chunk.json of a chunk job
+  if (job) chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
+  if (job) r.chunk_json = JsonText(chunk) + "\n";
   r.stopped = r.refine.stopped;
   if (!r.stopped) r.stop_reason.clear();
   r.divergence = CheckRefineResult(r.refine, args.options.divergence,
@@ -521,13 +524,14 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   origin.ToUser(&r.refine.trajectory);
   origin.ToUser(&r.refine.map.p);
   times.wall_s = SecondsSince(t0);
-  r.summary = Summary(args, r, (*reader)->stats(), raw_points, times);
-  r.summary["local_origin"] = LocalOriginJson(origin);
-  if (*survey != nullptr) AddSurveySummary(**survey, args.options.survey.crs, &r.summary);
-  r.summary["truncated"] = (*reader)->truncated();
-  r.summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
-  if (job) r.summary["chunk"] = r.chunk;
-  if (deviation) r.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  nlohmann::json summary = Summary(args, r, (*reader)->stats(), raw_points, times);
+  summary["local_origin"] = LocalOriginJson(origin);
+  if (*survey != nullptr) AddSurveySummary(**survey, args.options.survey.crs, &summary);
+  summary["truncated"] = (*reader)->truncated();
+  summary["init_coverage"] = CoverageJson(seen, init_span, args.options.imu.init_duration);
+  if (job) summary["chunk"] = std::move(chunk);
+  if (deviation) summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  r.summary_json = JsonText(summary) + "\n";
   if (!write) return r;
   if (Status s = WriteOutputs(args.out_dir, r, deviation ? &*deviation : nullptr, *las); !s.ok())
     return s;

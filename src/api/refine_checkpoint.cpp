@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rvlio/common/fnv1a.h"
+#include "rvlio/config/config_json.h"
 #include "rvlio/formats/atomic_file.h"
 
 namespace rvlio {

@@ -11,6 +11,8 @@
 
 #include "rvlio/common/cpu_time.h"
 #include "rvlio/api.h"
+#include "rvlio/api/result_json.h"
+#include "rvlio/config/config_json.h"
 #include "rvlio/formats/atomic_file.h"
 #include "rvlio/outputs/deviation_outputs.h"
 #include "rvlio/outputs/extrinsic_json.h"
@@ -168,7 +170,7 @@ Status WriteOutputs(const std::string& out_dir, const MapCloud& map,
   if (Status s = WriteMapOutputs(&stage, map, deviation, las); !s.ok()) return s;
   if (Status s = WriteScansCsv(stage.Path("scans.csv"), result.scans, result.rss_mb); !s.ok())
     return stage.Explain(s);
-  if (Status s = WriteFileAtomically(stage.Path("summary.json"), JsonText(result.summary) + "\n");
+  if (Status s = WriteFileAtomically(stage.Path("summary.json"), result.summary_json);
       !s.ok())
     return stage.Explain(s);
   return stage.Commit();
@@ -340,7 +342,9 @@ StatusOr<std::unique_ptr<SensorBagReader>> OpenReader(const RunArgs& args) {
 
 }  // namespace
 
-StatusOr<RunResult> RunRecording(const RunArgs& in) {
+StatusOr<RunResult> RunRecording(const RunArgs& args) { return RunRecordingAnnotated(args, nullptr); }
+
+StatusOr<RunResult> RunRecordingAnnotated(const RunArgs& in, const SummaryAnnotator& annotate) {
   RunArgs args = in;  // an Ouster recording may supply the default extrinsic
   std::vector<std::string> notes;
   if (args.source == nullptr)
@@ -427,10 +431,11 @@ StatusOr<RunResult> RunRecording(const RunArgs& in) {
     result.imu_trajectory = streams.imu_rate->TakePoses();
     origin.ToUser(&result.imu_trajectory);
   }
-  result.summary = Summary(args, **odo, reader_stats, data, result);
-  result.summary["local_origin"] = LocalOriginJson(origin);
-  if (deviation) result.summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
-  if (args.annotate_summary) args.annotate_summary(&result.summary);
+  nlohmann::json summary = Summary(args, **odo, reader_stats, data, result);
+  summary["local_origin"] = LocalOriginJson(origin);
+  if (deviation) summary["localization"]["deviation"] = DeviationSummaryJson(*deviation);
+  if (annotate) annotate(&summary);
+  result.summary_json = JsonText(summary) + "\n";
   if (!write) return result;
   const Status written =
       WriteOutputs(args.out_dir, map, result, deviation ? &*deviation : nullptr, *las);

@@ -39,25 +39,13 @@ bool Overlaps(const RestPeriod& rest, const ControlRow& row) {
 
 // RMS and largest 3D residual of the estimated rows of one role.
 nlohmann::json RoleJson(const std::vector<ControlResidual>& rows, ControlRole role) {
-  int n = 0;
-  double sum2 = 0.0, max_m = 0.0;
-  std::string max_name;
-  Eigen::Vector3d sum2_axes = Eigen::Vector3d::Zero();
-  for (const ControlResidual& r : rows) {
-    if (r.row.role != role || !r.estimated) continue;
-    const Eigen::Vector3d d = r.Residual();
-    ++n;
-    sum2 += d.squaredNorm();
-    sum2_axes += d.cwiseAbs2();
-    if (d.norm() >= max_m) max_m = d.norm(), max_name = r.row.name;
-  }
-  nlohmann::json j = {{"count", n}};
-  if (n == 0) return j;
-  j["rms_m"] = std::sqrt(sum2 / n);
-  j["rms_xyz_m"] = {std::sqrt(sum2_axes.x() / n), std::sqrt(sum2_axes.y() / n),
-                    std::sqrt(sum2_axes.z() / n)};
-  j["max_m"] = max_m;
-  j["max_name"] = max_name;
+  const ControlRoleSummary r = SummarizeControlRole(rows, role);
+  nlohmann::json j = {{"count", r.count}};
+  if (r.count == 0) return j;
+  j["rms_m"] = r.rms_m;
+  j["rms_xyz_m"] = {r.rms_xyz_m.x(), r.rms_xyz_m.y(), r.rms_xyz_m.z()};
+  j["max_m"] = r.max_m;
+  j["max_name"] = r.max_name;
   return j;
 }
 
@@ -380,12 +368,12 @@ void SurveyTies::Evaluate(const Trajectory& refined_local) {
 std::string SurveyTies::ControlCsv() const { return ControlCsvText(residuals_); }
 
 nlohmann::json SurveyTies::SurveyJson(const std::string& crs) const {
-  int control = 0, check = 0, targets = 0, outliers = 0;
+  int control = 0, check = 0, targets = 0;
   for (const ControlRow& row : rows_) {
     (row.role == ControlRole::kControl ? control : check) += 1;
     targets += row.target ? 1 : 0;
   }
-  for (bool o : fix_outlier_) outliers += o ? 1 : 0;
+  const int outliers = GnssOutliers();
   nlohmann::json j = {{"crs", crs},
                       {"control_file", control_path_},
                       {"control_points", control},
@@ -412,6 +400,12 @@ nlohmann::json SurveyTies::SurveyJson(const std::string& crs) const {
 }
 
 nlohmann::json SurveyTies::ControlJson() const { return ControlSummaryJson(residuals_); }
+
+int SurveyTies::GnssOutliers() const {
+  int outliers = 0;
+  for (bool o : fix_outlier_) outliers += o ? 1 : 0;
+  return outliers;
+}
 
 uint64_t SurveyTies::ContentHash() const {
   Fnv1a h;
@@ -489,6 +483,9 @@ StatusOr<std::vector<SurveyFix>> ReadSurveyFixes(const std::string& bag,
 void DeliverInSurveyFrame(SurveyTies* survey, RefineRunResult* r) {
   survey->Evaluate(r->refine.trajectory);
   if (survey->has_control_file()) r->control_csv = survey->ControlCsv();
+  r->control = survey->residuals();
+  r->gnss_outliers = survey->GnssOutliers();
+  r->gnss_fixes = survey->GnssFixes() - r->gnss_outliers;
   r->refine.warnings.insert(r->refine.warnings.end(), survey->warnings().begin(),
                             survey->warnings().end());
 }

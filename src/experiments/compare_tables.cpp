@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "csv_text.h"
+#include "rvlio/api/result_json.h"
 #include "rvlio/common/text.h"
 #include "rvlio/experiments/compare.h"
 #include "rvlio/formats/atomic_file.h"

@@ -205,6 +205,25 @@ StatusOr<std::vector<ControlRow>> ReadControlFile(const std::string& path) {
 constexpr const char* kControlCsvHeader =
     "name,role,kind,x,y,z,x_est,y_est,z_est,dx,dy,dz,d3d,sigma_m,t_s,scans";
 
+ControlRoleSummary SummarizeControlRole(const std::vector<ControlResidual>& rows,
+                                        ControlRole role) {
+  ControlRoleSummary out;
+  double sum2 = 0.0;
+  Eigen::Vector3d sum2_axes = Eigen::Vector3d::Zero();
+  for (const ControlResidual& r : rows) {
+    if (r.row.role != role || !r.estimated) continue;
+    const Eigen::Vector3d d = r.Residual();
+    ++out.count;
+    sum2 += d.squaredNorm();
+    sum2_axes += d.cwiseAbs2();
+    if (d.norm() >= out.max_m) out.max_m = d.norm(), out.max_name = r.row.name;
+  }
+  if (out.count == 0) return out;
+  out.rms_m = std::sqrt(sum2 / out.count);
+  out.rms_xyz_m = (sum2_axes / out.count).cwiseSqrt();
+  return out;
+}
+
 std::string ControlCsvText(const std::vector<ControlResidual>& rows) {
   std::string text = std::string(kControlCsvHeader) + "\n";
   for (const ControlResidual& r : rows) {

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "publisher.h"
+#include "rvlio/api/result_json.h"
 #include "rvlio/formats/ouster.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/outputs/output_stage.h"
@@ -157,7 +158,7 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
     figures.imu_dropped = s.imu_dropped;
     publisher.Fill(&figures);
   };
-  run.annotate_summary = [&](nlohmann::json* summary) {
+  const SummaryAnnotator annotate = [&](nlohmann::json* summary) {
     net.Shutdown();  // nothing arrives any more: the figures are final
     fill();
     (*summary)["command"] = "live";
@@ -173,7 +174,7 @@ StatusOr<LiveResult> RunLive(const LiveArgs& args) {
       (*summary)["last_stamp_s"] = NsToSeconds(std::max<TimeNs>(publisher.last_result_ns(), 0));
     }
   };
-  StatusOr<RunResult> result = RunRecording(run);
+  StatusOr<RunResult> result = RunRecordingAnnotated(run, annotate);
   net.Shutdown();
   if (result.ok()) net.Flush();  // the poses of the last scans reach the subscribers
   fill();

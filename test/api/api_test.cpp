@@ -12,6 +12,7 @@
 
 #include "cli/cli_util.h"
 #include "rvlio/api.h"
+#include "rvlio/api/result_json.h"
 #include "rvlio/outputs/run_outputs.h"
 #include "rvlio/formats/trajectory_io.h"
 #include "rvlio/outputs/scan_columns.h"
@@ -104,7 +105,9 @@ TEST_F(ApiTest, RunWithAndWithoutOutputFolderGivesTheSameTrajectory) {
   const nlohmann::json summary = nlohmann::json::parse(ReadFile(out + "/summary.json"));
   EXPECT_EQ(summary["scan_count"], written->scans.size());
   EXPECT_EQ(summary["version"], RVLIO_VERSION);
-  EXPECT_EQ(summary["config"], written->summary["config"]);
+  EXPECT_EQ(ReadFile(out + "/summary.json"), written->summary_json);  // the text written
+  EXPECT_EQ(summary["per_scan_ms"]["median"].get<double>(), written->per_scan.median_ms);
+  EXPECT_EQ(summary["sequence_duration_s"].get<double>(), written->sequence_duration_s);
   EXPECT_FALSE(summary["interrupted"].get<bool>());
   for (const char* f : {"map.pcd", "scans.csv"})
     EXPECT_TRUE(std::filesystem::is_regular_file(out + "/" + f)) << f;
@@ -189,8 +192,8 @@ TEST_F(ApiTest, AnOpenedSourceGivesTheRecordingsRunAndEveryResultOnce) {
     seen.push_back(r.t_ns);
     EXPECT_EQ(odo.stats().scans_processed, static_cast<int64_t>(seen.size()));
   };
-  args.annotate_summary = [](nlohmann::json* j) { (*j)["extra"] = 7; };
-  StatusOr<RunResult> run = RunRecording(args);
+  StatusOr<RunResult> run =
+      RunRecordingAnnotated(args, [](nlohmann::json* j) { (*j)["extra"] = 7; });
   ASSERT_TRUE(run.ok()) << run.status().message();
   ASSERT_EQ(run->trajectory.size(), bag->trajectory.size());
   ASSERT_EQ(seen.size(), run->scans.size());
@@ -264,7 +267,9 @@ TEST_F(ApiTest, RefineFromAnInMemoryTrajectory) {
   EXPECT_FALSE(r->stopped);
   EXPECT_TRUE(r->written);
   EXPECT_EQ(r->refine.trajectory.size(), run->trajectory.size());
-  EXPECT_EQ(r->summary["command"], "refine");
+  EXPECT_EQ(nlohmann::json::parse(r->summary_json)["command"], "refine");
+  EXPECT_EQ(ReadFile(args.out_dir + "/summary.json"), r->summary_json);
+  EXPECT_TRUE(r->chunk_json.empty());  // not a chunk job
   EXPECT_TRUE(std::filesystem::is_regular_file(args.out_dir + "/trajectory.tum"));
 }
 

@@ -11,6 +11,7 @@
 
 #include "config_test_util.h"
 #include "rvlio/config/config.h"
+#include "rvlio/config/config_json.h"
 #include "rvlio/sim/options.h"
 
 namespace rvlio {

@@ -10,6 +10,7 @@
 
 #include "config_test_util.h"
 #include "rvlio/config/config.h"
+#include "rvlio/config/config_json.h"
 
 namespace rvlio {
 namespace {

@@ -77,6 +77,8 @@ class SurveyTies {
   const std::vector<std::string>& warnings() const { return warnings_; }
   const std::vector<ControlResidual>& residuals() const { return residuals_; }
   bool has_control_file() const { return !control_path_.empty(); }
+  int GnssFixes() const { return static_cast<int>(fix_ties_.size()); }  // ties, outliers included
+  int GnssOutliers() const;  // left out by the robust alignment
   // FNV-1a of the rows and fixes: part of a checkpoint's fingerprint.
   uint64_t ContentHash() const;
   void set_gnss_stats(const NavSatFixStats& stats) { gnss_stats_ = stats; }

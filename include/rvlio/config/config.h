@@ -17,7 +17,6 @@
 #include <utility>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 
 #include "rvlio/common/options.h"
 #include "rvlio/common/status.h"
@@ -272,27 +271,6 @@ class DumpVisitor {
   std::vector<std::pair<std::string, std::string>> lines_;  // text, comment
 };
 
-class JsonVisitor {
- public:
-  template <typename T>
-  void Field(const char* name, T& value, const Spec&) {
-    if constexpr (std::is_floating_point_v<T>) {
-      json[name] = std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-    } else if constexpr (std::is_enum_v<T>) {
-      json[name] = EnumName(value);
-    } else {
-      json[name] = value;
-    }
-  }
-  template <typename Sub>
-  void Section(const char* name, Sub& sub) {
-    JsonVisitor inner;
-    sub.Visit(inner);
-    json[name] = std::move(inner.json);
-  }
-  nlohmann::json json = nlohmann::json::object();
-};
-
 // Keys (leaves and sections) used for "did you mean" suggestions.
 template <class Opts>
 std::vector<std::string> KnownKeys(const Opts& options) {
@@ -443,16 +421,6 @@ std::string DumpYaml(const Opts& options) {
   config_detail::DumpVisitor v;
   copy.Visit(v);
   return v.Text();
-}
-
-// The resolved configuration as a JSON object (summary.json). Non-finite
-// doubles become null.
-template <class Opts>
-nlohmann::json ToJson(const Opts& options) {
-  Opts copy = options;
-  config_detail::JsonVisitor v;
-  copy.Visit(v);
-  return std::move(v.json);
 }
 
 }  // namespace rvlio

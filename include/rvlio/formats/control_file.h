@@ -54,6 +54,16 @@ struct ControlResidual {
   Eigen::Vector3d Residual() const { return p_estimated - row.p_survey; }
 };
 
+// The residuals of one role's estimated rows (summary.json "control"), m.
+struct ControlRoleSummary {
+  int count = 0;  // rows of the role with an estimate
+  double rms_m = 0.0;
+  Eigen::Vector3d rms_xyz_m = Eigen::Vector3d::Zero();  // per survey axis
+  double max_m = 0.0;
+  std::string max_name;  // the row of the largest residual (the later of equals)
+};
+ControlRoleSummary SummarizeControlRole(const std::vector<ControlResidual>& rows, ControlRole role);
+
 // control.csv's text of the rows (name, role, kind, x, y, z, x_est, y_est,
 // z_est, dx, dy, dz, d3d, sigma_m, t_s, scans; coordinates with 4 decimals;
 // the estimate's cells empty when there is none) and back (InvalidInput
