@@ -9,7 +9,8 @@
 # first flight refine (whole, and --chunk 1/2 + 2/2 then merge), compare and a
 # 2-cell ablate; on a tunnel simulated with its reference map, run in that map
 # (--map, --initial-pose-tum) and with the online time offset and extrinsic
-# estimated (each backend), and refine --map. The outputs are normalized (scans.csv without the time and memory
+# estimated (each backend), refine --map, and compare --ref-map (the map
+# figures). The outputs are normalized (scans.csv without the time and memory
 # columns `ms` and `rss_mb`; JSON files without timing/memory/environment keys) and
 # saved to, or diffed against, DIR. Exit 0 when every file is identical.
 set -euo pipefail
@@ -68,6 +69,8 @@ for k in 1 2; do
 done
 Rq merge --chunks "$s/chunk1" --chunks "$s/chunk2" --out "$s/merge"
 R compare --bag "$s/sim/seq.bag" --gt "$s/sim/seq_gt.tum" --config "$s/sim/seq.yaml" --out "$s/compare" --no-plots
+R compare --bag "$m/sim/seq.bag" --gt "$m/sim/seq_gt.tum" --config "$m/sim/seq.yaml" \
+  --ref-map "$m/sim/reference_map.pcd" --out "$m/compare_map" --no-plots
 cat > "$work/grid.yaml" <<GRID
 sequences:
   - name: sim

@@ -90,6 +90,11 @@ struct RunArgs {
   // odometry that made it and the odometry's local frame (where its
   // MapPoints are) relative to the user's frame (math/local_origin.h).
   std::function<void(const ScanResult&, const Odometry&, const LocalOrigin&)> on_result;
+  // Called once after the last scan with the output map (map.pcd's points
+  // and attributes, in the user's frame, double precision;
+  // MapPointsAsStored, outputs/run_outputs.h, rounds them as the file
+  // does), whether or not out_dir is set; not called when no scan was done.
+  std::function<void(const MapCloud&)> on_map;
 };
 
 struct RunResult {

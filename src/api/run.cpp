@@ -419,13 +419,14 @@ StatusOr<RunResult> RunRecordingAnnotated(const RunArgs& in, const SummaryAnnota
   }
   SetFigures(data, &result);
   MapCloud map;  // the output map, when written or compared
-  if (write || reference != nullptr) map = (*odo)->MapWithAttributes();
+  if (write || reference != nullptr || args.on_map) map = (*odo)->MapWithAttributes();
   std::optional<MapDeviation> deviation;  // in the local frame, as the reference
   if (reference != nullptr)
     deviation = ComputeMapDeviation(map.p, *reference, ToTrajectory(result.scans),
                                     args.options.localization.deviation);
   MoveToUserFrame(origin, &result.scans);
   origin.ToUser(&map.p);
+  if (args.on_map) args.on_map(map);
   result.trajectory = ToTrajectory(result.scans);
   if (streams.imu_rate) {
     result.imu_trajectory = streams.imu_rate->TakePoses();

@@ -10,6 +10,7 @@
 #include "rvlio/formats/point_cloud_file.h"
 #include "rvlio/formats/sensor_bag.h"
 #include "rvlio/formats/trajectory_io.h"
+#include "rvlio/outputs/run_outputs.h"
 
 namespace rvlio::experiments {
 namespace {
@@ -81,20 +82,18 @@ std::string StepDir(const CompareRequest& req, const std::string& name) {
   return req.out_dir + "/" + name;
 }
 
-// The run's map.pcd against the reference cloud, as `rvlio eval --map`,
-// after moving it into the ground truth's frame by the alignment of the
-// run's poses (eval->T_ref_est_poses: the estimate's world frame is its own,
-// and a small initial tilt moves far walls by centimetres; the ATE's
-// Umeyama alignment of positions leaves the roll about a straight path
-// free). A failure is a warning and leaves the row's map figures empty.
-void EvaluateRowMap(const CompareRequest& req, const Truth& truth, CompareRow* row) {
+// The step's map, as its map.pcd stores it, against the reference cloud, as
+// `rvlio eval --map`, after moving it into the ground truth's frame by the
+// alignment of the run's poses (eval->T_ref_est_poses: the estimate's world
+// frame is its own, and a small initial tilt moves far walls by centimetres;
+// the ATE's Umeyama alignment of positions leaves the roll about a straight
+// path free). A failure is a warning and leaves the row's map figures empty.
+void EvaluateRowMap(const CompareRequest& req, const Truth& truth,
+                    std::vector<Eigen::Vector3d> map_points, CompareRow* row) {
   if (truth.ref_map.empty() || !row->eval) return;
-  StatusOr<PointCloudFile> map =
-      ReadPointCloud(StepDir(req, row->name) + "/map.pcd", PointCloudReadOptions{false});
-  if (map.ok())
-    for (Eigen::Vector3d& p : map->points) p = row->eval->T_ref_est_poses * p;
-  StatusOr<MapEvalResult> m = map.ok() ? EvaluateMap(map->points, truth.ref_map, MapEvalOptions())
-                                       : StatusOr<MapEvalResult>(map.status());
+  map_points = MapPointsAsStored(std::move(map_points));
+  for (Eigen::Vector3d& p : map_points) p = row->eval->T_ref_est_poses * p;
+  StatusOr<MapEvalResult> m = EvaluateMap(map_points, truth.ref_map, MapEvalOptions());
   if (!m.ok()) {
     Warn(req, row->name, "map evaluation: " + m.status().message());
     return;
@@ -105,7 +104,7 @@ void EvaluateRowMap(const CompareRequest& req, const Truth& truth, CompareRow* r
 // Evaluates the estimate as its trajectory.tum holds it (the figures equal
 // `rvlio eval` on that file).
 void EvaluateRow(const CompareRequest& req, const Truth& truth, const Trajectory& estimate,
-                 CompareRow* row) {
+                 std::vector<Eigen::Vector3d> map_points, CompareRow* row) {
   StatusOr<Trajectory> written =
       RoundTripTum(estimate, StepDir(req, row->name) + "/trajectory.tum");
   if (written.ok()) row->trajectory = std::move(*written);
@@ -118,7 +117,7 @@ void EvaluateRow(const CompareRequest& req, const Truth& truth, const Trajectory
     return;
   }
   row->eval = std::move(*e);
-  EvaluateRowMap(req, truth, row);
+  EvaluateRowMap(req, truth, std::move(map_points), row);
 }
 
 int StopExitCode(const CompareRequest& req) {
@@ -153,7 +152,7 @@ CompareRow TimedStep(const CompareRequest& req, CompareRow row, Call call, Take 
 // Fills `row` from a finished run (the command `rvlio run` with
 // --allow-divergence would have exited 0, or 2 after a read error).
 void TakeRunResult(const CompareRequest& req, const Truth& truth, const RunResult& r,
-                   CompareRow* row) {
+                   std::vector<Eigen::Vector3d> map_points, CompareRow* row) {
   if (r.scans.empty() || r.stopped) return MarkInterrupted(req, row);
   for (const std::string& w : r.warnings) Warn(req, row->name, w);
   if (!r.read_error.ok())
@@ -165,7 +164,7 @@ void TakeRunResult(const CompareRequest& req, const Truth& truth, const RunResul
   row->ms_per_scan = r.per_scan.median_ms;
   row->real_time_factor = r.real_time_factor;
   row->diverged = r.divergence.detected;
-  EvaluateRow(req, truth, r.trajectory, row);
+  EvaluateRow(req, truth, r.trajectory, std::move(map_points), row);
 }
 
 CompareRow RunVariant(const CompareRequest& req, CompareRow row, const Configuration& options,
@@ -177,9 +176,13 @@ CompareRow RunVariant(const CompareRequest& req, CompareRow row, const Configura
   run.window = req.window;
   run.stop = req.stop;
   run.progress = req.on_run_progress;
+  std::vector<Eigen::Vector3d> map_points;  // for the map figures only
+  if (!truth.ref_map.empty()) run.on_map = [&map_points](const MapCloud& m) { map_points = m.p; };
   return TimedStep(
       req, std::move(row), [&] { return RunRecording(run); },
-      [&](const RunResult& r, CompareRow* out) { TakeRunResult(req, truth, r, out); });
+      [&](const RunResult& r, CompareRow* out) {
+        TakeRunResult(req, truth, r, std::move(map_points), out);
+      });
 }
 
 void TakeRefineResult(const CompareRequest& req, const Truth& truth, const RefineRunResult& r,
@@ -195,7 +198,8 @@ void TakeRefineResult(const CompareRequest& req, const Truth& truth, const Refin
       NsToSeconds(refined.trajectory.back().t_ns - refined.trajectory.front().t_ns);
   if (refined.total_s > 0) row->real_time_factor = duration_s / refined.total_s;
   row->diverged = r.divergence.detected;
-  EvaluateRow(req, truth, refined.trajectory, row);
+  EvaluateRow(req, truth, refined.trajectory,
+              truth.ref_map.empty() ? std::vector<Eigen::Vector3d>() : refined.map.p, row);
 }
 
 CompareRow RunRefine(const CompareRequest& req, CompareRow row, const CompareRow& start,

@@ -235,8 +235,7 @@ Status WriteMapLas(const std::string& path, const MapCloud& map,
   for (size_t first = 0; first < map.size(); first += chunk_points) {
     const size_t n = std::min(chunk_points, map.size() - first);
     chunk.points.assign(map.p.begin() + first, map.p.begin() + first + n);
-    if (float32_xyz)
-      for (Eigen::Vector3d& p : chunk.points) p = p.cast<float>().cast<double>();
+    if (float32_xyz) RoundToFloat32(&chunk.points);
     for (size_t k = 0; k < specs.size(); ++k) {
       chunk.fields[k].resize(n);
       for (size_t i = 0; i < n; ++i)

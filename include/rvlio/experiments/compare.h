@@ -84,7 +84,7 @@ struct CompareRow {
   Status run_error;        // why the run failed (exit_code != 0)
   std::string eval_error;  // "evaluation: ..." when the run ended but could not be evaluated
   std::optional<EvalResult> eval;
-  std::optional<MapEvalResult> map_eval;  // with ref_map: the run's map.pcd against it
+  std::optional<MapEvalResult> map_eval;  // with ref_map: the step's map (as map.pcd stores it) against it
   // The estimate as trajectory.tum holds it (RoundTripTum): what was evaluated.
   Trajectory trajectory;
   int scans = 0;

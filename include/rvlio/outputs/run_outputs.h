@@ -22,6 +22,13 @@ namespace rvlio {
 // its millimetres.
 // True when a coordinate of p_world reaches kFloat32MillimetreReach_m.
 bool MapNeedsFloat64(const std::vector<Eigen::Vector3d>& p_world);
+// The points as map.pcd stores them (rounded to float32 unless
+// MapNeedsFloat64): what ReadMapPcd of the written file gives back, without
+// the file.
+std::vector<Eigen::Vector3d> MapPointsAsStored(std::vector<Eigen::Vector3d> p_world);
+// Each coordinate rounded to the nearest float32 (map.pcd's x y z below
+// kFloat32MillimetreReach_m).
+void RoundToFloat32(std::vector<Eigen::Vector3d>* points);
 
 // Binary PCD (x y z float32, or float64 when MapNeedsFloat64; header made by
 // PCL), written atomically: x y z, then the map's attributes (intensity F4,

@@ -20,6 +20,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -436,6 +437,37 @@ TEST_F(PointCloudFileTest, ReadingLeavesTheFileAndItsFolderUnchanged) {
   EXPECT_EQ(fs::last_write_time(Path("c.pcd")), before);
   EXPECT_EQ(fs::file_size(Path("c.pcd")), size);
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+// MapPointsAsStored is what ReadMapPcd gives back of the written map.pcd,
+// bit for bit, in both encodings (compare's map figures rest on it): random
+// points of every magnitude below the float64 reach (float32, each of x y z
+// rounded), and the same shifted to UTM coordinates (float64, unchanged).
+TEST_F(PointCloudFileTest, MapPointsAsStoredIsWhatTheFileGivesBack) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> near;
+  for (int i = 0; i < 1001; ++i) {  // an odd count: no vector lane left unchecked
+    const double scale = std::pow(10.0, 3.0 * (u(rng) + 1.0) / 2.0 - 1.0);  // 0.1 .. 100 m
+    near.emplace_back(scale * u(rng), scale * u(rng), scale * u(rng));
+  }
+  std::vector<Eigen::Vector3d> far = near;
+  for (Eigen::Vector3d& p : far) p += Eigen::Vector3d(500000.0, 5400000.0, 250.0);
+  for (const auto* points : {&near, &far}) {
+    const std::vector<Eigen::Vector3d> stored = MapPointsAsStored(*points);
+    ASSERT_TRUE(WriteMapPcd(Path("map.pcd"), *points).ok());
+    StatusOr<std::vector<Eigen::Vector3d>> read = ReadMapPcd(Path("map.pcd"));
+    ASSERT_TRUE(read.ok()) << read.status().message();
+    ASSERT_EQ(read->size(), stored.size());
+    int rounded = 0;
+    for (size_t i = 0; i < stored.size(); ++i) {
+      ASSERT_EQ(stored[i], (*read)[i]) << i;
+      for (int k = 0; k < 3; ++k) rounded += stored[i][k] != (*points)[i][k] ? 1 : 0;
+    }
+    if (points == &near) EXPECT_GT(rounded, 2900);  // nearly every coordinate moves
+    else EXPECT_EQ(rounded, 0);
+  }
+  EXPECT_TRUE(MapPointsAsStored({}).empty());
 }
 
 }  // namespace
