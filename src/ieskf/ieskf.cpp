@@ -155,7 +155,14 @@ Ieskf::Ieskf(const IeskfOptions& options, const ImuOptions& imu,
       constraints_(constraints),
       rv_(EffectiveRvOptions(rv, degeneracy)),
       degeneracy_(degeneracy),
-      lidar_(lidar) {}
+      lidar_(lidar),
+      state_kind_(lidar.estimate_time_offset ? KindOf<TimeOffsetState>()
+                                             : KindOf<NoTimeOffsetState>()) {}
+
+template <class StatePolicy>
+Ieskf::StateKind Ieskf::KindOf() {
+  return {&StatePolicy::Start, &StatePolicy::Propagate, &Ieskf::UpdateImpl<StatePolicy>};
+}
 
 void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last_imu) {
   x_ = x0;
@@ -165,11 +172,7 @@ void Ieskf::Initialize(const FilterState& x0, TimeNs t_ns, const ImuSample& last
   excitation_ = ExtrinsicExcitation(ExtrinsicPriorStd(options_));
   t_ns_ = t_ns;
   last_imu_ = last_imu;
-  td_ = TimeOffsetEstimate();
-  td_.td_s = td_.td_lin_s = lidar_.time_offset;
-  td_.P_td_td = lidar_.estimate_time_offset
-                    ? lidar_.time_offset_init_std * lidar_.time_offset_init_std
-                    : 0.0;
+  state_kind_.start(lidar_, &td_);
   ClearPoseHistory();
 }
 
@@ -268,10 +271,7 @@ void Ieskf::Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu
   x_.R_world_imu = x_.R_world_imu * so3::Exp(w_dt);
 
   PropagateCovariance(F, imu_, dt_s, &P_);
-  if (lidar_.estimate_time_offset) {
-    td_.P_x_td = F * td_.P_x_td;  // the offset itself is constant: identity row
-    td_.P_td_td += lidar_.time_offset_random_walk * lidar_.time_offset_random_walk * dt_s;
-  }
+  state_kind_.propagate(F, dt_s, lidar_, &td_);
   if (options_.estimate_extrinsics) {
     PropagateCovariance(F, imu_, dt_s, &P_all_extrinsic_);
     AddExtrinsicRandomWalk(dt_s);
@@ -294,8 +294,7 @@ void Ieskf::AddExtrinsicRandomWalk(double dt_s) {
 // which equals -K z - (I - K H) e of Eq. (1); the posterior covariance
 // (I - K H) Pv equals (H^T R^-1 H + Pv^-1)^-1.
 IeskfUpdateResult Ieskf::Update(const AssociateFn& associate) {
-  if (lidar_.estimate_time_offset) return UpdateImpl<TimeOffsetState>(associate);
-  return UpdateImpl<NoTimeOffsetState>(associate);
+  return (this->*state_kind_.update)(associate);
 }
 
 // The motion held at the state's time: the newest pose sample's (the IMU

@@ -74,6 +74,11 @@ bool TimeOffsetObservable(const Eigen::Vector3d& v_world_imu, const ScanTimeMoti
   return motion.gyro_imu.norm() >= kTimeOffsetMinRate || v_world_imu.norm() >= kTimeOffsetMinSpeed;
 }
 
+void NoTimeOffsetState::Start(const LidarOptions& lidar, TimeOffsetEstimate* td) {
+  *td = TimeOffsetEstimate();
+  td->td_s = td->td_lin_s = lidar.time_offset;
+}
+
 NoTimeOffsetState::NoTimeOffsetState(const StateUpdateStart& start)
     : P_(start.P), extrinsic_(start.extrinsic), E_(ErrorStateColumns(start.extrinsic.free)) {}
 
@@ -107,6 +112,17 @@ void NoTimeOffsetState::AddColumns(const MatrixC& HtRinvH, const VectorC& HtRinv
 // At rest the offset's column (w, v) is IMU noise alone: no update of the
 // offset (it would fit the noise and leave a confident wrong value for the
 // motion to undo).
+void TimeOffsetState::Start(const LidarOptions& lidar, TimeOffsetEstimate* td) {
+  NoTimeOffsetState::Start(lidar, td);
+  td->P_td_td = lidar.time_offset_init_std * lidar.time_offset_init_std;
+}
+
+void TimeOffsetState::Propagate(const Matrix24d& F, double dt_s, const LidarOptions& lidar,
+                                TimeOffsetEstimate* td) {
+  td->P_x_td = F * td->P_x_td;
+  td->P_td_td += lidar.time_offset_random_walk * lidar.time_offset_random_walk * dt_s;
+}
+
 TimeOffsetState::TimeOffsetState(const StateUpdateStart& start)
     : P_(start.P),
       extrinsic_(start.extrinsic),

@@ -2,13 +2,15 @@
 // The optional states of the IESKF update as policy types (docs/design.md,
 // "Features as policies"). Ieskf::UpdateImpl<StatePolicy> is the iterated
 // update of paper Eq. (1) written once; what an optional state changes in it
-// is a type, chosen once per update (Ieskf::Update):
+// is a type, chosen once when the filter is made (Ieskf::StateKind):
 //   NoTimeOffsetState  the 24-dim error state of FilterState; 12 Jacobian
 //                      columns [dtheta, dp, dphi, dt] at the state's pose
 //   TimeOffsetState    augmented with the LiDAR-IMU time offset (entry 24);
 //                      the residuals at the scan's time, the 16 columns of
 //                      TimeOffsetJacobian [dtheta, dp, dphi, dt, dv, d(td)]
 // A policy has
+//   Start(lidar, &td)                its entries when the filter starts
+//   Propagate(F, dt, lidar, &td)     its covariance over one IMU step
 //   kDim, kCols, MatrixN/VectorN (error state), MatrixC/VectorC (columns)
 //   Policy(const StateUpdateStart&)  begins a scan's update
 //   Prior()                          P0 of its error state
@@ -66,6 +68,10 @@ class NoTimeOffsetState {
   using MatrixC = Eigen::Matrix<double, kCols, kCols>;
   using VectorC = Eigen::Matrix<double, kCols, 1>;
 
+  // The offset at lidar.time_offset, not estimated (variance 0).
+  static void Start(const LidarOptions& lidar, TimeOffsetEstimate* td);
+  static void Propagate(const Matrix24d&, double, const LidarOptions&, TimeOffsetEstimate*) {}
+
   explicit NoTimeOffsetState(const StateUpdateStart& start);
   MatrixN Prior() const { return P_; }
   FilterState AtScanTime(const FilterState& x) const { return x; }
@@ -97,6 +103,13 @@ class TimeOffsetState {
   using VectorN = Eigen::Matrix<double, kDim, 1>;
   using MatrixC = Eigen::Matrix<double, kCols, kCols>;
   using VectorC = Eigen::Matrix<double, kCols, 1>;
+
+  // The offset at lidar.time_offset with variance time_offset_init_std^2.
+  static void Start(const LidarOptions& lidar, TimeOffsetEstimate* td);
+  // Its cross covariance through F (the offset itself is constant: an
+  // identity row) and its random walk (lidar.time_offset_random_walk).
+  static void Propagate(const Matrix24d& F, double dt_s, const LidarOptions& lidar,
+                        TimeOffsetEstimate* td);
 
   // Sets the filter's offset linearization point and scan motion to this scan's.
   explicit TimeOffsetState(const StateUpdateStart& start);

@@ -1,5 +1,6 @@
 #include "scan_factor.h"
 
+#include "rvlio/factors/parameter_blocks.h"
 #include "rvlio/factors/plane_extrinsic_factor.h"
 #include "rvlio/factors/plane_summary_factor.h"
 #include "rvlio/factors/plane_time_offset_factor.h"
@@ -38,6 +39,15 @@ class TimeOffsetScanFactor final : public ScanFactorKind {
   }
   std::vector<double*> Blocks(const ScanFactorBlocks& b) const override {
     return {b.pose, b.speed_bias, b.time_offset};
+  }
+  // The state's pose moved by the offset's change since the scan was
+  // deskewed (ScanTimePose, constraints/time_offset_residual.h).
+  Pose3 ScanPose(const ScanPoseInput& in) const override {
+    FilterState x;
+    x.R_world_imu = in.T_world_imu.R;
+    x.p_world_imu = in.T_world_imu.t;
+    x.v_world_imu = SpeedBiasBlock::FromArray(in.speed_bias).v_world_imu;
+    return ScanTimePose(x, in.motion, in.dtd_s);
   }
 };
 

@@ -8,9 +8,10 @@
 //   TimeOffsetScanFactor  PlaneTimeOffsetFactor on the pose, the state's
 //                         speed-bias block and the window's time offset
 //                         (lidar.estimate_time_offset)
-// A kind makes the factor of an association and names the parameter blocks
-// it acts on, so the solve and the marginalization add a scan's factor with
-// one call each. A new kind of scan factor is a new type; the window stays.
+// A kind makes the factor of an association, names the parameter blocks it
+// acts on, and gives the IMU pose the scan is associated at, so the solve,
+// the marginalization and the association each ask it once. A new kind of
+// scan factor is a new type; the window stays.
 #include <memory>
 #include <vector>
 
@@ -31,6 +32,14 @@ struct ScanFactorBlocks {
   double* time_offset;  // the window's offset, s (the leaving scan's in a marginalization)
 };
 
+// A state's pose and what moves it to its scan's time.
+struct ScanPoseInput {
+  const Pose3& T_world_imu;            // the state's pose
+  const double* speed_bias;            // its SpeedBiasBlock
+  const ScanTimeMotion& motion;        // held at the state's time
+  double dtd_s;                        // the window's offset minus the scan's td_lin_s
+};
+
 // What a scan's factor is made from at an association.
 struct ScanFactorInput {
   const ConstraintList& constraints;  // non-empty, Huber weights applied
@@ -48,6 +57,9 @@ class ScanFactorKind {
   virtual std::unique_ptr<ceres::CostFunction> Make(const ScanFactorInput& in) const = 0;
   // The factor's parameter blocks, in its order.
   virtual std::vector<double*> Blocks(const ScanFactorBlocks& b) const = 0;
+  // T_world_imu at the scan's time: the state's pose, unless the kind
+  // estimates the time offset.
+  virtual Pose3 ScanPose(const ScanPoseInput& in) const { return in.T_world_imu; }
 };
 
 // The kind for the window's options (not both estimated: SlidingWindow checks).

@@ -178,13 +178,8 @@ std::unique_ptr<ceres::CostFunction> TimeOffsetPrior(double td_s, double std_s) 
 }  // namespace
 
 Pose3 SlidingWindow::ScanPose(const Node& node) const {
-  if (!estimate_time_offset()) return node.T_world_imu();
-  FilterState x;
-  const Pose3 T = node.T_world_imu();
-  x.R_world_imu = T.R;
-  x.p_world_imu = T.t;
-  x.v_world_imu = SpeedBiasBlock::FromArray(node.sb).v_world_imu;
-  return ScanTimePose(x, node.motion, time_offset_[0] - node.td_lin_s);
+  return scan_factor_kind_->ScanPose(
+      {node.T_world_imu(), node.sb, node.motion, time_offset_[0] - node.td_lin_s});
 }
 
 Pose3 SlidingWindow::ScanTimeImuPose(int k) const {

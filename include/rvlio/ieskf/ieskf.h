@@ -147,6 +147,16 @@ class Ieskf {
   // (NoTimeOffsetState or TimeOffsetState, src/ieskf/state_policies.h).
   template <class StatePolicy>
   IeskfUpdateResult UpdateImpl(const AssociateFn& associate);
+  // The optional state's policy, chosen once from lidar.estimate_time_offset:
+  // how it starts, propagates and updates (src/ieskf/state_policies.h).
+  struct StateKind {
+    void (*start)(const LidarOptions& lidar, TimeOffsetEstimate* td);
+    void (*propagate)(const Matrix24d& F, double dt_s, const LidarOptions& lidar,
+                      TimeOffsetEstimate* td);
+    IeskfUpdateResult (Ieskf::*update)(const AssociateFn& associate);
+  };
+  template <class StatePolicy>
+  static StateKind KindOf();
   ExtrinsicColumns ExtrinsicColumnsNow() const;
   ScanTimeMotion MotionAtStateTime() const;
   void Step(const Eigen::Vector3d& gyro_imu, const Eigen::Vector3d& acc_imu, double dt_s);
@@ -170,6 +180,7 @@ class Ieskf {
   ImuPoseHistory pose_history_;
   RvWorkspace rv_workspace_;
   LidarOptions lidar_;
+  StateKind state_kind_;
   TimeOffsetEstimate td_;
 };
 
