@@ -102,8 +102,15 @@ std::string OutDir(const py::handle& out) {
   return dir;
 }
 
+// trajectory_imu.tum's rows, or None when output.imu_trajectory is off.
+py::object ImuTrajectoryArray(const Trajectory& imu_trajectory) {
+  if (imu_trajectory.empty()) return py::none();
+  return TrajectoryArray(imu_trajectory);
+}
+
 struct RunOutput {
   py::array_t<double> trajectory;
+  py::object imu_trajectory;  // None without output.imu_trajectory
   py::dict scans;
   py::object summary;
   std::vector<ScanResult> results;
@@ -160,6 +167,7 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
   if (!r.read_error.ok()) Raise(r.read_error);
   RunOutput o;
   o.trajectory = TrajectoryArray(r.trajectory);
+  o.imu_trajectory = ImuTrajectoryArray(r.imu_trajectory);
   o.scans = ScanTable(r.scans, r.rss_mb);
   o.summary = ToPython(nlohmann::json::parse(r.summary_json));
   o.results = std::move(r.scans);
@@ -173,6 +181,7 @@ RunOutput Run(const py::handle& bag_obj, const py::handle& config, const py::han
 
 struct RefineOutput {
   py::array_t<double> trajectory;
+  py::object imu_trajectory;
   py::object summary;
   py::list rounds;
   bool converged = false;
@@ -249,6 +258,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
   RefineRunResult r = Take(std::move(result));
   RefineOutput o;
   o.trajectory = TrajectoryArray(r.refine.trajectory);
+  o.imu_trajectory = ImuTrajectoryArray(r.imu_trajectory);
   o.summary = ToPython(nlohmann::json::parse(r.summary_json));
   for (const RefineRound& round : r.refine.rounds) o.rounds.append(RoundDict(round));
   o.converged = r.refine.converged;
@@ -260,6 +270,7 @@ RefineOutput Refine(const py::handle& bag_obj, const py::handle& init, const py:
 
 struct MergeOutput {
   py::array_t<double> trajectory;
+  py::object imu_trajectory;
   py::array_t<double> map_points;
   py::object summary;
   std::vector<std::string> warnings;
@@ -275,6 +286,7 @@ MergeOutput Merge(const py::iterable& chunks, const py::handle& out, const py::h
   MergeResult r = Take(std::move(result));
   MergeOutput o;
   o.trajectory = TrajectoryArray(r.trajectory);
+  o.imu_trajectory = ImuTrajectoryArray(r.imu_trajectory);
   o.map_points = PointsArray(r.map.p);
   o.summary = ToPython(nlohmann::json::parse(r.summary_json));
   o.warnings = r.warnings;
@@ -323,6 +335,9 @@ void BindRun(py::module_& m) {
   py::class_<RunOutput>(m, "RunResult", "What rvlio.run returns.")
       .def_readonly("trajectory", &RunOutput::trajectory,
                     "(N, 8) [t_s, x, y, z, qx, qy, qz, qw]: trajectory.tum")
+      .def_readonly("imu_trajectory", &RunOutput::imu_trajectory,
+                    "with output.imu_trajectory: (M, 8) the poses at IMU rate "
+                    "(trajectory_imu.tum); None otherwise")
       .def_readonly("scans", &RunOutput::scans,
                     "per-scan table: column name -> (N,) array (the columns of scans.csv, plus "
                     "the velocity vx vy vz)")
@@ -339,6 +354,8 @@ void BindRun(py::module_& m) {
   py::class_<RefineOutput>(m, "RefineResult", "What rvlio.refine returns.")
       .def_readonly("trajectory", &RefineOutput::trajectory,
                     "(N, 8) [t_s, x, y, z, qx, qy, qz, qw]: the refined trajectory.tum")
+      .def_readonly("imu_trajectory", &RefineOutput::imu_trajectory,
+                    "with output.imu_trajectory: (M, 8) the refined poses at IMU rate; None otherwise")
       .def_readonly("summary", &RefineOutput::summary, "summary.json as a dict")
       .def_readonly("rounds", &RefineOutput::rounds, "one dict per round")
       .def_readonly("converged", &RefineOutput::converged)
@@ -351,6 +368,8 @@ void BindRun(py::module_& m) {
   py::class_<MergeOutput>(m, "MergeResult", "What rvlio.merge returns.")
       .def_readonly("trajectory", &MergeOutput::trajectory,
                     "(N, 8) [t_s, x, y, z, qx, qy, qz, qw]: the merged trajectory.tum")
+      .def_readonly("imu_trajectory", &MergeOutput::imu_trajectory,
+                    "the chunks' IMU-rate poses merged (when each wrote them); None otherwise")
       .def_readonly("map_points", &MergeOutput::map_points,
                     "(K, 3) the chunks' maps in the merged frame (map.pcd)")
       .def_readonly("summary", &MergeOutput::summary, "summary.json as a dict")

@@ -132,6 +132,22 @@ def test_an_exception_in_progress_stops_the_run(tunnel):
     assert calls and all(0.0 <= f <= 1.1 for _, f in calls)
 
 
+def test_imu_trajectory_is_trajectory_imu_tum(tunnel, py_run, tmp_path):
+    _, plain = py_run
+    assert plain.imu_trajectory is None  # output.imu_trajectory is off by default
+    config = rvlio.Config.load(tunnel["config"], set={"output.imu_trajectory": True,
+                                                      "refine.rounds": 1})
+    run = rvlio.run(tunnel["bag"], config, out=tmp_path / "run")
+    refined = rvlio.refine(tunnel["bag"], run, config, out=tmp_path / "refine")
+    for result, out in ((run, tmp_path / "run"), (refined, tmp_path / "refine")):
+        written = np.loadtxt(out / "trajectory_imu.tum")
+        assert result.imu_trajectory.shape == written.shape
+        assert len(written) > 5 * len(result.trajectory)  # 200 Hz against 10 Hz scans
+        np.testing.assert_allclose(result.imu_trajectory[:, 0], written[:, 0], rtol=0, atol=1e-6)
+        np.testing.assert_allclose(result.imu_trajectory[:, 1:], written[:, 1:], rtol=0,
+                                   atol=6e-10)
+
+
 def test_refine_chunks_and_merge_give_the_cli_files(rvlio_bin, tunnel, cli_run, tmp_path):
     sets = ["refine.rounds=1", "refine.job_overlap_s=1"]
     config = rvlio.Config.load(tunnel["config"], set={"refine.rounds": 1,
