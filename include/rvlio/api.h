@@ -181,7 +181,7 @@ struct RefineRunResult {
   std::optional<RefineJobSpan> job;  // a chunk job's span (chunk.json; none otherwise)
   std::string chunk_json;       // chunk.json's text of a chunk job (empty otherwise)
   // With a control file: control.csv's text (the residual of every row) and
-  // its rows (SummarizeControl, refine/control.h, gives summary.json
+  // its rows (SummarizeControlRole, formats/control_file.h, gives summary.json
   // "control"); empty otherwise.
   std::string control_csv;
   std::vector<ControlResidual> control;

@@ -506,8 +506,10 @@ StatusOr<RefineRunResult> RefineRecording(const RefineArgs& in) {
   if (std::string w = CoverageWarning(seen, init_span, args.options.imu.init_duration); !w.empty()) r.refine.warnings.push_back(w);
   r.job = job;
   nlohmann::json chunk;  // chunk.json of a chunk job
-  if (job) chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
-  if (job) r.chunk_json = JsonText(chunk) + "\n";
+  if (job) {
+    chunk = ChunkJson(args, *job, seen, init_hash, map_hash, r.refine);
+    r.chunk_json = JsonText(chunk) + "\n";
+  }
   r.stopped = r.refine.stopped;
   if (!r.stopped) r.stop_reason.clear();
   r.divergence = CheckRefineResult(r.refine, args.options.divergence,

@@ -2,6 +2,8 @@
 // The JSON the command writes of the API's typed results (`rvlio eval
 // --json`, summary.json "chunks"). Private to the I/O layer, the command
 // and Python: the public API (rvlio/api.h) carries no JSON type.
+#include <functional>
+
 #include <nlohmann/json.hpp>
 
 #include "rvlio/api.h"
