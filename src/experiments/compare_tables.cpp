@@ -64,22 +64,13 @@ std::string MarkdownRow(const CompareRow& r, bool with_map) {
   return os.str();
 }
 
-nlohmann::json StatsJson(const ErrorStats& s) {
-  return {{"rmse", Num(s.rmse)}, {"mean", Num(s.mean)}, {"median", Num(s.median)},
-          {"std", Num(s.std)},   {"min", Num(s.min)},   {"max", Num(s.max)}};
-}
-
+// A row's evaluation: `rvlio eval --json`'s object (EvalJson) without the
+// scale and the RPE's pair count, which compare.json has never carried.
 nlohmann::json CompareEvalJson(const EvalResult& e) {
-  return {
-      {"matched", e.matched},
-      {"align", AlignModeName(e.align)},
-      {"ape", StatsJson(e.ape_m)},
-      {"ape_rot_deg", StatsJson(e.ape_rot_deg)},
-      {"rpe", StatsJson(e.rpe.trans_m)},
-      {"rpe_rot_deg", StatsJson(e.rpe.rot_deg)},
-      {"end_point_error", Num(e.end_point_error_m)},
-      {"along_axis", {{"rmse", Num(e.along_axis.rmse_m)}, {"max", Num(e.along_axis.max_abs_m)}}},
-      {"warnings", e.warnings}};
+  nlohmann::json j = EvalJson(e);
+  j.erase("scale");
+  j["rpe"].erase("pairs");
+  return j;
 }
 
 nlohmann::json RowJson(const CompareRequest& req, const CompareRow& r) {
